@@ -1,0 +1,103 @@
+"""Ancillary (tube) feedback laws kappa(e, e_hat) = -sigma K(e) (e - e_hat).
+
+* ``paper``: K = I, eq. (kappa_law). Its closed-loop gain J(e) K = J(e) has a
+  symmetric part that is negative definite when the vehicle points at the
+  target (see :mod:`tubekit.audit`), so it cannot be certified there.
+* ``corrected``: K = J(e)^-1 (inverse-Jacobian law). The closed-loop gain is
+  J K = I, so rho^T J kappa = -sigma ||rho||^2 in *both* heading hemispheres
+  wherever J is non-singular (|e_o| < 1). The price is input usage
+  |kappa_i| <= sigma ||row_i(J^-1)|| ||rho||, which the verifier bounds.
+
+J is always the *derived* J of :mod:`tubekit.derivation`, evaluated at the real
+state (the real state is measured; the law is full-state feedback).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Callable
+
+import numpy as np
+
+from .derivation import error_coordinates, numeric
+from .exceptions import ConfigError
+
+__all__ = ["AncillaryLaw", "get_law", "jacobian_at", "LAWS"]
+
+
+def _identity_gain(J: np.ndarray) -> np.ndarray:
+    return np.broadcast_to(np.eye(3), J.shape).copy()
+
+
+def _inverse_gain(J: np.ndarray) -> np.ndarray:
+    return np.linalg.inv(J)
+
+
+@dataclass(frozen=True)
+class AncillaryLaw:
+    """An ancillary law kappa = -sigma K(J(e)) rho.
+
+    Attributes
+    ----------
+    name : str
+        ``"paper"`` or ``"corrected"``.
+    gain_of_jacobian : callable
+        Maps J (..., 3, 3) to K (..., 3, 3).
+    description : str
+        One line for reports.
+    """
+
+    name: str
+    gain_of_jacobian: Callable[[np.ndarray], np.ndarray]
+    description: str
+
+    def gain(self, state: np.ndarray, p_d: np.ndarray) -> np.ndarray:
+        """K(e) at the real state (..., 4) w.r.t. p_d (..., 3)."""
+        J = jacobian_at(state, p_d)
+        return self.gain_of_jacobian(J)
+
+    def closed_loop_matrix(self, J: np.ndarray) -> np.ndarray:
+        """J K, whose symmetric part's lambda_min is the certificate's J_lower."""
+        return J @ self.gain_of_jacobian(J)
+
+    def __call__(self, state: np.ndarray, state_hat: np.ndarray, p_d: np.ndarray, sigma: float) -> np.ndarray:
+        """kappa (3,) in [u, w, r] units for real ``state`` and nominal ``state_hat``.
+
+        Parameters
+        ----------
+        state, state_hat : array (4,)
+            Real and nominal [x, y, z, psi].
+        p_d : array (3,)
+            Desired position at this time (m).
+        sigma : float
+            Gain (1/s).
+        """
+        rho = error_coordinates(state, p_d) - error_coordinates(state_hat, p_d)
+        K = self.gain(state, p_d)
+        out = -sigma * (K @ rho)
+        if not np.all(np.isfinite(out)):
+            raise ConfigError("state", "a state with e_d > 0 and |e_o| < 1 (J non-singular)",
+                              np.asarray(state).tolist())
+        return out
+
+
+def jacobian_at(state: np.ndarray, p_d: np.ndarray) -> np.ndarray:
+    """The derived J (..., 3, 3) at ``state`` (..., 4) w.r.t. ``p_d`` (..., 3)."""
+    state = np.asarray(state, dtype=float)
+    p_d = np.asarray(p_d, dtype=float)
+    return numeric().J(state[..., 0] - p_d[..., 0], state[..., 1] - p_d[..., 1], state[..., 3])
+
+
+LAWS: dict[str, AncillaryLaw] = {
+    "paper": AncillaryLaw("paper", _identity_gain, "kappa = -sigma (e - e_hat)   [paper, eq. kappa_law]"),
+    "corrected": AncillaryLaw("corrected", _inverse_gain,
+                              "kappa = -sigma J(e)^-1 (e - e_hat)   [inverse-Jacobian law]"),
+}
+
+
+def get_law(name: str) -> AncillaryLaw:
+    """Look up a law by name; raises :class:`ConfigError` for an unknown name."""
+    try:
+        return LAWS[name]
+    except KeyError:
+        raise ConfigError("law", f"one of {tuple(LAWS)}", name) from None

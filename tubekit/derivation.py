@@ -1,0 +1,171 @@
+"""Symbolic derivation of the error dynamics (eqs. 12-18) with sympy.
+
+The error e = [e_d, e_z, e_o] is differentiated along the kinematics of eq. (11);
+nothing is typed in from the paper. The result is decomposed as
+``e_dot = J v + zeta + xi`` (eq. 18) with
+
+* ``J = d e_dot / d v``                      (input matrix),
+* ``zeta = e_dot |_(v=0, omega=0)``          (drift from the moving target),
+* ``xi = e_dot |_(v=0, p_d_dot=0)``          (disturbance term).
+
+All expressions use the symbols of :data:`SYMBOL_NAMES`; ``e_x = x - x_d`` etc.
+Numeric versions (lambdify with common-subexpression elimination) are
+vectorised over any broadcastable arrays.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from functools import lru_cache
+from typing import Callable
+
+import numpy as np
+import sympy as sp
+
+__all__ = [
+    "SYMBOL_NAMES",
+    "symbols",
+    "DerivedDynamics",
+    "derive",
+    "numeric",
+    "NumericDynamics",
+    "error_coordinates",
+    "bearing",
+]
+
+SYMBOL_NAMES: tuple[str, ...] = (
+    "e_x", "e_y", "e_z", "psi", "u", "w", "r",
+    "omega_1", "omega_2", "omega_3", "xdot_d", "ydot_d", "zdot_d",
+)
+
+
+@lru_cache(maxsize=1)
+def symbols() -> dict[str, sp.Symbol]:
+    """The real sympy symbols used throughout, keyed by name."""
+    return {name: sp.Symbol(name, real=True) for name in SYMBOL_NAMES}
+
+
+@dataclass(frozen=True)
+class DerivedDynamics:
+    """The derived error dynamics.
+
+    Attributes
+    ----------
+    e : sympy.Matrix (3, 1)
+        [e_d, e_z, e_o] in terms of e_x, e_y, e_z, psi.
+    e_dot : sympy.Matrix (3, 1)
+        Time derivative along eq. (11).
+    J, zeta, xi : sympy.Matrix
+        Decomposition e_dot = J v + zeta + xi (eq. 18), (3,3), (3,1), (3,1).
+    residual : sympy.Matrix (3, 1)
+        e_dot - (J v + zeta + xi), simplified; zero when the split is exact.
+    """
+
+    e: sp.Matrix
+    e_dot: sp.Matrix
+    J: sp.Matrix
+    zeta: sp.Matrix
+    xi: sp.Matrix
+    residual: sp.Matrix
+
+
+@lru_cache(maxsize=1)
+def derive() -> DerivedDynamics:
+    """Differentiate e = [e_d, e_z, e_o] along the kinematics and split it (eq. 18)."""
+    s = symbols()
+    ex, ey, ez, psi = s["e_x"], s["e_y"], s["e_z"], s["psi"]
+    u, w, r = s["u"], s["w"], s["r"]
+    om = sp.Matrix([s["omega_1"], s["omega_2"], s["omega_3"]])
+    pdd = sp.Matrix([s["xdot_d"], s["ydot_d"], s["zdot_d"]])
+    v = sp.Matrix([u, w, r])
+
+    # Kinematics eq. (11) written for the error state (e_x, e_y, e_z, psi):
+    # d/dt (x - x_d) = u cos psi + omega_1 - xdot_d, etc.  f(x) v + omega - [p_d_dot, 0]
+    f = sp.Matrix([[sp.cos(psi), 0, 0], [sp.sin(psi), 0, 0], [0, 1, 0], [0, 0, 1]])
+    state_dot = f * v + sp.Matrix([om[0], om[1], om[2], 0]) - sp.Matrix([pdd[0], pdd[1], pdd[2], 0])
+
+    e_d = sp.sqrt(ex**2 + ey**2)
+    e_o = ex / e_d * sp.sin(psi) - ey / e_d * sp.cos(psi)
+    e = sp.Matrix([e_d, ez, e_o])
+    state = sp.Matrix([ex, ey, ez, psi])
+    e_dot = (e.jacobian(state) * state_dot).applyfunc(sp.expand)
+
+    J = e_dot.jacobian(v).applyfunc(sp.simplify)
+    zero_v = {u: 0, w: 0, r: 0}
+    zeta = e_dot.subs(zero_v).subs({om[0]: 0, om[1]: 0, om[2]: 0}).applyfunc(sp.simplify)
+    xi = e_dot.subs(zero_v).subs({pdd[0]: 0, pdd[1]: 0, pdd[2]: 0}).applyfunc(sp.simplify)
+    residual = (e_dot - (J * v + zeta + xi)).applyfunc(sp.simplify)
+    return DerivedDynamics(e=e, e_dot=e_dot, J=J, zeta=zeta, xi=xi, residual=residual)
+
+
+def _lambdify(expr: sp.Matrix, args: list[sp.Symbol]) -> Callable[..., np.ndarray]:
+    """Lambdify a matrix with CSE into a function returning a broadcast array."""
+    shape = expr.shape
+    flat = list(expr)
+    fn = sp.lambdify(args, flat, modules="numpy", cse=True)
+
+    def call(*values: np.ndarray) -> np.ndarray:
+        arrays = [np.asarray(v, dtype=float) for v in values]
+        out = fn(*arrays)
+        b = np.broadcast_shapes(*(a.shape for a in arrays))
+        stacked = np.stack([np.broadcast_to(np.asarray(o, dtype=float), b) for o in out], axis=-1)
+        if shape[1] == 1:
+            return stacked.reshape(b + (shape[0],))
+        return stacked.reshape(b + shape)
+
+    return call
+
+
+@dataclass(frozen=True)
+class NumericDynamics:
+    """Vectorised numeric versions of the derived J, zeta, xi and e_dot.
+
+    Each callable takes arrays (broadcastable) in the order given; the trailing
+    axes of the result are (3, 3) for ``J`` and (3,) for the vectors.
+
+    * ``J(e_x, e_y, psi)``
+    * ``zeta(e_x, e_y, psi, xdot_d, ydot_d, zdot_d)``
+    * ``xi(e_x, e_y, psi, omega_1, omega_2, omega_3)``
+    * ``e_dot(e_x, e_y, psi, u, w, r, omega_1, omega_2, omega_3, xdot_d, ydot_d, zdot_d)``
+    """
+
+    J: Callable[..., np.ndarray]
+    zeta: Callable[..., np.ndarray]
+    xi: Callable[..., np.ndarray]
+    e_dot: Callable[..., np.ndarray]
+
+
+@lru_cache(maxsize=1)
+def numeric() -> NumericDynamics:
+    """Build (once) the numeric callables from the sympy derivation."""
+    d = derive()
+    s = symbols()
+    ex, ey, psi = s["e_x"], s["e_y"], s["psi"]
+    om = [s["omega_1"], s["omega_2"], s["omega_3"]]
+    pdd = [s["xdot_d"], s["ydot_d"], s["zdot_d"]]
+    v = [s["u"], s["w"], s["r"]]
+    return NumericDynamics(
+        J=_lambdify(d.J, [ex, ey, psi]),
+        zeta=_lambdify(d.zeta, [ex, ey, psi, *pdd]),
+        xi=_lambdify(d.xi, [ex, ey, psi, *om]),
+        e_dot=_lambdify(d.e_dot, [ex, ey, psi, *v, *om, *pdd]),
+    )
+
+
+def bearing(e_x: np.ndarray, e_y: np.ndarray) -> np.ndarray:
+    """Bearing theta = atan2(e_y, e_x) (rad) of the vehicle as seen from the target."""
+    return np.arctan2(e_y, e_x)
+
+
+def error_coordinates(state: np.ndarray, p_d: np.ndarray) -> np.ndarray:
+    """Error e = [e_d, e_z, e_o] (eqs. 12-14) of ``state`` (..., 4) w.r.t. ``p_d`` (..., 3)."""
+    state = np.asarray(state, dtype=float)
+    p_d = np.asarray(p_d, dtype=float)
+    ex = state[..., 0] - p_d[..., 0]
+    ey = state[..., 1] - p_d[..., 1]
+    ez = state[..., 2] - p_d[..., 2]
+    psi = state[..., 3]
+    ed = np.hypot(ex, ey)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        eo = (ex * np.sin(psi) - ey * np.cos(psi)) / ed
+    return np.stack([ed, ez, eo], axis=-1)

@@ -1,0 +1,135 @@
+"""Underactuated AUV kinematics, eqs. (2) and (11) of the paper.
+
+State ``x = [x, y, z, psi]`` (m, m, m, rad), input ``v = [u, w, r]`` (surge m/s,
+heave m/s, yaw rate rad/s), disturbance ``omega = [omega_1, omega_2, omega_3]``
+(m/s, inertial frame) = current ``delta`` + sway term ``g(x, v_sway)``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from .validation import nonnegative, positive
+
+__all__ = [
+    "InputLimits",
+    "SwayModel",
+    "nominal_kinematics",
+    "kinematics",
+    "sway_velocity_term",
+]
+
+
+@dataclass(frozen=True)
+class InputLimits:
+    """Box input set V = {|u| <= u_max, |w| <= w_max, |r| <= r_max}.
+
+    Parameters
+    ----------
+    u_max, w_max : float
+        Surge and heave speed limits (m/s).
+    r_max : float
+        Yaw-rate limit (rad/s).
+    """
+
+    u_max: float
+    w_max: float
+    r_max: float
+
+    def __post_init__(self) -> None:
+        for name in ("u_max", "w_max", "r_max"):
+            object.__setattr__(self, name, positive(f"limits.{name}", getattr(self, name)))
+
+    @property
+    def vector(self) -> np.ndarray:
+        """The limits as ``[u_max, w_max, r_max]``."""
+        return np.array([self.u_max, self.w_max, self.r_max])
+
+    @property
+    def norm(self) -> float:
+        """The paper's scalar bound V-bar = sqrt(u_max^2 + w_max^2 + r_max^2) (eq. Vbar)."""
+        return float(np.linalg.norm(self.vector))
+
+    def contains(self, v: np.ndarray, tol: float = 1e-9) -> bool:
+        """True when every component of ``v`` is within its limit (plus ``tol``)."""
+        return bool(np.all(np.abs(np.asarray(v)) <= self.vector + tol))
+
+
+@dataclass(frozen=True)
+class SwayModel:
+    """How the unactuated sway velocity v_s is generated (the paper leaves it open).
+
+    ``v_s = clip(gain * u * r + amplitude * sin(2 pi t / period), -bound, bound)``.
+    ``gain * u * r`` is the steady-turn side-slip of a slender hull (sway
+    proportional to centripetal acceleration); the sinusoid models wave-induced
+    sway. ``bound`` (m/s) is the paper's v-bar = gamma-bar; the clip enforces it.
+
+    Parameters
+    ----------
+    gain : float
+        Side-slip coefficient (s); v_s contribution gain*u*r (m/s).
+    amplitude : float
+        Wave-induced sway amplitude (m/s).
+    period : float
+        Wave period (s).
+    bound : float
+        Hard bound on |v_s| (m/s); zero disables sway entirely.
+    """
+
+    gain: float = 0.1
+    amplitude: float = 0.0
+    period: float = 10.0
+    bound: float = 0.02
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "gain", nonnegative("sway.gain", self.gain))
+        object.__setattr__(self, "amplitude", nonnegative("sway.amplitude", self.amplitude))
+        object.__setattr__(self, "period", positive("sway.period", self.period))
+        object.__setattr__(self, "bound", nonnegative("sway.bound", self.bound))
+
+    def velocity(self, t: float, v: np.ndarray) -> float:
+        """Sway velocity v_s (m/s) at time ``t`` (s) under input ``v``."""
+        raw = self.gain * v[0] * v[2] + self.amplitude * np.sin(2.0 * np.pi * t / self.period)
+        return float(np.clip(raw, -self.bound, self.bound))
+
+
+def sway_velocity_term(x: np.ndarray, v_sway: float) -> np.ndarray:
+    """The inner disturbance g(x, v_s) = v_s [-sin psi, cos psi, 0] (m/s), eq. (2)."""
+    psi = x[3]
+    return v_sway * np.array([-np.sin(psi), np.cos(psi), 0.0])
+
+
+def nominal_kinematics(x: np.ndarray, v: np.ndarray) -> np.ndarray:
+    """Nominal kinematics f(x) v of eq. (3); vectorised over leading axes.
+
+    Parameters
+    ----------
+    x : array (..., 4)
+        State [x, y, z, psi].
+    v : array (..., 3)
+        Input [u, w, r].
+
+    Returns
+    -------
+    array (..., 4)
+        [x_dot, y_dot, z_dot, psi_dot].
+    """
+    x = np.asarray(x, dtype=float)
+    v = np.asarray(v, dtype=float)
+    psi = x[..., 3]
+    u, w, r = v[..., 0], v[..., 1], v[..., 2]
+    return np.stack([u * np.cos(psi), u * np.sin(psi), w, r + 0.0 * psi], axis=-1)
+
+
+def kinematics(x: np.ndarray, v: np.ndarray, omega: np.ndarray) -> np.ndarray:
+    """Perturbed kinematics f(x) v + [omega, 0] of eq. (11); vectorised.
+
+    ``omega`` (..., 3) is the total inertial disturbance (current + sway term).
+    """
+    omega = np.asarray(omega, dtype=float)
+    dx = nominal_kinematics(x, v)
+    return dx + np.concatenate([omega, np.zeros(omega.shape[:-1] + (1,))], axis=-1)
+
+

@@ -1,0 +1,411 @@
+"""Scenarios: everything a run or a certificate needs, with the paper's Section VI as default.
+
+A scenario is loaded from TOML (see ``docs/scenario.md`` and :func:`load_scenario`)
+or built in Python. Values the paper leaves out are chosen here and documented:
+
+* obstacle radius 0.4 m, vehicle radius 0.2 m (the paper gives neither);
+* initial pose 0.5 m behind the target, 0.2 m above it, heading along the path;
+* sway ``v_s = clip(0.1 u r, +-0.02 m/s)`` (:class:`tubekit.model.SwayModel`);
+* FHOCP weights Q, R, P (diagonal) and the verification region.
+"""
+
+from __future__ import annotations
+
+import math
+import tomllib
+from dataclasses import asdict, dataclass, field, replace
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from .exceptions import ConfigError
+from .model import InputLimits, SwayModel
+from .trajectory import Circle, Trajectory, trajectory_from_dict
+from .validation import as_vector, finite, nonnegative, positive
+
+__all__ = [
+    "Obstacle",
+    "Disturbance",
+    "ControllerSettings",
+    "RegionSettings",
+    "Scenario",
+    "paper_scenario",
+    "load_scenario",
+    "scenario_from_dict",
+    "LAW_NAMES",
+    "HEADINGS",
+]
+
+LAW_NAMES = ("paper", "corrected")
+HEADINGS = ("toward", "away", "both")
+
+
+@dataclass(frozen=True)
+class Obstacle:
+    """A spherical obstacle B(center, radius) (m)."""
+
+    center: tuple[float, float, float]
+    radius: float
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "center", tuple(float(c) for c in as_vector("obstacle.center", self.center, 3)))
+        object.__setattr__(self, "radius", positive("obstacle.radius", self.radius))
+
+
+@dataclass(frozen=True)
+class Disturbance:
+    """Current delta(t) plus sway; the total omega has ||omega|| <= omega_bar.
+
+    ``delta(t) = amplitude * [sin(a), cos(a), sin(a)] + constant``,
+    ``a = 2 pi t / period``; the paper uses amplitude 0.1 m/s, period 15 s.
+
+    Parameters
+    ----------
+    amplitude : array (3,)
+        Current amplitudes along x, y, z (m/s).
+    period : float
+        Current period (s).
+    constant : array (3,)
+        Constant current (m/s).
+    sway : SwayModel
+        Unactuated sway model.
+    """
+
+    amplitude: tuple[float, float, float] = (0.1, 0.1, 0.1)
+    period: float = 15.0
+    constant: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    sway: SwayModel = field(default_factory=SwayModel)
+
+    def __post_init__(self) -> None:
+        amp = as_vector("disturbance.amplitude", self.amplitude, 3)
+        if np.any(amp < 0):
+            raise ConfigError("disturbance.amplitude", "three numbers >= 0", self.amplitude)
+        object.__setattr__(self, "amplitude", tuple(float(a) for a in amp))
+        object.__setattr__(self, "period", positive("disturbance.period", self.period))
+        object.__setattr__(self, "constant",
+                           tuple(float(c) for c in as_vector("disturbance.constant", self.constant, 3)))
+
+    def current(self, t: float | np.ndarray) -> np.ndarray:
+        """Current delta(t) (m/s), shape t.shape + (3,)."""
+        a = 2.0 * np.pi * np.asarray(t, dtype=float) / self.period
+        amp = np.asarray(self.amplitude)
+        base = np.stack([np.sin(a), np.cos(a), np.sin(a)], axis=-1) * amp
+        return base + np.asarray(self.constant)
+
+    @property
+    def current_bound(self) -> float:
+        """delta-bar: exact max over t of ||delta(t)|| for zero constant, else a triangle bound (m/s)."""
+        a1, a2, a3 = self.amplitude
+        periodic = math.sqrt(max(a1 * a1 + a3 * a3, a2 * a2))
+        return periodic + float(np.linalg.norm(self.constant))
+
+    @property
+    def omega_bar(self) -> float:
+        """omega-bar = delta-bar + gamma-bar (eq. Wset), m/s."""
+        return self.current_bound + self.sway.bound
+
+
+@dataclass(frozen=True)
+class ControllerSettings:
+    """Tube-MPC settings.
+
+    Parameters
+    ----------
+    dt : float
+        FHOCP sampling period delta_t (s).
+    horizon_steps : int
+        N; the horizon is T = N dt (s).
+    Q, R, P : array (3,)
+        Diagonals of the stage, input and terminal weights.
+    law : str
+        Ancillary law, one of :data:`LAW_NAMES`.
+    sigma : float or None
+        Ancillary gain; ``None`` lets the verifier choose it.
+    ancillary_rate_hz : float
+        Rate of the ancillary feedback kappa (Hz); a multiple of 1/dt.
+    terminal_level : float
+        epsilon-bar of the terminal set F = {||e||_P <= epsilon-bar}.
+    scp_iterations : int
+        Convex subproblems per FHOCP in converged mode (1 = real-time mode).
+    """
+
+    dt: float = 0.1
+    horizon_steps: int = 8
+    Q: tuple[float, float, float] = (1.0, 1.0, 0.5)
+    R: tuple[float, float, float] = (0.5, 0.5, 0.1)
+    P: tuple[float, float, float] = (5.0, 5.0, 2.5)
+    law: str = "corrected"
+    sigma: float | None = None
+    ancillary_rate_hz: float = 100.0
+    terminal_level: float = 2.0
+    scp_iterations: int = 1
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "dt", positive("controller.dt", self.dt))
+        if not isinstance(self.horizon_steps, int) or self.horizon_steps < 1:
+            raise ConfigError("controller.horizon_steps", "an integer >= 1", self.horizon_steps)
+        for name in ("Q", "R", "P"):
+            vec = as_vector(f"controller.{name}", getattr(self, name), 3)
+            if np.any(vec <= 0):
+                raise ConfigError(f"controller.{name}", "three numbers > 0 (a positive diagonal)",
+                                  getattr(self, name))
+            object.__setattr__(self, name, tuple(float(x) for x in vec))
+        if self.law not in LAW_NAMES:
+            raise ConfigError("controller.law", f"one of {LAW_NAMES}", self.law)
+        if self.sigma is not None:
+            object.__setattr__(self, "sigma", positive("controller.sigma", self.sigma))
+        object.__setattr__(self, "ancillary_rate_hz",
+                           positive("controller.ancillary_rate_hz", self.ancillary_rate_hz))
+        ratio = self.ancillary_rate_hz * self.dt
+        if abs(ratio - round(ratio)) > 1e-9 or round(ratio) < 1:
+            raise ConfigError("controller.ancillary_rate_hz", "a positive multiple of 1/dt",
+                              self.ancillary_rate_hz)
+        object.__setattr__(self, "terminal_level", positive("controller.terminal_level", self.terminal_level))
+        if not isinstance(self.scp_iterations, int) or self.scp_iterations < 1:
+            raise ConfigError("controller.scp_iterations", "an integer >= 1", self.scp_iterations)
+
+    @property
+    def horizon(self) -> float:
+        """Prediction horizon T = N dt (s)."""
+        return self.horizon_steps * self.dt
+
+
+@dataclass(frozen=True)
+class RegionSettings:
+    """The error region the verifier's bounds must hold over.
+
+    e_d in [epsilon, e_d_max], |e_z| <= e_z_max, |e_o| <= e_o_max, heading
+    hemisphere "toward" (cos(psi - bearing) < 0: the vehicle points at the
+    target), "away" or "both". The FHOCP keeps the nominal inside the region
+    shrunk by the tube, so the bounds apply along the closed loop.
+    """
+
+    e_d_max: float = 3.0
+    e_z_max: float = 1.0
+    e_o_max: float = 0.9
+    heading: str = "toward"
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "e_d_max", positive("region.e_d_max", self.e_d_max))
+        object.__setattr__(self, "e_z_max", positive("region.e_z_max", self.e_z_max))
+        eo = positive("region.e_o_max", self.e_o_max)
+        if eo >= 1.0:
+            raise ConfigError("region.e_o_max", "a number in (0, 1) (|e_o| = 1 makes J singular)", eo)
+        object.__setattr__(self, "e_o_max", eo)
+        if self.heading not in HEADINGS:
+            raise ConfigError("region.heading", f"one of {HEADINGS}", self.heading)
+
+
+@dataclass(frozen=True)
+class Scenario:
+    """A complete scenario (units: m, s, rad).
+
+    Parameters
+    ----------
+    name : str
+        Label used in outputs.
+    trajectory : Trajectory
+        Desired trajectory p_d(t).
+    obstacles : tuple of Obstacle
+        Static spherical obstacles.
+    limits : InputLimits
+        Input set V.
+    vehicle_radius : float
+        r-bar, radius of the ball covering the vehicle (m).
+    sensing_range : float
+        R-bar (m); obstacles join the FHOCP once their surface is within it.
+    epsilon : float
+        Lower bound on e_d (m).
+    duration : float
+        Simulated time (s).
+    initial_state : array (4,)
+        [x, y, z, psi] at t = 0.
+    disturbance : Disturbance
+        Current and sway.
+    controller : ControllerSettings
+        Tube-MPC settings.
+    region : RegionSettings
+        Verification region.
+    workspace : tuple of two (3,) arrays or None
+        Axis-aligned workspace box [lower, upper] (m).
+    """
+
+    name: str = "paper-section-VI"
+    trajectory: Trajectory = field(default_factory=Circle)
+    obstacles: tuple[Obstacle, ...] = ()
+    limits: InputLimits = field(default_factory=lambda: InputLimits(0.4, 0.3, 0.5))
+    vehicle_radius: float = 0.2
+    sensing_range: float = 1.5
+    epsilon: float = 0.1
+    duration: float = 100.0
+    initial_state: tuple[float, float, float, float] = (-0.5, 3.0, 0.2, 0.0)
+    disturbance: Disturbance = field(default_factory=Disturbance)
+    controller: ControllerSettings = field(default_factory=ControllerSettings)
+    region: RegionSettings = field(default_factory=RegionSettings)
+    workspace: tuple[tuple[float, float, float], tuple[float, float, float]] | None = (
+        (-10.0, -10.0, -5.0), (10.0, 10.0, 5.0))
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "vehicle_radius", positive("vehicle_radius", self.vehicle_radius))
+        object.__setattr__(self, "sensing_range", positive("sensing_range", self.sensing_range))
+        if self.sensing_range <= self.vehicle_radius:
+            raise ConfigError("sensing_range", f"a number > vehicle_radius = {self.vehicle_radius}",
+                              self.sensing_range, "the paper requires R-bar > r-bar")
+        object.__setattr__(self, "epsilon", positive("epsilon", self.epsilon))
+        object.__setattr__(self, "duration", positive("duration", self.duration))
+        object.__setattr__(self, "initial_state",
+                           tuple(float(x) for x in as_vector("initial_state", self.initial_state, 4)))
+        obstacles = tuple(o if isinstance(o, Obstacle) else Obstacle(**o) for o in self.obstacles)
+        object.__setattr__(self, "obstacles", obstacles)
+        for i, a in enumerate(obstacles):
+            for j in range(i + 1, len(obstacles)):
+                b = obstacles[j]
+                gap = float(np.linalg.norm(np.subtract(a.center, b.center)))
+                need = 2 * self.vehicle_radius + a.radius + b.radius
+                if gap <= need:
+                    raise ConfigError(
+                        f"obstacles[{i}], obstacles[{j}]",
+                        f"centres more than 2 r-bar + r_i + r_j = {need:.4g} m apart (eq. obstacle_dis)",
+                        f"{gap:.4g} m", "move the obstacles apart or shrink them")
+        if self.region.e_d_max <= self.epsilon:
+            raise ConfigError("region.e_d_max", f"a number > epsilon = {self.epsilon}", self.region.e_d_max,
+                              "the region e_d in [epsilon, e_d_max] would be empty")
+        if self.workspace is not None:
+            lo = as_vector("workspace[0]", self.workspace[0], 3)
+            hi = as_vector("workspace[1]", self.workspace[1], 3)
+            if np.any(hi <= lo):
+                raise ConfigError("workspace", "lower < upper on every axis", self.workspace)
+            object.__setattr__(self, "workspace", (tuple(lo), tuple(hi)))
+
+    @property
+    def steps(self) -> int:
+        """Number of FHOCP sampling periods in the run."""
+        return int(round(self.duration / self.controller.dt))
+
+    def with_changes(self, **changes: Any) -> "Scenario":
+        """A copy with top-level fields replaced (``dataclasses.replace``)."""
+        return replace(self, **changes)
+
+    def to_dict(self) -> dict:
+        """A JSON/TOML-friendly description (the inverse of :func:`scenario_from_dict`)."""
+        d = {
+            "name": self.name,
+            "trajectory": self.trajectory.to_dict(),
+            "obstacles": [{"center": list(o.center), "radius": o.radius} for o in self.obstacles],
+            "limits": {"u_max": self.limits.u_max, "w_max": self.limits.w_max, "r_max": self.limits.r_max},
+            "vehicle_radius": self.vehicle_radius,
+            "sensing_range": self.sensing_range,
+            "epsilon": self.epsilon,
+            "duration": self.duration,
+            "initial_state": list(self.initial_state),
+            "disturbance": {
+                "amplitude": list(self.disturbance.amplitude),
+                "period": self.disturbance.period,
+                "constant": list(self.disturbance.constant),
+                "sway": asdict(self.disturbance.sway),
+            },
+            "controller": {k: (list(v) if isinstance(v, tuple) else v)
+                           for k, v in asdict(self.controller).items() if v is not None},
+            "region": asdict(self.region),
+        }
+        if self.workspace is not None:
+            d["workspace"] = [list(self.workspace[0]), list(self.workspace[1])]
+        return d
+
+
+def paper_scenario() -> Scenario:
+    """Section VI of the paper, with the choices it leaves out filled in (see module doc)."""
+    return Scenario(
+        obstacles=(Obstacle((3.0, 0.0, 0.0), 0.4), Obstacle((-3.0, 0.0, 0.0), 0.4)),
+    )
+
+
+_TOP_KEYS = {"name", "trajectory", "obstacles", "limits", "vehicle_radius", "sensing_range", "epsilon",
+             "duration", "initial_state", "disturbance", "controller", "region", "workspace"}
+
+
+def _table(d: dict, key: str, cls, allowed: set[str]):
+    sub = d.get(key, {})
+    if not isinstance(sub, dict):
+        raise ConfigError(key, "a table", sub)
+    unknown = set(sub) - allowed
+    if unknown:
+        raise ConfigError(f"{key}.{sorted(unknown)[0]}", f"one of the keys {sorted(allowed)}",
+                          sorted(unknown)[0])
+    return sub
+
+
+def scenario_from_dict(d: dict) -> Scenario:
+    """Build a :class:`Scenario` from a dict (parsed TOML); missing keys take the paper's values.
+
+    Raises
+    ------
+    ConfigError
+        Naming the offending field and what was expected.
+    """
+    if not isinstance(d, dict):
+        raise ConfigError("scenario", "a table", type(d).__name__)
+    unknown = set(d) - _TOP_KEYS
+    if unknown:
+        raise ConfigError(sorted(unknown)[0], f"one of the top-level keys {sorted(_TOP_KEYS)}", sorted(unknown)[0])
+    base = paper_scenario()
+    kw: dict[str, Any] = {}
+    if "name" in d:
+        kw["name"] = str(d["name"])
+    if "trajectory" in d:
+        kw["trajectory"] = trajectory_from_dict(d["trajectory"])
+    if "obstacles" in d:
+        obs = d["obstacles"]
+        if not isinstance(obs, list):
+            raise ConfigError("obstacles", "a list of {center, radius} tables", obs)
+        built = []
+        for i, o in enumerate(obs):
+            if not isinstance(o, dict) or set(o) != {"center", "radius"}:
+                raise ConfigError(f"obstacles[{i}]", "a table with exactly 'center' and 'radius'", o)
+            try:
+                built.append(Obstacle(o["center"], o["radius"]))
+            except ConfigError as exc:
+                raise ConfigError(f"obstacles[{i}].{exc.field.split('.')[-1]}", exc.expected, exc.received) from None
+        kw["obstacles"] = tuple(built)
+    if "limits" in d:
+        lim = _table(d, "limits", InputLimits, {"u_max", "w_max", "r_max"})
+        b = base.limits
+        kw["limits"] = InputLimits(lim.get("u_max", b.u_max), lim.get("w_max", b.w_max), lim.get("r_max", b.r_max))
+    for key in ("vehicle_radius", "sensing_range", "epsilon", "duration"):
+        if key in d:
+            kw[key] = d[key]
+    if "initial_state" in d:
+        kw["initial_state"] = d["initial_state"]
+    if "disturbance" in d:
+        dist = dict(_table(d, "disturbance", Disturbance, {"amplitude", "period", "constant", "sway"}))
+        sway = dist.pop("sway", None)
+        if sway is not None:
+            if not isinstance(sway, dict) or set(sway) - {"gain", "amplitude", "period", "bound"}:
+                raise ConfigError("disturbance.sway", "a table with keys gain, amplitude, period, bound", sway)
+            dist["sway"] = SwayModel(**sway)
+        kw["disturbance"] = Disturbance(**dist)
+    if "controller" in d:
+        ctrl = _table(d, "controller", ControllerSettings, set(ControllerSettings.__dataclass_fields__))
+        kw["controller"] = ControllerSettings(**ctrl)
+    if "region" in d:
+        reg = _table(d, "region", RegionSettings, set(RegionSettings.__dataclass_fields__))
+        kw["region"] = RegionSettings(**reg)
+    if "workspace" in d:
+        ws = d["workspace"]
+        if ws is not None and (not isinstance(ws, list) or len(ws) != 2):
+            raise ConfigError("workspace", "[[x_lo, y_lo, z_lo], [x_hi, y_hi, z_hi]]", ws)
+        kw["workspace"] = None if ws is None else (tuple(ws[0]), tuple(ws[1]))
+    return replace(base, **kw)
+
+
+def load_scenario(path: str | Path) -> Scenario:
+    """Load a scenario from a TOML file (see :func:`scenario_from_dict`)."""
+    p = Path(path)
+    if not p.is_file():
+        raise ConfigError("CONFIG", "a path to an existing TOML file", str(p))
+    try:
+        data = tomllib.loads(p.read_text())
+    except tomllib.TOMLDecodeError as exc:
+        raise ConfigError("CONFIG", "valid TOML", str(p), str(exc)) from None
+    return scenario_from_dict(data)

@@ -73,8 +73,12 @@ class AncillaryLaw:
             Gain (1/s).
         """
         rho = error_coordinates(state, p_d) - error_coordinates(state_hat, p_d)
-        K = self.gain(state, p_d)
-        out = -sigma * (K @ rho)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            try:
+                K = self.gain(state, p_d)
+            except np.linalg.LinAlgError:
+                K = np.full((3, 3), np.nan)
+            out = -sigma * (K @ rho)
         if not np.all(np.isfinite(out)):
             raise ConfigError("state", "a state with e_d > 0 and |e_o| < 1 (J non-singular)",
                               np.asarray(state).tolist())
@@ -85,7 +89,8 @@ def jacobian_at(state: np.ndarray, p_d: np.ndarray) -> np.ndarray:
     """The derived J (..., 3, 3) at ``state`` (..., 4) w.r.t. ``p_d`` (..., 3)."""
     state = np.asarray(state, dtype=float)
     p_d = np.asarray(p_d, dtype=float)
-    return numeric().J(state[..., 0] - p_d[..., 0], state[..., 1] - p_d[..., 1], state[..., 3])
+    with np.errstate(invalid="ignore", divide="ignore"):
+        return numeric().J(state[..., 0] - p_d[..., 0], state[..., 1] - p_d[..., 1], state[..., 3])
 
 
 LAWS: dict[str, AncillaryLaw] = {

@@ -1,0 +1,92 @@
+"""Pointwise tube invariance: the sign of d/dt (1/2 ||rho||^2) at one configuration.
+
+A :class:`TubeConfiguration` fixes everything the derivative depends on: the real
+and nominal states relative to the target (p_d = 0), the nominal input v_hat, the
+disturbance omega and the target velocity p_d_dot. With rho = e - e_hat,
+
+    rho^T rho_dot = rho^T [ e_dot(real, v_hat + kappa, omega, p_d_dot) - e_dot(nominal, v_hat, 0, p_d_dot) ],
+
+always with the *derived* dynamics (:mod:`tubekit.derivation`). The tube is
+invariant at a configuration on its boundary (||rho|| = rho-tilde) when this is <= 0.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from tubekit.ancillary import AncillaryLaw
+from tubekit.derivation import error_coordinates, numeric
+
+__all__ = ["TubeConfiguration", "rho_dot_inner", "applied_input"]
+
+_STATE_KEYS = ("e_x", "e_y", "e_z", "psi")
+
+
+@dataclass(frozen=True)
+class TubeConfiguration:
+    """One point of the tube-invariance question (units m, m/s, rad, rad/s).
+
+    Attributes
+    ----------
+    real, nominal : array (4,)
+        [e_x, e_y, e_z, psi] of the real and nominal vehicle relative to the target.
+    v_hat : array (3,)
+        Nominal input [u, w, r].
+    omega : array (3,)
+        Disturbance [omega_1, omega_2, omega_3].
+    pd_dot : array (3,)
+        Target velocity [xdot_d, ydot_d, zdot_d].
+    """
+
+    real: np.ndarray
+    nominal: np.ndarray
+    v_hat: np.ndarray
+    omega: np.ndarray
+    pd_dot: np.ndarray
+
+    @property
+    def rho(self) -> np.ndarray:
+        """rho = e - e_hat in error coordinates [e_d, e_z, e_o]."""
+        zero = np.zeros(3)
+        return error_coordinates(self.real, zero) - error_coordinates(self.nominal, zero)
+
+    def to_dict(self) -> dict:
+        """JSON form: ``real``/``nominal`` as {e_x, e_y, e_z, psi}, vectors as lists."""
+        return {
+            "real": dict(zip(_STATE_KEYS, map(float, self.real))),
+            "nominal": dict(zip(_STATE_KEYS, map(float, self.nominal))),
+            "v_hat": [float(x) for x in self.v_hat],
+            "omega": [float(x) for x in self.omega],
+            "pd_dot": [float(x) for x in self.pd_dot],
+        }
+
+
+def applied_input(config: TubeConfiguration, law: AncillaryLaw, sigma: float) -> np.ndarray:
+    """v = v_hat + kappa(e, e_hat) applied to the real vehicle (3,)."""
+    zero = np.zeros(3)
+    return config.v_hat + law(config.real, config.nominal, zero, sigma)
+
+
+def rho_dot_inner(config: TubeConfiguration, law: AncillaryLaw, sigma: float) -> float:
+    """rho^T rho_dot at ``config`` under ``law`` with gain ``sigma`` (1/s); > 0 is a violation.
+
+    Returns ``nan`` where the law is undefined (e_d = 0).
+    """
+    zero = np.zeros(3)
+    e = error_coordinates(config.real, zero)
+    e_hat = error_coordinates(config.nominal, zero)
+    rho = e - e_hat
+    with np.errstate(all="ignore"):
+        J = numeric().J(config.real[0], config.real[1], config.real[3])
+        try:
+            K = law.gain_of_jacobian(J)
+        except np.linalg.LinAlgError:
+            return float("nan")
+        v = config.v_hat - sigma * (K @ rho)
+        dyn = numeric().e_dot
+        e_dot = dyn(config.real[0], config.real[1], config.real[3], *v, *config.omega, *config.pd_dot)
+        e_hat_dot = dyn(config.nominal[0], config.nominal[1], config.nominal[3], *config.v_hat, 0.0, 0.0, 0.0,
+                        *config.pd_dot)
+    return float(rho @ (e_dot - e_hat_dot))

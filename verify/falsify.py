@@ -20,7 +20,7 @@ import json
 import math
 import random
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 import numpy as np
@@ -28,7 +28,7 @@ from hypothesis import HealthCheck, Phase, find, settings, target
 from hypothesis.errors import NoSuchExample
 from scipy.optimize import minimize
 
-from tubekit.ancillary import get_law
+from tubekit.ancillary import AncillaryLaw, get_law
 from tubekit.exceptions import ConfigError
 from tubekit.scenario import Scenario, load_scenario, paper_scenario
 
@@ -145,7 +145,8 @@ class FalsifyResult:
 
 def falsify(scenario: Scenario, law: str | None = None, *, budget: int = 500, seed: int = 0,
             sigma: float | None = None, rho_tilde: float | None = None, certificate=None,
-            space: SearchSpace | None = None, local_iterations: int = 3000) -> FalsifyResult:
+            space: SearchSpace | None = None, local_iterations: int = 3000,
+            controller: AncillaryLaw | None = None) -> FalsifyResult:
     """Search for a violation of pointwise tube invariance.
 
     Parameters
@@ -166,13 +167,19 @@ def falsify(scenario: Scenario, law: str | None = None, *, budget: int = 500, se
         Search this space directly (skips the certificate).
     local_iterations : int
         Function evaluations of the stage-2 local search.
+    controller : AncillaryLaw, optional
+        Your own law (kappa = -sigma K(J) rho with your ``gain_of_jacobian``) to attack
+        instead of the named one; the search space still comes from ``space`` or the
+        certificate of ``law``.
     """
     if not isinstance(budget, int) or budget < 1:
         raise ConfigError("budget", "an integer >= 1", budget)
     t0 = time.perf_counter()
     if space is None:
         space = search_space(scenario, law, sigma=sigma, rho_tilde=rho_tilde, certificate=certificate)
-    ancillary = get_law(space.law)
+    if controller is not None:
+        space = replace(space, law=controller.name)
+    ancillary = controller if controller is not None else get_law(space.law)
     count = 0
     worst: list = [None, -math.inf]
 

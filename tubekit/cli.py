@@ -61,6 +61,9 @@ def main(argv: list[str] | None = None) -> int:
     except TubekitError as exc:
         print(f"tubekit {args.command}: error: {exc}", file=sys.stderr)
         return 2
+    except BrokenPipeError:  # e.g. `tubekit certify | head`
+        sys.stderr.close()
+        return 0
 
 
 if __name__ == "__main__":  # pragma: no cover

@@ -1,7 +1,48 @@
-"""verify: certified bounds, tube radius and tightened sets for tubekit scenarios."""
+"""verify: certified bounds, tube radius and tightened sets for tubekit scenarios.
+
+``certify(scenario, law)`` returns a :class:`Certificate` (Lemma 1, Section V
+tightened sets, terminal set, horizon condition, obstacle separation), every
+number rigorous (Arb interval arithmetic), every failure named;
+``envelope(scenario, law)`` searches the certifiable design envelope.
+See ``docs/verify.md``.
+"""
 
 from __future__ import annotations
 
+from pathlib import Path
+
+from tubekit.scenario import Scenario, load_scenario
+
+from .bounds import BOUND_NAMES, BoundResult, Bounds, compute_bounds
+from .certificate import Certificate, Condition, NotCertifiedError, certify
+from .envelope import EnvelopeResult, envelope, plot_envelope
+from .region import Region
+
 __version__ = "0.1.0"
 
-__all__ = ["__version__"]
+#: Directory of the scenarios shipped with verify.
+SCENARIOS_DIR = Path(__file__).resolve().parent / "scenarios"
+
+
+def certifiable_scenario() -> Scenario:
+    """The documented scenario the corrected law certifies (``scenarios/certifiable.toml``)."""
+    return load_scenario(SCENARIOS_DIR / "certifiable.toml")
+
+
+__all__ = [
+    "__version__",
+    "certify",
+    "Certificate",
+    "Condition",
+    "NotCertifiedError",
+    "Region",
+    "compute_bounds",
+    "Bounds",
+    "BoundResult",
+    "BOUND_NAMES",
+    "envelope",
+    "EnvelopeResult",
+    "plot_envelope",
+    "SCENARIOS_DIR",
+    "certifiable_scenario",
+]

@@ -51,7 +51,7 @@ def _xi_matrix(state):
     return np.stack([numeric().xi(state[0], state[1], state[3], *e) for e in np.eye(3)], axis=-1)
 
 
-@settings(max_examples=12)
+@settings(max_examples=max(10, settings.default.max_examples // 4))  # scales with the profile
 @given(region=vs.regions(max_e_o=0.9), law=st.sampled_from(sorted(LAWS)), data=st.data())
 def test_certificate_soundness(region, law, data):
     """Property: no sampled point beats a certified bound (L1, L2, J_lower, xi_bar) on random regions."""
@@ -91,7 +91,7 @@ def test_pointwise_invariance_certified_law(certified):
     space = search_space(scenario, "corrected", certificate=cert)
     law = LAWS["corrected"]
 
-    @settings(max_examples=300)
+    @settings(max_examples=8 * settings.default.max_examples)  # 320 in 'ci', 8000 in 'thorough'
     @given(vs.tube_configurations(space.region, space.rho_tilde, space.v_bar, space.delta_theta))
     def prop(cfg):
         assert rho_dot_inner(cfg, law, space.sigma) <= 0.0
@@ -120,3 +120,37 @@ def test_falsifier_finds_nothing_for_certified_design(certified):
     result = falsify(scenario, "corrected", certificate=cert, budget=300, local_iterations=1500)
     assert not result.found, result.summary()
     assert result.worst_value <= 0
+
+
+# ---------------------------------------------------------------- c. closed-loop containment
+def test_closed_loop_containment(certified):
+    """Property: for random bounded disturbances in Omega (time-varying) and random starts in E-bar of the
+    certified scenario, the closed loop keeps ||rho(t)|| <= rho_tilde and v(t) in V at every tick."""
+    from dataclasses import replace
+
+    from tubekit.closed_loop import simulate
+    from tubekit.derivation import error_coordinates
+
+    scenario, cert = certified
+    tight = cert.tightening()
+    rho_t = tight.rho_tilde
+    start_region = cert.region.replace(e_d=(tight.e_d_min, min(tight.e_d_min + 0.5, tight.e_d_max)),
+                                       e_o=(-0.3, 0.3), e_z=(-0.3, 0.3))
+    short = replace(scenario, duration=2.0)
+    p0 = scenario.trajectory.position(0.0)
+
+    @settings(max_examples=max(3, settings.default.max_examples // 10), deadline=None)
+    @given(start=vs.error_states(start_region), signal=vs.disturbance_signals(cert.region.omega_bar))
+    def prop(start, signal):
+        init = (p0[0] + start[0], p0[1] + start[1], p0[2] + start[2], start[3])
+        run = simulate(replace(short, initial_state=init), tightening=tight, law="corrected", progress=False,
+                       disturbance=signal)
+        e = error_coordinates(run.states, run.desired)
+        e_hat = error_coordinates(run.nominal, run.desired)
+        rho = np.linalg.norm(e - e_hat, axis=-1)
+        assert np.nanmax(rho) <= rho_t
+        applied = run.inputs[:-1]
+        assert np.all(np.abs(applied) <= scenario.limits.vector + 1e-12)
+        assert int(run.saturated.sum()) == 0
+
+    prop()

@@ -33,6 +33,8 @@ class ShapeError(TubekitError, ValueError):
 
     def __init__(self, name: str, expected: str, received: tuple[int, ...]) -> None:
         self.name = name
+        self.expected = expected
+        self.received = received
         super().__init__(f"{name}: expected shape {expected}, received shape {received}")
 
 

@@ -13,13 +13,14 @@ from __future__ import annotations
 
 import math
 import tomllib
+from contextlib import contextmanager
 from dataclasses import asdict, dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-from .exceptions import ConfigError
+from .exceptions import ConfigError, ShapeError
 from .model import InputLimits, SwayModel
 from .trajectory import Circle, Trajectory, trajectory_from_dict
 from .validation import as_vector, finite, nonnegative, positive
@@ -325,6 +326,19 @@ _TOP_KEYS = {"name", "trajectory", "obstacles", "limits", "vehicle_radius", "sen
              "duration", "initial_state", "disturbance", "controller", "region", "workspace"}
 
 
+@contextmanager
+def _field_prefix(old: str, new: str):
+    """Re-raise errors of a nested constructor with the full TOML path (``old`` -> ``new``)."""
+    try:
+        yield
+    except ShapeError as exc:
+        name = new + exc.name[len(old):] if exc.name.startswith(old) else f"{new}.{exc.name}"
+        raise ShapeError(name, exc.expected, exc.received) from None
+    except ConfigError as exc:
+        name = new + exc.field[len(old):] if exc.field.startswith(old) else f"{new}.{exc.field}"
+        raise ConfigError(name, exc.expected, exc.received) from None
+
+
 def _table(d: dict, key: str, cls, allowed: set[str]):
     sub = d.get(key, {})
     if not isinstance(sub, dict):
@@ -363,10 +377,8 @@ def scenario_from_dict(d: dict) -> Scenario:
         for i, o in enumerate(obs):
             if not isinstance(o, dict) or set(o) != {"center", "radius"}:
                 raise ConfigError(f"obstacles[{i}]", "a table with exactly 'center' and 'radius'", o)
-            try:
+            with _field_prefix("obstacle", f"obstacles[{i}]"):
                 built.append(Obstacle(o["center"], o["radius"]))
-            except ConfigError as exc:
-                raise ConfigError(f"obstacles[{i}].{exc.field.split('.')[-1]}", exc.expected, exc.received) from None
         kw["obstacles"] = tuple(built)
     if "limits" in d:
         lim = _table(d, "limits", InputLimits, {"u_max", "w_max", "r_max"})
@@ -383,7 +395,8 @@ def scenario_from_dict(d: dict) -> Scenario:
         if sway is not None:
             if not isinstance(sway, dict) or set(sway) - {"gain", "amplitude", "period", "bound"}:
                 raise ConfigError("disturbance.sway", "a table with keys gain, amplitude, period, bound", sway)
-            dist["sway"] = SwayModel(**sway)
+            with _field_prefix("sway", "disturbance.sway"):
+                dist["sway"] = SwayModel(**sway)
         kw["disturbance"] = Disturbance(**dist)
     if "controller" in d:
         ctrl = _table(d, "controller", ControllerSettings, set(ControllerSettings.__dataclass_fields__))

@@ -13,7 +13,9 @@ __all__ = ["as_vector", "positive", "nonnegative", "finite"]
 
 
 def finite(field: str, value: Any) -> float:
-    """Return ``value`` as a finite float or raise :class:`ConfigError`."""
+    """Return ``value`` as a finite float or raise :class:`ConfigError` (booleans are not numbers)."""
+    if isinstance(value, (bool, np.bool_)):
+        raise ConfigError(field, "a finite number", value)
     try:
         x = float(value)
     except (TypeError, ValueError):
@@ -41,6 +43,8 @@ def nonnegative(field: str, value: Any) -> float:
 
 def as_vector(name: str, value: Any, size: int) -> np.ndarray:
     """Return ``value`` as a finite float vector of length ``size``."""
+    if isinstance(value, (list, tuple)) and any(isinstance(v, (bool, np.bool_)) for v in value):
+        raise ConfigError(name, f"{size} numbers", value)
     try:
         arr = np.asarray(value, dtype=float)
     except (TypeError, ValueError):

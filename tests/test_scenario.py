@@ -1,0 +1,162 @@
+"""The scenario TOML schema (docs/scenario.md): round trip, examples, one error per bad field."""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import pytest
+
+from tubekit import ConfigError, TubekitError, load_scenario, paper_scenario, scenario_from_dict
+from tubekit.trajectory import Circle, Helix, Line, Waypoints
+
+EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
+
+
+def _toml_value(v) -> str:
+    if isinstance(v, bool):
+        return "true" if v else "false"
+    if isinstance(v, (int, float)):
+        return repr(float(v)) if isinstance(v, float) else str(v)
+    if isinstance(v, str):
+        return '"' + v.replace("\\", "\\\\").replace('"', '\\"') + '"'
+    if isinstance(v, (list, tuple)):
+        return "[" + ", ".join(_toml_value(x) for x in v) + "]"
+    raise TypeError(type(v))
+
+
+def _to_toml(d: dict, prefix: str = "") -> str:
+    """A minimal TOML writer for scenario dicts (scalars, arrays, tables, arrays of tables)."""
+    lines, tables, arrays = [], [], []
+    for k, v in d.items():
+        if isinstance(v, dict):
+            tables.append((k, v))
+        elif isinstance(v, list) and v and all(isinstance(x, dict) for x in v):
+            arrays.append((k, v))
+        else:
+            lines.append(f"{k} = {_toml_value(v)}")
+    out = "\n".join(lines) + "\n"
+    for k, v in tables:
+        name = f"{prefix}{k}"
+        out += f"\n[{name}]\n" + _to_toml(v, name + ".")
+    for k, v in arrays:
+        for item in v:
+            out += f"\n[[{prefix}{k}]]\n" + _to_toml(item, f"{prefix}{k}.")
+    return out
+
+
+def test_paper_scenario_round_trips_through_toml(tmp_path):
+    sc = paper_scenario()
+    path = tmp_path / "paper.toml"
+    path.write_text(_to_toml(sc.to_dict()))
+    back = load_scenario(path)
+    assert back == sc
+    assert back.to_dict() == sc.to_dict()
+
+
+def test_paper_defaults_are_section_vi():
+    sc = scenario_from_dict({})
+    assert isinstance(sc.trajectory, Circle) and sc.trajectory.radius == 3.0
+    assert sc.trajectory.rate == pytest.approx(math.pi / 25)
+    assert [o.center for o in sc.obstacles] == [(3.0, 0.0, 0.0), (-3.0, 0.0, 0.0)]
+    assert tuple(sc.limits.vector) == (0.4, 0.3, 0.5)
+    assert (sc.sensing_range, sc.epsilon, sc.duration) == (1.5, 0.1, 100.0)
+    assert (sc.controller.dt, sc.controller.horizon_steps) == (0.1, 8)
+    assert sc.disturbance.amplitude == (0.1, 0.1, 0.1) and sc.disturbance.period == 15.0
+
+
+@pytest.mark.parametrize("name, cls", [("circle", Circle), ("helix", Helix), ("line", Line),
+                                       ("waypoints", Waypoints)])
+def test_examples_load(name, cls):
+    sc = load_scenario(EXAMPLES / f"{name}.toml")
+    assert type(sc.trajectory) is cls and sc.name == name
+    assert len(sc.obstacles) >= 1
+
+
+def test_circle_example_is_the_paper_scenario():
+    a = load_scenario(EXAMPLES / "circle.toml").to_dict()
+    b = paper_scenario().to_dict()
+    a.pop("name"), b.pop("name")
+    assert a == b
+
+
+def test_missing_keys_take_paper_values_and_tables_merge():
+    sc = scenario_from_dict({"limits": {"u_max": 0.6}, "controller": {"dt": 0.2, "ancillary_rate_hz": 50.0}})
+    assert tuple(sc.limits.vector) == (0.6, 0.3, 0.5)
+    assert sc.controller.dt == 0.2 and sc.controller.horizon_steps == 8
+
+
+BAD = [
+    ({"speed": 1.0}, "speed"),
+    ({"trajectory": {"kind": "spiral"}}, r"trajectory\.kind"),
+    ({"trajectory": {"radius": 3.0}}, r"trajectory\.kind"),
+    ({"trajectory": {"kind": "circle", "radius": -1.0}}, r"trajectory\.radius"),
+    ({"trajectory": {"kind": "circle", "foo": 1.0}}, r"trajectory"),
+    ({"trajectory": {"kind": "waypoints", "points": [[0.0, 0.0, 0.0]]}}, r"trajectory\.points"),
+    ({"obstacles": [{"center": [3.0, 0.0, 0.0], "radius": 0.4}, {"center": [-3.0, 0.0, 0.0], "radius": 0.0}]},
+     r"obstacles\[1\]\.radius"),
+    ({"obstacles": [{"center": [3.0, 0.0, 0.0]}]}, r"obstacles\[0\]"),
+    ({"obstacles": [{"center": "here", "radius": 0.4}]}, r"obstacles\[0\]\.center"),
+    ({"obstacles": {"center": [0.0, 0.0, 0.0], "radius": 1.0}}, r"obstacles"),
+    ({"obstacles": [{"center": [0.0, 0.0, 0.0], "radius": 0.4}, {"center": [1.0, 0.0, 0.0], "radius": 0.4}]},
+     r"obstacles\[0\], obstacles\[1\]"),
+    ({"limits": {"u_max": 0.0}}, r"limits\.u_max"),
+    ({"limits": {"v_max": 1.0}}, r"limits\.v_max"),
+    ({"limits": 5}, r"limits"),
+    ({"vehicle_radius": -0.2}, r"vehicle_radius"),
+    ({"sensing_range": 0.1}, r"sensing_range"),
+    ({"epsilon": "small"}, r"epsilon"),
+    ({"duration": float("nan")}, r"duration"),
+    ({"disturbance": {"period": -15.0}}, r"disturbance\.period"),
+    ({"disturbance": {"amplitude": [-0.1, 0.1, 0.1]}}, r"disturbance\.amplitude"),
+    ({"disturbance": {"sway": {"gian": 0.1}}}, r"disturbance\.sway"),
+    ({"controller": {"law": "magic"}}, r"controller\.law"),
+    ({"controller": {"ancillary_rate_hz": 15.0}}, r"controller\.ancillary_rate_hz"),
+    ({"controller": {"horizon_steps": 0}}, r"controller\.horizon_steps"),
+    ({"controller": {"Q": [1.0, 0.0, 1.0]}}, r"controller\.Q"),
+    ({"controller": {"sigma": -1.0}}, r"controller\.sigma"),
+    ({"controller": {"gain": 1.0}}, r"controller\.gain"),
+    ({"region": {"e_o_max": 1.0}}, r"region\.e_o_max"),
+    ({"region": {"heading": "sideways"}}, r"region\.heading"),
+    ({"region": {"e_d_max": 0.05}}, r"region\.e_d_max"),
+    ({"workspace": [[0.0, 0.0, 0.0], [-1.0, 1.0, 1.0]]}, r"workspace"),
+    ({"workspace": [[0.0, 0.0, 0.0]]}, r"workspace"),
+]
+
+
+@pytest.mark.parametrize("data, field", BAD, ids=[f for _, f in BAD])
+def test_each_bad_field_is_named(data, field):
+    with pytest.raises(ConfigError, match=field):
+        scenario_from_dict(data)
+
+
+@pytest.mark.parametrize("data, field", [({"initial_state": [1.0, 2.0, 3.0]}, "initial_state"),
+                                         ({"controller": {"R": [1.0, 1.0]}}, r"controller\.R")])
+def test_wrong_lengths_are_named(data, field):
+    with pytest.raises(TubekitError, match=field):
+        scenario_from_dict(data)
+
+
+
+def test_sway_errors_name_the_full_path():
+    with pytest.raises(ConfigError, match=r"disturbance\.sway\.bound"):
+        scenario_from_dict({"disturbance": {"sway": {"bound": -1.0}}})
+
+
+def test_obstacle_centre_length_names_the_index():
+    with pytest.raises(TubekitError, match=r"obstacles\[0\]\.center"):
+        scenario_from_dict({"obstacles": [{"center": [1.0, 2.0], "radius": 0.4}]})
+
+
+def test_boolean_is_not_a_number():
+    with pytest.raises(ConfigError, match="duration"):
+        scenario_from_dict({"duration": True})
+
+
+def test_file_errors_name_config(tmp_path):
+    with pytest.raises(ConfigError, match="CONFIG"):
+        load_scenario(tmp_path / "missing.toml")
+    bad = tmp_path / "bad.toml"
+    bad.write_text("duration = = 3\n")
+    with pytest.raises(ConfigError, match="CONFIG.*valid TOML"):
+        load_scenario(bad)

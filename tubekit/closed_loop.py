@@ -298,7 +298,7 @@ class SimulationResult:
                 f"wall={self.wall_s:.2f} s, checks={'ok' if all(ch.values()) else ch}")
 
 
-def _default_factory(mode: str) -> Callable[[Scenario, Tightening], Any]:
+def _default_factory(mode: str | None) -> Callable[[Scenario, Tightening], Any]:
     def build(scenario: Scenario, tightening: Tightening):
         from .fhocp import FHOCP  # imported lazily: the solver is optional for tests with fakes
         return FHOCP(scenario, tightening, mode=mode)
@@ -326,7 +326,7 @@ def _progress(total: int, enabled: bool, label: str):
 def simulate(scenario: Scenario, *, tightening: Tightening | None = None,
              law: str | AncillaryLaw | None = None, sigma: float | None = None, tube: bool = True,
              progress: bool = True, solver_factory: Callable[[Scenario, Tightening], Any] | None = None,
-             mode: str = "realtime", plant_substeps: int = 2, remember_obstacles: bool = True,
+             mode: str | None = None, plant_substeps: int = 2, remember_obstacles: bool = True,
              label: str | None = None,
              disturbance: Callable[[float], Any] | None = None) -> SimulationResult:
     """Run the closed loop on ``scenario`` for ``scenario.duration`` seconds.
@@ -349,8 +349,8 @@ def simulate(scenario: Scenario, *, tightening: Tightening | None = None,
     solver_factory : callable, optional
         ``factory(scenario, tightening)`` returning an object with
         ``solve(t, state, obstacles)``; default :class:`tubekit.fhocp.FHOCP`.
-    mode : str
-        FHOCP mode for the default factory.
+    mode : str, optional
+        FHOCP mode for the default factory; default ``scenario.controller.fhocp_mode``.
     plant_substeps : int
         RK4 steps per ancillary tick (plant step = 1 / (rate * substeps) s).
     remember_obstacles : bool

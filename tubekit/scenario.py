@@ -127,8 +127,11 @@ class ControllerSettings:
         Rate of the ancillary feedback kappa (Hz); a multiple of 1/dt.
     terminal_level : float
         epsilon-bar of the terminal set F = {||e||_P <= epsilon-bar}.
-    scp_iterations : int
-        Convex subproblems per FHOCP in converged mode (1 = real-time mode).
+    fhocp_mode : str
+        ``"realtime"`` (one convex solve per step, warm-started) or ``"converged"``
+        (sequential convex programming to convergence), see :mod:`tubekit.fhocp`.
+    terminal_mode : str
+        Terminal set F: ``"soft"`` (exact penalty), ``"hard"`` or ``"off"``.
     """
 
     dt: float = 0.1
@@ -140,7 +143,8 @@ class ControllerSettings:
     sigma: float | None = None
     ancillary_rate_hz: float = 100.0
     terminal_level: float = 2.0
-    scp_iterations: int = 1
+    fhocp_mode: str = "realtime"
+    terminal_mode: str = "soft"
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "dt", positive("controller.dt", self.dt))
@@ -163,8 +167,10 @@ class ControllerSettings:
             raise ConfigError("controller.ancillary_rate_hz", "a positive multiple of 1/dt",
                               self.ancillary_rate_hz)
         object.__setattr__(self, "terminal_level", positive("controller.terminal_level", self.terminal_level))
-        if not isinstance(self.scp_iterations, int) or self.scp_iterations < 1:
-            raise ConfigError("controller.scp_iterations", "an integer >= 1", self.scp_iterations)
+        if self.fhocp_mode not in ("realtime", "converged"):
+            raise ConfigError("controller.fhocp_mode", "one of ('realtime', 'converged')", self.fhocp_mode)
+        if self.terminal_mode not in ("soft", "hard", "off"):
+            raise ConfigError("controller.terminal_mode", "one of ('soft', 'hard', 'off')", self.terminal_mode)
 
     @property
     def horizon(self) -> float:

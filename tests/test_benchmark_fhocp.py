@@ -1,0 +1,31 @@
+"""The FHOCP benchmark runs in quick mode and writes every required key (timings not asserted)."""
+
+from __future__ import annotations
+
+import json
+import math
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+KEYS = ("rt_step_ms_median", "converged_ms_median", "ipopt_ms_median", "clarabel_ms_median",
+        "ratio_rt_vs_ipopt", "ratio_converged_vs_ipopt", "cost_gap_max", "n_states")
+
+
+def test_quick_benchmark_writes_all_keys(tmp_path):
+    pytest.importorskip("casadi")
+    out = tmp_path / "fhocp.json"
+    proc = subprocess.run([sys.executable, str(ROOT / "benchmarks" / "fhocp.py"), "--quick", "--json", str(out)],
+                          capture_output=True, text=True, timeout=120, cwd=tmp_path)
+    assert proc.returncode == 0, proc.stderr
+    assert "real-time SCP step" in proc.stdout
+    res = json.loads(out.read_text())
+    for key in KEYS:
+        assert key in res, key
+        assert isinstance(res[key], (int, float)) and math.isfinite(res[key]), (key, res[key])
+    assert res["n_states"] >= 100
+    assert res["clarabel_ms_median"] <= res["rt_step_ms_median"]
+    assert res["details"]["rt_fallbacks"] == 0

@@ -1,0 +1,290 @@
+"""Re-solving a DPP cvxpy problem without cvxpy's solve path: compiled map + persistent Clarabel.
+
+cvxpy compiles a DPP problem once into an affine map from the parameter vector
+to the solver's data (``ParamConeProg``). :class:`CompiledConeProgram` takes
+that map (``problem.get_problem_data(cp.CLARABEL)``, called once), keeps the
+parameter vector as one numpy array whose slices are writeable views per
+parameter, and on each solve
+
+1. multiplies the reduced parameter-to-data tensors by that vector (three
+   sparse mat-vecs; the sparsity pattern is structural, hence fixed),
+2. hands the new values of q, A, b (and P, if parametric) to a persistent
+   ``clarabel.DefaultSolver`` through ``solver.update`` (no re-allocation,
+   no new symbolic factorisation; presolve and chordal decomposition are
+   off because they forbid data updates),
+3. splits Clarabel's x into the problem's variables by their column offsets.
+
+No cvxpy reduction runs after construction. :meth:`CompiledConeProgram.verify`
+compares the data with cvxpy's own ``ParamConeProg.apply_parameters``.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass
+
+import clarabel
+import cvxpy as cp
+import numpy as np
+import scipy.sparse as sp
+from cvxpy.lin_ops.lin_op import CONSTANT_ID
+
+from .exceptions import SolverError
+
+__all__ = ["CompiledConeProgram", "ConeSolution", "clarabel_settings", "CLARABEL_STATUS"]
+
+#: Clarabel status string -> cvxpy-style status used by tubekit
+CLARABEL_STATUS: dict[str, str] = {
+    "Solved": "optimal",
+    "AlmostSolved": "optimal_inaccurate",
+    "PrimalInfeasible": "infeasible",
+    "AlmostPrimalInfeasible": "infeasible_inaccurate",
+    "DualInfeasible": "unbounded",
+    "AlmostDualInfeasible": "unbounded_inaccurate",
+    "MaxIterations": "user_limit",
+    "MaxTime": "user_limit",
+    "NumericalError": "solver_error",
+    "InsufficientProgress": "solver_error",
+    "Unsolved": "solver_error",
+}
+
+
+def clarabel_settings(overrides: dict | None = None) -> clarabel.DefaultSettings:
+    """Clarabel settings that allow data updates (presolve/chordal off), quiet, plus ``overrides``."""
+    st = clarabel.DefaultSettings()
+    st.verbose = False
+    st.presolve_enable = False
+    st.chordal_decomposition_enable = False
+    st.input_sparse_dropzeros = False
+    for key, value in (overrides or {}).items():
+        setattr(st, key, value)
+    return st
+
+
+@dataclass(frozen=True)
+class ConeSolution:
+    """One Clarabel solve mapped back to the problem's variables.
+
+    Attributes
+    ----------
+    status : str
+        Mapped status (:data:`CLARABEL_STATUS`), e.g. ``"optimal"``.
+    raw_status : str
+        Clarabel's own status string.
+    x : array or None
+        Clarabel's primal solution (None without a usable solution); see
+        :meth:`CompiledConeProgram.value` for one variable's value.
+    objective : float
+        Objective value including cvxpy's constant offset (nan without a solution).
+    solver_time_s : float
+        Wall time of Clarabel's ``solve()`` call alone (s): the floor of a re-solve.
+    iterations : int
+        Interior-point iterations.
+    """
+
+    status: str
+    raw_status: str
+    x: np.ndarray | None
+    objective: float
+    solver_time_s: float
+    iterations: int
+
+
+class CompiledConeProgram:
+    """A DPP ``cvxpy.Problem`` compiled once for Clarabel, re-solved by data updates.
+
+    Parameters
+    ----------
+    problem : cvxpy.Problem
+        Must satisfy ``problem.is_dcp(dpp=True)``.
+    settings : dict, optional
+        Clarabel setting overrides.
+    """
+
+    def __init__(self, problem: cp.Problem, settings: dict | None = None) -> None:
+        if not problem.is_dcp(dpp=True):
+            raise SolverError("the problem is not DPP; it cannot be compiled once")
+        t0 = time.perf_counter()
+        data, _chain, _inv = problem.get_problem_data(cp.CLARABEL)
+        pp = data[cp.settings.PARAM_PROB]
+        self._pp = pp
+        self._settings_overrides = dict(settings or {})
+        self.n = int(pp.x.size)
+        # the parameter vector (F-order values of each parameter at its column, then 1)
+        self.param_vector = np.zeros(pp.total_param_size + 1)
+        self.views: dict[int, np.ndarray] = {}
+        for pid, col in pp.param_id_to_col.items():
+            if pid == CONSTANT_ID:
+                self.param_vector[col] = 1.0
+                continue
+            size = pp.param_id_to_size[pid]
+            self.views[pid] = self.param_vector[col:col + size]
+        # A and b: reduced tensor, fixed CSC pattern of [A | b]
+        pp.reduced_A.cache(keep_zeros=True)
+        if pp.reduced_A.problem_data_index is None:
+            raise SolverError("cvxpy returned no reduced constraint tensor")
+        indices, indptr, shape = pp.reduced_A.problem_data_index
+        self.m = int(shape[0])
+        nnz_a = int(indptr[self.n])
+        a_map = sp.csr_matrix(pp.reduced_A.reduced_mat)
+        self._nnz_a = nnz_a
+        self._A_indices = np.asarray(indices[:nnz_a], dtype=np.int64)
+        self._A_indptr = np.asarray(indptr[:self.n + 1], dtype=np.int64)
+        self._b_rows = np.asarray(indices[nnz_a:], dtype=np.int64)
+        self._b_map = a_map[nnz_a:]
+        # entries of A that depend on a parameter; the others are constant
+        top = a_map[:nnz_a]
+        self._a_par = np.flatnonzero(top[:, :-1].getnnz(axis=1)).astype(np.int64)
+        self._a_par_map = top[self._a_par]
+        self._a_data = -np.asarray(top[:, -1].toarray()).ravel()
+        # q (with the offset d as its last entry)
+        self._q_map = sp.csr_matrix(pp.q)
+        # P: reduced tensor restricted to the upper triangle
+        self._P_map = None
+        self._P_const = None
+        self._P_indices = np.zeros(0, dtype=np.int64)
+        self._P_indptr = np.zeros(self.n + 1, dtype=np.int64)
+        if pp.P is not None:
+            pp.reduced_P.cache(keep_zeros=True)
+            p_idx, p_ptr, _ = pp.reduced_P.problem_data_index
+            cols = np.repeat(np.arange(self.n), np.diff(p_ptr))
+            keep = np.asarray(p_idx) <= cols
+            red = sp.csr_matrix(pp.reduced_P.reduced_mat)[np.flatnonzero(keep)]
+            counts = np.bincount(cols[keep], minlength=self.n)
+            self._P_indices = np.asarray(p_idx)[keep].astype(np.int64)
+            self._P_indptr = np.concatenate([[0], np.cumsum(counts)]).astype(np.int64)
+            if red[:, :-1].nnz == 0:  # no parameter enters P
+                self._P_const = np.asarray(red[:, -1].toarray()).ravel()
+            else:
+                self._P_map = red
+        dims = data[cp.reductions.solvers.conic_solvers.conic_solver.ConicSolver.DIMS]
+        self.cones = []
+        if dims.zero:
+            self.cones.append(clarabel.ZeroConeT(dims.zero))
+        if dims.nonneg:
+            self.cones.append(clarabel.NonnegativeConeT(dims.nonneg))
+        for d in dims.soc:
+            self.cones.append(clarabel.SecondOrderConeT(d))
+        if dims.exp or dims.psd or dims.p3d or getattr(dims, "pnd", []):
+            raise SolverError("only zero, nonnegative and second-order cones are supported")
+        self.var_id_to_col = dict(pp.var_id_to_col)
+        self._solver: clarabel.DefaultSolver | None = None
+        self.compile_time_s = time.perf_counter() - t0
+        self.rebuilds = 0
+        self.updates = 0
+
+    # ------------------------------------------------------------------ data
+    def load_parameter_values(self, problem: cp.Problem) -> None:
+        """Copy the current ``.value`` of every parameter of ``problem`` into the vector."""
+        for p in problem.parameters():
+            if p.id in self.views:
+                if p.value is None:
+                    raise SolverError(f"parameter {p.name()} has no value")
+                self.views[p.id][:] = np.asarray(p.value, dtype=float).ravel(order="F")
+
+    def columns(self, parameter: cp.Parameter) -> np.ndarray:
+        """Indices of ``parameter``'s entries (F order) in :attr:`param_vector`."""
+        col = self._pp.param_id_to_col.get(parameter.id)
+        if col is None:
+            raise SolverError(f"parameter {parameter.name()} is not part of the compiled problem")
+        return np.arange(col, col + parameter.size)
+
+    def _vectors(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, float]:
+        """(parametric A values, b, q, d) for the current parameter vector (sparse mat-vecs).
+
+        Also refreshes the parametric entries of the full A value array.
+        """
+        pv = self.param_vector
+        a_par = -(self._a_par_map @ pv)
+        self._a_data[self._a_par] = a_par
+        b = np.zeros(self.m)
+        b[self._b_rows] = self._b_map @ pv
+        qd = self._q_map @ pv
+        return a_par, b, np.ascontiguousarray(qd[:self.n]), float(qd[self.n])
+
+    def data(self) -> tuple[sp.csc_matrix, np.ndarray, sp.csc_matrix, np.ndarray, float]:
+        """(P upper triangle, q, A, b, d) for the current parameter vector; Clarabel's Ax + s = b."""
+        _, b, q, d = self._vectors()
+        p_data = self._p_data()
+        A = sp.csc_matrix((self._a_data.copy(), self._A_indices, self._A_indptr), shape=(self.m, self.n))
+        P = sp.csc_matrix((p_data, self._P_indices, self._P_indptr), shape=(self.n, self.n)) \
+            if p_data is not None else sp.csc_matrix((self.n, self.n))
+        return P, q, A, b, d
+
+    def _p_data(self) -> np.ndarray | None:
+        if self._P_const is not None:
+            return self._P_const
+        if self._P_map is not None:
+            return self._P_map @ self.param_vector
+        return None
+
+    def verify(self, atol: float = 1e-12) -> float:
+        """Largest difference between this data and cvxpy's ``apply_parameters`` (same values)."""
+        id_to_value = {pid: view.copy() for pid, view in self.views.items()}
+        out = self._pp.apply_parameters(id_to_value, keep_zeros=True, quad_obj=self._pp.P is not None)
+        if self._pp.P is not None:
+            P_ref, q_ref, d_ref, A_ref, b_ref = out
+            P_ref = sp.triu(P_ref).tocsc()
+        else:
+            q_ref, d_ref, A_ref, b_ref = out
+            P_ref = sp.csc_matrix((self.n, self.n))
+        P, q, A, b, d = self.data()
+        errs = [abs(d - d_ref), np.max(np.abs(q - q_ref), initial=0.0),
+                np.max(np.abs(b - b_ref), initial=0.0),
+                abs(A + A_ref).max() if A.nnz or A_ref.nnz else 0.0,
+                abs(P - P_ref).max() if P.nnz or P_ref.nnz else 0.0]
+        return float(max(errs))
+
+    # ----------------------------------------------------------------- solve
+    def solve(self) -> ConeSolution:
+        """Update (or, the first time, build) the Clarabel solver and solve."""
+        a_par, b, q, d = self._vectors()
+        if self._solver is None:
+            self._build(b, q)
+        else:
+            kw = {"q": q, "A": (self._a_par, a_par), "b": b}
+            if self._P_map is not None:
+                kw["P"] = self._P_map @ self.param_vector
+            try:
+                self._solver.update(**kw)
+                self.updates += 1
+            except Exception:  # pattern/dimension mismatch: rebuild (should not happen)
+                self._build(b, q)
+        t0 = time.perf_counter()
+        sol = self._solver.solve()
+        wall = time.perf_counter() - t0
+        raw = str(sol.status)
+        status = CLARABEL_STATUS.get(raw, "solver_error")
+        x: np.ndarray | None = None
+        objective = math.nan
+        if status in ("optimal", "optimal_inaccurate"):
+            x = np.asarray(sol.x, dtype=float)
+            objective = float(sol.obj_val) + d
+            if x.size != self.n or not (np.isfinite(x).all() and math.isfinite(objective)):
+                x, objective, status = None, math.nan, "solver_error"
+        return ConeSolution(status=status, raw_status=raw, x=x, objective=objective,
+                            solver_time_s=wall, iterations=int(sol.iterations))
+
+    def columns_of(self, variable: cp.Variable) -> np.ndarray:
+        """Indices of ``variable``'s entries (F order) in Clarabel's x."""
+        col = self.var_id_to_col[variable.id]
+        return np.arange(col, col + variable.size)
+
+    def value(self, solution: ConeSolution, variable: cp.Variable) -> np.ndarray | None:
+        """``variable``'s value in ``solution`` (shaped like the variable), or None."""
+        if solution.x is None:
+            return None
+        return solution.x[self.columns_of(variable)].reshape(variable.shape, order="F")
+
+    def _build(self, b: np.ndarray, q: np.ndarray) -> None:
+        A = sp.csc_matrix((self._a_data.copy(), self._A_indices, self._A_indptr), shape=(self.m, self.n))
+        p_data = self._p_data()
+        P = sp.csc_matrix((p_data, self._P_indices, self._P_indptr), shape=(self.n, self.n)) \
+            if p_data is not None else sp.csc_matrix((self.n, self.n))
+        self._solver = clarabel.DefaultSolver(P, q, A, b, self.cones, clarabel_settings(self._settings_overrides))
+        self.rebuilds += 1
+
+    def reset_solver(self) -> None:
+        """Drop the persistent Clarabel solver (the next solve rebuilds it)."""
+        self._solver = None

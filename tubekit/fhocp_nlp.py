@@ -1,0 +1,501 @@
+"""The discretised FHOCP of Section V as a nonlinear program (NLP).
+
+This module is the single definition of the NLP that both the sequential
+convex programming solver (:mod:`tubekit.fhocp`) and its CasADi + IPOPT peer
+(:mod:`tubekit.fhocp_ipopt`) solve; both evaluate their answers with
+:meth:`FhocpNlp.evaluate`.
+
+Discretisation
+--------------
+The nominal state is kept in absolute coordinates ``s = [x, y, z, psi]``
+(the error e alone does not determine the bearing). Inputs are piecewise
+constant over ``dt`` (zero-order hold) and each step is the *exact* flow of
+the unicycle kinematics for a constant input::
+
+    a = r dt / 2,   S(a) = sin(a) / a
+    x+ = x + u dt S(a) cos(psi + a),   y+ = y + u dt S(a) sin(psi + a)
+    z+ = z + w dt,                     psi+ = psi + r dt
+
+so the local (one-step) error with respect to the continuous-time nominal
+dynamics (eq. diff_mpc) under a zero-order-hold input is zero (round-off
+only). The cost integral is a left rectangle rule, whose local error is
+O(dt^2) per step (global O(dt)); state constraints are imposed at the N
+samples k = 1..N (the inter-sample excursion ||p - p_hat|| is what
+``Tightening.obstacle_margin`` covers).
+
+NLP (k = 0..N-1 stages, e_k = error_coordinates(s_k, p_d(t + k dt)))::
+
+    min  sum_k dt (Q1 e_d,k^2 + Q2 e_z,k^2 + Q3 e_o,k^2 + v_k' R v_k)
+         + P1 e_d,N^2 + P2 e_z,N^2 + P3 e_o,N^2
+         + mu sum_{k=1..N} (sig_ed,k + sig_obs,k + sig_eo,k + sig_box,k)
+         + mu_T sig_T                                  (terminal "soft")
+    s.t. s_0 = measured state,  s_{k+1} = F(s_k, v_k),  |v_k| <= v_max,
+         e_d,k >= e_d_min - sig_ed,k,
+         ||p_k - c_j|| >= r_j + r_bar + margin - sig_obs,k     (each obstacle j),
+         |e_o,k| <= e_o_max + sig_eo,k,
+         e_d,k <= e_d_max + sig_box,k,  |e_z,k| <= e_z_max + sig_box,k,
+         lo + r_bar + margin - sig_box,k <= p_k <= hi - r_bar - margin + sig_box,k,
+         ||e_N||_P <= terminal_level + sig_T,   all sig >= 0.
+
+Q, R, P are diagonal (the scenario's 3-vectors). The slacks are exact
+(l1) penalties: whenever the hard-constrained problem is feasible and
+``mu`` exceeds its multipliers the two have the same minimisers; the
+violations are reported, never hidden. "hard" terminal mode fixes
+``sig_T = 0``; "off" drops the terminal set (terminal *cost* stays).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import Sequence
+
+import numpy as np
+
+from .exceptions import ConfigError, ShapeError
+from .scenario import Obstacle, Scenario
+from .tightening import Tightening
+from .validation import as_vector, positive
+
+__all__ = [
+    "TERMINAL_MODES",
+    "SINC_SERIES_THRESHOLD",
+    "sinc",
+    "dsinc",
+    "discrete_step",
+    "rollout",
+    "step_linearisation",
+    "STEP_LINEARISATION_ROWS",
+    "eo_linearisation",
+    "obstacle_array",
+    "select_obstacles",
+    "FhocpNlp",
+    "NlpEvaluation",
+]
+
+TERMINAL_MODES: tuple[str, ...] = ("soft", "hard", "off")
+#: below this |a| = |r| dt / 2 the derivative of sin(a)/a uses its Taylor series (error < 1e-19)
+SINC_SERIES_THRESHOLD = 0.1
+_ED_FLOOR = 1e-9  # guards e_o = (...)/e_d against e_d = 0 (m)
+
+
+def _dsinc_series(a: np.ndarray, a2: np.ndarray) -> np.ndarray:
+    """d/da sin(a)/a by its Taylor series to a^9 (error < 1e-19 for |a| < 0.1)."""
+    return a * (-1.0 / 3.0 + a2 * (1.0 / 30.0 + a2 * (-1.0 / 840.0 + a2 * (1.0 / 45360.0
+                + a2 * (-1.0 / 3991680.0)))))
+
+
+def sinc(a: np.ndarray) -> np.ndarray:
+    """S(a) = sin(a)/a with S(0) = 1 (unnormalised sinc), vectorised.
+
+    sin(a)/a has no cancellation, so the quotient is accurate to round-off for every a != 0.
+    """
+    a = np.asarray(a, dtype=float)
+    safe = np.where(a == 0.0, 1e-300, a)  # sin(1e-300)/1e-300 == 1.0
+    return np.sin(safe) / safe
+
+
+def dsinc(a: np.ndarray) -> np.ndarray:
+    """S'(a) = (a cos a - sin a)/a^2 with S'(0) = 0, vectorised.
+
+    The quotient cancels for small a, so |a| < :data:`SINC_SERIES_THRESHOLD` uses the
+    Taylor series (error < 1e-19 there).
+    """
+    a = np.asarray(a, dtype=float)
+    a2 = a * a
+    series = _dsinc_series(a, a2)
+    if a.size == 0 or a2.max() < SINC_SERIES_THRESHOLD ** 2:
+        return series
+    small = a2 < SINC_SERIES_THRESHOLD ** 2
+    safe = np.where(small, 1.0, a)
+    return np.where(small, series, (safe * np.cos(safe) - np.sin(safe)) / (safe * safe))
+
+
+def discrete_step(s: np.ndarray, v: np.ndarray, dt: float) -> np.ndarray:
+    """Exact zero-order-hold step F(s, v) of the nominal kinematics; vectorised.
+
+    Parameters
+    ----------
+    s : array (..., 4)
+        State [x, y, z, psi] (m, m, m, rad).
+    v : array (..., 3)
+        Input [u, w, r] (m/s, m/s, rad/s), held for ``dt``.
+    dt : float
+        Step (s).
+
+    Returns
+    -------
+    array (..., 4)
+        The state after ``dt``; exact for constant input.
+    """
+    s = np.asarray(s, dtype=float)
+    v = np.asarray(v, dtype=float)
+    if s.ndim != 2 or v.ndim != 2 or s.shape[0] != v.shape[0]:
+        s, v = np.broadcast_arrays(s, v[..., [0, 0, 1, 2]])
+        v = v[..., [0, 2, 3]]
+        lead = s.shape[:-1]
+        return discrete_step(s.reshape(-1, 4), v.reshape(-1, 3), dt).reshape(lead + (4,))
+    u, w, r = v.T
+    a = (0.5 * dt) * r
+    th = s[:, 3] + a
+    k = (dt * u) * sinc(a)
+    out = np.empty_like(s)
+    out[:, 0] = s[:, 0] + k * np.cos(th)
+    out[:, 1] = s[:, 1] + k * np.sin(th)
+    out[:, 2] = s[:, 2] + dt * w
+    out[:, 3] = s[:, 3] + dt * r
+    return out
+
+
+def rollout(s0: np.ndarray, inputs: np.ndarray, dt: float) -> np.ndarray:
+    """States (N+1, 4) obtained by applying ``inputs`` (N, 3) from ``s0`` (4,) with :func:`discrete_step`.
+
+    Vectorised: psi and z are cumulative sums, then so are the x, y increments.
+    """
+    inputs = np.asarray(inputs, dtype=float)
+    n = inputs.shape[0]
+    out = np.empty((n + 1, 4))
+    out[0] = s0
+    a = (0.5 * dt) * inputs[:, 2]
+    out[1:, 3] = dt * inputs[:, 2]
+    out[1:, 2] = dt * inputs[:, 1]
+    out[:, 2:].cumsum(axis=0, out=out[:, 2:])
+    th = out[:-1, 3] + a
+    k = (dt * inputs[:, 0]) * sinc(a)
+    out[1:, 0] = k * np.cos(th)
+    out[1:, 1] = k * np.sin(th)
+    out[:, :2].cumsum(axis=0, out=out[:, :2])
+    return out
+
+
+#: row order of :func:`step_linearisation`
+STEP_LINEARISATION_ROWS: tuple[str, ...] = ("ax", "bxu", "bxr", "cx", "ay", "byu", "byr", "cy")
+
+
+def step_linearisation(states: np.ndarray, inputs: np.ndarray, dt: float) -> np.ndarray:
+    """Jacobian entries of F at a plan; the only non-constant ones are in the x and y rows.
+
+    The linearised step is::
+
+        x_{k+1} = x_k + ax psi_k + bxu u_k + bxr r_k + cx
+        y_{k+1} = y_k + ay psi_k + byu u_k + byr r_k + cy
+        z_{k+1} = z_k + dt w_k,   psi_{k+1} = psi_k + dt r_k
+
+    exact (value and first derivatives) at the plan.
+
+    Parameters
+    ----------
+    states : array (N+1, 4) or (N, 4)
+        Linearisation states (only the first N are used).
+    inputs : array (N, 3)
+        Linearisation inputs.
+    dt : float
+        Step (s).
+
+    Returns
+    -------
+    array (8, N)
+        Rows ``ax, bxu, bxr, cx, ay, byu, byr, cy`` (:data:`STEP_LINEARISATION_ROWS`).
+    """
+    n = inputs.shape[0]
+    psi = states[:n, 3]
+    u = inputs[:, 0]
+    r = inputs[:, 2]
+    a = 0.5 * dt * r
+    sa = sinc(a)
+    dsa = dsinc(a)
+    th = psi + a
+    c, s = np.cos(th), np.sin(th)
+    out = np.empty((8, n))
+    out[1] = dt * sa * c            # bxu
+    out[5] = dt * sa * s            # byu
+    dx = u * out[1]
+    dy = u * out[5]
+    out[0] = -dy                    # ax
+    out[4] = dx                     # ay
+    half = 0.5 * dt * dt * u
+    out[2] = half * (dsa * c - sa * s)   # bxr
+    out[6] = half * (dsa * s + sa * c)   # byr
+    out[3] = dy * psi - out[2] * r    # cx = dx - ax psi - bxu u - bxr r  (bxu u = dx)
+    out[7] = -dx * psi - out[6] * r   # cy = dy - ay psi - byu u - byr r  (byu u = dy)
+    return out
+
+
+def eo_linearisation(states: np.ndarray, ref: np.ndarray) -> np.ndarray:
+    """First-order model e_o ~ gx x + gy y + gpsi psi + h at ``states`` (K, 4), ``ref`` (K, 3).
+
+    With c = e_x cos psi + e_y sin psi: de_o/dx = e_y c / e_d^3,
+    de_o/dy = -e_x c / e_d^3, de_o/dpsi = c / e_d.
+
+    Returns
+    -------
+    array (5, K)
+        Rows ``gx, gy, gpsi, h, e_o``.
+    """
+    ex = states[:, 0] - ref[:, 0]
+    ey = states[:, 1] - ref[:, 1]
+    psi = states[:, 3]
+    ed = np.maximum(np.sqrt(ex * ex + ey * ey), _ED_FLOOR)
+    cp_, sp_ = np.cos(psi), np.sin(psi)
+    out = np.empty((5, states.shape[0]))
+    c = ex * cp_ + ey * sp_
+    out[4] = (ex * sp_ - ey * cp_) / ed
+    cd = c / (ed * ed * ed)
+    out[0] = ey * cd
+    out[1] = -ex * cd
+    out[2] = c / ed
+    out[3] = out[4] - out[0] * states[:, 0] - out[1] * states[:, 1] - out[2] * psi
+    return out
+
+
+def obstacle_array(obstacles: Sequence[Obstacle] | np.ndarray) -> np.ndarray:
+    """Obstacles as an (M, 4) array of [cx, cy, cz, radius] (m)."""
+    if isinstance(obstacles, np.ndarray):
+        arr = np.asarray(obstacles, dtype=float)
+        if arr.ndim != 2 or arr.shape[1] != 4:
+            raise ShapeError("obstacles", "(M, 4)", arr.shape)
+        return arr
+    rows = []
+    for i, o in enumerate(obstacles):
+        if not isinstance(o, Obstacle):
+            raise ConfigError(f"obstacles[{i}]", "a tubekit.Obstacle", type(o).__name__)
+        rows.append((*o.center, o.radius))
+    return np.array(rows, dtype=float).reshape(-1, 4)
+
+
+def select_obstacles(state: np.ndarray, obstacles: Sequence[Obstacle] | np.ndarray, sensing_range: float,
+                     max_count: int) -> tuple[np.ndarray, int]:
+    """The obstacles the FHOCP sees from ``state``: surface within ``sensing_range``, nearest first.
+
+    Parameters
+    ----------
+    state : array (4,)
+        Vehicle state; only its position is used (m).
+    obstacles : sequence of Obstacle or array (M, 4)
+        Candidates (the caller normally filters by range already).
+    sensing_range : float
+        R-bar (m): an obstacle is kept when ||p - c|| - radius <= R-bar.
+    max_count : int
+        Number of obstacle slots; the nearest ``max_count`` are kept.
+
+    Returns
+    -------
+    (array (K, 4), int)
+        The kept obstacles as [cx, cy, cz, radius] and how many in-range ones were dropped.
+    """
+    arr = obstacle_array(obstacles)
+    if arr.size == 0:
+        return arr.reshape(0, 4), 0
+    gap = np.linalg.norm(arr[:, :3] - np.asarray(state, dtype=float)[:3], axis=1) - arr[:, 3]
+    inside = np.flatnonzero(gap <= sensing_range)
+    order = inside[np.argsort(gap[inside], kind="stable")]
+    return arr[order[:max_count]], max(0, order.size - max_count)
+
+
+@dataclass(frozen=True)
+class NlpEvaluation:
+    """The NLP's functions evaluated on one plan (units of the respective constraints).
+
+    Attributes
+    ----------
+    cost : float
+        Stage + terminal quadratic cost (no penalties).
+    merit : float
+        ``cost`` + the exact penalties = the NLP objective at its optimal slacks.
+    violations : dict
+        Largest violation per constraint family over k = 1..N: ``e_d_min``,
+        ``obstacle``, ``e_o``, ``box`` (e_d_max, |e_z|, workspace),
+        ``terminal`` (0 if off), ``input``, ``dynamics``.
+    per_step : dict
+        Per-step (N,) violations of the four slackened families.
+    max_violation : float
+        max over ``violations``.
+    """
+
+    cost: float
+    merit: float
+    violations: dict[str, float]
+    per_step: dict[str, np.ndarray] = field(repr=False)
+    max_violation: float
+
+
+@dataclass(frozen=True)
+class FhocpNlp:
+    """The discretised FHOCP (see the module docstring) with all its constants.
+
+    Attributes
+    ----------
+    dt : float
+        Sampling period delta_t (s).
+    horizon_steps : int
+        N.
+    q, r, p : array (3,)
+        Diagonals of Q (on [e_d, e_z, e_o]), R (on [u, w, r]) and P.
+    v_max : array (3,)
+        Nominal input box V-bar.
+    e_d_min, e_d_max, e_z_max, e_o_max : float
+        Tightened state bounds.
+    clearance : float
+        Vehicle radius + obstacle margin (m): added to each obstacle radius and
+        kept from the workspace walls.
+    workspace : array (2, 3) or None
+        [lower, upper] corners (m).
+    terminal : str
+        One of :data:`TERMINAL_MODES`.
+    terminal_level : float
+        epsilon-bar of F = {||e||_P <= epsilon-bar}.
+    penalty, terminal_penalty : float
+        Exact-penalty weights mu (state-constraint slacks: obstacles, e_d, e_o, e_z,
+        workspace) and mu_T (soft terminal set). Default mu_T = mu / 20: the safety
+        slacks outrank the terminal set, so an unreachable F never pulls the plan into
+        an obstacle (with mu_T = mu the paper's default run grazed an obstacle by 14 mm).
+    """
+
+    dt: float
+    horizon_steps: int
+    q: np.ndarray
+    r: np.ndarray
+    p: np.ndarray
+    v_max: np.ndarray
+    e_d_min: float
+    e_d_max: float
+    e_z_max: float
+    e_o_max: float
+    clearance: float
+    workspace: np.ndarray | None
+    terminal: str = "soft"
+    terminal_level: float = 2.0
+    penalty: float = 1e3
+    terminal_penalty: float = 50.0
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "dt", positive("dt", self.dt))
+        if not isinstance(self.horizon_steps, int) or self.horizon_steps < 1:
+            raise ConfigError("horizon_steps", "an integer >= 1", self.horizon_steps)
+        for name in ("q", "r", "p", "v_max"):
+            vec = as_vector(name, getattr(self, name), 3)
+            if np.any(vec <= 0):
+                raise ConfigError(name, "three numbers > 0", getattr(self, name))
+            object.__setattr__(self, name, vec)
+        for name in ("e_d_min", "e_d_max", "e_z_max", "e_o_max", "terminal_level", "penalty",
+                     "terminal_penalty"):
+            object.__setattr__(self, name, positive(name, getattr(self, name)))
+        if self.e_d_max <= self.e_d_min:
+            raise ConfigError("e_d_max", f"a number > e_d_min = {self.e_d_min}", self.e_d_max)
+        if self.clearance < 0 or not math.isfinite(self.clearance):
+            raise ConfigError("clearance", "a finite number >= 0", self.clearance)
+        if self.terminal not in TERMINAL_MODES:
+            raise ConfigError("terminal", f"one of {TERMINAL_MODES}", self.terminal)
+        if self.workspace is not None:
+            ws = np.asarray(self.workspace, dtype=float)
+            if ws.shape != (2, 3):
+                raise ShapeError("workspace", "(2, 3)", ws.shape)
+            object.__setattr__(self, "workspace", ws)
+        # per-sample weights of e_d^2, e_z^2, e_o^2: dt*Q for k < N, P for k = N, shape (3, N+1)
+        w = np.empty((3, self.horizon_steps + 1))
+        w[:, :-1] = (self.dt * self.q)[:, None]
+        w[:, -1] = self.p
+        object.__setattr__(self, "_w", w)
+        object.__setattr__(self, "_dt_r", self.dt * self.r)
+
+    @classmethod
+    def from_scenario(cls, scenario: Scenario, tightening: Tightening, *, terminal: str = "soft",
+                      penalty: float = 1e3, terminal_penalty: float | None = None) -> "FhocpNlp":
+        """The NLP of ``scenario`` (weights, horizon, workspace) with the sets of ``tightening``."""
+        if not isinstance(scenario, Scenario):
+            raise ConfigError("scenario", "a tubekit.Scenario", type(scenario).__name__)
+        if not isinstance(tightening, Tightening):
+            raise ConfigError("tightening", "a tubekit.Tightening", type(tightening).__name__)
+        c = scenario.controller
+        ws = None if scenario.workspace is None else np.array(scenario.workspace, dtype=float)
+        margin = float(tightening.obstacle_margin)
+        if not math.isfinite(margin) or margin < 0:
+            raise ConfigError("tightening.obstacle_margin", "a finite number >= 0", margin)
+        return cls(dt=c.dt, horizon_steps=c.horizon_steps, q=np.array(c.Q), r=np.array(c.R),
+                   p=np.array(c.P), v_max=np.asarray(tightening.v_max, dtype=float),
+                   e_d_min=tightening.e_d_min, e_d_max=tightening.e_d_max, e_z_max=tightening.e_z_max,
+                   e_o_max=tightening.e_o_max, clearance=scenario.vehicle_radius + margin,
+                   workspace=ws, terminal=terminal, terminal_level=c.terminal_level,
+                   penalty=penalty,
+                   terminal_penalty=penalty / 20.0 if terminal_penalty is None else terminal_penalty)
+
+    @property
+    def n(self) -> int:
+        """Horizon steps N."""
+        return self.horizon_steps
+
+    def reference(self, trajectory, t: float) -> np.ndarray:
+        """p_d(t + k dt), k = 0..N, shape (N+1, 3) (m)."""
+        return np.asarray(trajectory.position(t + self.dt * np.arange(self.n + 1)), dtype=float)
+
+    def errors(self, states: np.ndarray, ref: np.ndarray) -> np.ndarray:
+        """[e_d, e_z, e_o] (K, 3) of ``states`` (K, 4) w.r.t. ``ref`` (K, 3), e_d floored at 1e-9."""
+        ex = states[:, 0] - ref[:, 0]
+        ey = states[:, 1] - ref[:, 1]
+        ed = np.maximum(np.hypot(ex, ey), _ED_FLOOR)
+        psi = states[:, 3]
+        eo = (ex * np.sin(psi) - ey * np.cos(psi)) / ed
+        return np.stack([ed, states[:, 2] - ref[:, 2], eo], axis=-1)
+
+    def cost(self, states: np.ndarray, inputs: np.ndarray, ref: np.ndarray) -> float:
+        """Stage + terminal cost (no penalties)."""
+        e = self.errors(states, ref)
+        return float(np.einsum("kc,kc,ck->", e, e, self._w) + np.einsum("kc,kc,c->", inputs, inputs, self._dt_r))
+
+    def evaluate(self, states: np.ndarray, inputs: np.ndarray, ref: np.ndarray,
+                 obstacles: np.ndarray) -> NlpEvaluation:
+        """Cost, merit and nonlinear-constraint violations of a plan.
+
+        Parameters
+        ----------
+        states : array (N+1, 4)
+        inputs : array (N, 3)
+        ref : array (N+1, 3)
+            p_d at the samples.
+        obstacles : array (M, 4)
+            [cx, cy, cz, radius] of the obstacles in the problem.
+        """
+        states = np.asarray(states, dtype=float)
+        inputs = np.asarray(inputs, dtype=float)
+        n = self.n
+        d = states[:, :3] - ref
+        e = np.empty((n + 1, 3))
+        ed2 = d[:, 0] * d[:, 0] + d[:, 1] * d[:, 1]
+        np.sqrt(np.maximum(ed2, _ED_FLOOR * _ED_FLOOR), out=e[:, 0])
+        e[:, 1] = d[:, 2]
+        psi = states[:, 3]
+        e[:, 2] = (d[:, 0] * np.sin(psi) - d[:, 1] * np.cos(psi)) / e[:, 0]
+        e2 = e * e
+        cost = float(np.einsum("kc,ck->", e2, self._w) + np.einsum("kc,kc,c->", inputs, inputs, self._dt_r))
+        # per-step violations, rows: e_d_min, obstacle, e_o, box (k = 1..N)
+        viol = np.zeros((4, n))
+        e1 = e[1:]
+        np.maximum(self.e_d_min - e1[:, 0], 0.0, out=viol[0])
+        if len(obstacles):
+            diff = states[1:, None, :3] - obstacles[None, :, :3]
+            dist = np.sqrt(np.einsum("kjc,kjc->kj", diff, diff))
+            np.maximum((obstacles[:, 3] + self.clearance - dist).max(axis=1), 0.0, out=viol[1])
+        np.maximum(np.abs(e1[:, 2]) - self.e_o_max, 0.0, out=viol[2])
+        box = np.maximum(e1[:, 0] - self.e_d_max, np.abs(e1[:, 1]) - self.e_z_max)
+        if self.workspace is not None:
+            p1 = states[1:, :3]
+            wall = np.maximum(self.workspace[0] + self.clearance - p1, p1 - self.workspace[1] + self.clearance)
+            box = np.maximum(box, wall.max(axis=1))
+        np.maximum(box, 0.0, out=viol[3])
+        term = 0.0
+        if self.terminal != "off":
+            term = max(0.0, math.sqrt(float(e2[n] @ self.p)) - self.terminal_level)
+        inp = max(0.0, float((np.abs(inputs) - self.v_max).max()))
+        dyn = float(np.abs(states[1:] - discrete_step(states[:-1], inputs, self.dt)).max())
+        vmax = viol.max(axis=1)
+        merit = cost + self.penalty * float(viol.sum())
+        if self.terminal == "soft":
+            merit += self.terminal_penalty * term
+        violations = {"e_d_min": float(vmax[0]), "obstacle": float(vmax[1]), "e_o": float(vmax[2]),
+                      "box": float(vmax[3]), "terminal": term, "input": inp, "dynamics": dyn}
+        mv = max(float(vmax.max()), term, inp, dyn)
+        if not (math.isfinite(cost) and math.isfinite(mv) and math.isfinite(merit)):
+            cost, merit, mv = math.inf, math.inf, math.inf
+        per_step = {"e_d_min": viol[0], "obstacle": viol[1], "e_o": viol[2], "box": viol[3]}
+        return NlpEvaluation(cost=cost, merit=merit, violations=violations, per_step=per_step,
+                             max_violation=mv)

@@ -293,19 +293,34 @@ def test_forced_infeasible_subproblem_returns_shifted_previous_plan():
     assert "infeasible" in res.message
     assert np.all(np.isfinite(res.inputs)) and np.all(np.isfinite(res.states))
     assert np.array_equal(res.inputs[:-1], ok.inputs[1:])
-    assert np.array_equal(res.inputs[-1], ok.inputs[-1])
     assert np.allclose(res.states[0], far)
     assert res.max_violation > 0.1                       # reported, not hidden
+    # the appended input is searched over V-bar: never worse than repeating the last input
+    repeat = np.vstack([ok.inputs[1:], ok.inputs[-1:]])
+    assert np.all(np.abs(res.inputs) <= solver.nlp.v_max + 1e-12)
+    assert _state_violation(solver, far, res.inputs, t + SC.controller.dt) <= \
+        _state_violation(solver, far, repeat, t + SC.controller.dt) + 1e-12
 
 
-def test_fallback_without_previous_plan_is_zero_input():
+def _state_violation(solver, s0, inputs, t):
+    """Largest non-terminal violation of a plan, via the NLP's own evaluation of a rollout."""
+    from tubekit.fhocp_nlp import rollout
+    nlp = solver.nlp
+    ev = nlp.evaluate(rollout(s0, inputs, nlp.dt), inputs, nlp.reference(SC.trajectory, t),
+                      solver.select_obstacles(s0, OBSTACLES))
+    return max(v for k, v in ev.violations.items() if k != "terminal")
+
+
+def test_fallback_without_previous_plan_is_searched_from_rest():
     solver = _hard_terminal_solver()
     t, s = STATES[1]
     far = np.array(s) + np.array([2.0, 2.0, 0.0, 0.0])
     with pytest.warns(FallbackWarning):
         res = solver.solve(t, far, OBSTACLES)
-    assert res.fallback and not res.inputs.any()
-    assert np.allclose(res.states, far)
+    assert res.fallback and np.all(np.isfinite(res.inputs))
+    assert np.all(np.abs(res.inputs) <= solver.nlp.v_max + 1e-12)
+    assert np.allclose(res.states[0], far)
+    assert _state_violation(solver, far, res.inputs, t) <= _state_violation(solver, far, np.zeros_like(res.inputs), t)
 
 
 def test_nan_from_the_solver_never_reaches_the_plant(monkeypatch):

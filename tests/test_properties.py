@@ -154,3 +154,72 @@ def test_closed_loop_containment(certified):
         assert int(run.saturated.sum()) == 0
 
     prop()
+
+
+# ---------------------------------------------------------------- d. the FHOCP
+@pytest.fixture(scope="module")
+def fhocp_solver(certified):
+    from tubekit.fhocp import FHOCP
+
+    scenario, cert = certified
+    return FHOCP(scenario, cert.tightening(), mode="converged")
+
+
+def test_fhocp_plans_and_shifted_candidate(certified, fhocp_solver):
+    """Property: from states in E-bar at any time, the FHOCP's plan satisfies the tightened constraints
+    (V-bar, e_d >= epsilon + rho_tilde, inflated obstacles, |e_o|, |e_z|, e_d_max, dynamics) within 1e-6,
+    and the shifted plan (tube MPC's candidate) is feasible at the next step w.r.t. the same constraints.
+    Checked by an independent rollout with fine RK4 and direct distance computations."""
+    from tubekit.model import nominal_kinematics
+    from tubekit.sensing import detected_obstacles
+
+    scenario, cert = certified
+    tight = cert.tightening()
+    dt, n = scenario.controller.dt, scenario.controller.horizon_steps
+    start_region = cert.region.replace(e_d=(tight.e_d_min, tight.e_d_min + 1.0), e_o=(-0.3, 0.3), e_z=(-0.3, 0.3))
+
+    def fine_rollout(s0, inputs):
+        out, s = [np.asarray(s0, float)], np.asarray(s0, float)
+        for v in inputs:
+            h = dt / 50
+            for _ in range(50):
+                k1 = nominal_kinematics(s, v); k2 = nominal_kinematics(s + h / 2 * k1, v)
+                k3 = nominal_kinematics(s + h / 2 * k2, v); k4 = nominal_kinematics(s + h * k3, v)
+                s = s + h / 6 * (k1 + 2 * k2 + 2 * k3 + k4)
+            out.append(s)
+        return np.array(out)
+
+    def check(states, inputs, t0, obstacles, tol):
+        assert np.all(np.abs(inputs) <= tight.v_max + tol)
+        times = t0 + dt * np.arange(1, n + 1)
+        p_d = scenario.trajectory.position(times)
+        indep = fine_rollout(states[0], inputs)[1:]
+        assert np.allclose(indep, states[1:], atol=1e-6)
+        e_x, e_y = indep[:, 0] - p_d[:, 0], indep[:, 1] - p_d[:, 1]
+        e_d = np.hypot(e_x, e_y)
+        assert np.all(e_d >= tight.e_d_min - tol) and np.all(e_d <= tight.e_d_max + tol)
+        assert np.all(np.abs(indep[:, 2] - p_d[:, 2]) <= tight.e_z_max + tol)
+        e_o = (e_x * np.sin(indep[:, 3]) - e_y * np.cos(indep[:, 3])) / e_d
+        assert np.all(np.abs(e_o) <= tight.e_o_max + tol)
+        for ob in obstacles:
+            dist = np.linalg.norm(indep[:, :3] - np.asarray(ob.center), axis=1)
+            assert np.all(dist >= ob.radius + scenario.vehicle_radius + tight.obstacle_margin - tol)
+
+    p_traj = scenario.trajectory
+
+    @settings(max_examples=max(5, settings.default.max_examples // 4), deadline=None)
+    @given(rel=vs.error_states(start_region), t=st.floats(0.0, 80.0))
+    def prop(rel, t):
+        p = p_traj.position(t)
+        state = np.array([p[0] + rel[0], p[1] + rel[1], p[2] + rel[2], rel[3]])
+        obstacles = detected_obstacles(state[:3], scenario.obstacles, scenario.sensing_range)
+        fhocp_solver.reset()
+        plan = fhocp_solver.solve(t, state, obstacles)
+        assert not plan.fallback
+        check(plan.states, plan.inputs, t, obstacles, 1e-6)
+        nxt = plan.states[1]
+        seen = detected_obstacles(nxt[:3], scenario.obstacles, scenario.sensing_range)
+        s2, v2, _ = fhocp_solver.shifted_candidate(t + dt, nxt, seen)
+        check(s2, v2, t + dt, seen, 1e-6)
+
+    prop()

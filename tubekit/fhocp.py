@@ -85,7 +85,7 @@ def obstacle_slots(scenario: Scenario) -> int:
 
 
 class FallbackWarning(UserWarning):
-    """The FHOCP failed; the shifted previous plan (or a zero-input plan) is returned."""
+    """The FHOCP failed; the shifted previous plan with a searched tail is returned."""
 
 
 @dataclass(frozen=True)
@@ -663,12 +663,63 @@ class FHOCP:
             s_b = rollout(s0, v_b, nlp.dt)
         return v_b, s_b, ev_b
 
+    def shifted_candidate(self, t: float, state: np.ndarray,
+                          obstacles: Sequence[Obstacle] | np.ndarray = ()) -> tuple[np.ndarray, np.ndarray, object]:
+        """Tube MPC's candidate at ``t``: the stored plan shifted, its new tail input searched.
+
+        The inputs the previous plan still covers are kept; each appended input is
+        the point of a grid over V-bar (7 x 5 x 7) whose plan violates the state
+        constraints least (terminal set excluded), ties broken by the merit. Without
+        a stored plan the search starts from zero inputs.
+
+        Parameters
+        ----------
+        t : float
+            Time of the candidate (s), normally the previous solve's t + dt.
+        state : array (4,)
+            State the candidate starts from (m, rad).
+        obstacles : sequence of Obstacle
+            Obstacles to check against (filtered like :meth:`solve`).
+
+        Returns
+        -------
+        states (N+1, 4), inputs (N, 3), evaluation (:class:`tubekit.fhocp_nlp.NlpEvaluation`)
+        """
+        s0 = as_vector("state", state, 4)
+        obs = self.select_obstacles(s0, obstacles)
+        ref = self.nlp.reference(self.scenario.trajectory, finite("t", t))
+        guess, warm = self.warm_start_inputs(t)
+        return self._searched_tail(s0, np.where(np.isfinite(guess), guess, 0.0), self._kept_steps(t) if warm else 0,
+                                   ref, obs)
+
+    def _kept_steps(self, t: float) -> int:
+        shift = int(round((t - self._plan_t) / self.nlp.dt))
+        return max(0, self.nlp.n - max(shift, 0))
+
+    def _searched_tail(self, s0: np.ndarray, v: np.ndarray, kept: int, ref: np.ndarray, obs: np.ndarray):
+        nlp = self.nlp
+        v = np.clip(v, -nlp.v_max, nlp.v_max)
+        grid = np.stack(np.meshgrid(*[np.linspace(-b, b, k) for b, k in zip(nlp.v_max, (7, 5, 7))],
+                                    indexing="ij"), axis=-1).reshape(-1, 3)
+        for j in range(kept, nlp.n):
+            best_key, best_u = None, v[j]
+            for cand in grid:
+                v[j:] = cand
+                ev = nlp.evaluate(rollout(s0, v, nlp.dt), v, ref, obs)
+                viol = max(val for key, val in ev.violations.items() if key != "terminal")
+                key = (round(viol, 9), ev.merit)
+                if best_key is None or key < best_key:
+                    best_key, best_u = key, cand.copy()
+            v[j:] = best_u
+        s = rollout(s0, v, nlp.dt)
+        return s, v, nlp.evaluate(s, v, ref, obs)
+
     def _fallback(self, t: float, s0: np.ndarray, guess: np.ndarray, ref: np.ndarray, obs: np.ndarray,
                   reason: str, iters: int, setup: float, solver_time: float, t_start: float) -> FhocpResult:
-        """The shifted previous plan (zeros without one), rolled out from ``s0``, flagged."""
-        v = np.where(np.isfinite(guess), guess, 0.0)
-        s = rollout(s0, v, self.nlp.dt)
-        ev = self.nlp.evaluate(s, v, ref, obs)
+        """The shifted previous plan with a searched tail (zeros without one), rolled out from ``s0``, flagged."""
+        warm = self._plan_inputs is not None and self._plan_t is not None and t >= self._plan_t
+        kept = self._kept_steps(t) if warm else 0
+        s, v, ev = self._searched_tail(s0, np.where(np.isfinite(guess), guess, 0.0), kept, ref, obs)
         msg = f"FHOCP at t={t:.3f} s failed ({reason}); returning the shifted previous plan"
         warnings.warn(msg, FallbackWarning, stacklevel=3)
         self._plan_t, self._plan_inputs = t, v.copy()

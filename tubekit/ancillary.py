@@ -18,11 +18,12 @@ from dataclasses import dataclass
 from typing import Callable
 
 import numpy as np
+import sympy as sp
 
 from .derivation import error_coordinates, numeric
 from .exceptions import ConfigError
 
-__all__ = ["AncillaryLaw", "get_law", "jacobian_at", "LAWS"]
+__all__ = ["AncillaryLaw", "get_law", "register_law", "jacobian_at", "LAWS"]
 
 
 def _identity_gain(J: np.ndarray) -> np.ndarray:
@@ -45,11 +46,16 @@ class AncillaryLaw:
         Maps J (..., 3, 3) to K (..., 3, 3).
     description : str
         One line for reports.
+    symbolic_gain : callable, optional
+        The same map on a sympy Matrix, J -> K. Needed for :func:`verify.certify`,
+        which bounds K(e) and J(e) K(e) with interval arithmetic; a law without it
+        can be simulated and falsified, not certified.
     """
 
     name: str
     gain_of_jacobian: Callable[[np.ndarray], np.ndarray]
     description: str
+    symbolic_gain: Callable[[sp.Matrix], sp.Matrix] | None = None
 
     def gain(self, state: np.ndarray, p_d: np.ndarray) -> np.ndarray:
         """K(e) at the real state (..., 4) w.r.t. p_d (..., 3)."""
@@ -93,11 +99,31 @@ def jacobian_at(state: np.ndarray, p_d: np.ndarray) -> np.ndarray:
         return numeric().J(state[..., 0] - p_d[..., 0], state[..., 1] - p_d[..., 1], state[..., 3])
 
 
+#: The law registry: the two built-in laws plus any added with :func:`register_law`.
 LAWS: dict[str, AncillaryLaw] = {
-    "paper": AncillaryLaw("paper", _identity_gain, "kappa = -sigma (e - e_hat)   [paper, eq. kappa_law]"),
+    "paper": AncillaryLaw("paper", _identity_gain, "kappa = -sigma (e - e_hat)   [paper, eq. kappa_law]",
+                          symbolic_gain=lambda J: sp.eye(3)),
     "corrected": AncillaryLaw("corrected", _inverse_gain,
-                              "kappa = -sigma J(e)^-1 (e - e_hat)   [inverse-Jacobian law]"),
+                              "kappa = -sigma J(e)^-1 (e - e_hat)   [inverse-Jacobian law]",
+                              symbolic_gain=lambda J: J.inv().applyfunc(sp.simplify)),
 }
+
+
+def register_law(law: AncillaryLaw) -> AncillaryLaw:
+    """Add ``law`` to :data:`LAWS` so it can be selected by name (scenarios, CLI, verify).
+
+    Raises :class:`ConfigError` if a *different* law already has that name.
+    """
+    if not isinstance(law, AncillaryLaw):
+        raise ConfigError("law", "an AncillaryLaw", type(law).__name__)
+    if not law.name or not isinstance(law.name, str):
+        raise ConfigError("law.name", "a non-empty string", law.name)
+    known = LAWS.get(law.name)
+    if known is not None and known is not law:
+        raise ConfigError("law.name", f"a name not already registered ({tuple(LAWS)})", law.name,
+                          "choose another name")
+    LAWS[law.name] = law
+    return law
 
 
 def get_law(name: str) -> AncillaryLaw:

@@ -120,7 +120,7 @@ class ControllerSettings:
     Q, R, P : array (3,)
         Diagonals of the stage, input and terminal weights.
     law : str
-        Ancillary law, one of :data:`LAW_NAMES`.
+        Ancillary law: a name in :data:`tubekit.ancillary.LAWS` (built-in: :data:`LAW_NAMES`).
     sigma : float or None
         Ancillary gain; ``None`` lets the verifier choose it.
     ancillary_rate_hz : float
@@ -156,8 +156,9 @@ class ControllerSettings:
                 raise ConfigError(f"controller.{name}", "three numbers > 0 (a positive diagonal)",
                                   getattr(self, name))
             object.__setattr__(self, name, tuple(float(x) for x in vec))
-        if self.law not in LAW_NAMES:
-            raise ConfigError("controller.law", f"one of {LAW_NAMES}", self.law)
+        from .ancillary import LAWS  # the registry: built-in laws plus registered ones
+        if self.law not in LAWS:
+            raise ConfigError("controller.law", f"one of {tuple(LAWS)}", self.law)
         if self.sigma is not None:
             object.__setattr__(self, "sigma", positive("controller.sigma", self.sigma))
         object.__setattr__(self, "ancillary_rate_hz",

@@ -134,4 +134,4 @@ print("wrote", FIGURES / "07_property_testing.png")
 # about 0.43 on this region instead of the corrected law's 1: the tube radius certified for the
 # corrected law is too small for it, and the shrunk counterexample shows where — the bearing
 # mismatch term (real and nominal bearings Δθ apart) pushes ρ outward. To certify your own law,
-# its gain must come with its own certificate: tutorial 08.
+# give it a sympy `symbolic_gain` and pass it to `verify.certify`: tutorial 08 does that.

@@ -28,7 +28,6 @@ import itertools
 import math
 from dataclasses import dataclass, field
 from functools import lru_cache
-from typing import Callable
 
 import numpy as np
 import sympy as sp
@@ -171,25 +170,25 @@ def polar_model(s: int) -> PolarModel:
                       zeta_rotation_form=bool(rot))
 
 
-_GAINS: dict[str, Callable[[sp.Matrix], sp.Matrix]] = {
-    "paper": lambda J: sp.eye(3),
-    "corrected": lambda J: J.inv().applyfunc(sp.simplify),
-}
-
 
 @lru_cache(maxsize=8)
 def law_gain(law: str, s: int) -> tuple[sp.Matrix, sp.Matrix]:
     """Symbolic (K(e), J(e) K(e)) of an ancillary law in hemisphere ``s``.
 
-    The symbolic gain mirrors :data:`tubekit.ancillary.LAWS` (K = I for
-    ``paper``, K = J^-1 for ``corrected``); the tests cross-check them numerically.
+    The symbolic gain is the law's ``symbolic_gain`` in :data:`tubekit.ancillary.LAWS`
+    (K = I for ``paper``, K = J^-1 for ``corrected``, or a registered user law); the
+    tests cross-check it against the numeric gain.
     """
     if law not in LAWS:
         raise ConfigError("law", f"one of {tuple(LAWS)}", law)
-    if law not in _GAINS:
-        raise ConfigError("law", f"a law with a symbolic gain, one of {tuple(_GAINS)}", law)
+    gain = LAWS[law].symbolic_gain
+    if gain is None:
+        raise ConfigError("law", "a law with a symbolic gain (AncillaryLaw.symbolic_gain)", law,
+                          "a law without one can be simulated and falsified, not certified")
     J = polar_model(s).J
-    K = _GAINS[law](J)
+    K = sp.Matrix(gain(J))
+    if K.shape != (3, 3):
+        raise ConfigError("law.symbolic_gain", "a map returning a 3x3 sympy Matrix", K.shape)
     JK = (J * K).applyfunc(sp.simplify)
     return K, JK
 

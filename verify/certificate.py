@@ -32,7 +32,7 @@ from typing import Any
 import numpy as np
 from flint import arb
 
-from tubekit.ancillary import get_law
+from tubekit.ancillary import AncillaryLaw, get_law, register_law
 from tubekit.derivation import error_coordinates
 from tubekit.exceptions import ConfigError, TubekitError
 from tubekit.scenario import Scenario
@@ -343,7 +343,7 @@ _ASSUMPTIONS = (
 )
 
 
-def certify(scenario: Scenario, law: str | None = None, *, region: Region | None = None,
+def certify(scenario: Scenario, law: str | AncillaryLaw | None = None, *, region: Region | None = None,
             time_budget_s: float = DEFAULT_TIME_BUDGET_S, gap: float = 0.05) -> Certificate:
     """Certify a scenario for an ancillary law.
 
@@ -351,8 +351,10 @@ def certify(scenario: Scenario, law: str | None = None, *, region: Region | None
     ----------
     scenario : Scenario
         Vehicle, limits, disturbance, trajectory, obstacles, sensing range, epsilon, horizon.
-    law : str, optional
-        ``"paper"`` or ``"corrected"``; default ``scenario.controller.law``.
+    law : str or AncillaryLaw, optional
+        A registered law name (``"paper"``, ``"corrected"``, or one added with
+        :func:`tubekit.ancillary.register_law`) or an :class:`AncillaryLaw` with a
+        ``symbolic_gain`` (registered on the way); default ``scenario.controller.law``.
     region : Region, optional
         The set the bounds hold over; default :meth:`Region.from_scenario`.
     time_budget_s : float
@@ -368,6 +370,8 @@ def certify(scenario: Scenario, law: str | None = None, *, region: Region | None
     if not isinstance(scenario, Scenario):
         raise ConfigError("scenario", "a tubekit.scenario.Scenario", type(scenario).__name__)
     law = scenario.controller.law if law is None else law
+    if isinstance(law, AncillaryLaw):
+        law = register_law(law).name
     get_law(law)
     if region is None:
         region = Region.from_scenario(scenario)

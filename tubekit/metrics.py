@@ -40,6 +40,7 @@ from .scenario import Obstacle, Scenario
 from .trajectory import Circle
 
 __all__ = [
+    "rho_period_peaks",
     "clearance",
     "input_ratio",
     "encirclements",
@@ -73,6 +74,22 @@ def clearance(positions: np.ndarray, obstacles: Sequence[Obstacle | Mapping[str,
     radii = np.array([_radius(o) for o in obstacles], dtype=float)
     d = np.linalg.norm(p[:, None, :] - centers[None, :, :], axis=2) - radii[None, :] - vehicle_radius
     return d.min(axis=1)
+
+
+def rho_period_peaks(columns: Mapping[str, np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
+    """Per sampling period: the time it ends (s) and the max of ||rho|| over it (its pre-reset peak).
+
+    ``columns`` needs ``t``, ``step`` and ``rho_norm`` (as in ``trajectory.csv`` or
+    :meth:`tubekit.closed_loop.SimulationResult.columns`). Falls back to the raw
+    series when the log is not a whole number of periods.
+    """
+    step = np.asarray(columns["step"])
+    m = int(np.sum(step == step[0]))
+    rho = np.asarray(columns["rho_norm"], dtype=float)
+    n = (len(rho) - 1) // m if m else 0
+    if m < 1 or n < 1 or n * m + 1 != len(rho):
+        return np.asarray(columns["t"]), rho
+    return np.asarray(columns["t"])[m::m][:n], rho[1:n * m + 1].reshape(n, m).max(axis=1)
 
 
 def input_ratio(inputs: np.ndarray, limits: Sequence[float]) -> np.ndarray:

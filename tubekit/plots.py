@@ -14,7 +14,7 @@ import numpy as np
 from matplotlib.figure import Figure
 from matplotlib.patches import Circle as CirclePatch
 
-from .metrics import clearance
+from .metrics import clearance, rho_period_peaks
 from .scenario import Scenario
 
 __all__ = [
@@ -115,23 +115,12 @@ def inputs_figure(scenario: Scenario, runs: Sequence[Run]) -> Figure:
     return fig
 
 
-def _interval_peaks(c: Mapping[str, np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
-    """Per sampling period: the time it ends and the max of ‖ρ‖ over it (its pre-reset peak)."""
-    step = np.asarray(c["step"])
-    m = int(np.sum(step == step[0]))
-    rho = np.asarray(c["rho_norm"], dtype=float)
-    n = (len(rho) - 1) // m
-    if m < 1 or n < 1 or n * m + 1 != len(rho):
-        return np.asarray(c["t"]), rho
-    return np.asarray(c["t"])[m::m][:n], rho[1:n * m + 1].reshape(n, m).max(axis=1)
-
-
 def rho_figure(runs: Sequence[Run], rho_tilde: float | None, certified: bool) -> Figure:
     """‖ρ(t)‖ = ‖e − ê‖ (peak of each sampling period) against the tube radius ρ̃."""
     fig = Figure(figsize=(7.5, 3.8), layout="constrained")
     ax = fig.add_subplot()
     for i, (label, c) in enumerate(runs):
-        tt, peak = _interval_peaks(c)
+        tt, peak = rho_period_peaks(c)
         ax.plot(tt, peak, label=rf"$\max\|\rho\|$ per period, {label}", **_style(i))
     if rho_tilde is not None and np.isfinite(rho_tilde) and rho_tilde > 0:
         lab = (rf"$\tilde\rho$ = {rho_tilde:.3g} (certified)" if certified

@@ -33,3 +33,12 @@ def test_no_command_prints_help(capsys):
 def test_console_script_installed():
     out = subprocess.run([sys.executable, "-m", "tubekit.cli", "--help"], capture_output=True, text=True)
     assert out.returncode == 0 and "reproduce" in out.stdout
+
+
+def test_missing_dependency_disables_only_that_command(monkeypatch, capsys):
+    import tubekit.cli as cli
+    monkeypatch.setitem(cli.SUBCOMMANDS, "broken", ("tubekit._no_such_module_for_test", "a broken command"))
+    assert main(["broken"]) == 1
+    err = capsys.readouterr().err
+    assert "not available" in err and "_no_such_module_for_test" in err
+    assert main(["audit", "--samples", "20"]) == 0  # the others still work

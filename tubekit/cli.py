@@ -35,10 +35,8 @@ def _build_parser() -> argparse.ArgumentParser:
         p = sub.add_parser(name, help=help_text, description=help_text)
         try:
             module = importlib.import_module(module_name)
-        except ModuleNotFoundError as exc:
-            if exc.name != module_name:
-                raise
-            p.set_defaults(_unavailable=module_name)
+        except ImportError as exc:  # a missing optional dependency must not break the other commands
+            p.set_defaults(_unavailable=f"{module_name} cannot be imported: {exc}")
             continue
         getattr(module, f"configure_{name}")(p)
         p.set_defaults(_run=getattr(module, f"run_{name}"))
@@ -53,8 +51,8 @@ def main(argv: list[str] | None = None) -> int:
         parser.print_help()
         return 2
     if getattr(args, "_unavailable", None):
-        print(f"tubekit {args.command}: not implemented yet in this version "
-              f"(module {args._unavailable} is missing).", file=sys.stderr)
+        print(f"tubekit {args.command}: not available: {args._unavailable}. "
+              f"Try: pip install -e . (it installs every dependency of the commands).", file=sys.stderr)
         return 1
     try:
         return int(args._run(args))

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from .ancillary import LAWS, AncillaryLaw, get_law
+from .ancillary import LAWS, AncillaryLaw, get_law, register_law
 from .derivation import derive, error_coordinates, numeric
 from .exceptions import ConfigError, NotAvailableError, ShapeError, SolverError, TubekitError
 from .model import InputLimits, SwayModel, kinematics, nominal_kinematics
@@ -18,7 +18,7 @@ __all__ = [
     "TubekitError", "ConfigError", "ShapeError", "SolverError", "NotAvailableError",
     "InputLimits", "SwayModel", "kinematics", "nominal_kinematics",
     "derive", "numeric", "error_coordinates",
-    "AncillaryLaw", "LAWS", "get_law",
+    "AncillaryLaw", "LAWS", "get_law", "register_law",
     "Trajectory", "Circle", "Helix", "Line", "Waypoints",
     "Obstacle", "Disturbance", "ControllerSettings", "RegionSettings", "Scenario",
     "paper_scenario", "load_scenario", "scenario_from_dict",

@@ -5,6 +5,10 @@ tightened sets, terminal set, horizon condition, obstacle separation), every
 number rigorous (Arb interval arithmetic), every failure named;
 ``envelope(scenario, law)`` searches the certifiable design envelope.
 See ``docs/verify.md``.
+
+Submodules for property-based testing: :mod:`verify.strategies` (hypothesis
+strategies), :mod:`verify.invariance` (rho^T rho_dot at a configuration) and
+:mod:`verify.falsify` (the falsifier behind ``tubekit falsify``).
 """
 
 from __future__ import annotations

@@ -516,15 +516,18 @@ class FHOCP:
         """The stored plan's inputs (N, 3) or None after :meth:`reset`."""
         return None if self._plan_inputs is None else self._plan_inputs.copy()
 
+    def _shift(self, t: float) -> int | None:
+        """Steps from the stored plan to ``t`` (at most N), or None without a usable plan."""
+        if self._plan_inputs is None or self._plan_t is None:
+            return None
+        shift = int(round((t - self._plan_t) / self.nlp.dt))
+        return None if shift < 0 else min(shift, self.nlp.n)
+
     def warm_start_inputs(self, t: float) -> tuple[np.ndarray, bool]:
         """The previous plan shifted to time ``t`` (last input repeated), or zeros and False."""
-        n = self.nlp.n
-        if self._plan_inputs is None or self._plan_t is None:
-            return np.zeros((n, 3)), False
-        shift = int(round((t - self._plan_t) / self.nlp.dt))
-        if shift < 0:
-            return np.zeros((n, 3)), False
-        shift = min(shift, n)
+        shift = self._shift(t)
+        if shift is None:
+            return np.zeros((self.nlp.n, 3)), False
         v = self._plan_inputs
         if shift:
             v = np.vstack([v[shift:], np.repeat(v[-1:], shift, axis=0)])
@@ -688,13 +691,13 @@ class FHOCP:
         s0 = as_vector("state", state, 4)
         obs = self.select_obstacles(s0, obstacles)
         ref = self.nlp.reference(self.scenario.trajectory, finite("t", t))
-        guess, warm = self.warm_start_inputs(t)
-        return self._searched_tail(s0, np.where(np.isfinite(guess), guess, 0.0), self._kept_steps(t) if warm else 0,
-                                   ref, obs)
+        guess, _ = self.warm_start_inputs(t)
+        return self._searched_tail(s0, np.where(np.isfinite(guess), guess, 0.0), self._kept_steps(t), ref, obs)
 
     def _kept_steps(self, t: float) -> int:
-        shift = int(round((t - self._plan_t) / self.nlp.dt))
-        return max(0, self.nlp.n - max(shift, 0))
+        """Inputs of the stored plan still covering [t, t + T] (0 without a usable plan)."""
+        shift = self._shift(t)
+        return 0 if shift is None else self.nlp.n - shift
 
     def _searched_tail(self, s0: np.ndarray, v: np.ndarray, kept: int, ref: np.ndarray, obs: np.ndarray):
         nlp = self.nlp
@@ -717,9 +720,7 @@ class FHOCP:
     def _fallback(self, t: float, s0: np.ndarray, guess: np.ndarray, ref: np.ndarray, obs: np.ndarray,
                   reason: str, iters: int, setup: float, solver_time: float, t_start: float) -> FhocpResult:
         """The shifted previous plan with a searched tail (zeros without one), rolled out from ``s0``, flagged."""
-        warm = self._plan_inputs is not None and self._plan_t is not None and t >= self._plan_t
-        kept = self._kept_steps(t) if warm else 0
-        s, v, ev = self._searched_tail(s0, np.where(np.isfinite(guess), guess, 0.0), kept, ref, obs)
+        s, v, ev = self._searched_tail(s0, np.where(np.isfinite(guess), guess, 0.0), self._kept_steps(t), ref, obs)
         msg = f"FHOCP at t={t:.3f} s failed ({reason}); returning the shifted previous plan"
         warnings.warn(msg, FallbackWarning, stacklevel=3)
         self._plan_t, self._plan_inputs = t, v.copy()

@@ -215,14 +215,9 @@ def _compiled(kind: str, A: sp.Matrix, dim_syms: tuple, par_syms: tuple):
     """
     args = list(dim_syms) + list(par_syms)
     n_r, n_c = A.shape
-    if kind == "norm":
-        G = _gram(A)
-        m = G.shape[0]
-        idx = [(i, j) for i in range(m) for j in range(i, m)]
-    else:
-        G = ((A + A.T) / 2).applyfunc(sp.simplify)
-        m = G.shape[0]
-        idx = [(i, j) for i in range(m) for j in range(i, m)]
+    G = _gram(A) if kind == "norm" else ((A + A.T) / 2).applyfunc(sp.simplify)
+    m = G.shape[0]
+    idx = [(i, j) for i in range(m) for j in range(i, m)]
     f_arb = compile_arb([G[i, j] for i, j in idx], args)
     f_np = compile_numpy(list(A), args)
 
@@ -234,32 +229,34 @@ def _compiled(kind: str, A: sp.Matrix, dim_syms: tuple, par_syms: tuple):
             M[j][i] = v
         return M
 
+    def matrices(X: np.ndarray, pars: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """A at the rows of X (non-finite ones zeroed) and the mask of those rows."""
+        cols = [X[:, k] for k in range(X.shape[1])] + [np.full(len(X), p) for p in pars]
+        M = f_np(*cols).reshape(len(X), n_r, n_c)
+        bad = ~np.all(np.isfinite(M), axis=(1, 2))
+        M[bad] = 0.0
+        return M, bad
+
     if kind == "norm":
         def interval(balls: list[arb]) -> arb:
             _, hi = sym_eig_bounds(entries(balls))
             return arb(max(hi, 0.0)).sqrt() if math.isfinite(hi) else arb("nan")
 
-        def pointwise(X: np.ndarray, pars: np.ndarray) -> np.ndarray:
-            cols = [X[:, k] for k in range(X.shape[1])] + [np.full(len(X), p) for p in pars]
-            M = f_np(*cols).reshape(len(X), n_r, n_c)
-            bad = ~np.all(np.isfinite(M), axis=(1, 2))
-            M[bad] = 0.0
-            out = np.linalg.svd(M, compute_uv=False)[:, 0]
-            out[bad] = np.nan
-            return out
+        def value(M: np.ndarray) -> np.ndarray:
+            return np.linalg.svd(M, compute_uv=False)[:, 0]
     else:
         def interval(balls: list[arb]) -> arb:
             lo, _ = sym_eig_bounds(entries(balls))
             return arb(-lo) if math.isfinite(lo) else arb("nan")
 
-        def pointwise(X: np.ndarray, pars: np.ndarray) -> np.ndarray:
-            cols = [X[:, k] for k in range(X.shape[1])] + [np.full(len(X), p) for p in pars]
-            M = f_np(*cols).reshape(len(X), n_r, n_c)
-            bad = ~np.all(np.isfinite(M), axis=(1, 2))
-            M[bad] = 0.0
-            out = -np.linalg.eigvalsh(0.5 * (M + np.swapaxes(M, 1, 2)))[:, 0]
-            out[bad] = np.nan
-            return out
+        def value(M: np.ndarray) -> np.ndarray:
+            return -np.linalg.eigvalsh(0.5 * (M + np.swapaxes(M, 1, 2)))[:, 0]
+
+    def pointwise(X: np.ndarray, pars: np.ndarray) -> np.ndarray:
+        M, bad = matrices(X, pars)
+        out = value(M)
+        out[bad] = np.nan
+        return out
     return interval, pointwise
 
 

@@ -18,6 +18,7 @@ import numpy as np
 
 from tubekit.ancillary import AncillaryLaw
 from tubekit.derivation import error_coordinates, numeric
+from tubekit.exceptions import ConfigError
 
 __all__ = ["TubeConfiguration", "rho_dot_inner", "applied_input"]
 
@@ -74,19 +75,13 @@ def rho_dot_inner(config: TubeConfiguration, law: AncillaryLaw, sigma: float) ->
 
     Returns ``nan`` where the law is undefined (e_d = 0).
     """
-    zero = np.zeros(3)
-    e = error_coordinates(config.real, zero)
-    e_hat = error_coordinates(config.nominal, zero)
-    rho = e - e_hat
+    try:
+        v = applied_input(config, law, sigma)
+    except ConfigError:  # the law is undefined here (e_d = 0 or J singular)
+        return float("nan")
+    dyn = numeric().e_dot
     with np.errstate(all="ignore"):
-        J = numeric().J(config.real[0], config.real[1], config.real[3])
-        try:
-            K = law.gain_of_jacobian(J)
-        except np.linalg.LinAlgError:
-            return float("nan")
-        v = config.v_hat - sigma * (K @ rho)
-        dyn = numeric().e_dot
         e_dot = dyn(config.real[0], config.real[1], config.real[3], *v, *config.omega, *config.pd_dot)
         e_hat_dot = dyn(config.nominal[0], config.nominal[1], config.nominal[3], *config.v_hat, 0.0, 0.0, 0.0,
                         *config.pd_dot)
-    return float(rho @ (e_dot - e_hat_dot))
+    return float(config.rho @ (e_dot - e_hat_dot))

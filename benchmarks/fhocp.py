@@ -53,6 +53,7 @@ import numpy as np
 from tubekit import Tightening, paper_scenario
 from tubekit.fhocp import FHOCP
 from tubekit.model import kinematics
+from tubekit.plant import Plant
 from tubekit.scenario import Scenario
 
 REQUIRED_KEYS = ("rt_step_ms_median", "converged_ms_median", "ipopt_ms_median", "clarabel_ms_median",
@@ -71,9 +72,10 @@ def plant_step(scenario: Scenario, t: float, s: np.ndarray, v: np.ndarray, dt: f
                substeps: int = 10) -> np.ndarray:
     """Integrate nominal kinematics + current over ``dt`` with RK4 (input held)."""
     h = dt / substeps
+    current = Plant.of(scenario).current
 
     def f(tt: float, ss: np.ndarray) -> np.ndarray:
-        return kinematics(ss, v, scenario.disturbance.current(tt))
+        return kinematics(ss, v, current(tt))
 
     for i in range(substeps):
         ti = t + i * h
@@ -145,7 +147,7 @@ def run(duration: float, with_ipopt: bool = True, profile: bool = False, toleran
         FHOCP(sc, tg, mode="converged", tolerance=tolerance)
     ip = None
     if with_ipopt:
-        from tubekit.fhocp_ipopt import IpoptFHOCP
+        from tubekit.fhocp import IpoptFHOCP
         ip = IpoptFHOCP(sc, tg, warm_start_duals=True)
     rec: dict[str, list] = {k: [] for k in ("rt", "rt_clarabel", "cv", "cv_iters", "cv_merit", "ip",
                                            "ip_iters", "ip_merit", "rt_viol", "cv_viol", "ip_viol",

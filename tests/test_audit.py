@@ -9,7 +9,7 @@ import pytest
 import sympy as sp
 
 from tubekit.audit import audit
-from tubekit.cli import main
+from tubekit.app.cli import main
 from tubekit.derivation import SYMBOL_NAMES, symbols
 from tubekit.exceptions import ConfigError
 from tubekit.paper_equations import TERM_NAMES

@@ -4,22 +4,17 @@ from __future__ import annotations
 
 import dataclasses
 import math
-from types import SimpleNamespace
 
 import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
 
 from tubekit import ConfigError, SolverError, Tightening, paper_scenario
-from tubekit.closed_loop import CSV_COLUMNS, nominal_arc, plant_rhs, rk4_hold, simulate
+from tubekit.closed_loop import CSV_COLUMNS, PlanMemory, nominal_arc, saturate, simulate
+from tubekit.fhocp import FhocpResult
 from tubekit.metrics import read_trajectory_csv
-from tubekit.model import SwayModel, kinematics, nominal_kinematics, sway_velocity_term
+from tubekit.model import SwayModel
 from tubekit.scenario import Disturbance
-
-
-def _omega_reference(sc, t, x, v):
-    d = sc.disturbance
-    return d.current(t) + sway_velocity_term(x, d.sway.velocity(t, v))
 
 
 def _scenario(duration=5.0, **dist):
@@ -52,53 +47,17 @@ class Pursuit:
         plan = np.column_stack([np.full(n, self.u), 0.1 * np.arange(n) / n - 0.05,
                                 np.clip(1.5 * err + 0.01 * np.arange(n), -0.45, 0.45)])
         self.plans[self.k] = plan
-        first = plan[0].copy()
+        inputs = plan.copy()
         if self.k in self.nan_at:
-            first[:] = np.nan
-        return SimpleNamespace(states=np.zeros((n + 1, 4)), inputs=plan, first_input=first, cost=1.0,
-                               iterations=1, solve_time_s=2e-5, max_violation=0.0,
-                               fallback=self.k in self.nan_at or self.k in self.flag_at, status="ok")
+            inputs[0] = np.nan  # the first input is not finite
+        fallback = self.k in self.nan_at or self.k in self.flag_at
+        return FhocpResult(status="fallback" if fallback else "optimal", states=np.zeros((n + 1, 4)),
+                           inputs=inputs, cost=1.0, iterations=1, solve_time_s=2e-5, setup_time_s=0.0,
+                           max_violation=0.0, fallback=fallback, t=t)
 
 
 def _tightening(sc, sigma):
     return dataclasses.replace(Tightening.untightened(sc), sigma=sigma)
-
-
-# ---- plant and nominal --------------------------------------------------------------
-
-def test_plant_rhs_is_eq11_with_model_disturbance():
-    sc = paper_scenario().with_changes(disturbance=Disturbance(amplitude=(0.1, 0.2, 0.05), constant=(0.01, -0.02, 0.03),
-                                                 sway=SwayModel(gain=0.3, amplitude=0.05, period=7.0, bound=0.04)))
-    rng = np.random.default_rng(0)
-    for _ in range(50):
-        t = rng.uniform(0, 100)
-        x = rng.uniform(-3, 3, 4)
-        v = rng.uniform(-0.5, 0.5, 3)
-        want = kinematics(x, v, _omega_reference(sc, t, x, v))
-        np.testing.assert_allclose(plant_rhs(sc, t, x, v), want, atol=1e-14)
-
-
-def test_rk4_matches_tight_solve_ivp():
-    sc = paper_scenario().with_changes(disturbance=Disturbance(
-        sway=SwayModel(gain=0.0, amplitude=0.015, period=3.0, bound=0.02)))
-    x0 = np.array([0.2, 2.9, 0.1, 0.3])
-    v = np.array([0.35, -0.1, 0.4])
-
-    def f(t, x):
-        return kinematics(x, v, _omega_reference(sc, t, x, v))
-
-    ref = solve_ivp(f, (3.0, 3.5), x0, rtol=1e-12, atol=1e-12, method="DOP853").y[:, -1]
-    got = rk4_hold(sc, 3.0, x0, v, 0.5, 100)  # 5 ms steps, as in the closed loop
-    np.testing.assert_allclose(got, ref, atol=1e-10)
-
-
-def test_nominal_arc_is_exact():
-    x0 = np.array([1.0, -2.0, 0.5, 2.0])
-    tau = np.linspace(0, 0.1, 11)
-    for v in (np.array([0.4, 0.2, -0.5]), np.array([0.3, -0.1, 0.0]), np.array([0.0, 0.0, 0.3])):
-        ref = solve_ivp(lambda t, x: nominal_kinematics(x, v), (0, 0.1), x0, t_eval=tau, rtol=1e-12,
-                        atol=1e-13).y.T
-        np.testing.assert_allclose(nominal_arc(x0, v, tau), ref, atol=1e-11)
 
 
 # ---- closed loop ---------------------------------------------------------------------
@@ -187,9 +146,7 @@ class AtTheBounds(Pursuit):
     def solve(self, t, state, obstacles):
         res = super().solve(t, state, obstacles)
         sign = 1.0 if self.k % 2 == 0 else -1.0
-        res.first_input = sign * self.sc.limits.vector
-        res.inputs = np.tile(res.first_input, (len(res.inputs), 1))
-        return res
+        return dataclasses.replace(res, inputs=np.tile(sign * self.sc.limits.vector, (len(res.inputs), 1)))
 
 
 def test_saturation_only_when_needed_and_counted():
@@ -257,3 +214,26 @@ def test_real_fhocp_with_injected_fallbacks():
     assert res.fallback_steps == 3 and res.replaced_steps == 1
     assert res.statuses.count("fallback") == 2
     assert np.all(np.isfinite(res.v_hat[12 * m:13 * m]))
+
+
+# ---- named steps -----------------------------------------------------------------------
+
+def test_saturate_clips_only_outside_the_box():
+    lim = (0.4, 0.3, 0.5)
+    assert saturate((0.1, -0.3, 0.5), lim) == ((0.1, -0.3, 0.5), False)
+    v, clipped = saturate((0.5, -0.35, 0.2), lim)
+    assert clipped and v == (0.4, -0.3, 0.2)
+
+
+def test_plan_memory_shifts_the_last_good_plan_then_stops():
+    sc = _scenario(duration=1.0)
+    good = Pursuit(sc, None).solve(0.0, np.asarray(sc.initial_state, dtype=float), ())
+    memory = PlanMemory()
+    np.testing.assert_array_equal(memory.replacement(), 0.0)  # nothing to shift yet
+    assert memory.remember(good) is False and memory.age == 0
+    flagged = dataclasses.replace(good, fallback=True)
+    assert memory.remember(flagged) is True and memory.age == 1  # a flagged plan is not remembered
+    np.testing.assert_array_equal(memory.replacement(), good.inputs[2])
+    for _ in range(len(good.inputs)):
+        last = memory.replacement()
+    np.testing.assert_array_equal(last, 0.0)

@@ -1,62 +1,95 @@
-"""tubekit falsify: exit codes, JSON schema, shrinking, bad input."""
+"""tubekit falsify: the one-period and closed-loop falsifiers, exit codes, JSON schema, bad input."""
 
 from __future__ import annotations
 
 import json
+from dataclasses import replace
 
 import numpy as np
 import pytest
 
 import verify
-from tubekit.ancillary import LAWS
-from tubekit.cli import main
+from tubekit.app.cli import main
 from tubekit.exceptions import ConfigError
-from tubekit.scenario import paper_scenario
-from verify.falsify import SearchSpace, falsify
-from verify.invariance import rho_dot_inner
-from verify.region import Region
+from tubekit.scenario import load_scenario, paper_scenario
+from verify.falsify import falsify, falsify_closed_loop, search_space
 
 CERTIFIABLE = str(verify.SCENARIOS_DIR / "certifiable.toml")
+PAPER_CURRENTS = verify.SCENARIOS_DIR / "paper_currents.toml"
 STATE_KEYS = {"e_x", "e_y", "e_z", "psi"}
 
 
-def test_paper_law_counterexample_json(tmp_path, capsys):
-    out = tmp_path / "ce.json"
-    assert main(["falsify", "--law", "paper", "--budget", "100", "--json", str(out)]) == 3
+@pytest.fixture(scope="module")
+def currents():
+    scenario = load_scenario(PAPER_CURRENTS)
+    return scenario, verify.certify(scenario)
+
+
+def test_search_space_from_certificate(currents):
+    scenario, cert = currents
+    space = search_space(scenario, certificate=cert)
+    assert space.sigma == cert.design.sigma and space.tube == tuple(cert.tube["rho"])
+    assert space.theta == cert.tube["theta"] and space.certified
+    assert space.ticks * space.tick == pytest.approx(scenario.controller.dt)
+    assert all(lo < hi for lo, hi in space.start)
+
+
+def test_one_period_certified_finds_nothing(currents):
+    scenario, cert = currents
+    res = falsify(scenario, certificate=cert, budget=60, local_iterations=150)
+    assert not res.found and res.stage == "none"
+    assert 0.3 < res.worst_value <= 1.0  # tightness: the search reaches the tube
+
+
+def test_one_period_shrunk_tube_is_found(currents):
+    scenario, cert = currents
+    space = search_space(scenario, certificate=cert)
+    small = replace(space, tube=tuple(x / 2 for x in space.tube))
+    res = falsify(scenario, space=small, budget=60, local_iterations=150)
+    assert res.found and res.value > 1.0
+    data = res.to_dict()
+    assert set(data["counterexample"]["real"]) == STATE_KEYS and data["counterexample"]["ratio"] > 1
+
+
+def test_closed_loop_certified_finds_nothing(currents):
+    """Tightness figure on paper_currents: largest observed deviation / certified radius."""
+    scenario, cert = currents
+    res = falsify_closed_loop(scenario, budget=5, seed=0, duration=2.0, certificate=cert)
+    assert res.check() and not res.found
+    assert 0.3 < res.ratio <= 1.0
+    assert res.simulations == 5 and res.worst.promises
+    data = json.loads(json.dumps(res.to_dict()))
+    assert data["found"] is False and data["mode"] == "closed-loop"
+
+
+def test_closed_loop_shrunk_tube_is_found(currents):
+    scenario, cert = currents
+    tight = cert.tightening()
+    small = replace(tight, tube=np.asarray(tight.tube) / 2)
+    res = falsify_closed_loop(scenario, budget=2, seed=0, duration=2.0, certificate=cert, tightening=small)
+    assert res.found and not res.check() and res.ratio > 1.0
+    assert "COUNTEREXAMPLE" in res.summary()
+
+
+def test_closed_loop_cli_exit_0(tmp_path):
+    out = tmp_path / "cl.json"
+    assert main(["falsify", str(PAPER_CURRENTS), "--closed-loop", "--budget", "2", "--duration", "1",
+                 "--json", str(out)]) == 0
     data = json.loads(out.read_text())
-    assert data["found"] is True
-    ce = data["counterexample"]
-    assert set(ce["real"]) == STATE_KEYS and set(ce["nominal"]) == STATE_KEYS
-    assert len(ce["v_hat"]) == 3 and len(ce["omega"]) == 3 and len(ce["pd_dot"]) == 3
-    assert ce["rho_dot_inner"] > 0 and ce["rho_norm"] > 0 and ce["sigma"] > 0
-    assert "COUNTEREXAMPLE" in capsys.readouterr().out
+    assert data["found"] is False and data["simulations"] == 2
 
 
 def test_certified_design_exit_0(tmp_path):
     out = tmp_path / "none.json"
-    assert main(["falsify", CERTIFIABLE, "--law", "corrected", "--budget", "150", "--json", str(out)]) == 0
+    assert main(["falsify", CERTIFIABLE, "--law", "corrected", "--budget", "40", "--json", str(out)]) == 0
     data = json.loads(out.read_text())
     assert data["found"] is False and "counterexample" not in data
 
 
-def test_counterexample_is_shrunk():
-    """The hypothesis stage returns a minimal example: simpler (closer to the unit cube's origin) than
-    the worst configuration seen, and still a violation when re-evaluated."""
-    region = Region(e_d=(0.2, 3.0), e_z=(-1, 1), e_o=(-0.9, 0.9), heading="toward", pd_dot_max=(0.3, 0.3, 0),
-                    pd_dot_xy_max=0.3, omega_bar=0.1, v_max=(0.4, 0.3, 0.5))
-    space = SearchSpace(region, "paper", 5.0, 0.05, 0.3, (0.3, 0.2, 0.4), False)
-    res = falsify(paper_scenario(), space=space, budget=200)
-    assert res.found and res.stage == "hypothesis"
-    assert rho_dot_inner(res.counterexample, LAWS["paper"], 5.0) == pytest.approx(res.value) and res.value > 0
-    assert res.worst_value >= res.value
-    # the shrunk example sits on the simplest corner: zero disturbance and target velocity
-    assert np.allclose(res.counterexample.omega, 0) and np.allclose(res.counterexample.pd_dot, 0)
-
-
 @pytest.mark.parametrize("argv, field", [
     (["falsify", "--budget", "0"], "budget"),
-    (["falsify", "--sigma", "-1"], "--sigma"),
-    (["falsify", "--rho", "nan"], "--rho"),
+    (["falsify", CERTIFIABLE, "--sigma", "-1"], "--sigma"),
+    (["falsify", CERTIFIABLE, "--closed-loop", "--duration", "0"], "--duration"),
     (["falsify", "no/such/file.toml"], "CONFIG"),
 ])
 def test_bad_input_exit_2(argv, field, capsys):
@@ -68,3 +101,5 @@ def test_bad_input_exit_2(argv, field, capsys):
 def test_budget_validation_in_python():
     with pytest.raises(ConfigError, match="budget"):
         falsify(paper_scenario(), "paper", budget=-5)
+    with pytest.raises(ConfigError, match="budget"):
+        falsify_closed_loop(paper_scenario(), budget=0)

@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from tubekit.exceptions import SolverError
-from tubekit.fhocp_fastpath import CLARABEL_STATUS, CompiledConeProgram
+from tubekit.fhocp.fastpath import CLARABEL_STATUS, CompiledConeProgram
 
 
 def _problem():

@@ -1,13 +1,17 @@
-"""The discretised NLP: rollout, obstacle selection and the nonlinear-constraint violations."""
+"""The discretised NLP: exact step, rollout, linearisations, obstacle selection, nonlinear violations."""
 
 from __future__ import annotations
 
 import numpy as np
 import pytest
 
-from tubekit.fhocp_nlp import FhocpNlp, discrete_step, obstacle_array, rollout, select_obstacles
+from tubekit.fhocp.nlp import (FhocpNlp, discrete_step, dsinc, eo_linearisation, obstacle_array, rollout,
+                               select_obstacles, sinc, step_linearisation)
+from tubekit.model import nominal_kinematics
 from tubekit.scenario import Obstacle, paper_scenario
 from tubekit.tightening import Tightening
+
+from .fhocp_cases import tightening
 
 SC = paper_scenario()
 TIGHT = Tightening(v_max=np.array([0.3, 0.2, 0.4]), e_d_min=0.3, e_o_max=0.8, e_z_max=0.9, e_d_max=2.9,
@@ -57,3 +61,65 @@ def test_select_obstacles_by_surface_distance_nearest_first():
     assert kept.shape == (1, 4) and np.allclose(kept[0], [2.0, 0, 0, 0.4]) and dropped == 0
     kept, dropped = select_obstacles(np.zeros(4), obs, sensing_range=10.0, max_count=2)
     assert np.allclose(kept[:, 0], [2.0, 1.5]) and dropped == 1
+
+
+# ------------------------------------------------------------------ discretisation
+def test_exact_step_matches_fine_rk4():
+    rng = np.random.default_rng(0)
+    for _ in range(6):
+        s = rng.normal(size=4)
+        v = rng.uniform(-1, 1, 3) * np.array([0.4, 0.3, 0.5])
+        x = s.copy()
+        h = 0.1 / 2000
+        for _ in range(2000):
+            k1 = nominal_kinematics(x, v)
+            k2 = nominal_kinematics(x + h / 2 * k1, v)
+            k3 = nominal_kinematics(x + h / 2 * k2, v)
+            k4 = nominal_kinematics(x + h * k3, v)
+            x = x + h / 6 * (k1 + 2 * k2 + 2 * k3 + k4)
+        assert np.allclose(discrete_step(s, v, 0.1), x, atol=1e-12, rtol=0)  # RK4 error ~1e-15
+
+
+def test_rollout_is_repeated_step():
+    rng = np.random.default_rng(1)
+    v = rng.uniform(-1, 1, (8, 3)) * np.array([0.4, 0.3, 3.0])
+    s = rollout(np.array([1.0, -2.0, 0.3, 5.0]), v, 0.1)
+    assert np.max(np.abs(s[1:] - discrete_step(s[:-1], v, 0.1))) < 1e-14
+
+
+def test_sinc_and_derivative_near_zero():
+    a = np.array([0.0, 1e-12, -1e-5, 0.05, -0.099, 0.101, 0.7])
+    safe = np.where(a == 0, 1.0, a)
+    exact = np.where(a == 0, 1.0, np.sin(safe) / safe)
+    assert np.allclose(sinc(a), exact, rtol=1e-15, atol=0)
+    h = 1e-6
+    fd = (np.sin(a + h) / (a + h) - np.sin(a - h) / (a - h)) / (2 * h)
+    assert np.allclose(dsinc(a[1:]), fd[1:], atol=1e-9)
+    assert dsinc(np.array([0.0]))[0] == 0.0
+
+
+def test_step_and_eo_linearisations_match_finite_differences():
+    rng = np.random.default_rng(2)
+    s = rng.normal(size=(9, 4))
+    v = rng.uniform(-1, 1, (8, 3)) * np.array([0.4, 0.3, 2.0])
+    lin = step_linearisation(s, v, 0.1)
+    f0 = discrete_step(s[:8], v, 0.1)
+    h = 1e-7
+    for row, (kind, col, out) in {0: ("s", 3, 0), 1: ("v", 0, 0), 2: ("v", 2, 0),
+                                  4: ("s", 3, 1), 5: ("v", 0, 1), 6: ("v", 2, 1)}.items():
+        s2, v2 = s.copy(), v.copy()
+        (s2 if kind == "s" else v2)[:, col] += h
+        fd = (discrete_step(s2[:8], v2, 0.1) - f0)[:, out] / h
+        assert np.allclose(fd, lin[row], atol=1e-6)
+    # the affine model reproduces F at the linearisation point
+    x_lin = s[:8, 0] + lin[0] * s[:8, 3] + lin[1] * v[:, 0] + lin[2] * v[:, 2] + lin[3]
+    assert np.allclose(x_lin, f0[:, 0], atol=1e-14)
+    ref = rng.normal(size=(9, 3))
+    g = eo_linearisation(s, ref)
+    nlp = FhocpNlp.from_scenario(SC, tightening())
+    e0 = nlp.errors(s, ref)[:, 2]
+    assert np.allclose(g[4], e0)
+    for row, col in ((0, 0), (1, 1), (2, 3)):
+        s2 = s.copy()
+        s2[:, col] += h
+        assert np.allclose((nlp.errors(s2, ref)[:, 2] - e0) / h, g[row], atol=1e-5)

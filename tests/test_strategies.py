@@ -98,3 +98,24 @@ def test_obstacle_sets_separated(obstacles):
 def test_tube_too_wide_for_region_is_rejected():
     with pytest.raises(ConfigError, match="rho_tilde"):
         vs.tube_pairs(REGION, rho_tilde=5.0)
+
+
+START = ((0.6, 2.5), (-0.4, 0.4), (-0.3, 0.3))
+
+
+@given(vs.period_configurations(REGION, START, [0.3, 0.2, 0.4], (0.12, 0.05)))
+def test_period_configurations_in_sets(cfg):
+    """Property: a period starts at the reset (real = nominal) with e in E-bar, v_hat in V-bar,
+    ||omega_xy|| <= omega_bar_xy, |omega_z| <= omega_bar_z and p_d_dot in P."""
+    assert np.array_equal(cfg.real, cfg.nominal)
+    e = error_coordinates(cfg.real, np.zeros(3))
+    for x, (lo, hi) in zip(e, START):
+        assert lo - 1e-9 <= x <= hi + 1e-9
+    assert np.all(np.abs(cfg.v_hat) <= [0.3, 0.2, 0.4])
+    assert np.hypot(cfg.omega[0], cfg.omega[1]) <= 0.12 + 1e-12 and abs(cfg.omega[2]) <= 0.05 + 1e-12
+    assert np.hypot(cfg.pd_dot[0], cfg.pd_dot[1]) <= REGION.pd_dot_xy_max + 1e-12
+
+
+def test_period_configurations_reject_empty_start():
+    with pytest.raises(ConfigError, match="start"):
+        vs.period_configurations(REGION, ((1.0, 0.5), (-1, 1), (-0.5, 0.5)), [0.3, 0.2, 0.4], (0.1, 0.1))

@@ -6,7 +6,8 @@ import numpy as np
 import pytest
 
 from tubekit.exceptions import ConfigError, ShapeError
-from tubekit.validation import as_vector, finite, nonnegative, positive
+from tubekit.validation import (as_vector, finite, interval, nonnegative, nonnegative_triple, positive,
+                                positive_triple)
 
 
 @pytest.mark.parametrize("fn, value, match", [
@@ -39,3 +40,37 @@ def test_vector_errors(value, exc, match):
 
 def test_vector_ok():
     assert np.array_equal(as_vector("v", (1, 2, 3), 3), [1.0, 2.0, 3.0])
+
+
+@pytest.mark.parametrize("value, match", [
+    (1.0, r"i: expected a pair \[lo, hi\]"),
+    ((1, 2, 3), r"i: expected a pair \[lo, hi\]"),
+    ((float("nan"), 1.0), r"i\[0\]: expected a finite number"),
+    ((0.0, True), r"i\[1\]: expected a finite number"),
+    ((2.0, 1.0), r"i: expected lo < hi \(a non-empty interval\)"),
+    ((1.0, 1.0), r"i: expected lo < hi"),
+])
+def test_interval_errors(value, match):
+    with pytest.raises(ConfigError, match=match):
+        interval("i", value)
+
+
+def test_interval_ok():
+    assert interval("i", ["-1", 2]) == (-1.0, 2.0)
+
+
+@pytest.mark.parametrize("fn, value, match", [
+    (positive_triple, 3.0, "t: expected three numbers"),
+    (positive_triple, (1, 2), "t: expected three numbers"),
+    (positive_triple, (1, 0, 2), "t: expected three numbers > 0"),
+    (nonnegative_triple, (1, -0.1, 2), "t: expected three numbers >= 0"),
+    (nonnegative_triple, (1, float("inf"), 2), r"t\[1\]: expected a finite number"),
+])
+def test_triple_errors(fn, value, match):
+    with pytest.raises(ConfigError, match=match):
+        fn("t", value)
+
+
+def test_triple_ok():
+    assert positive_triple("t", [1, 2, 3]) == (1.0, 2.0, 3.0)
+    assert nonnegative_triple("t", np.zeros(3)) == (0.0, 0.0, 0.0)

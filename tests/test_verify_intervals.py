@@ -103,7 +103,7 @@ def _case(expr, lo, hi) -> Case:
 
 def test_maximise_brackets_a_known_sup():
     # sup of sin(x) + cos(y) over [0, 3]^2 is 2 (x = pi/2, y = 0)
-    res = maximise([_case(sp.sin(X) + sp.cos(Y), [0, 0], [3, 3])], gap=0.01, time_budget_s=5)
+    res = maximise([_case(sp.sin(X) + sp.cos(Y), [0, 0], [3, 3])], gap=0.01, max_boxes=20000)
     assert res.sampled <= 2.0 + 1e-12 <= res.bound + 1e-12
     assert res.converged and res.gap <= 0.01
     assert res.bound <= 2.0 * 1.01
@@ -111,7 +111,7 @@ def test_maximise_brackets_a_known_sup():
 
 def test_maximise_over_a_union_takes_the_largest_case():
     cases = [_case(-(X - 1) ** 2 - Y**2, [-2, -2], [2, 2]), _case(3 - (X**2 + Y**2), [1, 1], [2, 2])]
-    res = maximise(cases, gap=0.02, time_budget_s=5)
+    res = maximise(cases, gap=0.02, max_boxes=20000)
     # case 1 sup 0; case 2 sup 3 - 2 = 1 at (1, 1)
     assert res.sampled <= 1.0 + 1e-12 <= res.bound
     assert res.bound <= 1.02 + 1e-9
@@ -119,7 +119,7 @@ def test_maximise_over_a_union_takes_the_largest_case():
 
 def test_maximise_reports_an_unreached_gap_honestly():
     res = maximise([_case(sp.sin(3 * X) * sp.cos(2 * Y) + X * Y / 5, [-3, -3], [3, 3])], gap=1e-9,
-                   time_budget_s=0.05, n_samples=50)
+                   max_boxes=3, n_samples=50)
     assert not res.converged
     assert res.gap > 1e-9
     assert res.bound >= res.sampled

@@ -1,7 +1,10 @@
-"""``python -m tubekit`` runs the console script."""
+"""``python -m tubekit`` runs the console script (:func:`tubekit.app.cli.main`)."""
 
-import sys
+__all__: list[str] = []
 
-from .cli import main
+if __name__ == "__main__":
+    import sys
 
-sys.exit(main())
+    from tubekit.app.cli import main
+
+    sys.exit(main())

@@ -13,11 +13,8 @@ range and sign of lambda_min((J + J^T)/2) in each heading hemisphere
 
 from __future__ import annotations
 
-import argparse
-import json
 from dataclasses import asdict, dataclass, field
 from functools import lru_cache
-from pathlib import Path
 from typing import Mapping
 
 import numpy as np
@@ -32,8 +29,6 @@ __all__ = [
     "AuditReport",
     "derived_terms",
     "audit",
-    "configure_audit",
-    "run_audit",
 ]
 
 
@@ -245,24 +240,3 @@ def audit(paper_terms: Mapping[str, sp.Expr] | None = None, *, samples: int = 20
                      "(and e_d = 0, where e_o is undefined)",
         sym_eigenvalues=eig, hemispheres=hemis, samples=samples, seed=seed,
         mismatches=[t.name for t in rows if not t.match])
-
-
-def configure_audit(parser: argparse.ArgumentParser) -> None:
-    """Add the ``tubekit audit`` options."""
-    parser.add_argument("--json", metavar="FILE", help="write the audit as JSON to FILE")
-    parser.add_argument("--samples", type=int, default=2000, help="random points per term (default 2000)")
-    parser.add_argument("--seed", type=int, default=0, help="RNG seed (default 0)")
-
-
-def run_audit(args: argparse.Namespace) -> int:
-    """Run the audit, print the table, optionally write JSON; exit 0."""
-    from .exceptions import ConfigError
-    if args.samples < 10:
-        raise ConfigError("--samples", "an integer >= 10", args.samples)
-    report = audit(samples=args.samples, seed=args.seed)
-    print(report.table())
-    if args.json:
-        Path(args.json).parent.mkdir(parents=True, exist_ok=True)
-        Path(args.json).write_text(json.dumps(report.to_dict(), indent=2))
-        print(f"\nwrote {args.json}")
-    return 0

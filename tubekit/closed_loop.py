@@ -7,13 +7,19 @@ Timeline (dt = FHOCP period, h = 1 / ancillary_rate_hz, m = dt / h ticks):
   state (nominal reset, ê(t_k) = e(t_k), paper eq. diff_mpc) and its first input
   v̂ is held over [t_k, t_k + dt);
 * the nominal state x̂ is propagated from x(t_k) with v̂ and the nominal
-  kinematics (eq. 3), in closed form (exact unicycle arcs);
+  kinematics (eq. 3), in closed form (exact unicycle arcs, :func:`nominal_arc`);
 * at every tick t_i = i h the ancillary law gives κ(e, ê) (zero-order hold over
   [t_i, t_i + h)), the applied input is v = v̂ + κ; only when v leaves V is it
   clipped to V (saturation, counted per tick and per sampling period);
-* the plant ẋ = f(x) v + ω(t, x, v) (eq. 11, ω = current δ(t) + sway term
-  g(x, v_s)) is integrated with classical RK4 at a fixed step h / plant_substeps
+* the plant ẋ = f(x) v + ω(t, x, v) (eq. 11, :class:`tubekit.plant.Plant`) is
+  integrated with classical RK4 at a fixed step h / plant_substeps
   (5 ms by default: 100 Hz ticks, 2 substeps).
+
+:func:`simulate` is a pipeline of named steps: :func:`validate_inputs` →
+:func:`build_solver` → per sampling period (:meth:`_ClosedLoop.run_period`):
+sense → solve (:meth:`_ClosedLoop.solve`, :class:`PlanMemory`) → nominal arc →
+ticks (:meth:`_ClosedLoop.run_ticks`: ancillary law, :func:`saturate`, plant) →
+log (:class:`_Log`).
 
 Fallbacks: a FHOCP result flagged ``fallback`` is used (its first input) and
 counted; a result whose first input is not finite, or a :class:`SolverError`,
@@ -30,22 +36,27 @@ applied at that tick uses the reset nominal (ρ = 0).
 
 from __future__ import annotations
 
+import enum
 import math
 import sys
 import time
 import warnings
 from dataclasses import dataclass, field
-from pathlib import Path
-from typing import Any, Callable
+from typing import TYPE_CHECKING, Any, Callable, Protocol, Sequence
 
 import numpy as np
 
 from .ancillary import AncillaryLaw, get_law
-from .derivation import error_coordinates
 from .exceptions import ConfigError, SolverError
-from .scenario import Scenario
+from .plan_check import check_plan
+from .plant import OmegaOverride, Plant, nominal_arc, plant_rhs, rk4_hold
+from .scenario import Obstacle, Scenario
 from .sensing import ObstacleMap
+from .simulation_result import CSV_COLUMNS, SimulationResult
 from .tightening import Tightening
+
+if TYPE_CHECKING:  # the solver package (cvxpy) is loaded only when a solver is built
+    from .fhocp import FhocpResult
 
 __all__ = [
     "SimulationResult",
@@ -54,255 +65,72 @@ __all__ = [
     "plant_rhs",
     "rk4_hold",
     "CSV_COLUMNS",
+    "FhocpSolver",
+    "SolverFactory",
+    "PlanMemory",
+    "validate_inputs",
+    "build_solver",
+    "saturate",
 ]
 
-#: Column order of ``trajectory.csv`` (see :meth:`SimulationResult.columns`).
-CSV_COLUMNS: tuple[str, ...] = (
-    "t", "step", "x", "y", "z", "psi", "u", "w", "r", "x_d", "y_d", "z_d",
-    "e_d", "e_z", "e_o", "x_hat", "y_hat", "z_hat", "psi_hat", "rho_d", "rho_z", "rho_o", "rho_norm",
-    "u_hat", "w_hat", "r_hat", "kappa_u", "kappa_w", "kappa_r", "omega_1", "omega_2", "omega_3",
-    "saturated", "fallback", "replaced", "n_detected", "solve_ms", "step_ms", "plan_violation", "wall_s",
-)
+
+class FhocpSolver(Protocol):
+    """What the closed loop needs from a FHOCP solver (e.g. :class:`tubekit.fhocp.FHOCP`)."""
+
+    def solve(self, t: float, state: np.ndarray, obstacles: Sequence[Obstacle]) -> FhocpResult:
+        """Plan from ``state`` [x, y, z, psi] (m, rad) at time ``t`` (s) around the known ``obstacles``."""
+        ...
 
 
-def nominal_arc(x0: np.ndarray, v: np.ndarray, tau: np.ndarray) -> np.ndarray:
-    """Exact solution of the nominal kinematics (eq. 3) under a constant input.
+#: ``factory(scenario, tightening)`` returning a :class:`FhocpSolver`.
+SolverFactory = Callable[[Scenario, Tightening], FhocpSolver]
 
-    Parameters
-    ----------
-    x0 : array (4,)
-        State [x, y, z, psi] at tau = 0 (m, rad).
-    v : array (3,)
-        Constant input [u, w, r] (m/s, m/s, rad/s).
-    tau : array (n,)
-        Elapsed times (s).
+#: Sign of cos(psi - theta) in each certified hemisphere (0: either).
+HEMISPHERE: dict[str, int] = {"toward": -1, "away": 1, "both": 0}
 
-    Returns
-    -------
-    array (n, 4)
-        States at ``tau``.
+_ZERO_INPUT = np.zeros(3)
+_ZERO_INPUT.setflags(write=False)
+
+
+# ---- setup ------------------------------------------------------------------------------
+
+def validate_inputs(scenario: Scenario, tightening: Tightening | None, law: str | AncillaryLaw | None,
+                    sigma: float | None, tube: bool,
+                    plant_substeps: int) -> tuple[Tightening, AncillaryLaw, float]:
+    """Check the arguments of :func:`simulate`; return (tightening, ancillary law, σ in 1/s).
+
+    Raises
+    ------
+    ConfigError
+        Bad ``plant_substeps``, a duration shorter than one period, a tube run
+        without tightening, or a σ that is not finite and >= 0.
     """
-    x0 = np.asarray(x0, dtype=float)
-    u, w, r = (float(c) for c in v)
-    tau = np.asarray(tau, dtype=float)
-    psi0 = x0[3]
-    psi = psi0 + r * tau
-    if abs(r) * float(np.max(np.abs(tau), initial=0.0)) > 1e-9:
-        with np.errstate(invalid="ignore", divide="ignore"):
-            dx = u * (np.sin(psi) - np.sin(psi0)) / r
-            dy = -u * (np.cos(psi) - np.cos(psi0)) / r
-    else:  # straight line (second-order accurate in r tau, exact for r = 0)
-        mid = psi0 + 0.5 * r * tau
-        dx = u * tau * np.cos(mid)
-        dy = u * tau * np.sin(mid)
-    return np.stack([x0[0] + dx, x0[1] + dy, x0[2] + w * tau, psi], axis=-1)
+    ctrl = scenario.controller
+    if not isinstance(plant_substeps, int) or plant_substeps < 1:
+        raise ConfigError("plant_substeps", "an integer >= 1", plant_substeps)
+    if scenario.steps < 1:
+        raise ConfigError("duration", f"at least one FHOCP period (dt = {ctrl.dt:g} s)", scenario.duration)
+    if tightening is None:
+        if tube:
+            raise ConfigError("tightening", "a Tightening (e.g. verify.certify(...).tightening()) for the tube run",
+                              None)
+        tightening = Tightening.untightened(scenario)
+    law_obj = law if isinstance(law, AncillaryLaw) else get_law(law if law is not None else ctrl.law)
+    if not tube:
+        return tightening, law_obj, 0.0
+    sig = float(tightening.sigma if sigma is None else sigma)
+    if not math.isfinite(sig) or sig < 0:
+        raise ConfigError("sigma", "a finite number >= 0", sig)
+    return tightening, law_obj, sig
 
 
-class _Plant:
-    """Scalar, allocation-free right-hand side of eq. (11) (fast inner loop)."""
-
-    def __init__(self, scenario: Scenario, override: Callable[[float], Any] | None = None) -> None:
-        self.override = override
-        d = scenario.disturbance
-        self.amp = tuple(float(a) for a in d.amplitude)
-        self.const = tuple(float(c) for c in d.constant)
-        self.omega_c = 2.0 * math.pi / d.period
-        s = d.sway
-        self.gain, self.s_amp, self.s_bound = float(s.gain), float(s.amplitude), float(s.bound)
-        self.omega_s = 2.0 * math.pi / s.period
-
-    def omega(self, t: float, psi: float, u: float, r: float) -> tuple[float, float, float]:
-        if self.override is not None:
-            o = self.override(t)
-            return float(o[0]), float(o[1]), float(o[2])
-        a = self.omega_c * t
-        sa, ca = math.sin(a), math.cos(a)
-        vs = self.gain * u * r + self.s_amp * math.sin(self.omega_s * t)
-        vs = min(max(vs, -self.s_bound), self.s_bound)
-        return (self.amp[0] * sa + self.const[0] - vs * math.sin(psi),
-                self.amp[1] * ca + self.const[1] + vs * math.cos(psi),
-                self.amp[2] * sa + self.const[2])
-
-    def rhs(self, t: float, x: tuple, v: tuple) -> tuple[float, float, float, float]:
-        u, w, r = v
-        psi = x[3]
-        o1, o2, o3 = self.omega(t, psi, u, r)
-        return (u * math.cos(psi) + o1, u * math.sin(psi) + o2, w + o3, r)
-
-
-def plant_rhs(scenario: Scenario, t: float, x: np.ndarray, v: np.ndarray) -> np.ndarray:
-    """ẋ = f(x) v + ω (eq. 11) with ω = δ(t) + g(x, v_s) of ``scenario`` (array (4,))."""
-    return np.array(_Plant(scenario).rhs(float(t), tuple(map(float, x)), tuple(map(float, v))))
-
-
-def rk4_hold(plant: _Plant | Scenario, t0: float, x0: np.ndarray, v: np.ndarray,
-             duration: float, substeps: int) -> np.ndarray:
-    """Integrate the plant over ``duration`` (s) with input ``v`` held, RK4 with ``substeps`` steps."""
-    p = plant if isinstance(plant, _Plant) else _Plant(plant)
-    return np.array(_rk4(p, float(t0), tuple(map(float, x0)), tuple(map(float, v)), duration / substeps,
-                         substeps))
-
-
-def _rk4(p: _Plant, t: float, x: tuple, v: tuple, h: float, n: int) -> tuple:
-    f = p.rhs
-    for _ in range(n):
-        k1 = f(t, x, v)
-        k2 = f(t + 0.5 * h, tuple(xi + 0.5 * h * ki for xi, ki in zip(x, k1)), v)
-        k3 = f(t + 0.5 * h, tuple(xi + 0.5 * h * ki for xi, ki in zip(x, k2)), v)
-        k4 = f(t + h, tuple(xi + h * ki for xi, ki in zip(x, k3)), v)
-        x = tuple(xi + h / 6.0 * (a + 2.0 * b + 2.0 * c + d) for xi, a, b, c, d in zip(x, k1, k2, k3, k4))
-        t += h
-    return x
-
-
-@dataclass
-class SimulationResult:
-    """A closed-loop run: per-tick log, per-step solver data, counts, timings and checks.
-
-    Per-tick arrays have K + 1 rows (K = steps * ticks per step; the last row is
-    the final state at t = duration with NaN inputs). Units: m, rad, s, m/s, rad/s.
-    """
-
-    scenario: Scenario
-    tube: bool
-    law: str
-    sigma: float
-    tightening: Tightening
-    plant_step_s: float
-    ticks_per_step: int
-    t: np.ndarray
-    step: np.ndarray
-    states: np.ndarray
-    desired: np.ndarray
-    nominal: np.ndarray
-    v_hat: np.ndarray
-    kappa: np.ndarray
-    inputs: np.ndarray
-    omega: np.ndarray
-    saturated: np.ndarray
-    fallback: np.ndarray
-    replaced: np.ndarray
-    n_detected: np.ndarray
-    solve_ms: np.ndarray
-    step_ms: np.ndarray
-    wall: np.ndarray
-    statuses: list[str] = field(default_factory=list)
-    iterations: np.ndarray = field(default_factory=lambda: np.zeros(0))
-    max_violation: np.ndarray = field(default_factory=lambda: np.zeros(0))
-    kappa_failures: int = 0
-    wall_s: float = 0.0
-
-    # ---- derived -------------------------------------------------------------------
-    @property
-    def errors(self) -> np.ndarray:
-        """e = [e_d, e_z, e_o] of the real state, (K+1, 3)."""
-        return error_coordinates(self.states, self.desired)
-
-    @property
-    def nominal_errors(self) -> np.ndarray:
-        """ê of the logged nominal, (K+1, 3)."""
-        return error_coordinates(self.nominal, self.desired)
-
-    @property
-    def rho(self) -> np.ndarray:
-        """ρ = e - ê, (K+1, 3)."""
-        return self.errors - self.nominal_errors
-
-    @property
-    def steps(self) -> int:
-        """Number of FHOCP sampling periods."""
-        return int(round((len(self.t) - 1) / self.ticks_per_step))
-
-    @property
-    def saturated_ticks(self) -> int:
-        """Ticks at which v̂ + κ left V and was clipped."""
-        return int(np.sum(self.saturated))
-
-    @property
-    def saturated_steps(self) -> int:
-        """Sampling periods containing at least one clipped tick."""
-        return int(np.unique(self.step[self.saturated.astype(bool)]).size)
-
-    @property
-    def fallback_steps(self) -> int:
-        """Sampling periods whose FHOCP result was a fallback (flagged or replaced)."""
-        first = np.arange(0, len(self.t) - 1, self.ticks_per_step)
-        return int(np.sum(self.fallback[first] | self.replaced[first]))
-
-    @property
-    def replaced_steps(self) -> int:
-        """Sampling periods whose FHOCP input was not finite (or raised) and was replaced."""
-        first = np.arange(0, len(self.t) - 1, self.ticks_per_step)
-        return int(np.sum(self.replaced[first]))
-
-    @property
-    def checks(self) -> dict[str, bool]:
-        """Self-checks of the run: finiteness and input admissibility of what reached the plant."""
-        applied = self.inputs[:-1]
-        lim = self.scenario.limits.vector
-        return {
-            "inputs_finite": bool(np.all(np.isfinite(applied))),
-            "states_finite": bool(np.all(np.isfinite(self.states))),
-            "inputs_within_limits": bool(np.all(np.abs(applied) <= lim + 1e-12)),
-        }
-
-    def columns(self) -> dict[str, np.ndarray]:
-        """The log as named columns, in :data:`CSV_COLUMNS` order."""
-        e, eh = self.errors, self.nominal_errors
-        rho = e - eh
-        c: dict[str, np.ndarray] = {"t": self.t, "step": self.step}
-        for i, n in enumerate(("x", "y", "z", "psi")):
-            c[n] = self.states[:, i]
-        for i, n in enumerate(("u", "w", "r")):
-            c[n] = self.inputs[:, i]
-        for i, n in enumerate(("x_d", "y_d", "z_d")):
-            c[n] = self.desired[:, i]
-        for i, n in enumerate(("e_d", "e_z", "e_o")):
-            c[n] = e[:, i]
-        for i, n in enumerate(("x_hat", "y_hat", "z_hat", "psi_hat")):
-            c[n] = self.nominal[:, i]
-        for i, n in enumerate(("rho_d", "rho_z", "rho_o")):
-            c[n] = rho[:, i]
-        c["rho_norm"] = np.linalg.norm(rho, axis=1)
-        for i, n in enumerate(("u_hat", "w_hat", "r_hat")):
-            c[n] = self.v_hat[:, i]
-        for i, n in enumerate(("kappa_u", "kappa_w", "kappa_r")):
-            c[n] = self.kappa[:, i]
-        for i, n in enumerate(("omega_1", "omega_2", "omega_3")):
-            c[n] = self.omega[:, i]
-        c["saturated"] = self.saturated.astype(int)
-        c["fallback"] = self.fallback.astype(int)
-        c["replaced"] = self.replaced.astype(int)
-        c["n_detected"] = self.n_detected
-        c["solve_ms"] = self.solve_ms
-        c["step_ms"] = self.step_ms
-        pv = np.full(len(self.t), np.nan)
-        pv[0:-1:self.ticks_per_step] = self.max_violation
-        c["plan_violation"] = pv
-        c["wall_s"] = self.wall
-        return {k: np.asarray(c[k]) for k in CSV_COLUMNS}
-
-    def write_csv(self, path: str | Path) -> Path:
-        """Write :meth:`columns` as CSV (header row, ``nan`` for missing values)."""
-        path = Path(path)
-        cols = self.columns()
-        data = np.column_stack([np.asarray(v, dtype=float) for v in cols.values()])
-        np.savetxt(path, data, delimiter=",", header=",".join(cols), comments="", fmt="%.12g")
-        return path
-
-    def summary(self) -> str:
-        """A few lines for the terminal."""
-        ch = self.checks
-        return (f"{'tube' if self.tube else 'baseline'}: {self.steps} steps, law={self.law}, sigma={self.sigma:.4g}, "
-                f"saturated ticks={self.saturated_ticks}, fallback steps={self.fallback_steps}, "
-                f"wall={self.wall_s:.2f} s, checks={'ok' if all(ch.values()) else ch}")
-
-
-def _default_factory(mode: str | None) -> Callable[[Scenario, Tightening], Any]:
-    def build(scenario: Scenario, tightening: Tightening):
-        from .fhocp import FHOCP  # imported lazily: the solver is optional for tests with fakes
-        return FHOCP(scenario, tightening, mode=mode)
-    return build
+def build_solver(scenario: Scenario, tightening: Tightening, solver_factory: SolverFactory | None,
+                 mode: str | None) -> FhocpSolver:
+    """``solver_factory(scenario, tightening)``, or :class:`tubekit.fhocp.FHOCP` in ``mode``."""
+    if solver_factory is not None:
+        return solver_factory(scenario, tightening)
+    from .fhocp import FHOCP  # imported lazily: the solver is optional for tests with fakes
+    return FHOCP(scenario, tightening, mode=mode)
 
 
 def _silence_fallback_warnings() -> None:
@@ -313,7 +141,7 @@ def _silence_fallback_warnings() -> None:
     warnings.simplefilter("ignore", FallbackWarning)
 
 
-def _progress(total: int, enabled: bool, label: str):
+def _progress(total: int, enabled: bool, label: str) -> Any:
     if not enabled or not sys.stderr.isatty():
         return None
     try:
@@ -323,12 +151,268 @@ def _progress(total: int, enabled: bool, label: str):
     return tqdm(total=total, desc=label, unit="step", leave=False, dynamic_ncols=True)
 
 
+@dataclass(frozen=True)
+class _Clock:
+    """The time grid: ``steps`` periods of ``ticks`` ticks of ``h`` s, ``substeps`` RK4 steps per tick."""
+
+    steps: int
+    ticks: int
+    h: float
+    substeps: int
+    t: np.ndarray  # (K + 1,) tick times (s), K = steps * ticks
+    tau: np.ndarray  # (ticks + 1,) times within a period (s)
+
+    @classmethod
+    def of(cls, scenario: Scenario, substeps: int) -> _Clock:
+        dt = scenario.controller.dt
+        m = int(round(scenario.controller.ancillary_rate_hz * dt))
+        h = dt / m
+        k_total = scenario.steps * m
+        return cls(steps=scenario.steps, ticks=m, h=h, substeps=substeps,
+                   t=np.round(np.arange(k_total + 1) * h, 9), tau=np.arange(m + 1) * h)
+
+    @property
+    def plant_step(self) -> float:
+        """RK4 step (s)."""
+        return self.h / self.substeps
+
+
+# ---- the "never pass NaN on" rule -----------------------------------------------------
+
+@dataclass
+class PlanMemory:
+    """The last good plan and its age, to replace a FHOCP result that cannot be applied.
+
+    Attributes
+    ----------
+    plan : array (N, 3) or None
+        Inputs of the last non-fallback, finite plan (m/s, m/s, rad/s).
+    age : int
+        Sampling periods elapsed since ``plan`` was computed.
+    """
+
+    plan: np.ndarray | None = None
+    age: int = 0
+
+    def remember(self, result: FhocpResult, accepted: bool = False) -> bool:
+        """Keep the plan of a usable result when it is a good one; return its ``fallback`` flag.
+
+        ``accepted`` (it passed :func:`tubekit.plan_check.check_plan`) makes any finite plan a good one.
+        """
+        is_fallback = bool(result.fallback)
+        plan = np.asarray(result.inputs, dtype=float)
+        if (accepted or not is_fallback) and plan.ndim == 2 and np.all(np.isfinite(plan)):
+            self.plan, self.age = plan, 0
+        else:
+            self.age += 1
+        return is_fallback
+
+    def replacement(self) -> np.ndarray:
+        """v̂ (3,) replacing an unusable result: the last good plan shifted by its age, else zero."""
+        self.age += 1
+        if self.plan is not None and self.age < len(self.plan):
+            return self.plan[self.age].copy()
+        return _ZERO_INPUT.copy()
+
+
+def saturate(v: tuple[float, float, float],
+             limits: tuple[float, float, float]) -> tuple[tuple[float, float, float], bool]:
+    """Clip ``v`` to the box |v_i| <= limits_i (m/s, m/s, rad/s); return (v, whether it was clipped)."""
+    if abs(v[0]) <= limits[0] and abs(v[1]) <= limits[1] and abs(v[2]) <= limits[2]:
+        return v, False
+    return tuple(min(max(vi, -li), li) for vi, li in zip(v, limits)), True
+
+
+def _status_text(status: Any) -> str:
+    """A result status (a str-valued enum member or a str) as plain text."""
+    return str(status.value) if isinstance(status, enum.Enum) else str(status)
+
+
+# ---- the log ----------------------------------------------------------------------------
+
+@dataclass
+class _Log:
+    """Preallocated per-tick (K + 1 rows) and per-period arrays; see :class:`SimulationResult`."""
+
+    states: np.ndarray
+    nominal: np.ndarray
+    v_hat: np.ndarray
+    kappa: np.ndarray
+    inputs: np.ndarray
+    saturated: np.ndarray
+    fallback: np.ndarray
+    replaced: np.ndarray
+    n_detected: np.ndarray
+    solve_ms: np.ndarray
+    step_ms: np.ndarray
+    wall: np.ndarray
+    iterations: np.ndarray
+    max_violation: np.ndarray
+    rejected: np.ndarray
+    plan_age: np.ndarray
+    plan_slack: np.ndarray
+    statuses: list[str] = field(default_factory=list)
+    kappa_failures: int = 0
+
+    @classmethod
+    def allocate(cls, clock: _Clock) -> _Log:
+        rows, steps = len(clock.t), clock.steps
+        return cls(states=np.empty((rows, 4)), nominal=np.empty((rows, 4)), v_hat=np.full((rows, 3), np.nan),
+                   kappa=np.full((rows, 3), np.nan), inputs=np.full((rows, 3), np.nan),
+                   saturated=np.zeros(rows, dtype=bool), fallback=np.zeros(rows, dtype=bool),
+                   replaced=np.zeros(rows, dtype=bool), n_detected=np.zeros(rows, dtype=int),
+                   solve_ms=np.full(rows, np.nan), step_ms=np.full(rows, np.nan), wall=np.zeros(rows),
+                   iterations=np.zeros(steps), max_violation=np.full(steps, np.nan),
+                   rejected=np.zeros(steps, dtype=bool), plan_age=np.zeros(steps, dtype=int),
+                   plan_slack=np.full(steps, np.nan))
+
+    def record_solve(self, k: int, i0: int, result: FhocpResult | None, elapsed_s: float) -> None:
+        """Record the solver's answer at period ``k`` (first tick ``i0``); ``None`` when it raised."""
+        if result is None:
+            self.statuses.append("exception")
+            self.solve_ms[i0] = 1e3 * elapsed_s
+            return
+        self.statuses.append(_status_text(result.status))
+        self.iterations[k] = float(result.iterations)
+        self.max_violation[k] = float(result.max_violation)
+        self.solve_ms[i0] = 1e3 * float(result.solve_time_s)
+
+
+@dataclass
+class _Period:
+    """What one sampling period applies: the held v̂, its flags and the nominal arc (ticks + 1, 4)."""
+
+    v_hat: np.ndarray
+    fallback: bool
+    replaced: bool
+    arc: np.ndarray
+
+
+# ---- the loop ---------------------------------------------------------------------------
+
+class _ClosedLoop:
+    """One run's fixed context (scenario, sets, clock, solver, law, plant, map) and its log."""
+
+    def __init__(self, scenario: Scenario, tightening: Tightening, clock: _Clock, solver: FhocpSolver,
+                 law: AncillaryLaw, sigma: float, plant: Plant, obstacle_map: ObstacleMap) -> None:
+        self.scenario, self.tightening, self.clock, self.solver = scenario, tightening, clock, solver
+        self.law, self.sigma, self.plant, self.map = law, sigma, plant, obstacle_map
+        self.desired = np.asarray(scenario.trajectory.position(clock.t), dtype=float)
+        self.limits = tuple(float(c) for c in scenario.limits.vector)
+        self.memory = PlanMemory()
+        self.log = _Log.allocate(clock)
+        self.sign = HEMISPHERE.get(scenario.region.heading, 0)
+
+    def sense(self, xk: np.ndarray) -> tuple[Obstacle, ...]:
+        """Obstacles known after sensing at the position of ``xk``."""
+        return self.map.update(xk[:3])
+
+    def solve(self, k: int, tk: float, xk: np.ndarray,
+              known: tuple[Obstacle, ...]) -> tuple[np.ndarray, bool, bool]:
+        """Solve the FHOCP at ``tk`` and decide v̂; never pass NaN on. Returns (v̂, fallback, replaced)."""
+        c0 = time.perf_counter()
+        result: FhocpResult | None = None
+        try:
+            result = self.solver.solve(tk, xk.copy(), known)
+            first = np.asarray(result.first_input, dtype=float).reshape(3)
+            usable = bool(np.all(np.isfinite(first)))
+        except SolverError:
+            first, usable = _ZERO_INPUT, False
+        self.log.record_solve(k, k * self.clock.ticks, result, time.perf_counter() - c0)
+        accepted = usable and self.accept(k, tk, xk, result, known)
+        if accepted:
+            flagged = self.memory.remember(result, accepted=self.tightening.horizon_arcs > 0)
+            self.log.plan_age[k] = self.memory.age
+            return first, flagged, False
+        v_hat = self.memory.replacement()
+        self.log.plan_age[k] = self.memory.age
+        return v_hat, True, True
+
+    def accept(self, k: int, tk: float, xk: np.ndarray, result: FhocpResult, known: tuple[Obstacle, ...]) -> bool:
+        """Exact arc check of the plan against the certificate's margins (always True without margins)."""
+        if self.tightening.horizon_arcs == 0:
+            return True
+        check = check_plan(self.scenario, self.tightening, tk, xk, result.inputs, known, self.sign)
+        self.log.plan_slack[k] = check.slack
+        self.log.rejected[k] = not check.ok
+        return check.ok
+
+    def ancillary(self, i: int, xs: np.ndarray, x_hat: np.ndarray) -> np.ndarray:
+        """κ (3,) at tick ``i``; zero (and counted) when the law fails."""
+        try:
+            return self.law(xs, x_hat, self.desired[i], self.sigma)
+        except (ConfigError, FloatingPointError, np.linalg.LinAlgError):
+            self.log.kappa_failures += 1
+            return _ZERO_INPUT
+
+    def run_ticks(self, k: int, x: tuple, period: _Period) -> tuple[tuple, float]:
+        """Ticks of period ``k``: ancillary law, saturation, plant. Returns (state, ancillary time in s)."""
+        clock, log = self.clock, self.log
+        i0, h = k * clock.ticks, clock.plant_step
+        vh = tuple(float(c) for c in period.v_hat)
+        law_s = 0.0
+        for j in range(clock.ticks):
+            i = i0 + j
+            xs = np.asarray(x)
+            log.states[i] = xs
+            if self.sigma > 0.0:
+                a0 = time.perf_counter()
+                kap = self.ancillary(i, xs, period.arc[j])
+                law_s += time.perf_counter() - a0
+                log.kappa[i] = kap
+                v = (vh[0] + float(kap[0]), vh[1] + float(kap[1]), vh[2] + float(kap[2]))
+            else:
+                log.kappa[i] = 0.0
+                v = vh
+            v, log.saturated[i] = saturate(v, self.limits)
+            log.inputs[i] = v
+            x = self.plant.step_tuple(float(clock.t[i]), x, v, h, clock.substeps)
+        return x, law_s
+
+    def log_period(self, k: int, xk: np.ndarray, period: _Period, nominal_before: np.ndarray) -> None:
+        """Per-tick copies of the period's v̂, flags, map size and nominal (left limit at the sample)."""
+        m, log = self.clock.ticks, self.log
+        i0 = k * m
+        log.fallback[i0:i0 + m] = period.fallback
+        log.replaced[i0:i0 + m] = period.replaced
+        log.n_detected[i0:i0 + m] = self.map.count
+        log.nominal[i0] = nominal_before if k > 0 else xk
+        log.nominal[i0 + 1:i0 + m] = period.arc[1:m]
+        log.v_hat[i0:i0 + m] = period.v_hat
+
+    def run_period(self, k: int, x: tuple, nominal_before: np.ndarray,
+                   wall0: float) -> tuple[tuple, np.ndarray]:
+        """Sense → solve → nominal arc → ticks → log for period ``k``.
+
+        Returns (state at the next sample, nominal x̂ at its left limit there).
+        """
+        i0, m = k * self.clock.ticks, self.clock.ticks
+        xk = np.asarray(x)
+        c0 = time.perf_counter()
+        known = self.sense(xk)
+        v_hat, flagged, replaced = self.solve(k, float(self.clock.t[i0]), xk, known)
+        period = _Period(v_hat, flagged, replaced, nominal_arc(xk, v_hat, self.clock.tau))
+        control_s = time.perf_counter() - c0
+        self.log_period(k, xk, period, nominal_before)
+        x, law_s = self.run_ticks(k, x, period)
+        self.log.step_ms[i0] = 1e3 * (control_s + law_s)
+        self.log.wall[i0:i0 + m] = time.perf_counter() - wall0
+        return x, period.arc[m]
+
+    def omega_log(self) -> np.ndarray:
+        """ω (m/s) at the start of every tick (NaN where the input is NaN)."""
+        log, out = self.log, np.full((len(self.clock.t), 3), np.nan)
+        for i, ti in enumerate(self.clock.t):
+            if np.isfinite(log.inputs[i, 0]) and np.isfinite(log.inputs[i, 2]):
+                out[i] = self.plant.omega(float(ti), log.states[i], log.inputs[i])
+        return out
+
+
 def simulate(scenario: Scenario, *, tightening: Tightening | None = None,
              law: str | AncillaryLaw | None = None, sigma: float | None = None, tube: bool = True,
-             progress: bool = True, solver_factory: Callable[[Scenario, Tightening], Any] | None = None,
+             progress: bool = True, solver_factory: SolverFactory | None = None,
              mode: str | None = None, plant_substeps: int = 2, remember_obstacles: bool = True,
-             label: str | None = None,
-             disturbance: Callable[[float], Any] | None = None) -> SimulationResult:
+             label: str | None = None, disturbance: OmegaOverride | None = None) -> SimulationResult:
     """Run the closed loop on ``scenario`` for ``scenario.duration`` seconds.
 
     Parameters
@@ -347,8 +431,8 @@ def simulate(scenario: Scenario, *, tightening: Tightening | None = None,
     progress : bool
         Show a tqdm bar (only on a TTY).
     solver_factory : callable, optional
-        ``factory(scenario, tightening)`` returning an object with
-        ``solve(t, state, obstacles)``; default :class:`tubekit.fhocp.FHOCP`.
+        ``factory(scenario, tightening)`` returning a :class:`FhocpSolver`;
+        default :class:`tubekit.fhocp.FHOCP`.
     mode : str, optional
         FHOCP mode for the default factory; default ``scenario.controller.fhocp_mode``.
     plant_substeps : int
@@ -366,161 +450,42 @@ def simulate(scenario: Scenario, *, tightening: Tightening | None = None,
     SimulationResult
     """
     wall0 = time.perf_counter()
-    ctrl = scenario.controller
-    if not isinstance(plant_substeps, int) or plant_substeps < 1:
-        raise ConfigError("plant_substeps", "an integer >= 1", plant_substeps)
-    if scenario.steps < 1:
-        raise ConfigError("duration", f"at least one FHOCP period (dt = {ctrl.dt:g} s)", scenario.duration)
-    if tightening is None:
-        if tube:
-            raise ConfigError("tightening", "a Tightening (e.g. verify.certify(...).tightening()) for the tube run",
-                              None)
-        tightening = Tightening.untightened(scenario)
-    law_obj = law if isinstance(law, AncillaryLaw) else get_law(law if law is not None else ctrl.law)
-    if tube:
-        sig = float(tightening.sigma if sigma is None else sigma)
-        if not math.isfinite(sig) or sig < 0:
-            raise ConfigError("sigma", "a finite number >= 0", sig)
-    else:
-        sig = 0.0
-    factory = solver_factory or _default_factory(mode)
-    solver = factory(scenario, tightening)
-
-    m = int(round(ctrl.ancillary_rate_hz * ctrl.dt))
-    h = ctrl.dt / m
-    steps = scenario.steps
-    K = steps * m
-    t_all = np.round(np.arange(K + 1) * h, 9)
-    desired = np.asarray(scenario.trajectory.position(t_all), dtype=float)
-    lim = scenario.limits.vector
-    plant = _Plant(scenario, disturbance)
-    omap = ObstacleMap(scenario.obstacles, scenario.sensing_range, remember=remember_obstacles)
-    tau = np.arange(m + 1) * h
-    zeros3 = np.zeros(3)
-
-    states = np.empty((K + 1, 4))
-    nominal = np.empty((K + 1, 4))
-    v_hat_log = np.full((K + 1, 3), np.nan)
-    kappa_log = np.full((K + 1, 3), np.nan)
-    inputs = np.full((K + 1, 3), np.nan)
-    saturated = np.zeros(K + 1, dtype=bool)
-    fallback = np.zeros(K + 1, dtype=bool)
-    replaced = np.zeros(K + 1, dtype=bool)
-    n_detected = np.zeros(K + 1, dtype=int)
-    solve_ms = np.full(K + 1, np.nan)
-    step_ms = np.full(K + 1, np.nan)
-    wall = np.zeros(K + 1)
-    step_idx = np.minimum(np.arange(K + 1) // m, steps)
-    statuses: list[str] = []
-    iterations = np.zeros(steps)
-    max_violation = np.full(steps, np.nan)
-    kappa_failures = 0
-
+    tightening, law_obj, sig = validate_inputs(scenario, tightening, law, sigma, tube, plant_substeps)
+    solver = build_solver(scenario, tightening, solver_factory, mode)
+    clock = _Clock.of(scenario, plant_substeps)
+    loop = _ClosedLoop(scenario, tightening, clock, solver, law_obj, sig, Plant.of(scenario, disturbance),
+                       ObstacleMap(scenario.obstacles, scenario.sensing_range, remember=remember_obstacles))
     x = tuple(float(c) for c in scenario.initial_state)
-    prev_plan: np.ndarray | None = None
-    plan_age = 0
-    bar = _progress(steps, progress, label or ("tube" if tube else "baseline"))
-    nom_end = np.asarray(x)
+    nominal_end = np.asarray(x)
+    bar = _progress(clock.steps, progress, label or ("tube" if tube else "baseline"))
     with warnings.catch_warnings():
         _silence_fallback_warnings()  # fallbacks are counted; one warning each would flood the terminal
         try:
-            for k in range(steps):
-                i0 = k * m
-                tk = float(t_all[i0])
-                xk = np.asarray(x)
-                c0 = time.perf_counter()
-                known = omap.update(xk[:3])
-                res = None
-                try:
-                    res = solver.solve(tk, xk.copy(), known)
-                    vh = np.asarray(res.first_input, dtype=float).reshape(3)
-                    ok = bool(np.all(np.isfinite(vh)))
-                except SolverError:
-                    vh, ok = zeros3, False
-                c1 = time.perf_counter()
-                if ok:
-                    is_fb, rep = bool(getattr(res, "fallback", False)), False
-                    plan = np.asarray(getattr(res, "inputs", vh[None, :]), dtype=float)
-                    if not is_fb and plan.ndim == 2 and np.all(np.isfinite(plan)):
-                        prev_plan, plan_age = plan, 0
-                    else:
-                        plan_age += 1
-                else:  # never pass NaN on: shift the last good plan, or stop
-                    is_fb, rep = True, True
-                    plan_age += 1
-                    if prev_plan is not None and plan_age < len(prev_plan):
-                        vh = prev_plan[plan_age].copy()
-                    else:
-                        vh = zeros3.copy()
-                if res is not None:
-                    statuses.append(str(getattr(res, "status", "")))
-                    iterations[k] = float(getattr(res, "iterations", 0) or 0)
-                    mv = getattr(res, "max_violation", None)
-                    max_violation[k] = float(mv) if mv is not None else np.nan
-                    solve_ms[i0] = 1e3 * float(getattr(res, "solve_time_s", c1 - c0))
-                else:
-                    statuses.append("exception")
-                    solve_ms[i0] = 1e3 * (c1 - c0)
-                nom = nominal_arc(xk, vh, tau)
-                ctrl_s = time.perf_counter() - c0
-                fallback[i0:i0 + m] = is_fb
-                replaced[i0:i0 + m] = rep
-                n_detected[i0:i0 + m] = omap.count
-                nominal[i0] = nom_end if k > 0 else xk
-                nominal[i0 + 1:i0 + m] = nom[1:m]
-                v_hat_log[i0:i0 + m] = vh
-                vh_t = tuple(float(c) for c in vh)
-                for j in range(m):
-                    i = i0 + j
-                    xs = np.asarray(x)
-                    states[i] = xs
-                    if sig > 0.0:
-                        a0 = time.perf_counter()
-                        try:
-                            kap = law_obj(xs, nom[j], desired[i], sig)
-                        except (ConfigError, FloatingPointError, np.linalg.LinAlgError):
-                            kap = zeros3
-                            kappa_failures += 1
-                        ctrl_s += time.perf_counter() - a0
-                        kappa_log[i] = kap
-                        v = (vh_t[0] + kap[0], vh_t[1] + kap[1], vh_t[2] + kap[2])
-                    else:
-                        kappa_log[i] = 0.0
-                        v = vh_t
-                    if abs(v[0]) > lim[0] or abs(v[1]) > lim[1] or abs(v[2]) > lim[2]:
-                        v = (min(max(v[0], -lim[0]), lim[0]), min(max(v[1], -lim[1]), lim[1]),
-                             min(max(v[2], -lim[2]), lim[2]))
-                        saturated[i] = True
-                    inputs[i] = v
-                    x = _rk4(plant, float(t_all[i]), x, v, h / plant_substeps, plant_substeps)
-                nom_end = nom[m]
-                step_ms[i0] = 1e3 * ctrl_s
-                wall[i0:i0 + m] = time.perf_counter() - wall0
+            for k in range(clock.steps):
+                x, nominal_end = loop.run_period(k, x, nominal_end, wall0)
                 if bar is not None:
                     bar.update(1)
         finally:
             if bar is not None:
                 bar.close()
-    states[K] = np.asarray(x)
-    nominal[K] = nom_end
-    omega = _omega_log(plant, t_all, states, inputs)
+    loop.log.states[-1] = np.asarray(x)
+    loop.log.nominal[-1] = nominal_end
+    return _result(loop, tube, wall0)
+
+
+def _result(loop: _ClosedLoop, tube: bool, wall0: float) -> SimulationResult:
+    """Pack the log of a finished run."""
+    log, clock = loop.log, loop.clock
+    omega = loop.omega_log()
     wall_s = time.perf_counter() - wall0
-    wall[K] = wall_s
+    log.wall[-1] = wall_s
+    step_idx = np.minimum(np.arange(len(clock.t)) // clock.ticks, clock.steps)
     return SimulationResult(
-        scenario=scenario, tube=tube, law=law_obj.name if tube else "none", sigma=sig, tightening=tightening,
-        plant_step_s=h / plant_substeps, ticks_per_step=m, t=t_all, step=step_idx, states=states,
-        desired=desired, nominal=nominal, v_hat=v_hat_log, kappa=kappa_log, inputs=inputs, omega=omega,
-        saturated=saturated, fallback=fallback, replaced=replaced, n_detected=n_detected, solve_ms=solve_ms,
-        step_ms=step_ms, wall=wall, statuses=statuses, iterations=iterations, max_violation=max_violation,
-        kappa_failures=kappa_failures, wall_s=wall_s)
-
-
-def _omega_log(plant: _Plant, t: np.ndarray, states: np.ndarray, inputs: np.ndarray) -> np.ndarray:
-    """ω (m/s) at the start of every tick (NaN where the input is NaN)."""
-    out = np.full((len(t), 3), np.nan)
-    for i in range(len(t)):
-        u, r = inputs[i, 0], inputs[i, 2]
-        if np.isfinite(u) and np.isfinite(r):
-            out[i] = plant.omega(float(t[i]), float(states[i, 3]), float(u), float(r))
-    return out
-
+        scenario=loop.scenario, tube=tube, law=loop.law.name if tube else "none", sigma=loop.sigma,
+        tightening=loop.tightening, plant_step_s=clock.plant_step, ticks_per_step=clock.ticks,
+        t=clock.t, step=step_idx, states=log.states, desired=loop.desired, nominal=log.nominal, v_hat=log.v_hat,
+        kappa=log.kappa, inputs=log.inputs, omega=omega, saturated=log.saturated, fallback=log.fallback,
+        replaced=log.replaced, n_detected=log.n_detected, solve_ms=log.solve_ms, step_ms=log.step_ms,
+        wall=log.wall, statuses=log.statuses, iterations=log.iterations, max_violation=log.max_violation,
+        kappa_failures=log.kappa_failures, wall_s=wall_s, rejected=log.rejected, plan_age=log.plan_age,
+        plan_slack=log.plan_slack)

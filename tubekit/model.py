@@ -3,6 +3,7 @@
 State ``x = [x, y, z, psi]`` (m, m, m, rad), input ``v = [u, w, r]`` (surge m/s,
 heave m/s, yaw rate rad/s), disturbance ``omega = [omega_1, omega_2, omega_3]``
 (m/s, inertial frame) = current ``delta`` + sway term ``g(x, v_sway)``.
+The disturbance is evaluated (and the plant integrated) in :mod:`tubekit.plant`.
 """
 
 from __future__ import annotations
@@ -18,7 +19,6 @@ __all__ = [
     "SwayModel",
     "nominal_kinematics",
     "kinematics",
-    "sway_velocity_term",
 ]
 
 
@@ -61,10 +61,14 @@ class InputLimits:
 class SwayModel:
     """How the unactuated sway velocity v_s is generated (the paper leaves it open).
 
-    ``v_s = clip(gain * u * r + amplitude * sin(2 pi t / period), -bound, bound)``.
+    ``v_s = gain * u * r + amplitude * sin(2 pi t / period)`` (no clip).
     ``gain * u * r`` is the steady-turn side-slip of a slender hull (sway
     proportional to centripetal acceleration); the sinusoid models wave-induced
-    sway. ``bound`` (m/s) is the paper's v-bar = gamma-bar; the clip enforces it.
+    sway. Over V the model gives |v_s| <= gain u_max r_max + amplitude: that is
+    gamma-bar (the paper's v-bar), derived by the verifier. ``bound`` is the bound
+    the user *declares*; the certificate fails (condition ``sway_bound``) when it
+    is below what the model produces, and every run checks the sway it applied.
+    Evaluated by :meth:`tubekit.plant.Plant.sway_velocity`.
 
     Parameters
     ----------
@@ -75,7 +79,8 @@ class SwayModel:
     period : float
         Wave period (s).
     bound : float
-        Hard bound on |v_s| (m/s); zero disables sway entirely.
+        Declared bound on |v_s| (m/s); must cover gain u_max r_max + amplitude.
+        Set gain = amplitude = 0 for no sway.
     """
 
     gain: float = 0.1
@@ -88,17 +93,6 @@ class SwayModel:
         object.__setattr__(self, "amplitude", nonnegative("sway.amplitude", self.amplitude))
         object.__setattr__(self, "period", positive("sway.period", self.period))
         object.__setattr__(self, "bound", nonnegative("sway.bound", self.bound))
-
-    def velocity(self, t: float, v: np.ndarray) -> float:
-        """Sway velocity v_s (m/s) at time ``t`` (s) under input ``v``."""
-        raw = self.gain * v[0] * v[2] + self.amplitude * np.sin(2.0 * np.pi * t / self.period)
-        return float(np.clip(raw, -self.bound, self.bound))
-
-
-def sway_velocity_term(x: np.ndarray, v_sway: float) -> np.ndarray:
-    """The inner disturbance g(x, v_s) = v_s [-sin psi, cos psi, 0] (m/s), eq. (2)."""
-    psi = x[3]
-    return v_sway * np.array([-np.sin(psi), np.cos(psi), 0.0])
 
 
 def nominal_kinematics(x: np.ndarray, v: np.ndarray) -> np.ndarray:

@@ -60,6 +60,8 @@ class Disturbance:
 
     ``delta(t) = amplitude * [sin(a), cos(a), sin(a)] + constant``,
     ``a = 2 pi t / period``; the paper uses amplitude 0.1 m/s, period 15 s.
+    Evaluated by :class:`tubekit.plant.Plant` (this class only holds the settings
+    and their bounds).
 
     Parameters
     ----------
@@ -86,13 +88,6 @@ class Disturbance:
         object.__setattr__(self, "period", positive("disturbance.period", self.period))
         object.__setattr__(self, "constant",
                            tuple(float(c) for c in as_vector("disturbance.constant", self.constant, 3)))
-
-    def current(self, t: float | np.ndarray) -> np.ndarray:
-        """Current delta(t) (m/s), shape t.shape + (3,)."""
-        a = 2.0 * np.pi * np.asarray(t, dtype=float) / self.period
-        amp = np.asarray(self.amplitude)
-        base = np.stack([np.sin(a), np.cos(a), np.sin(a)], axis=-1) * amp
-        return base + np.asarray(self.constant)
 
     @property
     def current_bound(self) -> float:

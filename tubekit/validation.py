@@ -9,7 +9,7 @@ import numpy as np
 
 from .exceptions import ConfigError, ShapeError
 
-__all__ = ["as_vector", "positive", "nonnegative", "finite"]
+__all__ = ["as_vector", "positive", "nonnegative", "finite", "interval", "positive_triple", "nonnegative_triple"]
 
 
 def finite(field: str, value: Any) -> float:
@@ -39,6 +39,42 @@ def nonnegative(field: str, value: Any) -> float:
     if x < 0.0:
         raise ConfigError(field, "a number >= 0", value)
     return x
+
+
+def interval(field: str, value: Any) -> tuple[float, float]:
+    """Return ``value`` as a non-empty interval ``(lo, hi)`` of finite floats, lo < hi."""
+    try:
+        lo, hi = value
+    except (TypeError, ValueError):
+        raise ConfigError(field, "a pair [lo, hi]", value) from None
+    lo, hi = finite(f"{field}[0]", lo), finite(f"{field}[1]", hi)
+    if not lo < hi:
+        raise ConfigError(field, "lo < hi (a non-empty interval)", [lo, hi])
+    return lo, hi
+
+
+def _triple(field: str, value: Any, strict: bool) -> tuple[float, float, float]:
+    """Three finite floats, each > 0 (``strict``) or >= 0; every failure a :class:`ConfigError`."""
+    try:
+        items = tuple(value)
+    except TypeError:
+        raise ConfigError(field, "three numbers", value) from None
+    if len(items) != 3:
+        raise ConfigError(field, "three numbers", value)
+    out = tuple(finite(f"{field}[{i}]", x) for i, x in enumerate(items))
+    if any((x <= 0) if strict else (x < 0) for x in out):
+        raise ConfigError(field, "three numbers > 0" if strict else "three numbers >= 0", list(out))
+    return out  # type: ignore[return-value]
+
+
+def positive_triple(field: str, value: Any) -> tuple[float, float, float]:
+    """Return ``value`` as a tuple of three floats > 0 or raise :class:`ConfigError`."""
+    return _triple(field, value, strict=True)
+
+
+def nonnegative_triple(field: str, value: Any) -> tuple[float, float, float]:
+    """Return ``value`` as a tuple of three floats >= 0 or raise :class:`ConfigError`."""
+    return _triple(field, value, strict=False)
 
 
 def as_vector(name: str, value: Any, size: int) -> np.ndarray:

@@ -28,7 +28,8 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 import numpy as np
 
-from tubekit import SwayModel, kinematics, nominal_kinematics, paper_scenario
+from tubekit import Disturbance, SwayModel, kinematics, nominal_kinematics, paper_scenario
+from tubekit.plant import Plant
 
 QUICK = os.environ.get("TUBEKIT_QUICK") == "1"
 FIGURES = Path(os.environ.get("TUBEKIT_FIGURES", Path(__file__).resolve().parent / "figures"))
@@ -57,11 +58,12 @@ x0 = np.zeros(4)
 nominal = rk4(lambda t, x: nominal_kinematics(x, v_turn), x0, t_end, dt)
 
 sway = SwayModel(gain=0.5, amplitude=0.0, bound=0.1)  # exaggerated side-slip to make it visible
-with_sway = rk4(lambda t, x: kinematics(x, v_turn, sway.velocity(t, v_turn)
-                                        * np.array([-np.sin(x[3]), np.cos(x[3]), 0.0])), x0, t_end, dt)
+sway_only = Plant(Disturbance(amplitude=(0.0, 0.0, 0.0), sway=sway))  # eq. (11) with sway alone
+with_sway = rk4(lambda t, x: sway_only.rhs(t, x, v_turn), x0, t_end, dt)
 
 dist = paper_scenario().disturbance  # the paper's current, 0.1 m/s amplitude, 15 s period
-with_current = rk4(lambda t, x: kinematics(x, v_turn, dist.current(t)), x0, t_end, dt)
+plant = Plant(dist)
+with_current = rk4(lambda t, x: kinematics(x, v_turn, plant.current(t)), x0, t_end, dt)
 
 print(f"after {t_end:g} s: nominal ends at {nominal[-1, :2].round(2)}, "
       f"with sway at {with_sway[-1, :2].round(2)}, with current at {with_current[-1, :2].round(2)}")

@@ -258,7 +258,7 @@ print(f"max relative gap before the obstacle becomes active: {np.max(np.abs(rel[
 # %%
 ipopt_plan = None
 try:
-    from tubekit.fhocp_ipopt import IpoptFHOCP
+    from tubekit.fhocp import IpoptFHOCP
 
     tb = time.perf_counter()
     ipopt = IpoptFHOCP(scenario, tight, max_obstacles=1)

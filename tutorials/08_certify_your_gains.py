@@ -12,9 +12,10 @@
 # Tutorial 03 showed that the paper's Section VI scenario does not certify, with either law.
 # Here we ask the designer's question: *what would?* Two tools:
 #
-# * `verify.envelope(scenario, law)` searches, by bisection on certified / not certified, the
-#   largest disturbance bound ω̄ and target speed that certify for a grid of ε (the smallest
-#   allowed distance to the target), with everything else as in the scenario;
+# * `verify.envelope(scenario, law, eps=...)` finds, by bisection on certified / not certified,
+#   the largest horizontal disturbance ω̄_xy (current amplitude + sway bound) that certifies for
+#   each target speed, and puts it beside the physical-necessity frontier
+#   min(u_max − speed, r_max ε) that no controller can beat;
 # * building variants by hand — `Scenario.with_changes(...)` for top-level fields and
 #   `dataclasses.replace` for the nested settings — and certifying each one, to see which
 #   condition blocks which design.
@@ -32,7 +33,7 @@ import numpy as np
 from matplotlib.colors import ListedColormap
 
 import verify
-from tubekit import paper_scenario
+from tubekit import load_scenario, paper_scenario
 
 QUICK = os.environ.get("TUBEKIT_QUICK") == "1"
 FIGURES = Path(os.environ.get("TUBEKIT_FIGURES", Path(__file__).resolve().parent / "figures"))
@@ -40,51 +41,20 @@ FIGURES.mkdir(parents=True, exist_ok=True)
 
 # %% [markdown]
 # ## The envelope of the paper's scenario
-# Every point of the search is a full certificate (bounds that do not depend on the varied
-# quantity are cached, so a bisection step costs only the certificate's arithmetic).
-# `quick=True` uses coarser grids and looser (still rigorous) bounds.
+# Every point of the search is a full certificate; the bisection runs a fixed number of steps
+# (a work unit). `quick=True` uses fewer speeds and steps.
 
 # %%
 paper = paper_scenario()
 env_paper = verify.envelope(paper, "corrected", quick=QUICK)
-print(f"scenario: epsilon = {env_paper.epsilon:g} m, omega_bar = {env_paper.omega_bar:.4f} m/s, "
-      f"target speed = {env_paper.speed:.4f} m/s, certified: {env_paper.certified_at_scenario}")
-print(f"largest omega_bar at epsilon = {env_paper.epsilon:g} m: {env_paper.max_omega_bar}")
-print(f"smallest epsilon at omega_bar = {env_paper.omega_bar:.4f} m/s: {env_paper.min_epsilon}")
-print(f"largest target speed at the scenario's epsilon and omega_bar: {env_paper.max_speed}")
-print("\nwhat fails, per epsilon (at the scenario's omega_bar and speed):")
-for e, fails in zip(env_paper.eps_grid, env_paper.failures_by_eps):
-    print(f"  epsilon = {e:6.4g} m: {', '.join(fails) or 'certified'}")
+print(env_paper.summary())
 
 # %% [markdown]
-# Nothing certifies, at any ε in the searched range, for any ω̄ ≥ 0 — at the paper's target
-# speed. The failure lists say why: `keep_up_real[u]` and `keep_up_nominal[u]` fail at every ε.
-# The target moves at 0.377 m/s and the vehicle's surge limit is 0.4 m/s; the remaining
-# 0.023 m/s must pay for the current *and* for the tube feedback. The speed/disturbance
-# trade-off at the paper's ε makes that concrete:
-
-# %%
-print(f"at epsilon = {env_paper.epsilon:g} m: target speed -> largest certifiable omega_bar")
-for sp, w in zip(env_paper.speed_grid, env_paper.omega_max_by_speed):
-    print(f"  {sp:8.5f} m/s -> {'none' if not np.isfinite(w) else f'{w:.5f} m/s'}")
+# At ε = 0.1 m the yaw budget alone caps ω̄_xy at r_max ε = 0.05 m/s, and at the paper's
+# 0.377 m/s keep-up caps it at 0.023 m/s — about the sway bound alone. The paper's current
+# (0.1 m/s plus 0.02 m/s sway) is beyond physics there, whatever the tube.
 
 # %% [markdown]
-# At ε = 0.1 m only an (almost) stationary target certifies, and only against a current
-# of about 2 mm/s. The envelope keeps the region's |e_o| ≤ 0.9; the corrected law's input use
-# grows like 1/√(1 − e_o²), so let us also search with |e_o| ≤ 0.5:
-
-# %%
-paper_eo = paper.with_changes(region=dataclasses.replace(paper.region, e_o_max=0.5))
-env_eo = verify.envelope(paper_eo, "corrected", quick=QUICK)
-print(f"|e_o| <= 0.5: certified at the scenario: {env_eo.certified_at_scenario}; largest omega_bar for a "
-      f"stationary target at epsilon = 0.1 m: {env_eo.omega_max_by_speed[0]:.5f} m/s; "
-      "largest certifiable target speed there: "
-      f"{env_eo.speed_grid[np.isfinite(env_eo.omega_max_by_speed)].max():.4f} m/s")
-
-# %% [markdown]
-# Better by a factor of three to four, still far from the paper's numbers. No single knob of the
-# envelope is enough; we need to change several things at once.
-#
 # ## Variants by hand
 # Starting from the paper's scenario with the corrected law, we change one thing at a time,
 # then combine. Nested settings are frozen dataclasses: `dataclasses.replace` makes a
@@ -161,88 +131,26 @@ print("\n'all four' is verify.certifiable_scenario():",
 #   `controller.ancillary_rate_hz` to allow it).
 
 # %% [markdown]
-# ## How much margin does the certified design have?
-# The envelope of the certifiable scenario answers that.
+# ## How close is the certificate to physics?
+# The envelope of the paper's vehicle against the paper's currents (`paper_currents.toml`)
+# at ε = 0.5 m and 0.3 m: the ratio certified / necessary says what the tube costs.
 
 # %%
-easy = verify.certifiable_scenario()
-env_easy = verify.envelope(easy, quick=QUICK)
-print(f"largest omega_bar at epsilon = {env_easy.epsilon:g} m: {env_easy.max_omega_bar:.4f} m/s "
-      f"(design: {env_easy.omega_bar:.4f})")
-print(f"smallest epsilon at omega_bar = {env_easy.omega_bar:.4f} m/s: {env_easy.min_epsilon:.4f} m "
-      f"(design: {env_easy.epsilon:g})")
-print(f"largest target speed at the design's epsilon and omega_bar: {env_easy.max_speed:.4f} m/s "
-      f"(design: {env_easy.speed:.4f})")
-print(f"stationary target: largest omega_bar = {env_easy.omega_max_by_speed[0]:.4f} m/s")
-print("\nper epsilon:")
-def num(x):
-    return f"{x:8.4g}" if np.isfinite(x) else f"{'-':>8}"
-
-
-for e, w, sp, fails in zip(env_easy.eps_grid, env_easy.omega_max, env_easy.speed_max, env_easy.failures_by_eps):
-    print(f"  epsilon = {e:6.4g} m: largest omega_bar {num(w)} m/s, largest speed {num(sp)} m/s | "
-          f"{', '.join(fails) or 'certified'}")
+currents = load_scenario(verify.SCENARIOS_DIR / "paper_currents.toml")
+envs = {eps: verify.envelope(currents, "corrected", eps=eps, quick=QUICK) for eps in (0.5, 0.3)}
+for env in envs.values():
+    print(env.summary(), end="\n\n")
 
 # %% [markdown]
-# The design sits close to its envelope: about 25 % more current or 6 % more target speed
-# and it no longer certifies. Too small an ε blows up the tube (below ε ≈ 0.47 m the nominal
-# cannot keep up). A somewhat larger ε has more room (ε ≈ 0.58 m certifies up to
-# ω̄ ≈ 0.06 m/s), but too large an ε fails `initial` (the start e_d(0) = 0.8 m must lie in Ē)
-# and then `terminal` (F needs ‖ê‖_P ≤ ε̄ somewhere with e_d ≥ ε + ρ̃).
-# (`verify.plot_envelope(result, path)` draws the standard three-panel plot of one envelope,
-# as `tubekit envelope --plot` does; below we overlay several.)
-#
-# ## The figures
-# `08_envelope.png`: left, the speed/disturbance trade-off at each scenario's ε (paper,
-# paper with |e_o| ≤ 0.5, certifiable) with the designs starred; middle, the certifiable
-# scenario's (ε, ω̄) grid with its largest-ω̄ curve; right, the largest target speed per ε.
+# `08_envelope.png` (drawn by `tubekit.app.plots.envelope_figure`, as `tubekit envelope --plot`
+# does): both frontiers at each ε, the certified region shaded, the reference points marked.
 
 # %%
-fig, axes = plt.subplots(1, 3, figsize=(17, 4.8), layout="constrained")
-ax = axes[0]
-for env, label, col in ((env_paper, "paper (eps 0.1 m, |e_o| <= 0.9)", "tab:red"),
-                        (env_eo, "paper, |e_o| <= 0.5", "tab:orange"),
-                        (env_easy, "certifiable (eps 0.5 m, |e_o| <= 0.5)", "tab:green")):
-    ok = np.isfinite(env.omega_max_by_speed) & (env.omega_max_by_speed > 0)
-    ax.plot(env.speed_grid[ok], env.omega_max_by_speed[ok], "o-", ms=3, color=col, label=label)
-    if env is not env_eo:      # same design point as the paper's
-        ax.plot([env.speed], [env.omega_bar], "*", ms=14, color=col, mec="k")
-ax.set_yscale("log")
-ax.set_ylim(1e-4, 0.5)
-ax.set_xlabel("horizontal target speed (m/s)")
-ax.set_ylabel("largest certifiable omega_bar (m/s)")
-ax.set_title("certifiable below each curve (stars: the designs)")
-ax.annotate(f"paper design ({env_paper.speed:.3g} m/s, {env_paper.omega_bar:.3g} m/s)",
-            (env_paper.speed, env_paper.omega_bar), xytext=(0.2, 0.3), fontsize=8,
-            arrowprops=dict(arrowstyle="->", color="0.3"))
-ax.legend(fontsize=8, loc="lower right")
+from tubekit.app.plots import envelope_figure
 
-ax = axes[1]
-E, W = np.meshgrid(env_easy.eps_grid, env_easy.omega_grid, indexing="ij")
-g = env_easy.certified_grid
-ax.scatter(E[g], W[g], s=14, c="tab:green", label="certified")
-ax.scatter(E[~g], W[~g], s=8, c="lightgray", label="not certified")
-ax.plot(env_easy.eps_grid, env_easy.omega_max, "-", color="tab:green", label="largest certifiable omega_bar")
-ax.plot([env_easy.epsilon], [env_easy.omega_bar], "k*", ms=14, label="certifiable design")
-ax.set_xscale("log")
-ax.set_xlabel("epsilon = min e_d (m)")
-ax.set_ylabel("omega_bar (m/s)")
-ax.set_title(f"certifiable scenario: target speed {env_easy.speed:.3g} m/s")
-ax.legend(fontsize=8)
-
-ax = axes[2]
-ax.plot(env_easy.eps_grid, env_easy.speed_max, "o-", color="tab:green", ms=4,
-        label=f"certifiable scenario (omega_bar = {env_easy.omega_bar:.3g} m/s)")
-ax.plot(env_paper.eps_grid, np.nan_to_num(env_paper.speed_max, nan=0.0), "x", color="tab:red",
-        label=f"paper scenario (omega_bar = {env_paper.omega_bar:.3g} m/s): none")
-ax.axhline(env_paper.speed, color="tab:red", ls="--", lw=1, label=f"paper's target speed {env_paper.speed:.3g} m/s")
-ax.axhline(env_easy.speed, color="tab:green", ls="--", lw=1, label=f"certifiable design {env_easy.speed:.3g} m/s")
-ax.set_xscale("log")
-ax.set_xlabel("epsilon = min e_d (m)")
-ax.set_ylabel("largest certifiable target speed (m/s)")
-ax.set_title("largest target speed per epsilon (x: none certifies)")
-ax.legend(fontsize=8)
-fig.savefig(FIGURES / "08_envelope.png", dpi=110)
+for eps, env in envs.items():
+    envelope_figure(env).savefig(FIGURES / f"08_envelope_eps{eps:g}.png", dpi=110)
+envelope_figure(envs[0.5]).savefig(FIGURES / "08_envelope.png", dpi=110)
 print("wrote", FIGURES / "08_envelope.png")
 
 # %% [markdown]
@@ -281,7 +189,8 @@ print("wrote", FIGURES / "08_variants.png")
 # %% [markdown]
 # To certify your own design: change the scenario (TOML or `with_changes`), run
 # `verify.certify` (or `tubekit certify my.toml`), read the failed conditions' two sides, and
-# use `verify.envelope` (`tubekit envelope my.toml`) to see how far each knob would have to move.
+# use `verify.envelope` (`tubekit envelope my.toml --eps E`) to see how much current each target speed
+# can certify, and `tubekit certify my.toml --search-region` to find a region (e_o_max, e_d_max) that certifies.
 # Once it certifies, `certificate.tightening()` hands V̄, Ē and the obstacle margin to the
 # FHOCP (tutorial 04).
 

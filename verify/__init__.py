@@ -9,6 +9,9 @@ See ``docs/verify.md``.
 Submodules for property-based testing: :mod:`verify.strategies` (hypothesis
 strategies), :mod:`verify.invariance` (rho^T rho_dot at a configuration) and
 :mod:`verify.falsify` (the falsifier behind ``tubekit falsify``).
+
+verify imports the tubekit core only: no argparse, no matplotlib. The envelope plot
+is :func:`tubekit.app.plots.plot_envelope` (it was ``verify.plot_envelope``).
 """
 
 from __future__ import annotations
@@ -19,7 +22,7 @@ from tubekit.scenario import Scenario, load_scenario
 
 from .bounds import BOUND_NAMES, BoundResult, Bounds, compute_bounds
 from .certificate import Certificate, Condition, NotCertifiedError, certify
-from .envelope import EnvelopeResult, envelope, plot_envelope
+from .envelope import EnvelopeResult, envelope
 from .region import Region
 
 __version__ = "0.1.0"
@@ -46,7 +49,14 @@ __all__ = [
     "BOUND_NAMES",
     "envelope",
     "EnvelopeResult",
-    "plot_envelope",
     "SCENARIOS_DIR",
     "certifiable_scenario",
 ]
+
+
+def __getattr__(name: str):
+    """Point the moved ``plot_envelope`` at its new home instead of a bare AttributeError."""
+    if name == "plot_envelope":
+        raise AttributeError("verify.plot_envelope moved to tubekit.app.plots.plot_envelope "
+                             "(verify imports no plotting library)")
+    raise AttributeError(f"module 'verify' has no attribute {name!r}")

@@ -1,21 +1,13 @@
 """Certified bounds L1, L2, J_lower, xi_bar (and the auxiliary sups) by branch-and-bound.
 
-The dynamics are always the *derived* ones (:func:`tubekit.derivation.derive`).
-They are rewritten in polar form (:func:`polar_model`) by substituting
-
-    e_x = e_d cos(theta),  e_y = e_d sin(theta),  psi = theta + phi,
-    sin(phi) = e_o,  cos(phi) = c = s sqrt(1 - e_o^2)   (s = -1 toward, +1 away),
-    [xdot_d, ydot_d] = a n_theta + b t_theta,  [omega_1, omega_2] = alpha n_theta + beta t_theta,
-
-with n_theta = (cos theta, sin theta), t_theta = (-sin theta, cos theta). sympy
-then cancels theta, and derivatives w.r.t. e are taken at fixed theta and fixed
-Cartesian velocities (dc/de_o = -e_o / c). Because (a, b) is a rotation of
-p_d_dot_xy and the region's velocity set is contained in the disc of radius
-``pd_dot_xy_max`` (rotation invariant), a sup over all bearings and velocities
-equals a sup over (a, b) in that disc. Each sup of a convex function of the
-linear parameters (v_hat, p_d_dot) is taken at extreme points: vertices of
-boxes, the circle a = h cos(gamma), b = h sin(gamma) of the disc. omega enters
-xi linearly, so sup over the ball is omega_bar * ||d xi / d omega||_2.
+The objectives are matrices of the polar-form model (:mod:`verify.polar`).
+Because (a, b) is a rotation of p_d_dot_xy and the region's velocity set is
+contained in the disc of radius ``pd_dot_xy_max`` (rotation invariant), a sup
+over all bearings and velocities equals a sup over (a, b) in that disc. Each sup
+of a convex function of the linear parameters (v_hat, p_d_dot) is taken at
+extreme points: vertices of boxes, the circle a = h cos(gamma), b = h sin(gamma)
+of the disc. omega enters xi linearly, so sup over the ball is
+omega_bar * ||d xi / d omega||_2.
 
 Objectives are enclosed in Arb (:mod:`verify.intervals`): a matrix 2-norm as
 sqrt(lambda_max(A^T A)) of the symbolically simplified Gram matrix, lambda_min of
@@ -34,10 +26,12 @@ import sympy as sp
 from flint import arb
 
 from tubekit.ancillary import LAWS
-from tubekit.derivation import derive, symbols
+from tubekit.derivation import symbols
 from tubekit.exceptions import ConfigError, TubekitError
 
 from .intervals import Case, MaxResult, compile_arb, compile_numpy, maximise, point, sym_eig_bounds, upper
+from .polar import (A_V, B_V, E_D, E_O, E_Z, GAMMA, H_XY, P_Z, R_M, THETA, U_M, W_M, PolarModel, law_gain,
+                    polar_model)
 from .region import Region
 
 __all__ = [
@@ -53,152 +47,15 @@ __all__ = [
 #: Reported bounds: the four of issue item 2 and the auxiliary sups the certificate uses.
 BOUND_NAMES = ("L1", "L2", "J_lower", "xi_bar", "zeta_theta", "K_row_u", "K_row_w", "K_row_r", "JK_norm")
 
-# polar-form symbols
-E_D = sp.Symbol("e_d", positive=True)
-E_Z = sp.Symbol("e_z", real=True)
-E_O = sp.Symbol("e_o", real=True)
-_C = sp.Symbol("c", real=True)          # cos(psi - theta), eliminated before evaluation
-THETA = sp.Symbol("theta", real=True)
-A_V, B_V = sp.symbols("a b", real=True)              # target velocity along n_theta, t_theta
-ALPHA, BETA = sp.symbols("alpha beta", real=True)    # disturbance along n_theta, t_theta
-GAMMA = sp.Symbol("gamma", real=True)                # angle on the velocity disc
-H_XY, P_Z = sp.symbols("h_xy p_z", nonnegative=True)  # velocity-set parameters
-U_M, W_M, R_M = sp.symbols("u_max w_max r_max", positive=True)  # input-box parameters
-_PHI = sp.Symbol("phi", real=True)
-
-
-@dataclass(frozen=True)
-class PolarModel:
-    """The derived error dynamics in polar form for one hemisphere sign ``s``.
-
-    All matrices are sympy expressions in ``e_d, e_z, e_o`` (c already replaced
-    by s sqrt(1 - e_o^2)) and the named parameters.
-
-    Attributes
-    ----------
-    s : int
-        Hemisphere sign.
-    J : Matrix (3, 3)
-        Input matrix J(e).
-    zeta : Matrix (3, 1)
-        Drift in terms of a, b, zdot_d.
-    xi : Matrix (3, 1)
-        Disturbance term in terms of alpha, beta, omega_3.
-    dh_de : Matrix (3, 3)
-        d (J(e) v_hat) / d e in terms of u, w, r.
-    dzeta_de : Matrix (3, 3)
-        d zeta / d e at fixed bearing and Cartesian velocity.
-    dzeta_dtheta : Matrix (3, 1)
-        d zeta / d theta at fixed e and Cartesian velocity.
-    dxi_domega : Matrix (3, 3)
-        d xi / d (alpha, beta, omega_3); xi is linear in omega.
-    zeta_rotation_form : bool
-        zeta = zeta_0(e, zdot_d) + G(e) [a, b]^T with no other bearing dependence
-        (verified symbolically), so zeta(e, theta) - zeta(e, theta_hat) =
-        G (R_theta - R_theta_hat)^T p_d_dot_xy and its norm is at most
-        sup||d zeta/d theta|| * 2 |sin((theta - theta_hat)/2)|.
-    """
-
-    s: int
-    J: sp.Matrix
-    zeta: sp.Matrix
-    xi: sp.Matrix
-    dh_de: sp.Matrix
-    dzeta_de: sp.Matrix
-    dzeta_dtheta: sp.Matrix
-    dxi_domega: sp.Matrix
-    zeta_rotation_form: bool = False
-
-
-def _c_expr(s: int) -> sp.Expr:
-    return s * sp.sqrt(1 - E_O**2)
-
-
-def _to_polar(M: sp.Matrix, extra: dict) -> sp.Matrix:
-    """Substitute the polar coordinates and the rotated velocities; simplify with c kept symbolic."""
-    sy = symbols()
-    sub = {sy["e_x"]: E_D * sp.cos(THETA), sy["e_y"]: E_D * sp.sin(THETA), sy["psi"]: THETA + _PHI}
-    out = M.subs(sub).subs(extra)
-    out = out.applyfunc(lambda x: sp.expand_trig(sp.expand(x)))
-    out = out.subs({sp.sin(_PHI): E_O, sp.cos(_PHI): _C})
-    out = out.applyfunc(lambda x: sp.simplify(sp.trigsimp(x)))
-    if _PHI in out.free_symbols:
-        raise TubekitError("polar_model: psi - theta did not reduce to (e_o, c)")
-    return out
-
-
-def _d_de(M: sp.Matrix) -> sp.Matrix:
-    """d M / d [e_d, e_z, e_o] at fixed theta with c = c(e_o), dc/de_o = -e_o / c."""
-    cols = [M.diff(E_D), M.diff(E_Z), M.diff(E_O) + M.diff(_C) * (-E_O / _C)]
-    return sp.Matrix.hstack(*cols)
-
-
-def _finish(M: sp.Matrix, s: int) -> sp.Matrix:
-    return M.subs(_C, _c_expr(s)).applyfunc(sp.simplify)
-
-
-@lru_cache(maxsize=4)
-def polar_model(s: int) -> PolarModel:
-    """Derive the polar-form model for hemisphere sign ``s`` (-1 toward, +1 away); cached."""
-    if s not in (-1, 1):
-        raise ConfigError("hemisphere sign", "-1 or +1", s)
-    d = derive()
-    sy = symbols()
-    vel = {sy["xdot_d"]: A_V * sp.cos(THETA) - B_V * sp.sin(THETA),
-           sy["ydot_d"]: A_V * sp.sin(THETA) + B_V * sp.cos(THETA)}
-    om = {sy["omega_1"]: ALPHA * sp.cos(THETA) - BETA * sp.sin(THETA),
-          sy["omega_2"]: ALPHA * sp.sin(THETA) + BETA * sp.cos(THETA)}
-    J = _to_polar(d.J, {})
-    zeta = _to_polar(d.zeta, vel)
-    xi = _to_polar(d.xi, om)
-    # d zeta / d theta at fixed Cartesian velocity: differentiate before rotating the velocity.
-    sub = {sy["e_x"]: E_D * sp.cos(THETA), sy["e_y"]: E_D * sp.sin(THETA), sy["psi"]: THETA + _PHI}
-    dth = _to_polar(d.zeta.subs(sub).diff(THETA), vel)
-    u, w, r = sy["u"], sy["w"], sy["r"]
-    dh = _d_de(J * sp.Matrix([u, w, r]))
-    dz = _d_de(zeta)
-    om_vec = [ALPHA, BETA, sy["omega_3"]]
-    dxi = xi.jacobian(om_vec)
-    if (xi - dxi * sp.Matrix(om_vec)).applyfunc(sp.simplify) != sp.zeros(3, 1):
-        raise TubekitError("polar_model: xi is not linear in omega; the ball formula does not apply")
-    G = zeta.jacobian([A_V, B_V])
-    rot = (THETA not in zeta.free_symbols and THETA not in G.free_symbols
-           and A_V not in G.free_symbols and B_V not in G.free_symbols
-           and (dth - G * sp.Matrix([B_V, -A_V])).applyfunc(sp.simplify) == sp.zeros(3, 1))
-    return PolarModel(s=s, J=_finish(J, s), zeta=_finish(zeta, s), xi=_finish(xi, s), dh_de=_finish(dh, s),
-                      dzeta_de=_finish(dz, s), dzeta_dtheta=_finish(dth, s), dxi_domega=_finish(dxi, s),
-                      zeta_rotation_form=bool(rot))
-
-
-
-@lru_cache(maxsize=8)
-def law_gain(law: str, s: int) -> tuple[sp.Matrix, sp.Matrix]:
-    """Symbolic (K(e), J(e) K(e)) of an ancillary law in hemisphere ``s``.
-
-    The symbolic gain is the law's ``symbolic_gain`` in :data:`tubekit.ancillary.LAWS`
-    (K = I for ``paper``, K = J^-1 for ``corrected``, or a registered user law); the
-    tests cross-check it against the numeric gain.
-    """
-    if law not in LAWS:
-        raise ConfigError("law", f"one of {tuple(LAWS)}", law)
-    gain = LAWS[law].symbolic_gain
-    if gain is None:
-        raise ConfigError("law", "a law with a symbolic gain (AncillaryLaw.symbolic_gain)", law,
-                          "a law without one can be simulated and falsified, not certified")
-    J = polar_model(s).J
-    K = sp.Matrix(gain(J))
-    if K.shape != (3, 3):
-        raise ConfigError("law.symbolic_gain", "a map returning a 3x3 sympy Matrix", K.shape)
-    JK = (J * K).applyfunc(sp.simplify)
-    return K, JK
-
 
 # --------------------------------------------------------------------------- objectives
 def _gram(A: sp.Matrix) -> sp.Matrix:
+    """A^T A, simplified."""
     return (A.T * A).applyfunc(sp.simplify)
 
 
 def _dims(expr_syms: set, region: Region) -> list[tuple[sp.Symbol, float, float]]:
+    """(symbol, lo, hi) of the branch-and-bound dimensions an objective depends on (m, -, rad)."""
     dims = []
     for sym, rng in ((E_D, region.e_d), (E_Z, region.e_z), (E_O, region.e_o), (THETA, (0.0, 2 * math.pi)),
                      (GAMMA, (0.0, 2 * math.pi))):
@@ -336,7 +193,7 @@ class BoundResult:
     gap : float
         |bound - sampled| / |sampled|.
     converged : bool
-        Whether the target gap was reached within the time budget.
+        Whether the target gap was reached within the box budget.
     holds_over : str
         The set the bound holds over.
     quantity : str
@@ -383,6 +240,7 @@ class Bounds:
         return sum(b.elapsed_s for b in self.items.values())
 
     def to_dict(self) -> dict:
+        """``{name: BoundResult.to_dict()}``."""
         return {k: v.to_dict() for k, v in self.items.items()}
 
 
@@ -400,6 +258,7 @@ _QUANTITY = {
 
 
 def _holds_over(name: str, region: Region) -> str:
+    """Printable description of the set bound ``name`` holds over."""
     e = (f"e in R (e_d in [{region.e_d[0]:.6g}, {region.e_d[1]:.6g}], e_z in [{region.e_z[0]:.6g}, "
          f"{region.e_z[1]:.6g}], e_o in [{region.e_o[0]:.6g}, {region.e_o[1]:.6g}], heading {region.heading})")
     th = "any bearing theta"
@@ -411,42 +270,43 @@ def _holds_over(name: str, region: Region) -> str:
             "zeta_theta": f"{e}, {th}, {pd}"}.get(name, e)
 
 
+def _hemisphere_cases(name: str, law: str, s: int, region: Region, par: dict[str, float]) -> list[Case]:
+    """The branch-and-bound cases of bound ``name`` in hemisphere ``s`` (extreme points of its parameters)."""
+    pm = polar_model(s)
+    hem = "toward" if s < 0 else "away"
+    if name == "L1":
+        sy = symbols()
+        box = {sy["u"]: U_M, sy["w"]: W_M, sy["r"]: R_M}
+        vals = {U_M: par["u"], W_M: par["w"], R_M: par["r"]}
+        return [_case("norm", A, region, vals, f"{hem} {lab}".strip()) for A, lab in _vertex_cases(pm.dh_de, box)]
+    if name in ("L2", "zeta_theta"):
+        M = pm.dzeta_de if name == "L2" else pm.dzeta_dtheta
+        vals = {H_XY: par["h_xy"], P_Z: par["p_z"]}
+        return [_case("norm", A, region, vals, f"{hem} {lab}".strip()) for A, lab in _velocity_cases(M)]
+    if name == "xi_bar":
+        return [_case("norm", pm.dxi_domega, region, {}, hem)]
+    if name == "J_lower":
+        return [_case("lmin", law_gain(law, s)[1], region, {}, hem)]
+    if name == "JK_norm":
+        return [_case("norm", law_gain(law, s)[1], region, {}, hem)]
+    if name.startswith("K_row_"):
+        i = "uwr".index(name[-1])
+        return [_case("norm", law_gain(law, s)[0][i, :].T, region, {}, hem)]
+    raise ConfigError("bound", f"one of {BOUND_NAMES}", name)
+
+
 @lru_cache(maxsize=512)
 def _solve(name: str, law: str, signs: tuple, e_d: tuple, e_z: tuple, e_o: tuple, params: tuple,
-           gap: float, budget: float) -> MaxResult:
+           gap: float, budget: int) -> MaxResult:
+    """Branch-and-bound maximum of bound ``name`` over the error box (hashable arguments: cached)."""
     region = Region(e_d=e_d, e_z=e_z, e_o=e_o, heading="both" if len(signs) == 2 else
                     ("toward" if signs[0] < 0 else "away"), pd_dot_max=(0.0, 0.0, 0.0), pd_dot_xy_max=0.0,
                     omega_bar=0.0, v_max=(1.0, 1.0, 1.0))
     par = dict(params)
-    sy = symbols()
     cases: list[Case] = []
     for s in signs:
-        pm = polar_model(s)
-        hem = "toward" if s < 0 else "away"
-        if name == "L1":
-            box = {sy["u"]: U_M, sy["w"]: W_M, sy["r"]: R_M}
-            vals = {U_M: par["u"], W_M: par["w"], R_M: par["r"]}
-            for A, lab in _vertex_cases(pm.dh_de, box):
-                cases.append(_case("norm", A, region, vals, f"{hem} {lab}".strip()))
-        elif name in ("L2", "zeta_theta"):
-            M = pm.dzeta_de if name == "L2" else pm.dzeta_dtheta
-            for A, lab in _velocity_cases(M):
-                cases.append(_case("norm", A, region, {H_XY: par["h_xy"], P_Z: par["p_z"]}, f"{hem} {lab}".strip()))
-        elif name == "xi_bar":
-            cases.append(_case("norm", pm.dxi_domega, region, {}, hem))
-        elif name == "J_lower":
-            _, JK = law_gain(law, s)
-            cases.append(_case("lmin", JK, region, {}, hem))
-        elif name == "JK_norm":
-            _, JK = law_gain(law, s)
-            cases.append(_case("norm", JK, region, {}, hem))
-        elif name.startswith("K_row_"):
-            K, _ = law_gain(law, s)
-            i = "uwr".index(name[-1])
-            cases.append(_case("norm", K[i, :].T, region, {}, hem))
-        else:
-            raise ConfigError("bound", f"one of {BOUND_NAMES}", name)
-    return maximise(cases, gap=gap, time_budget_s=budget)
+        cases.extend(_hemisphere_cases(name, law, s, region, par))
+    return maximise(cases, gap=gap, max_boxes=budget)
 
 
 @lru_cache(maxsize=8)
@@ -464,7 +324,7 @@ def _linear_in_speed(name: str, s: int) -> bool:
     return zero == sp.zeros(*M.shape) and all(d == sp.zeros(*M.shape) for d in second)
 
 
-def compute_bounds(region: Region, law: str, *, gap: float = 0.05, time_budget_s: float = 3.0) -> Bounds:
+def compute_bounds(region: Region, law: str, *, gap: float = 0.05, max_boxes: int = 20000) -> Bounds:
     """Certify every bound of :data:`BOUND_NAMES` over ``region`` for ``law``.
 
     Parameters
@@ -475,8 +335,9 @@ def compute_bounds(region: Region, law: str, *, gap: float = 0.05, time_budget_s
         Ancillary law name (``paper`` or ``corrected``).
     gap : float
         Target relative gap between sampled and certified value (default 5 %).
-    time_budget_s : float
-        Branch-and-bound budget per bound (s); the gap reached is reported either way.
+    max_boxes : int
+        Branch-and-bound budget per bound (boxes: a work unit, so the result does not depend on
+        machine load); the gap reached is reported either way.
 
     Returns
     -------
@@ -487,37 +348,50 @@ def compute_bounds(region: Region, law: str, *, gap: float = 0.05, time_budget_s
         raise ConfigError("law", f"one of {tuple(LAWS)}", law)
     if not (0 < gap < 1):
         raise ConfigError("gap", "a number in (0, 1)", gap)
-    if not (time_budget_s > 0 and math.isfinite(time_budget_s)):
-        raise ConfigError("time_budget_s", "a finite number > 0", time_budget_s)
+    if not isinstance(max_boxes, int) or isinstance(max_boxes, bool) or max_boxes < 1:
+        raise ConfigError("max_boxes", "an integer >= 1", max_boxes)
     signs = region.hemisphere_signs
     common = (signs, region.e_d, region.e_z, region.e_o)
+    params, scale = _solver_parameters(region)
+    items: dict[str, BoundResult] = {}
+    for name in BOUND_NAMES:
+        key_law = law if name in ("J_lower", "JK_norm") or name.startswith("K_row_") else ""
+        info0 = _solve.cache_info().hits
+        res = _solve(name, key_law or "paper", *common, params.get(name, ()), float(gap), int(max_boxes))
+        cached = _solve.cache_info().hits > info0
+        items[name] = _bound_result(name, res, scale.get(name), region, cached)
+    return Bounds(law=law, items=items)
+
+
+def _solver_parameters(region: Region) -> tuple[dict[str, tuple], dict[str, float]]:
+    """Per-bound solver parameters (hashable) and the factors the solved sups are scaled by.
+
+    Sups that are homogeneous of degree 1 in a scalar parameter are solved at
+    parameter 1 and scaled: ``xi_bar`` by omega_bar (m/s), and ``L2`` /
+    ``zeta_theta`` by the horizontal target speed (m/s) when linear in it.
+    """
     params = {
         "L1": (("r", region.v_max[2]), ("u", region.v_max[0]), ("w", region.v_max[1])),
         "L2": (("h_xy", region.pd_dot_xy_max), ("p_z", region.pd_dot_max[2])),
         "zeta_theta": (("h_xy", region.pd_dot_xy_max), ("p_z", region.pd_dot_max[2])),
     }
-    # sups that are homogeneous of degree 1 in a scalar parameter are solved at parameter 1 and scaled
     scale = {"xi_bar": region.omega_bar}
     for name in ("L2", "zeta_theta"):
-        if all(_linear_in_speed(name, s) for s in signs):
+        if all(_linear_in_speed(name, s) for s in region.hemisphere_signs):
             params[name] = (("h_xy", 1.0), ("p_z", 0.0))
             scale[name] = region.pd_dot_xy_max
-    items: dict[str, BoundResult] = {}
-    for name in BOUND_NAMES:
-        key_law = law if name in ("J_lower", "JK_norm") or name.startswith("K_row_") else ""
-        info0 = _solve.cache_info().hits
-        res = _solve(name, key_law or "paper", *common, params.get(name, ()), float(gap), float(time_budget_s))
-        cached = _solve.cache_info().hits > info0
-        sampled, bound = res.sampled, res.bound
-        if name == "J_lower":
-            sampled, bound = -sampled, -res.bound
-        if name in scale:
-            k = scale[name]
-            sampled = sampled * k
-            bound = upper(arb(res.bound) * arb(k)) if math.isfinite(res.bound) else math.inf
-        items[name] = BoundResult(name=name, sampled=float(sampled), bound=float(bound), gap=float(res.gap),
-                                  converged=res.converged, holds_over=_holds_over(name, region),
-                                  quantity=_QUANTITY[name], boxes=res.boxes,
-                                  elapsed_s=0.0 if cached else res.elapsed_s, argmax=dict(res.argmax[1],
-                                                                                          case=res.argmax[0]))
-    return Bounds(law=law, items=items)
+    return params, scale
+
+
+def _bound_result(name: str, res: MaxResult, scale: float | None, region: Region, cached: bool) -> BoundResult:
+    """The reported :class:`BoundResult` of a solved sup: sign-flipped for ``J_lower``, scaled by ``scale``."""
+    sampled, bound = res.sampled, res.bound
+    if name == "J_lower":
+        sampled, bound = -sampled, -res.bound
+    if scale is not None:
+        sampled = sampled * scale
+        bound = upper(arb(res.bound) * arb(scale)) if math.isfinite(res.bound) else math.inf
+    return BoundResult(name=name, sampled=float(sampled), bound=float(bound), gap=float(res.gap),
+                       converged=res.converged, holds_over=_holds_over(name, region), quantity=_QUANTITY[name],
+                       boxes=res.boxes, elapsed_s=0.0 if cached else res.elapsed_s,
+                       argmax=dict(res.argmax[1], case=res.argmax[0]))

@@ -1,27 +1,25 @@
-"""The falsifier: search for a configuration where the tube is not invariant.
+"""The falsifiers: one sampled-data period (pointwise) and whole closed-loop runs.
 
-It looks for a point on the tube boundary (||rho|| = rho-tilde) where
-rho^T rho_dot > 0, always under the derived dynamics
-(:func:`verify.invariance.rho_dot_inner`). Stage 1 is hypothesis (``find`` guided
-by ``target`` on rho^T rho_dot; a counterexample found there is shrunk). If none is
-found, stage 2 runs a bounded local optimisation (scipy Powell) from the worst
-configuration seen, over exactly the set the strategies sample
-(:func:`verify.strategies.configuration_from_unit`).
+The certificate (:mod:`verify.sampled`) claims: from any state with ρ = 0 at a
+sample (the nominal reset), one period of the sampled-data loop keeps
+max_j |e_j - ê_j| / tube_j <= 1. :func:`falsify` searches the starts of one period
+(e in Ē, v̂ in V̄, constant ω with ‖ω_xy‖ <= ω̄_xy and |ω_z| <= ω̄_z, p_d_dot in P)
+for a ratio above 1, always with the loop's own law, plant and exact nominal arc
+(:func:`verify.invariance.one_period_ratio`). Stage 1 is hypothesis (``find``
+guided by ``target``; a counterexample is shrunk); if none is found, stage 2 runs a
+bounded Powell search from random points of the same unit cube
+(:func:`verify.strategies.period_configuration_from_unit`).
 
-The search space comes from a certificate: its region, its sigma, rho-tilde and
-bearing-mismatch bound Delta-theta, and V-bar for v_hat. For a design that does not
-certify, the certificate's best-effort tightening supplies sigma, rho-tilde and V-bar.
+:func:`falsify_closed_loop` (:mod:`verify.falsify_loop`) attacks whole runs of
+:func:`tubekit.closed_loop.simulate` with disturbance sequences.
 """
 
 from __future__ import annotations
 
-import argparse
-import json
 import math
 import random
 import time
 from dataclasses import dataclass, replace
-from pathlib import Path
 
 import numpy as np
 from hypothesis import HealthCheck, Phase, find, settings, target
@@ -30,51 +28,77 @@ from scipy.optimize import minimize
 
 from tubekit.ancillary import AncillaryLaw, get_law
 from tubekit.exceptions import ConfigError
-from tubekit.scenario import Scenario, load_scenario, paper_scenario
+from tubekit.scenario import Scenario
 
-from .invariance import TubeConfiguration, rho_dot_inner
+from .falsify_loop import ClosedLoopResult, LoopRun, falsify_closed_loop
+from .invariance import TubeConfiguration, one_period_ratio
 from .region import Region
-from .strategies import CONFIGURATION_DIM, configuration_from_unit, tube_configurations
+from .strategies import PERIOD_DIM, period_configuration_from_unit, period_configurations
 
-__all__ = ["FalsifyResult", "SearchSpace", "search_space", "falsify", "configure_falsify", "run_falsify"]
+__all__ = ["FalsifyResult", "SearchSpace", "search_space", "falsify", "VIOLATION_TOL", "falsify_closed_loop",
+           "ClosedLoopResult", "LoopRun"]
 
-#: rho^T rho_dot above this (m^2/s in error units) counts as a violation.
-VIOLATION_TOL = 1e-10
+#: A one-period ratio above 1 + this counts as a violation.
+VIOLATION_TOL = 1e-9
 
 
 @dataclass(frozen=True)
 class SearchSpace:
-    """What the falsifier searches over: a region, the tube and the law's gain."""
+    """What the falsifier searches over, all from a certificate (units m, m/s, rad, rad/s, s).
+
+    ``start`` is Ē (e_d, e_z, e_o intervals an accepted plan starts from), ``tube`` the per-axis
+    one-period tube, ``theta`` its bearing bound, ``omega_bar`` = (ω̄_xy, ω̄_z), ``tick`` = 1 / f and
+    ``ticks`` per period.
+    """
 
     region: Region
     law: str
     sigma: float
-    rho_tilde: float
-    delta_theta: float
+    tube: tuple[float, float, float]
+    theta: float
     v_bar: tuple[float, float, float]
+    omega_bar: tuple[float, float]
+    start: tuple[tuple[float, float], ...]
+    tick: float
+    ticks: int
     certified: bool
+
+    def to_dict(self) -> dict:
+        """JSON form."""
+        return {"region": self.region.to_dict(), "sigma": self.sigma, "tube": list(self.tube), "theta": self.theta,
+                "v_bar": list(self.v_bar), "omega_bar": list(self.omega_bar),
+                "start": [list(b) for b in self.start], "tick": self.tick, "ticks": self.ticks,
+                "certified": self.certified}
 
 
 def search_space(scenario: Scenario, law: str | None = None, *, sigma: float | None = None,
-                 rho_tilde: float | None = None, certificate=None) -> SearchSpace:
-    """Build the search space from ``certificate`` (computed with :func:`verify.certify` if None)."""
+                 certificate=None) -> SearchSpace:
+    """Build the search space from ``certificate`` (computed with :func:`verify.certify` if None).
+
+    ``sigma`` overrides the gain attacked (the tube stays the certificate's).
+    """
     from .certificate import certify
 
     law = scenario.controller.law if law is None else law
     get_law(law)
     cert = certificate if certificate is not None else certify(scenario, law)
     tight = cert.tightening(allow_uncertified=True)
-    dtheta = cert.rho.get("delta_theta")
+    tube = tuple(float(x) for x in cert.tube["rho"])
+    if not all(math.isfinite(x) and x > 0 for x in tube):
+        raise ConfigError("tube", "a certificate with a finite one-period tube", list(tube),
+                          "the design has no tube to attack")
+    ctrl = scenario.controller
+    ticks = int(round(ctrl.ancillary_rate_hz * ctrl.dt))
+    theta = float(cert.tube.get("theta", math.pi))
     space = SearchSpace(
-        region=cert.region, law=law,
-        sigma=float(sigma if sigma is not None else tight.sigma),
-        rho_tilde=float(rho_tilde if rho_tilde is not None else tight.rho_tilde),
-        delta_theta=float(dtheta) if dtheta is not None and math.isfinite(dtheta) else math.pi,
-        v_bar=tuple(float(x) for x in tight.v_max), certified=bool(cert.certified))
+        region=cert.region, law=law, sigma=float(sigma if sigma is not None else cert.design.sigma), tube=tube,
+        theta=theta if math.isfinite(theta) else math.pi, v_bar=tuple(float(x) for x in tight.v_max),
+        omega_bar=(float(cert.disturbance.omega_xy), float(cert.disturbance.omega_z)),
+        start=((float(tight.e_d_min), float(tight.e_d_max)), (-float(tight.e_z_max), float(tight.e_z_max)),
+               (-float(tight.e_o_max), float(tight.e_o_max))),
+        tick=ctrl.dt / ticks, ticks=ticks, certified=bool(cert.certified))
     if not space.sigma > 0:
         raise ConfigError("sigma", "a number > 0", space.sigma)
-    if not space.rho_tilde > 0:
-        raise ConfigError("rho_tilde", "a number > 0", space.rho_tilde)
     return space
 
 
@@ -85,13 +109,13 @@ class FalsifyResult:
     Attributes
     ----------
     found : bool
-        A configuration with rho^T rho_dot > 0 was found.
+        A start with one-period ratio max_j |rho_j| / tube_j > 1 was found.
     counterexample : TubeConfiguration or None
         The (shrunk, when from stage 1) counterexample.
     value : float
-        rho^T rho_dot at the counterexample, else at the worst configuration seen.
+        The ratio at the counterexample, else at the worst configuration seen.
     worst : TubeConfiguration
-        The configuration with the largest rho^T rho_dot seen.
+        The configuration with the largest ratio seen.
     stage : str
         ``"hypothesis"``, ``"local"`` or ``"none"``.
     examples : int
@@ -115,39 +139,36 @@ class FalsifyResult:
     def to_dict(self) -> dict:
         """JSON form (``found`` and, when found, ``counterexample`` with the issue's keys)."""
         sp = self.space
-        out: dict = {"found": self.found, "law": sp.law, "stage": self.stage, "examples": self.examples,
-                     "elapsed_s": self.elapsed_s, "worst_rho_dot_inner": self.worst_value,
-                     "search_space": {"region": sp.region.to_dict(), "sigma": sp.sigma, "rho_tilde": sp.rho_tilde,
-                                      "delta_theta": sp.delta_theta, "v_bar": list(sp.v_bar),
-                                      "certified": sp.certified}}
+        out: dict = {"mode": "one-period", "found": self.found, "law": sp.law, "stage": self.stage,
+                     "examples": self.examples, "elapsed_s": self.elapsed_s, "ratio": self.worst_value,
+                     "search_space": sp.to_dict()}
         if self.found and self.counterexample is not None:
             ce = self.counterexample.to_dict()
-            ce.update(sigma=sp.sigma, rho_norm=float(np.linalg.norm(self.counterexample.rho)),
-                      rho_dot_inner=self.value)
+            ce.update(sigma=sp.sigma, ratio=self.value)
             out["counterexample"] = ce
         return out
 
     def summary(self) -> str:
         """Readable text."""
         sp = self.space
-        head = (f"law '{sp.law}', sigma = {sp.sigma:.4g} 1/s, rho_tilde = {sp.rho_tilde:.4g}, "
-                f"Delta-theta = {sp.delta_theta:.4g} rad, {self.examples} configurations, {self.elapsed_s:.1f} s")
+        head = (f"one period, law '{sp.law}', sigma = {sp.sigma:.4g} 1/s, tube = {np.round(sp.tube, 6).tolist()}, "
+                f"{self.examples} configurations, {self.elapsed_s:.1f} s")
         if not self.found:
-            return f"no counterexample ({head}); worst rho^T rho_dot = {self.worst_value:.4g} <= 0"
+            return f"no counterexample ({head}); largest ratio = {self.worst_value:.4g} <= 1"
         ce = self.counterexample.to_dict()
         return "\n".join([
             f"COUNTEREXAMPLE found by {self.stage} ({head})",
-            f"  rho^T rho_dot = {self.value:.6g} > 0 at ||rho|| = {np.linalg.norm(self.counterexample.rho):.6g}",
-            f"  real    {ce['real']}", f"  nominal {ce['nominal']}",
+            f"  max_j |rho_j| / tube_j = {self.value:.6g} > 1 over one period from (rho = 0)",
+            f"  start   {ce['real']}",
             f"  v_hat {ce['v_hat']}, omega {ce['omega']}, pd_dot {ce['pd_dot']}",
         ])
 
 
 def falsify(scenario: Scenario, law: str | None = None, *, budget: int = 500, seed: int = 0,
-            sigma: float | None = None, rho_tilde: float | None = None, certificate=None,
+            sigma: float | None = None, certificate=None,
             space: SearchSpace | None = None, local_iterations: int = 3000,
             controller: AncillaryLaw | None = None) -> FalsifyResult:
-    """Search for a violation of pointwise tube invariance.
+    """Search the starts of one sampled-data period for a deviation beyond the certified tube.
 
     Parameters
     ----------
@@ -159,8 +180,8 @@ def falsify(scenario: Scenario, law: str | None = None, *, budget: int = 500, se
         Hypothesis examples in stage 1.
     seed : int
         Seed (the search is deterministic for a seed).
-    sigma, rho_tilde : float, optional
-        Override the certificate's gain / tube radius.
+    sigma : float, optional
+        Override the certificate's gain (the tube stays the certificate's).
     certificate : Certificate, optional
         Reuse a certificate instead of computing one.
     space : SearchSpace, optional
@@ -176,81 +197,85 @@ def falsify(scenario: Scenario, law: str | None = None, *, budget: int = 500, se
         raise ConfigError("budget", "an integer >= 1", budget)
     t0 = time.perf_counter()
     if space is None:
-        space = search_space(scenario, law, sigma=sigma, rho_tilde=rho_tilde, certificate=certificate)
+        space = search_space(scenario, law, sigma=sigma, certificate=certificate)
     if controller is not None:
         space = replace(space, law=controller.name)
-    ancillary = controller if controller is not None else get_law(space.law)
-    count = 0
-    worst: list = [None, -math.inf]
+    evaluate = _Evaluator(space, controller if controller is not None else get_law(space.law))
 
-    def value(cfg: TubeConfiguration) -> float:
-        nonlocal count
-        count += 1
-        v = rho_dot_inner(cfg, ancillary, space.sigma)
-        v = -math.inf if math.isnan(v) else v
-        if v > worst[1]:
-            worst[0], worst[1] = cfg, v
-        return v
+    def result(found: bool, counterexample: TubeConfiguration | None, value: float, stage: str) -> FalsifyResult:
+        return FalsifyResult(found, counterexample, value, evaluate.worst, evaluate.worst_value, stage,
+                             evaluate.count, space, time.perf_counter() - t0)
 
+    counterexample = _hypothesis_stage(space, evaluate, budget, seed)
+    if counterexample is not None:
+        return result(True, counterexample, evaluate.ratio(counterexample),
+                      "hypothesis")
+    best_unit, best_value = _local_stage(space, evaluate, seed, local_iterations)
+    if best_value > 1.0 + VIOLATION_TOL:
+        return result(True, _configuration(space, best_unit), best_value, "local")
+    return result(False, None, evaluate.worst_value, "none")
+
+
+class _Evaluator:
+    """One-period ratio of a configuration (NaN as -inf), counting calls and keeping the worst seen."""
+
+    def __init__(self, space: SearchSpace, ancillary: AncillaryLaw) -> None:
+        self.space, self.ancillary = space, ancillary
+        self.count = 0
+        self.worst: TubeConfiguration | None = None
+        self.worst_value = -math.inf
+
+    def ratio(self, cfg: TubeConfiguration) -> float:
+        """The one-period deviation/radius ratio from ``cfg`` (uncounted)."""
+        sp = self.space
+        return one_period_ratio(cfg, self.ancillary, sp.sigma, np.asarray(sp.tube), sp.tick, sp.ticks)
+
+    def __call__(self, cfg: TubeConfiguration) -> float:
+        self.count += 1
+        value = self.ratio(cfg)
+        value = -math.inf if math.isnan(value) else value
+        if value > self.worst_value:
+            self.worst, self.worst_value = cfg, value
+        return value
+
+
+def _configuration(space: SearchSpace, unit: np.ndarray) -> TubeConfiguration:
+    """The configuration at a point of the strategies' unit cube."""
+    return period_configuration_from_unit(space.region, space.start, space.v_bar, space.omega_bar, unit)
+
+
+def _hypothesis_stage(space: SearchSpace, evaluate: _Evaluator, budget: int, seed: int) -> TubeConfiguration | None:
+    """Stage 1: hypothesis ``find`` guided by ``target``; the shrunk counterexample, or None."""
     def violated(cfg: TubeConfiguration) -> bool:
-        v = value(cfg)
-        if math.isfinite(v):
-            target(v, label="rho_dot_inner")
-        return v > VIOLATION_TOL
+        value = evaluate(cfg)
+        if math.isfinite(value):
+            target(value, label="one_period_ratio")
+        return value > 1.0 + VIOLATION_TOL
 
-    strategy = tube_configurations(space.region, space.rho_tilde, space.v_bar, space.delta_theta)
+    strategy = period_configurations(space.region, space.start, space.v_bar, space.omega_bar)
     cfg_settings = settings(max_examples=budget, database=None, deadline=None,
                             phases=[Phase.generate, Phase.target, Phase.shrink],
                             suppress_health_check=list(HealthCheck))
     try:
-        ce = find(strategy, violated, settings=cfg_settings, random=random.Random(seed))
-        return FalsifyResult(True, ce, rho_dot_inner(ce, ancillary, space.sigma), worst[0], worst[1], "hypothesis",
-                             count, space, time.perf_counter() - t0)
+        return find(strategy, violated, settings=cfg_settings, random=random.Random(seed))
     except NoSuchExample:
-        pass
+        return None
 
-    # Stage 2: local optimisation from the worst configuration, in the strategies' unit cube.
+
+def _local_stage(space: SearchSpace, evaluate: _Evaluator, seed: int,
+                 local_iterations: int) -> tuple[np.ndarray | None, float]:
+    """Stage 2: Powell from three random points of the unit cube; the best point and its ratio."""
     rng = np.random.default_rng(seed)
-    starts = [rng.uniform(0, 1, CONFIGURATION_DIM) for _ in range(3)]
+    starts = [rng.uniform(0, 1, PERIOD_DIM) for _ in range(3)]
 
-    def neg(u: np.ndarray) -> float:
-        v = value(configuration_from_unit(space.region, space.rho_tilde, space.v_bar, space.delta_theta, u))
-        return 1e6 if not math.isfinite(v) else -v
+    def negative_value(unit: np.ndarray) -> float:
+        value = evaluate(_configuration(space, unit))
+        return 1e6 if not math.isfinite(value) else -value
 
-    best_u, best_v = None, -math.inf
-    for u0 in starts:
-        res = minimize(neg, u0, method="Powell", bounds=[(0.0, 1.0)] * CONFIGURATION_DIM,
+    best_unit, best_value = None, -math.inf
+    for start in starts:
+        res = minimize(negative_value, start, method="Powell", bounds=[(0.0, 1.0)] * PERIOD_DIM,
                        options={"maxfev": max(1, local_iterations // len(starts)), "xtol": 1e-6, "ftol": 1e-12})
-        if -res.fun > best_v:
-            best_u, best_v = res.x, -res.fun
-    if best_v > VIOLATION_TOL:
-        ce = configuration_from_unit(space.region, space.rho_tilde, space.v_bar, space.delta_theta, best_u)
-        return FalsifyResult(True, ce, best_v, worst[0], worst[1], "local", count, space, time.perf_counter() - t0)
-    return FalsifyResult(False, None, worst[1], worst[0], worst[1], "none", count, space, time.perf_counter() - t0)
-
-
-def configure_falsify(parser: argparse.ArgumentParser) -> None:
-    """Options of ``tubekit falsify``."""
-    parser.add_argument("config", nargs="?", metavar="CONFIG",
-                        help="scenario TOML (default: the paper's Section VI scenario)")
-    parser.add_argument("--law", choices=("paper", "corrected"), help="ancillary law (default: the scenario's)")
-    parser.add_argument("--budget", type=int, default=500, help="hypothesis examples (default 500)")
-    parser.add_argument("--seed", type=int, default=0, help="search seed (default 0)")
-    parser.add_argument("--sigma", type=float, help="override the ancillary gain sigma (1/s)")
-    parser.add_argument("--rho", type=float, help="override the tube radius rho-tilde")
-    parser.add_argument("--json", metavar="FILE", help="write the result as JSON")
-
-
-def run_falsify(args: argparse.Namespace) -> int:
-    """Exit 3 when a counterexample is found, 0 when none within the budget."""
-    scenario = load_scenario(args.config) if args.config else paper_scenario()
-    for name in ("sigma", "rho"):
-        val = getattr(args, name)
-        if val is not None and not (math.isfinite(val) and val > 0):
-            raise ConfigError(f"--{name}", "a number > 0", val)
-    result = falsify(scenario, args.law, budget=args.budget, seed=args.seed, sigma=args.sigma, rho_tilde=args.rho)
-    print(result.summary())
-    if args.json:
-        Path(args.json).parent.mkdir(parents=True, exist_ok=True)
-        Path(args.json).write_text(json.dumps(result.to_dict(), indent=2))
-    return 3 if result.found else 0
+        if -res.fun > best_value:
+            best_unit, best_value = res.x, -res.fun
+    return best_unit, best_value

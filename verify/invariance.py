@@ -8,6 +8,13 @@ disturbance omega and the target velocity p_d_dot. With rho = e - e_hat,
 
 always with the *derived* dynamics (:mod:`tubekit.derivation`). The tube is
 invariant at a configuration on its boundary (||rho|| = rho-tilde) when this is <= 0.
+
+That pointwise sign is no longer what the certificate claims (the sampled-data
+theorem, :mod:`verify.sampled`): :func:`one_period_ratio` runs one FHOCP period of
+the loop as it runs — reset ê(t_k) = e(t_k) (so ``real`` = ``nominal``), v̂ held,
+κ held over each tick, the plant of :mod:`tubekit.plant` under a constant ω and a
+target moving at p_d_dot — and returns max_j |e_j - ê_j| / tube_j over the period,
+which the certificate bounds by 1.
 """
 
 from __future__ import annotations
@@ -16,11 +23,15 @@ from dataclasses import dataclass
 
 import numpy as np
 
+import math
+
 from tubekit.ancillary import AncillaryLaw
 from tubekit.derivation import error_coordinates, numeric
 from tubekit.exceptions import ConfigError
+from tubekit.plant import Plant, nominal_arc
+from tubekit.scenario import Disturbance
 
-__all__ = ["TubeConfiguration", "rho_dot_inner", "applied_input"]
+__all__ = ["TubeConfiguration", "rho_dot_inner", "applied_input", "one_period_ratio"]
 
 _STATE_KEYS = ("e_x", "e_y", "e_z", "psi")
 
@@ -85,3 +96,32 @@ def rho_dot_inner(config: TubeConfiguration, law: AncillaryLaw, sigma: float) ->
         e_hat_dot = dyn(config.nominal[0], config.nominal[1], config.nominal[3], *config.v_hat, 0.0, 0.0, 0.0,
                         *config.pd_dot)
     return float(config.rho @ (e_dot - e_hat_dot))
+
+
+def one_period_ratio(config: TubeConfiguration, law: AncillaryLaw, sigma: float, tube: np.ndarray,
+                     tick: float, ticks: int, substeps: int = 2) -> float:
+    """max over one period of max_j |e_j - ê_j| / tube_j from the reset state ``config.real`` (-).
+
+    The target starts at the origin and moves at ``config.pd_dot``; κ is held over each tick of
+    ``tick`` s (``ticks`` per period), the plant integrated with RK4 (``substeps`` per tick) under
+    the constant ``config.omega``. Returns ``nan`` where the law is undefined.
+    """
+    omega = tuple(float(w) for w in config.omega)
+    plant = Plant(Disturbance(), override=lambda t: omega)
+    tube = np.asarray(tube, dtype=float)
+    pd_dot = np.asarray(config.pd_dot, dtype=float)
+    arc = nominal_arc(config.real, config.v_hat, np.arange(ticks + 1) * tick)
+    x = tuple(float(c) for c in config.real)
+    worst = 0.0
+    for i in range(ticks + 1):
+        p_d = pd_dot * (i * tick)
+        rho = error_coordinates(np.asarray(x), p_d) - error_coordinates(arc[i], p_d)
+        worst = max(worst, float(np.max(np.abs(rho) / tube)))
+        if i == ticks:
+            break
+        try:
+            v = config.v_hat + law(np.asarray(x), arc[i], p_d, sigma)
+        except ConfigError:
+            return math.nan
+        x = plant.step_tuple(i * tick, x, tuple(float(c) for c in v), tick / substeps, substeps)
+    return worst

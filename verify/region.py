@@ -24,36 +24,12 @@ from typing import Any
 
 from tubekit.exceptions import ConfigError
 from tubekit.scenario import HEADINGS, Scenario
-from tubekit.validation import finite
+from tubekit.validation import interval, nonnegative, nonnegative_triple, positive_triple
 
 __all__ = ["Region", "HEMISPHERE_SIGN"]
 
 #: cos(psi - theta) = s * sqrt(1 - e_o^2) in each hemisphere.
 HEMISPHERE_SIGN: dict[str, int] = {"toward": -1, "away": +1}
-
-
-def _interval(field: str, value: Any) -> tuple[float, float]:
-    try:
-        lo, hi = value
-    except (TypeError, ValueError):
-        raise ConfigError(field, "a pair [lo, hi]", value) from None
-    lo, hi = finite(f"{field}[0]", lo), finite(f"{field}[1]", hi)
-    if not lo < hi:
-        raise ConfigError(field, "lo < hi (a non-empty interval)", [lo, hi])
-    return lo, hi
-
-
-def _triple(field: str, value: Any, strict: bool) -> tuple[float, float, float]:
-    try:
-        items = tuple(value)
-    except TypeError:
-        raise ConfigError(field, "three numbers", value) from None
-    if len(items) != 3:
-        raise ConfigError(field, "three numbers", value)
-    out = tuple(finite(f"{field}[{i}]", x) for i, x in enumerate(items))
-    if any((x <= 0) if strict else (x < 0) for x in out):
-        raise ConfigError(field, "three numbers > 0" if strict else "three numbers >= 0", list(out))
-    return out  # type: ignore[return-value]
 
 
 @dataclass(frozen=True)
@@ -90,28 +66,23 @@ class Region:
     v_max: tuple[float, float, float]
 
     def __post_init__(self) -> None:
-        ed = _interval("region.e_d", self.e_d)
+        ed = interval("region.e_d", self.e_d)
         if ed[0] <= 0:
             raise ConfigError("region.e_d", "a lower end > 0 (e_o is undefined at e_d = 0)", list(ed))
-        eo = _interval("region.e_o", self.e_o)
+        eo = interval("region.e_o", self.e_o)
         if eo[0] <= -1 or eo[1] >= 1:
             raise ConfigError("region.e_o", "an interval inside (-1, 1) (|e_o| = 1 makes J singular)", list(eo))
         object.__setattr__(self, "e_d", ed)
-        object.__setattr__(self, "e_z", _interval("region.e_z", self.e_z))
+        object.__setattr__(self, "e_z", interval("region.e_z", self.e_z))
         object.__setattr__(self, "e_o", eo)
         if self.heading not in HEADINGS:
             raise ConfigError("region.heading", f"one of {HEADINGS}", self.heading)
-        pd = _triple("region.pd_dot_max", self.pd_dot_max, strict=False)
+        pd = nonnegative_triple("region.pd_dot_max", self.pd_dot_max)
         object.__setattr__(self, "pd_dot_max", pd)
-        hxy = finite("region.pd_dot_xy_max", self.pd_dot_xy_max)
-        if hxy < 0:
-            raise ConfigError("region.pd_dot_xy_max", "a number >= 0", hxy)
+        hxy = nonnegative("region.pd_dot_xy_max", self.pd_dot_xy_max)
         object.__setattr__(self, "pd_dot_xy_max", min(hxy, math.hypot(pd[0], pd[1])))
-        om = finite("region.omega_bar", self.omega_bar)
-        if om < 0:
-            raise ConfigError("region.omega_bar", "a number >= 0", om)
-        object.__setattr__(self, "omega_bar", om)
-        object.__setattr__(self, "v_max", _triple("region.v_max", self.v_max, strict=True))
+        object.__setattr__(self, "omega_bar", nonnegative("region.omega_bar", self.omega_bar))
+        object.__setattr__(self, "v_max", positive_triple("region.v_max", self.v_max))
 
     # ------------------------------------------------------------------ construction
     @classmethod

@@ -50,6 +50,9 @@ __all__ = [
     "state_from_error",
     "configuration_from_unit",
     "CONFIGURATION_DIM",
+    "period_configuration_from_unit",
+    "period_configurations",
+    "PERIOD_DIM",
 ]
 
 _unit = st.floats(0.0, 1.0, allow_nan=False, allow_infinity=False)
@@ -228,6 +231,40 @@ def tube_configurations(region: Region, rho_tilde: float, v_bar: Sequence[float]
     _shrunk(region, rho_tilde)
     return _units(CONFIGURATION_DIM).map(
         lambda u: configuration_from_unit(region, rho_tilde, v_bar, delta_theta, u))
+
+
+#: Length of the unit vector :func:`period_configuration_from_unit` reads.
+PERIOD_DIM = 5 + 3 + 3 + 3
+
+
+def _omega_box_from_unit(omega_xy: float, omega_z: float, u: np.ndarray) -> np.ndarray:
+    """ω with ‖ω_xy‖ <= ω̄_xy and |ω_z| <= ω̄_z (a fifth of the draws on the circle)."""
+    mag = omega_xy if u[1] > 0.8 else omega_xy * u[1] / 0.8
+    a = 2.0 * math.pi * u[0]
+    return np.array([mag * math.cos(a), mag * math.sin(a), _lerp(-omega_z, omega_z, u[2])])
+
+
+def period_configuration_from_unit(region: Region, start: Sequence[Sequence[float]], v_bar: Sequence[float],
+                                   omega_bar: Sequence[float], u: np.ndarray) -> TubeConfiguration:
+    """Map u in [0, 1]^PERIOD_DIM to the start of one period under the reset (``real`` = ``nominal``).
+
+    ``start`` = ((e_d lo, hi), (e_z lo, hi), (e_o lo, hi)) is Ē; ``omega_bar`` = (ω̄_xy, ω̄_z);
+    v̂ in the V̄ box, p_d_dot in P of ``region``.
+    """
+    u = np.clip(np.asarray(u, dtype=float), 0.0, 1.0)
+    e = [_lerp(lo, hi, x) for (lo, hi), x in zip(start, u[:3])]
+    state = state_from_error(*e, _lerp(-math.pi, math.pi, u[3]), _sign_from_unit(region, u[4]))
+    return TubeConfiguration(real=state, nominal=state.copy(), v_hat=_input_from_unit(v_bar, u[5:8]),
+                             omega=_omega_box_from_unit(omega_bar[0], omega_bar[1], u[8:11]),
+                             pd_dot=_pd_dot_from_unit(region, u[11:14]))
+
+
+def period_configurations(region: Region, start: Sequence[Sequence[float]], v_bar: Sequence[float],
+                          omega_bar: Sequence[float]) -> st.SearchStrategy[TubeConfiguration]:
+    """Starts of one sampled-data period: e in Ē (``start``), ρ = 0, v̂ in V̄, ω in the box-disk, p_d_dot in P."""
+    if any(lo > hi for lo, hi in start):
+        raise ConfigError("start", "non-empty intervals (lo <= hi) for e_d, e_z, e_o", [list(b) for b in start])
+    return _units(PERIOD_DIM).map(lambda u: period_configuration_from_unit(region, start, v_bar, omega_bar, u))
 
 
 # ------------------------------------------------------------------ trajectories and obstacles

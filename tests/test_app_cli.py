@@ -8,7 +8,7 @@ import sys
 import pytest
 
 from tubekit import __version__
-from tubekit.cli import SUBCOMMANDS, main
+from tubekit.app.cli import SUBCOMMANDS, Subcommand, main
 
 
 @pytest.mark.parametrize("name", sorted(SUBCOMMANDS))
@@ -31,13 +31,17 @@ def test_no_command_prints_help(capsys):
 
 
 def test_console_script_installed():
-    out = subprocess.run([sys.executable, "-m", "tubekit.cli", "--help"], capture_output=True, text=True)
+    out = subprocess.run([sys.executable, "-m", "tubekit.app.cli", "--help"], capture_output=True, text=True)
     assert out.returncode == 0 and "reproduce" in out.stdout
 
 
 def test_missing_dependency_disables_only_that_command(monkeypatch, capsys):
-    import tubekit.cli as cli
-    monkeypatch.setitem(cli.SUBCOMMANDS, "broken", ("tubekit._no_such_module_for_test", "a broken command"))
+    import tubekit.app.cli as cli
+
+    def configure_broken(parser):
+        import tubekit._no_such_module_for_test  # noqa: F401
+
+    monkeypatch.setitem(cli.SUBCOMMANDS, "broken", Subcommand("a broken command", configure_broken, lambda args: 0))
     assert main(["broken"]) == 1
     err = capsys.readouterr().err
     assert "not available" in err and "_no_such_module_for_test" in err

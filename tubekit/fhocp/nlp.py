@@ -1,8 +1,8 @@
 """The discretised FHOCP of Section V as a nonlinear program (NLP).
 
 This module is the single definition of the NLP that both the sequential
-convex programming solver (:mod:`tubekit.fhocp`) and its CasADi + IPOPT peer
-(:mod:`tubekit.fhocp_ipopt`) solve; both evaluate their answers with
+convex programming solver (:mod:`tubekit.fhocp.scp`) and its CasADi + IPOPT peer
+(:mod:`tubekit.fhocp.ipopt`) solve; both evaluate their answers with
 :meth:`FhocpNlp.evaluate`.
 
 Discretisation
@@ -52,26 +52,14 @@ from typing import Sequence
 
 import numpy as np
 
-from .exceptions import ConfigError, ShapeError
-from .scenario import Obstacle, Scenario
-from .tightening import Tightening
-from .validation import as_vector, positive
+from ..exceptions import ConfigError, ShapeError
+from ..scenario import Obstacle, Scenario
+from ..tightening import Tightening
+from ..validation import as_vector, positive
 
-__all__ = [
-    "TERMINAL_MODES",
-    "SINC_SERIES_THRESHOLD",
-    "sinc",
-    "dsinc",
-    "discrete_step",
-    "rollout",
-    "step_linearisation",
-    "STEP_LINEARISATION_ROWS",
-    "eo_linearisation",
-    "obstacle_array",
-    "select_obstacles",
-    "FhocpNlp",
-    "NlpEvaluation",
-]
+__all__ = ["TERMINAL_MODES", "SINC_SERIES_THRESHOLD", "sinc", "dsinc", "discrete_step", "rollout",
+           "step_linearisation", "STEP_LINEARISATION_ROWS", "eo_linearisation", "obstacle_array",
+           "select_obstacles", "FhocpNlp", "NlpEvaluation"]
 
 TERMINAL_MODES: tuple[str, ...] = ("soft", "hard", "off")
 #: below this |a| = |r| dt / 2 the derivative of sin(a)/a uses its Taylor series (error < 1e-19)

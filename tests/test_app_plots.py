@@ -10,7 +10,7 @@ import pytest
 
 from tubekit.closed_loop import simulate
 from tubekit.metrics import rho_period_peaks
-from tubekit.plots import FIGURE_FILES, errors_figure, plot_all, top_view
+from tubekit.app.plots import FIGURE_FILES, errors_figure, plot_all, top_view
 from tubekit.scenario import paper_scenario
 from tubekit.tightening import Tightening
 

@@ -1,40 +1,18 @@
-"""The FHOCP by sequential convex programming: DPP, build-once, fast path, constraints, fallback."""
+"""The FHOCP by sequential convex programming: solutions, warm start, fallback, validation."""
 
 from __future__ import annotations
 
 import math
 import warnings
 
-import cvxpy as cp
 import numpy as np
 import pytest
 
-from tubekit import ConfigError, Obstacle, ShapeError, SolverError, Tightening, paper_scenario
+from tubekit import ConfigError, Obstacle, ShapeError
 from tubekit.fhocp import FHOCP, FallbackWarning, FhocpResult
-from tubekit.fhocp_nlp import (FhocpNlp, discrete_step, dsinc, eo_linearisation, rollout, select_obstacles,
-                               sinc, step_linearisation)
-from tubekit.model import nominal_kinematics
+from tubekit.fhocp.nlp import rollout, select_obstacles
 
-SC = paper_scenario()
-OBSTACLES = SC.obstacles
-
-# (t, [x, y, z, psi]) from a closed-loop run of the paper's scenario; the obstacle at
-# (3, 0, 0) is within the sensing range for every state but the first and the last.
-STATES = [
-    (2.0, (0.366391, 3.058573, 0.042219, -0.314108)),
-    (8.0, (2.408496, 1.684077, 0.002093, -0.791507)),
-    (10.0, (2.729238, 1.022535, -0.044875, -0.944917)),
-    (11.0, (2.823856, 0.703198, -0.060977, -1.028208)),
-    (12.0, (2.780420, 0.612101, -0.094783, -1.160212)),
-    (25.0, (0.598401, -2.953194, -0.044877, -3.067312)),
-]
-
-
-def tightening(scenario=SC) -> Tightening:
-    reg = scenario.region
-    return Tightening(v_max=scenario.limits.vector.copy(), e_d_min=scenario.epsilon + 0.05,
-                      e_o_max=reg.e_o_max, e_z_max=reg.e_z_max, e_d_max=reg.e_d_max,
-                      obstacle_margin=0.05, rho_tilde=0.05, sigma=0.0)
+from .fhocp_cases import OBSTACLES, SC, STATES, tightening
 
 
 @pytest.fixture(scope="module")
@@ -45,154 +23,6 @@ def rt() -> FHOCP:
 @pytest.fixture(scope="module")
 def conv() -> FHOCP:
     return FHOCP(SC, tightening(), mode="converged")
-
-
-# ------------------------------------------------------------------ discretisation
-def test_exact_step_matches_fine_rk4():
-    rng = np.random.default_rng(0)
-    for _ in range(6):
-        s = rng.normal(size=4)
-        v = rng.uniform(-1, 1, 3) * np.array([0.4, 0.3, 0.5])
-        x = s.copy()
-        h = 0.1 / 2000
-        for _ in range(2000):
-            k1 = nominal_kinematics(x, v)
-            k2 = nominal_kinematics(x + h / 2 * k1, v)
-            k3 = nominal_kinematics(x + h / 2 * k2, v)
-            k4 = nominal_kinematics(x + h * k3, v)
-            x = x + h / 6 * (k1 + 2 * k2 + 2 * k3 + k4)
-        assert np.allclose(discrete_step(s, v, 0.1), x, atol=1e-12, rtol=0)  # RK4 error ~1e-15
-
-
-def test_rollout_is_repeated_step():
-    rng = np.random.default_rng(1)
-    v = rng.uniform(-1, 1, (8, 3)) * np.array([0.4, 0.3, 3.0])
-    s = rollout(np.array([1.0, -2.0, 0.3, 5.0]), v, 0.1)
-    assert np.max(np.abs(s[1:] - discrete_step(s[:-1], v, 0.1))) < 1e-14
-
-
-def test_sinc_and_derivative_near_zero():
-    a = np.array([0.0, 1e-12, -1e-5, 0.05, -0.099, 0.101, 0.7])
-    safe = np.where(a == 0, 1.0, a)
-    exact = np.where(a == 0, 1.0, np.sin(safe) / safe)
-    assert np.allclose(sinc(a), exact, rtol=1e-15, atol=0)
-    h = 1e-6
-    fd = (np.sin(a + h) / (a + h) - np.sin(a - h) / (a - h)) / (2 * h)
-    assert np.allclose(dsinc(a[1:]), fd[1:], atol=1e-9)
-    assert dsinc(np.array([0.0]))[0] == 0.0
-
-
-def test_step_and_eo_linearisations_match_finite_differences():
-    rng = np.random.default_rng(2)
-    s = rng.normal(size=(9, 4))
-    v = rng.uniform(-1, 1, (8, 3)) * np.array([0.4, 0.3, 2.0])
-    lin = step_linearisation(s, v, 0.1)
-    f0 = discrete_step(s[:8], v, 0.1)
-    h = 1e-7
-    for row, (kind, col, out) in {0: ("s", 3, 0), 1: ("v", 0, 0), 2: ("v", 2, 0),
-                                  4: ("s", 3, 1), 5: ("v", 0, 1), 6: ("v", 2, 1)}.items():
-        s2, v2 = s.copy(), v.copy()
-        (s2 if kind == "s" else v2)[:, col] += h
-        fd = (discrete_step(s2[:8], v2, 0.1) - f0)[:, out] / h
-        assert np.allclose(fd, lin[row], atol=1e-6)
-    # the affine model reproduces F at the linearisation point
-    x_lin = s[:8, 0] + lin[0] * s[:8, 3] + lin[1] * v[:, 0] + lin[2] * v[:, 2] + lin[3]
-    assert np.allclose(x_lin, f0[:, 0], atol=1e-14)
-    ref = rng.normal(size=(9, 3))
-    g = eo_linearisation(s, ref)
-    nlp = FhocpNlp.from_scenario(SC, tightening())
-    e0 = nlp.errors(s, ref)[:, 2]
-    assert np.allclose(g[4], e0)
-    for row, col in ((0, 0), (1, 1), (2, 3)):
-        s2 = s.copy()
-        s2[:, col] += h
-        assert np.allclose((nlp.errors(s2, ref)[:, 2] - e0) / h, g[row], atol=1e-5)
-
-
-# ------------------------------------------------------------------ build once
-def test_problem_is_dpp(rt):
-    assert isinstance(rt.problem, cp.Problem)
-    assert rt.problem.is_dcp(dpp=True)
-    assert rt.problem.is_dpp()
-
-
-def test_fast_path_data_equals_cvxpy_apply_parameters(rt):
-    rt.reset()
-    t, s = STATES[2]
-    rt.solve(t, np.array(s), OBSTACLES)
-    assert rt.compiled.verify() < 1e-12
-
-
-def test_resolve_does_not_recanonicalise(monkeypatch):
-    solver = FHOCP(SC, tightening(), mode="converged")
-    t, s = STATES[1]
-    solver.solve(t, np.array(s), OBSTACLES)
-    clarabel_obj = solver.compiled._solver
-    rebuilds = solver.compiled.rebuilds
-
-    def forbidden(*args, **kwargs):
-        raise AssertionError("cvxpy re-canonicalised the problem")
-
-    from cvxpy.reductions.cvx_attr2constr import CvxAttr2Constr
-    from cvxpy.reductions.dcp2cone.cone_matrix_stuffing import ConeMatrixStuffing
-    from cvxpy.reductions.dcp2cone.dcp2cone import Dcp2Cone
-    from cvxpy.reductions.solvers.solving_chain import SolvingChain
-    for cls in (Dcp2Cone, ConeMatrixStuffing, CvxAttr2Constr, SolvingChain):
-        monkeypatch.setattr(cls, "apply", forbidden)
-    monkeypatch.setattr(cp.Problem, "get_problem_data", forbidden)
-    updates = solver.compiled.updates
-    for k, (t, s) in enumerate(STATES):
-        res = solver.solve(t, np.array(s), OBSTACLES if k % 2 else ())
-        assert not res.fallback
-    assert solver.compiled._solver is clarabel_obj          # persistent Clarabel solver
-    assert solver.compiled.rebuilds == rebuilds              # never rebuilt
-    assert solver.compiled.updates > updates                 # data updates instead
-
-
-def test_cvxpy_path_reuses_its_compiled_map(monkeypatch):
-    solver = FHOCP(SC, tightening(), mode="realtime", fast_path=False)
-    t, s = STATES[1]
-    solver.solve(t, np.array(s), OBSTACLES)
-    prog = solver.problem._cache.param_prog
-    assert prog is not None
-
-    from cvxpy.reductions.dcp2cone.dcp2cone import Dcp2Cone
-    from cvxpy.reductions.solvers.solving_chain import SolvingChain
-
-    def forbidden(*args, **kwargs):
-        raise AssertionError("cvxpy re-canonicalised the problem")
-
-    monkeypatch.setattr(Dcp2Cone, "apply", forbidden)
-    monkeypatch.setattr(SolvingChain, "apply", forbidden)
-    for t, s in STATES[2:4]:
-        assert not solver.solve(t, np.array(s), OBSTACLES).fallback
-    assert solver.problem._cache.param_prog is prog
-
-
-@pytest.mark.parametrize("mode", ["realtime", "converged"])
-def test_fast_path_equals_problem_solve_path(mode):
-    fast = FHOCP(SC, tightening(), mode=mode)
-    slow = FHOCP(SC, tightening(), mode=mode, fast_path=False)
-    assert fast.compiled is not None and slow.compiled is None
-    for t, s in STATES[:4]:
-        a = fast.solve(t, np.array(s), OBSTACLES)
-        b = slow.solve(t, np.array(s), OBSTACLES)
-        assert a.iterations == b.iterations
-        assert np.allclose(a.inputs, b.inputs, atol=1e-5)
-        assert a.merit == pytest.approx(b.merit, rel=1e-6)
-
-
-def test_subproblem_objective_equals_cvxpy_value(rt):
-    rt.reset()
-    t, s = STATES[3]
-    rt.solve(t, np.array(s), OBSTACLES)
-    status, v, obj, _ = rt._solve_subproblem()
-    assert status == "optimal"
-    rt.push_parameters()
-    rt.problem.solve(solver=cp.CLARABEL, presolve_enable=False)
-    assert obj == pytest.approx(rt.problem.value, rel=1e-6)
-    vv = np.stack([rt.variables[k].value for k in ("u", "w", "r")], axis=1)
-    assert np.allclose(v, vv, atol=1e-5)
 
 
 # ------------------------------------------------------------------ solutions
@@ -304,7 +134,6 @@ def test_forced_infeasible_subproblem_returns_shifted_previous_plan():
 
 def _state_violation(solver, s0, inputs, t):
     """Largest non-terminal violation of a plan, via the NLP's own evaluation of a rollout."""
-    from tubekit.fhocp_nlp import rollout
     nlp = solver.nlp
     ev = nlp.evaluate(rollout(s0, inputs, nlp.dt), inputs, nlp.reference(SC.trajectory, t),
                       solver.select_obstacles(s0, OBSTACLES))
@@ -385,19 +214,6 @@ def test_solve_argument_errors(rt):
         rt.solve(0.0, np.array(SC.initial_state), [((3.0, 0.0, 0.0), 0.4)])
 
 
-def test_result_check_raises_on_violation(rt):
-    rt.reset()
-    t, s = STATES[1]
-    res = rt.solve(t, np.array(s), OBSTACLES)
-    res.check()
-    bad = FhocpResult(**{**res.__dict__, "max_violation": 0.3, "violations": {**res.violations, "obstacle": 0.3}})
-    with pytest.raises(SolverError, match="obstacle"):
-        bad.check()
-    nan = FhocpResult(**{**res.__dict__, "inputs": np.full_like(res.inputs, np.nan)})
-    with pytest.raises(SolverError, match="not finite"):
-        nan.check()
-
-
 def test_obstacle_selection_and_slots():
     s = np.array([0.0, 0.0, 0.0, 0.0])
     obs = [Obstacle((5.0, 0.0, 0.0), 0.4), Obstacle((1.0, 0.0, 0.0), 0.4), Obstacle((0.0, 1.2, 0.0), 0.4)]
@@ -421,17 +237,6 @@ def test_cold_start_cap_reports_iteration_limit():
         warnings.simplefilter("error")
         res = solver.solve(t, np.array(s), OBSTACLES)
     assert res.status == "iteration_limit" and not res.fallback and res.iterations == 1
-
-
-@pytest.mark.parametrize("terminal", ["soft", "hard", "off"])
-def test_terminal_modes_build_and_solve(terminal):
-    solver = FHOCP(SC, tightening(), terminal=terminal)
-    assert solver.problem.is_dcp(dpp=True)
-    t, s = STATES[1]
-    res = solver.solve(t, np.array(s), OBSTACLES)
-    assert not res.fallback
-    if terminal == "off":
-        assert res.violations["terminal"] == 0.0
 
 
 def test_default_obstacle_slots_from_the_scenario():

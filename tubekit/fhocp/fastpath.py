@@ -23,6 +23,7 @@ from __future__ import annotations
 import math
 import time
 from dataclasses import dataclass
+from typing import Any
 
 import clarabel
 import cvxpy as cp
@@ -30,23 +31,25 @@ import numpy as np
 import scipy.sparse as sp
 from cvxpy.lin_ops.lin_op import CONSTANT_ID
 
-from .exceptions import SolverError
+from ..exceptions import SolverError
+from .result import Status, status_from
 
 __all__ = ["CompiledConeProgram", "ConeSolution", "clarabel_settings", "CLARABEL_STATUS"]
 
-#: Clarabel status string -> cvxpy-style status used by tubekit
-CLARABEL_STATUS: dict[str, str] = {
-    "Solved": "optimal",
-    "AlmostSolved": "optimal_inaccurate",
-    "PrimalInfeasible": "infeasible",
-    "AlmostPrimalInfeasible": "infeasible_inaccurate",
-    "DualInfeasible": "unbounded",
-    "AlmostDualInfeasible": "unbounded_inaccurate",
-    "MaxIterations": "user_limit",
-    "MaxTime": "user_limit",
-    "NumericalError": "solver_error",
-    "InsufficientProgress": "solver_error",
-    "Unsolved": "solver_error",
+#: Clarabel's status (``str(clarabel.SolverStatus.X)``) -> :class:`Status`; any other is SOLVER_ERROR
+CLARABEL_STATUS: dict[str, Status] = {
+    "Solved": Status.OPTIMAL,
+    "AlmostSolved": Status.OPTIMAL_INACCURATE,
+    "PrimalInfeasible": Status.INFEASIBLE,
+    "AlmostPrimalInfeasible": Status.INFEASIBLE_INACCURATE,
+    "DualInfeasible": Status.UNBOUNDED,
+    "AlmostDualInfeasible": Status.UNBOUNDED_INACCURATE,
+    "MaxIterations": Status.USER_LIMIT,
+    "MaxTime": Status.USER_LIMIT,
+    "CallbackTerminated": Status.USER_LIMIT,
+    "NumericalError": Status.SOLVER_ERROR,
+    "InsufficientProgress": Status.SOLVER_ERROR,
+    "Unsolved": Status.SOLVER_ERROR,
 }
 
 
@@ -62,14 +65,28 @@ def clarabel_settings(overrides: dict | None = None) -> clarabel.DefaultSettings
     return st
 
 
+def _clarabel_cones(dims: Any) -> list:
+    """Clarabel's cone list for cvxpy's cone dimensions (zero, nonnegative, second-order only)."""
+    cones: list = []
+    if dims.zero:
+        cones.append(clarabel.ZeroConeT(dims.zero))
+    if dims.nonneg:
+        cones.append(clarabel.NonnegativeConeT(dims.nonneg))
+    for d in dims.soc:
+        cones.append(clarabel.SecondOrderConeT(d))
+    if dims.exp or dims.psd or dims.p3d or getattr(dims, "pnd", []):
+        raise SolverError("only zero, nonnegative and second-order cones are supported")
+    return cones
+
+
 @dataclass(frozen=True)
 class ConeSolution:
     """One Clarabel solve mapped back to the problem's variables.
 
     Attributes
     ----------
-    status : str
-        Mapped status (:data:`CLARABEL_STATUS`), e.g. ``"optimal"``.
+    status : Status
+        Mapped status (:data:`CLARABEL_STATUS`), e.g. ``Status.OPTIMAL``.
     raw_status : str
         Clarabel's own status string.
     x : array or None
@@ -83,7 +100,7 @@ class ConeSolution:
         Interior-point iterations.
     """
 
-    status: str
+    status: Status
     raw_status: str
     x: np.ndarray | None
     objective: float
@@ -140,39 +157,34 @@ class CompiledConeProgram:
         self._a_data = -np.asarray(top[:, -1].toarray()).ravel()
         # q (with the offset d as its last entry)
         self._q_map = sp.csr_matrix(pp.q)
-        # P: reduced tensor restricted to the upper triangle
-        self._P_map = None
-        self._P_const = None
-        self._P_indices = np.zeros(0, dtype=np.int64)
-        self._P_indptr = np.zeros(self.n + 1, dtype=np.int64)
-        if pp.P is not None:
-            pp.reduced_P.cache(keep_zeros=True)
-            p_idx, p_ptr, _ = pp.reduced_P.problem_data_index
-            cols = np.repeat(np.arange(self.n), np.diff(p_ptr))
-            keep = np.asarray(p_idx) <= cols
-            red = sp.csr_matrix(pp.reduced_P.reduced_mat)[np.flatnonzero(keep)]
-            counts = np.bincount(cols[keep], minlength=self.n)
-            self._P_indices = np.asarray(p_idx)[keep].astype(np.int64)
-            self._P_indptr = np.concatenate([[0], np.cumsum(counts)]).astype(np.int64)
-            if red[:, :-1].nnz == 0:  # no parameter enters P
-                self._P_const = np.asarray(red[:, -1].toarray()).ravel()
-            else:
-                self._P_map = red
-        dims = data[cp.reductions.solvers.conic_solvers.conic_solver.ConicSolver.DIMS]
-        self.cones = []
-        if dims.zero:
-            self.cones.append(clarabel.ZeroConeT(dims.zero))
-        if dims.nonneg:
-            self.cones.append(clarabel.NonnegativeConeT(dims.nonneg))
-        for d in dims.soc:
-            self.cones.append(clarabel.SecondOrderConeT(d))
-        if dims.exp or dims.psd or dims.p3d or getattr(dims, "pnd", []):
-            raise SolverError("only zero, nonnegative and second-order cones are supported")
+        self._compile_quadratic(pp)
+        self.cones = _clarabel_cones(data[cp.reductions.solvers.conic_solvers.conic_solver.ConicSolver.DIMS])
         self.var_id_to_col = dict(pp.var_id_to_col)
         self._solver: clarabel.DefaultSolver | None = None
         self.compile_time_s = time.perf_counter() - t0
         self.rebuilds = 0
         self.updates = 0
+
+    def _compile_quadratic(self, pp: Any) -> None:
+        """P: the reduced tensor restricted to the upper triangle (a constant when no parameter enters)."""
+        self._P_map = None
+        self._P_const = None
+        self._P_indices = np.zeros(0, dtype=np.int64)
+        self._P_indptr = np.zeros(self.n + 1, dtype=np.int64)
+        if pp.P is None:
+            return
+        pp.reduced_P.cache(keep_zeros=True)
+        p_idx, p_ptr, _ = pp.reduced_P.problem_data_index
+        cols = np.repeat(np.arange(self.n), np.diff(p_ptr))
+        keep = np.asarray(p_idx) <= cols
+        red = sp.csr_matrix(pp.reduced_P.reduced_mat)[np.flatnonzero(keep)]
+        counts = np.bincount(cols[keep], minlength=self.n)
+        self._P_indices = np.asarray(p_idx)[keep].astype(np.int64)
+        self._P_indptr = np.concatenate([[0], np.cumsum(counts)]).astype(np.int64)
+        if red[:, :-1].nnz == 0:  # no parameter enters P
+            self._P_const = np.asarray(red[:, -1].toarray()).ravel()
+        else:
+            self._P_map = red
 
     # ------------------------------------------------------------------ data
     def load_parameter_values(self, problem: cp.Problem) -> None:
@@ -255,14 +267,14 @@ class CompiledConeProgram:
         sol = self._solver.solve()
         wall = time.perf_counter() - t0
         raw = str(sol.status)
-        status = CLARABEL_STATUS.get(raw, "solver_error")
+        status = status_from(CLARABEL_STATUS, raw)
         x: np.ndarray | None = None
         objective = math.nan
-        if status in ("optimal", "optimal_inaccurate"):
+        if status.solved:
             x = np.asarray(sol.x, dtype=float)
             objective = float(sol.obj_val) + d
             if x.size != self.n or not (np.isfinite(x).all() and math.isfinite(objective)):
-                x, objective, status = None, math.nan, "solver_error"
+                x, objective, status = None, math.nan, Status.SOLVER_ERROR
         return ConeSolution(status=status, raw_status=raw, x=x, objective=objective,
                             solver_time_s=wall, iterations=int(sol.iterations))
 

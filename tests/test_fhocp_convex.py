@@ -1,0 +1,112 @@
+"""The convex subproblem: DPP, built once, fast path equal to cvxpy's own solve path, terminal modes."""
+
+from __future__ import annotations
+
+import cvxpy as cp
+import numpy as np
+import pytest
+
+from tubekit.fhocp import FHOCP
+
+from .fhocp_cases import OBSTACLES, SC, STATES, tightening
+
+
+@pytest.fixture(scope="module")
+def rt() -> FHOCP:
+    return FHOCP(SC, tightening(), mode="realtime")
+
+
+def test_problem_is_dpp(rt):
+    assert isinstance(rt.problem, cp.Problem)
+    assert rt.problem.is_dcp(dpp=True)
+    assert rt.problem.is_dpp()
+
+
+def test_fast_path_data_equals_cvxpy_apply_parameters(rt):
+    rt.reset()
+    t, s = STATES[2]
+    rt.solve(t, np.array(s), OBSTACLES)
+    assert rt.compiled.verify() < 1e-12
+
+
+def test_resolve_does_not_recanonicalise(monkeypatch):
+    solver = FHOCP(SC, tightening(), mode="converged")
+    t, s = STATES[1]
+    solver.solve(t, np.array(s), OBSTACLES)
+    clarabel_obj = solver.compiled._solver
+    rebuilds = solver.compiled.rebuilds
+
+    def forbidden(*args, **kwargs):
+        raise AssertionError("cvxpy re-canonicalised the problem")
+
+    from cvxpy.reductions.cvx_attr2constr import CvxAttr2Constr
+    from cvxpy.reductions.dcp2cone.cone_matrix_stuffing import ConeMatrixStuffing
+    from cvxpy.reductions.dcp2cone.dcp2cone import Dcp2Cone
+    from cvxpy.reductions.solvers.solving_chain import SolvingChain
+    for cls in (Dcp2Cone, ConeMatrixStuffing, CvxAttr2Constr, SolvingChain):
+        monkeypatch.setattr(cls, "apply", forbidden)
+    monkeypatch.setattr(cp.Problem, "get_problem_data", forbidden)
+    updates = solver.compiled.updates
+    for k, (t, s) in enumerate(STATES):
+        res = solver.solve(t, np.array(s), OBSTACLES if k % 2 else ())
+        assert not res.fallback
+    assert solver.compiled._solver is clarabel_obj          # persistent Clarabel solver
+    assert solver.compiled.rebuilds == rebuilds              # never rebuilt
+    assert solver.compiled.updates > updates                 # data updates instead
+
+
+def test_cvxpy_path_reuses_its_compiled_map(monkeypatch):
+    solver = FHOCP(SC, tightening(), mode="realtime", fast_path=False)
+    t, s = STATES[1]
+    solver.solve(t, np.array(s), OBSTACLES)
+    prog = solver.problem._cache.param_prog
+    assert prog is not None
+
+    from cvxpy.reductions.dcp2cone.dcp2cone import Dcp2Cone
+    from cvxpy.reductions.solvers.solving_chain import SolvingChain
+
+    def forbidden(*args, **kwargs):
+        raise AssertionError("cvxpy re-canonicalised the problem")
+
+    monkeypatch.setattr(Dcp2Cone, "apply", forbidden)
+    monkeypatch.setattr(SolvingChain, "apply", forbidden)
+    for t, s in STATES[2:4]:
+        assert not solver.solve(t, np.array(s), OBSTACLES).fallback
+    assert solver.problem._cache.param_prog is prog
+
+
+@pytest.mark.parametrize("mode", ["realtime", "converged"])
+def test_fast_path_equals_problem_solve_path(mode):
+    fast = FHOCP(SC, tightening(), mode=mode)
+    slow = FHOCP(SC, tightening(), mode=mode, fast_path=False)
+    assert fast.compiled is not None and slow.compiled is None
+    for t, s in STATES[:4]:
+        a = fast.solve(t, np.array(s), OBSTACLES)
+        b = slow.solve(t, np.array(s), OBSTACLES)
+        assert a.iterations == b.iterations
+        assert np.allclose(a.inputs, b.inputs, atol=1e-5)
+        assert a.merit == pytest.approx(b.merit, rel=1e-6)
+
+
+def test_subproblem_objective_equals_cvxpy_value(rt):
+    rt.reset()
+    t, s = STATES[3]
+    rt.solve(t, np.array(s), OBSTACLES)
+    status, v, obj, _ = rt._solve_subproblem()
+    assert status == "optimal"
+    rt.push_parameters()
+    rt.problem.solve(solver=cp.CLARABEL, presolve_enable=False)
+    assert obj == pytest.approx(rt.problem.value, rel=1e-6)
+    vv = np.stack([rt.variables[k].value for k in ("u", "w", "r")], axis=1)
+    assert np.allclose(v, vv, atol=1e-5)
+
+
+@pytest.mark.parametrize("terminal", ["soft", "hard", "off"])
+def test_terminal_modes_build_and_solve(terminal):
+    solver = FHOCP(SC, tightening(), terminal=terminal)
+    assert solver.problem.is_dcp(dpp=True)
+    t, s = STATES[1]
+    res = solver.solve(t, np.array(s), OBSTACLES)
+    assert not res.fallback
+    if terminal == "off":
+        assert res.violations["terminal"] == 0.0

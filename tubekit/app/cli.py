@@ -1,0 +1,358 @@
+"""The ``tubekit`` console script: one parser, one subcommand per capability.
+
+Every subcommand is a :class:`Subcommand` in :data:`SUBCOMMANDS`: its help line,
+the function adding its options and the function running it. Handlers import
+what they need (the study, verify, the plots) when they run, so a missing
+optional dependency disables only the commands that use it.
+
+Exit codes: 0 success / certified, 1 failure (a command not available),
+2 bad input (one message, no traceback), 3 not certified / counterexample found,
+4 a certified promise broken in a run (simulate, reproduce).
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any, Callable
+
+from .. import __version__
+from ..exceptions import ConfigError, TubekitError
+from ..jsonable import dumps, write_json
+from ..scenario import Scenario, load_scenario, paper_scenario
+from ..validation import positive
+
+__all__ = ["main", "build_parser", "Subcommand", "SUBCOMMANDS", "EXIT_OK", "EXIT_FAILURE", "EXIT_BAD_INPUT",
+           "EXIT_NOT_CERTIFIED", "EXIT_PROMISE_BROKEN"]
+
+EXIT_OK = 0
+EXIT_FAILURE = 1
+EXIT_BAD_INPUT = 2
+#: ``certify``: not certified; ``falsify``: counterexample found.
+EXIT_NOT_CERTIFIED = 3
+#: ``simulate``/``reproduce``: a certified scenario's run broke a promise of its certificate.
+EXIT_PROMISE_BROKEN = 4
+
+
+@dataclass(frozen=True)
+class Subcommand:
+    """One subcommand: a one-line help, ``configure(parser)`` adding its options, ``run(args) -> exit code``."""
+
+    help: str
+    configure: Callable[[argparse.ArgumentParser], None]
+    run: Callable[[argparse.Namespace], int]
+
+
+# ---- shared option groups and helpers -------------------------------------------------------------------
+
+def _study_options(parser: argparse.ArgumentParser, default_out: str | None) -> None:
+    from .study import QUICK_DURATION_S
+
+    parser.add_argument("--out", metavar="DIR", default=default_out,
+                        help="output directory" + (f" (default: {default_out})" if default_out else
+                                                   " (default: results/<scenario name>)"))
+    length = parser.add_mutually_exclusive_group()
+    length.add_argument("--duration", type=float, metavar="S", default=None,
+                        help="simulated time in seconds (default: the scenario's)")
+    length.add_argument("--quick", action="store_true",
+                        help=f"shorthand for --duration {QUICK_DURATION_S:g} (smoke test)")
+    parser.add_argument("--law", choices=("paper", "corrected"), default=None,
+                        help="ancillary law (default: the scenario's controller.law)")
+    parser.add_argument("--no-progress", action="store_true", help="no progress bar")
+
+
+def _verify_options(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("config", nargs="?", metavar="CONFIG", default=None,
+                        help="scenario TOML (default: the paper's Section VI scenario)")
+    parser.add_argument("--law", default=None, metavar="NAME",
+                        help="ancillary law: 'paper' or 'corrected' (default: the scenario's controller.law)")
+    parser.add_argument("--json", default=None, metavar="FILE", help="write the result as JSON ('-' = stdout)")
+
+
+def _scenario(config: str | None) -> Scenario:
+    return paper_scenario() if config is None else load_scenario(config)
+
+
+def _law(args: argparse.Namespace, scenario: Scenario) -> str:
+    """The ``--law`` option, else the scenario's; unknown names raise :class:`ConfigError`."""
+    from ..ancillary import get_law
+
+    law = args.law if args.law is not None else scenario.controller.law
+    get_law(law)
+    return law
+
+
+def _emit_json(path: str, data: Any) -> None:
+    """``--json FILE`` of certify/envelope: strict JSON to FILE ('-' = stdout); the directory must exist."""
+    if path == "-":
+        print(dumps(data))
+        return
+    target = Path(path)
+    if not target.parent.exists():
+        raise ConfigError("--json", "a file in an existing directory", path)
+    try:
+        write_json(target, data)
+    except OSError as exc:
+        raise ConfigError("--json", "a writable file", path, str(exc)) from None
+
+
+def _write_json_creating_dirs(path: str, data: Any) -> None:
+    """``--json FILE`` of audit/falsify: strict JSON to FILE, creating its directory."""
+    Path(path).parent.mkdir(parents=True, exist_ok=True)
+    write_json(path, data)
+
+
+# ---- reproduce / simulate -------------------------------------------------------------------------------
+
+def _configure_reproduce(parser: argparse.ArgumentParser) -> None:
+    _study_options(parser, "results/reproduce")
+
+
+def _configure_simulate(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("config", metavar="CONFIG", help="scenario TOML file (schema: docs/scenario.md)")
+    _study_options(parser, None)
+
+
+def _log(message: str) -> None:
+    print(message, flush=True)
+
+
+def _run_reproduce(args: argparse.Namespace) -> int:
+    """Section VI of the paper, tube against baseline, with the acceptance criteria."""
+    from .study import apply_overrides, run_study
+
+    scenario = apply_overrides(paper_scenario(), duration=args.duration, quick=args.quick, law=args.law)
+    out = Path(args.out or "results/reproduce")
+    metrics = run_study(scenario, out, progress=not args.no_progress, with_acceptance=True, log=_log)
+    return _study_exit(metrics)
+
+
+def _run_simulate(args: argparse.Namespace) -> int:
+    """The same study on a scenario from TOML."""
+    from .study import apply_overrides, output_dir_name, run_study
+
+    scenario = apply_overrides(load_scenario(args.config), duration=args.duration, quick=args.quick, law=args.law)
+    out = Path(args.out) if args.out else Path("results") / output_dir_name(scenario.name)
+    metrics = run_study(scenario, out, progress=not args.no_progress, with_acceptance=False, log=_log)
+    return _study_exit(metrics)
+
+
+def _study_exit(metrics: dict) -> int:
+    """4 when a certified scenario's tube run broke a promise, else 0."""
+    return EXIT_PROMISE_BROKEN if metrics["certified"] and not metrics["promises_kept"] else EXIT_OK
+
+
+# ---- audit ----------------------------------------------------------------------------------------------
+
+def _configure_audit(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("--json", metavar="FILE", help="write the audit as JSON to FILE")
+    parser.add_argument("--samples", type=int, default=2000, help="random points per term (default 2000)")
+    parser.add_argument("--seed", type=int, default=0, help="RNG seed (default 0)")
+
+
+def _run_audit(args: argparse.Namespace) -> int:
+    """Run the audit, print the table, optionally write JSON."""
+    from ..audit import audit
+
+    if args.samples < 10:
+        raise ConfigError("--samples", "an integer >= 10", args.samples)
+    report = audit(samples=args.samples, seed=args.seed)
+    print(report.table())
+    if args.json:
+        _write_json_creating_dirs(args.json, report.to_dict())
+        print(f"\nwrote {args.json}")
+    return EXIT_OK
+
+
+# ---- certify / envelope ---------------------------------------------------------------------------------
+
+def _configure_certify(parser: argparse.ArgumentParser) -> None:
+    _verify_options(parser)
+    parser.add_argument("--max-boxes", type=int, default=4000, metavar="N",
+                        help="branch-and-bound budget per gain entry, in boxes (a work unit: the verdict does not "
+                             "depend on machine load; default 4000)")
+    parser.add_argument("--quiet", action="store_true", help="do not print the summary")
+    parser.add_argument("--search-region", action="store_true",
+                        help="certify on a fixed grid of (region.e_o_max, region.e_d_max) and report every "
+                             "verdict; exit 0 if any certifies (the best is printed), else 3")
+
+
+def _run_certify(args: argparse.Namespace) -> int:
+    """Certify; print the summary; 0 certified, 3 not certified (``--search-region``: any point of the grid)."""
+    from verify import certify
+
+    scenario = _scenario(args.config)
+    law = _law(args, scenario)
+    if args.search_region:
+        from verify.region_search import search_region
+
+        found = search_region(scenario, law)
+        if not args.quiet and args.json != "-":
+            print(found.summary())
+        if args.json is not None:
+            _emit_json(args.json, found.to_dict())
+        return EXIT_OK if found.best is not None else EXIT_NOT_CERTIFIED
+    if args.max_boxes < 1:
+        raise ConfigError("--max-boxes", "an integer >= 1", args.max_boxes)
+    cert = certify(scenario, law, max_boxes=args.max_boxes)
+    if not args.quiet and args.json != "-":
+        print(cert.summary())
+    if args.json is not None:
+        _emit_json(args.json, cert.to_dict())
+    return EXIT_OK if cert.certified else EXIT_NOT_CERTIFIED
+
+
+def _configure_envelope(parser: argparse.ArgumentParser) -> None:
+    _verify_options(parser)
+    parser.add_argument("--plot", default=None, metavar="FILE", help="save the envelope plot (PNG/PDF/SVG)")
+    parser.add_argument("--quick", action="store_true", help="fewer speeds and bisection steps (faster)")
+    parser.add_argument("--eps", type=float, default=None, metavar="E",
+                        help="epsilon = min e_d in m for both frontiers (default: the scenario's)")
+
+
+def _run_envelope(args: argparse.Namespace) -> int:
+    """Certified and physical-necessity frontiers at one epsilon; print the table and the ratio; JSON, plot."""
+    from verify import envelope
+
+    from .plots import plot_envelope
+
+    scenario = _scenario(args.config)
+    law = _law(args, scenario)
+    if args.plot is not None and not Path(args.plot).parent.exists():
+        raise ConfigError("--plot", "a file in an existing directory", args.plot)
+    eps = None if args.eps is None else positive("--eps", args.eps)
+    result = envelope(scenario, law, eps=eps, quick=args.quick)
+    if args.json != "-":
+        print(result.summary())
+    if args.json is not None:
+        _emit_json(args.json, result.to_dict())
+    if args.plot is not None:
+        plot_envelope(result, args.plot)
+        if args.json != "-":
+            print(f"plot written to {args.plot}")
+    return EXIT_OK
+
+
+def _configure_recheck(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("cert", metavar="CERT", help="a certificate JSON written by tubekit certify --json")
+    parser.add_argument("--json", metavar="FILE", help="write the recheck as JSON")
+
+
+def _run_recheck(args: argparse.Namespace) -> int:
+    """0 when the certificate is confirmed, 3 when it is not certified or the recheck disagrees."""
+    from verify.recheck import recheck_file
+
+    result = recheck_file(args.cert)
+    print(result.summary())
+    if args.json:
+        _write_json_creating_dirs(args.json, result.to_dict())
+    return EXIT_OK if result.confirmed else EXIT_NOT_CERTIFIED
+
+
+# ---- falsify --------------------------------------------------------------------------------------------
+
+def _configure_falsify(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("config", nargs="?", metavar="CONFIG",
+                        help="scenario TOML (default: the paper's Section VI scenario)")
+    parser.add_argument("--law", choices=("paper", "corrected"), help="ancillary law (default: the scenario's)")
+    parser.add_argument("--budget", type=int, default=None,
+                        help="one-period starts searched by hypothesis (default 500), or with --closed-loop "
+                             "simulations (default 20)")
+    parser.add_argument("--seed", type=int, default=0, help="search seed (default 0)")
+    parser.add_argument("--sigma", type=float, help="override the ancillary gain sigma (1/s; one-period search)")
+    parser.add_argument("--closed-loop", action="store_true",
+                        help="attack whole runs of the loop with disturbance sequences (greedy + evolution)")
+    parser.add_argument("--duration", type=float, default=3.0, help="seconds per closed-loop run (default 3)")
+    parser.add_argument("--json", metavar="FILE", help="write the result as JSON")
+
+
+def _run_falsify(args: argparse.Namespace) -> int:
+    """3 when a counterexample is found (ratio > 1 or a promise broken), 0 when none within the budget."""
+    from verify.falsify import falsify, falsify_closed_loop
+
+    scenario = _scenario(args.config)
+    if args.sigma is not None:
+        positive("--sigma", args.sigma)
+    positive("--duration", args.duration)
+    if args.closed_loop:
+        budget = 20 if args.budget is None else args.budget
+        result = falsify_closed_loop(scenario, args.law, budget=budget, seed=args.seed, duration=args.duration)
+    else:
+        budget = 500 if args.budget is None else args.budget
+        result = falsify(scenario, args.law, budget=budget, seed=args.seed, sigma=args.sigma)
+    print(result.summary())
+    if args.json:
+        _write_json_creating_dirs(args.json, result.to_dict())
+    return EXIT_NOT_CERTIFIED if result.found else EXIT_OK
+
+
+# ---- the parser and the entry point ---------------------------------------------------------------------
+
+SUBCOMMANDS: dict[str, Subcommand] = {
+    "reproduce": Subcommand("reproduce the paper's Section VI simulation study (the main job)",
+                            _configure_reproduce, _run_reproduce),
+    "simulate": Subcommand("simulate any scenario given as TOML", _configure_simulate, _run_simulate),
+    "audit": Subcommand("audit the paper's printed error dynamics against the sympy derivation",
+                        _configure_audit, _run_audit),
+    "certify": Subcommand("certify a scenario: bounds, sigma, tube radius, tightened sets",
+                          _configure_certify, _run_certify),
+    "envelope": Subcommand("design search: the certifiable envelope of a scenario", _configure_envelope,
+                           _run_envelope),
+    "recheck": Subcommand("re-check a certificate JSON: every condition from its stored numbers, no search",
+                          _configure_recheck, _run_recheck),
+    "falsify": Subcommand("search for a run or period that breaks the certified tube", _configure_falsify,
+                          _run_falsify),
+}
+
+
+def build_parser() -> argparse.ArgumentParser:
+    """The ``tubekit`` parser with every subcommand of :data:`SUBCOMMANDS`.
+
+    A subcommand whose options cannot be built (a missing dependency) is kept,
+    marked unavailable, so the others still work.
+    """
+    parser = argparse.ArgumentParser(prog="tubekit", description="Robust tube-based NMPC for underactuated AUVs.")
+    parser.add_argument("--version", action="version", version=f"tubekit {__version__}")
+    sub = parser.add_subparsers(dest="command", metavar="COMMAND")
+    for name, command in SUBCOMMANDS.items():
+        subparser = sub.add_parser(name, help=command.help, description=command.help)
+        try:
+            command.configure(subparser)
+        except ImportError as exc:
+            subparser.set_defaults(_unavailable=str(exc))
+            continue
+        subparser.set_defaults(_run=command.run)
+    return parser
+
+
+def _not_available(command: str, reason: str) -> int:
+    print(f"tubekit {command}: not available: {reason}. "
+          f"Try: pip install -e . (it installs every dependency of the commands).", file=sys.stderr)
+    return EXIT_FAILURE
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Entry point; returns the process exit code."""
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    if args.command is None:
+        parser.print_help()
+        return EXIT_BAD_INPUT
+    if getattr(args, "_unavailable", None):
+        return _not_available(args.command, args._unavailable)
+    try:
+        return int(args._run(args))
+    except ImportError as exc:  # a dependency of this command only
+        return _not_available(args.command, str(exc))
+    except TubekitError as exc:
+        print(f"tubekit {args.command}: error: {exc}", file=sys.stderr)
+        return EXIT_BAD_INPUT
+    except BrokenPipeError:  # e.g. `tubekit certify | head`
+        sys.stderr.close()
+        return EXIT_OK
+
+
+if __name__ == "__main__":  # pragma: no cover
+    sys.exit(main())

@@ -1,0 +1,259 @@
+"""The closed-loop study behind ``tubekit reproduce`` and ``tubekit simulate`` (issue 5).
+
+Both run the same study on a scenario: certify it with :func:`verify.certify`
+(written even when it does not certify), run the tube controller with the
+certificate's (best-effort) tightened sets and gain, run the baseline (nominal
+MPC alone: no κ, no tightening) under the same disturbance, then write into
+the output directory:
+
+* ``trajectory.csv`` / ``baseline_trajectory.csv`` (columns: see
+  :data:`tubekit.closed_loop.CSV_COLUMNS`),
+* ``metrics.json`` (tube metrics at the top level, ``baseline`` nested,
+  ``acceptance`` for ``reproduce``),
+* ``certificate.json`` and ``certificate.txt``, ``scenario.json``,
+* the figures of :data:`tubekit.app.plots.FIGURE_FILES`.
+
+:func:`run_study` is the pipeline; each step is a function of its own.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass, replace
+from pathlib import Path
+from typing import Any, Callable
+
+import verify
+
+from ..closed_loop import SimulationResult, simulate
+from ..exceptions import ConfigError
+from ..jsonable import write_json, write_text
+from ..metrics import compute_metrics
+from ..promises import check_promises
+from ..scenario import Scenario
+from ..tightening import Tightening
+from .plots import plot_all
+
+__all__ = [
+    "run_study",
+    "apply_overrides",
+    "acceptance",
+    "output_dir_name",
+    "QUICK_DURATION_S",
+    "OUTPUT_FILES",
+]
+
+#: Simulated seconds of ``--quick``.
+QUICK_DURATION_S = 10.0
+#: Files (besides figures) every study writes.
+OUTPUT_FILES: tuple[str, ...] = ("trajectory.csv", "baseline_trajectory.csv", "metrics.json", "certificate.json",
+                                 "certificate.txt", "scenario.json")
+
+Log = Callable[[str], None]
+
+
+def apply_overrides(scenario: Scenario, *, duration: float | None = None, quick: bool = False,
+                    law: str | None = None) -> Scenario:
+    """The scenario with the command-line overrides applied.
+
+    Parameters
+    ----------
+    duration : float, optional
+        Simulated time (s); ``quick`` sets it to :data:`QUICK_DURATION_S`.
+    law : str, optional
+        Ancillary law replacing ``controller.law``.
+
+    Raises
+    ------
+    ConfigError
+        ``--duration`` not a positive number of seconds, or shorter than one FHOCP period.
+    """
+    duration = QUICK_DURATION_S if quick else duration
+    if duration is not None:
+        if not (isinstance(duration, (int, float)) and math.isfinite(duration) and duration > 0):
+            raise ConfigError("--duration", "a number of seconds > 0", duration)
+        scenario = scenario.with_changes(duration=float(duration))
+        if scenario.steps < 1:
+            raise ConfigError("--duration", f"at least one FHOCP period ({scenario.controller.dt:g} s)", duration)
+    if law:
+        scenario = scenario.with_changes(controller=replace(scenario.controller, law=law))
+    return scenario
+
+
+def output_dir_name(scenario_name: str) -> str:
+    """A file-system-safe directory name for a scenario (``results/<name>`` of ``tubekit simulate``)."""
+    keep = "".join(ch if ch.isalnum() or ch in "-_." else "_" for ch in scenario_name)
+    return keep or "scenario"
+
+
+def acceptance(metrics: dict[str, Any], total_wall_s: float) -> dict[str, Any]:
+    """Issue 5 item 7 on the tube run: each criterion with the number it rests on."""
+    enc, enc_d = metrics.get("encirclements"), metrics.get("desired_encirclements")
+    passes = metrics.get("obstacle_passes")
+    return {
+        "no_collision": not metrics["collision"],
+        "inputs_within_V": bool(metrics["inputs_within_limits"]),
+        "two_encirclements": bool(passes) and all(p >= 2 for p in passes),
+        "e_d_at_least_epsilon": not metrics["e_d_below_epsilon"],
+        "notes": {
+            "encirclements": enc, "desired_encirclements": enc_d, "obstacle_passes": passes,
+            "min_clearance": metrics["min_clearance"],
+            "min_e_d": metrics["min_e_d"], "epsilon": metrics["epsilon"],
+            "e_d_below_epsilon": metrics["e_d_below_epsilon"], "total_wall_s": total_wall_s,
+            "saturated_steps": metrics["saturated_steps"],
+            "rule": ("two_encirclements: every obstacle passed at least twice (the paper: 'two encirclements, "
+                     "which means that it should avoid the obstacles twice each'); collision: clearance < 0; "
+                     "inputs_within_V: applied inputs (after any counted saturation) inside V"),
+        },
+    }
+
+
+@dataclass(frozen=True)
+class CertifiedDesign:
+    """What the runs need from the certificate: the tightening, whether it is certified, and the time (s)."""
+
+    tightening: Tightening
+    certified: bool
+    certify_s: float
+
+
+def certify_and_write(scenario: Scenario, out: Path, log: Log) -> CertifiedDesign:
+    """Certify with :func:`verify.certify`; write ``certificate.json`` and ``certificate.txt``."""
+    log(f"certifying {scenario.name!r} (law {scenario.controller.law}) ...")
+    started = time.perf_counter()
+    cert = verify.certify(scenario, law=scenario.controller.law)
+    certify_s = time.perf_counter() - started
+    certified = bool(cert.certified)
+    write_json(out / "certificate.json", cert.to_dict())
+    write_text(out / "certificate.txt", str(cert.summary()) + "\n")
+    tightening: Tightening = cert.tightening(allow_uncertified=True)
+    log(f"  {'certified' if certified else 'NOT certified (best-effort tightening used)'} in {certify_s:.1f} s; "
+        f"sigma = {tightening.sigma:.4g}, rho_tilde = {tightening.rho_tilde:.4g}")
+    return CertifiedDesign(tightening, certified, certify_s)
+
+
+def run_tube_and_baseline(scenario: Scenario, tightening: Tightening, progress: bool,
+                          log: Log) -> tuple[SimulationResult, SimulationResult]:
+    """The tube controller with ``tightening``, then the baseline (untightened, no κ) under the same disturbance."""
+    log(f"tube run ({scenario.duration:g} s simulated) ...")
+    tube = simulate(scenario, tightening=tightening, tube=True, progress=progress, label="tube")
+    log(f"  {tube.summary()}")
+    log("baseline run (nominal MPC alone) ...")
+    base = simulate(scenario, tightening=Tightening.untightened(scenario), tube=False, progress=progress,
+                    label="baseline")
+    log(f"  {base.summary()}")
+    return tube, base
+
+
+def _run_facts(run: SimulationResult) -> dict[str, Any]:
+    return {"tube": run.tube, "law": run.law if run.tube else None, "sigma": run.sigma,
+            "kappa_failures": run.kappa_failures, "checks": run.checks}
+
+
+def closed_loop_notes(scenario: Scenario, tube: SimulationResult) -> dict[str, str]:
+    """How the closed loop was simulated, in words (``metrics.json["closed_loop"]``)."""
+    return {
+        "plant": f"eq. (11), classical RK4, fixed step {tube.plant_step_s * 1e3:g} ms, input held over each tick",
+        "ancillary": f"kappa at {scenario.controller.ancillary_rate_hz:g} Hz, zero-order hold",
+        "fhocp": f"every {scenario.controller.dt:g} s, nominal reset to the measured state, first input held",
+        "sensing": "obstacle known once its surface is within sensing_range of the vehicle centre; remembered",
+        "saturation": "v = v_hat + kappa clipped to V only when outside V; counted per tick and per period",
+    }
+
+
+def write_runs(out: Path, scenario: Scenario, design: CertifiedDesign, tube: SimulationResult,
+               base: SimulationResult) -> dict[str, Any]:
+    """Write both CSVs and the figures; return the metrics of both runs (baseline nested)."""
+    tube.write_csv(out / "trajectory.csv")
+    base.write_csv(out / "baseline_trajectory.csv")
+    tube_cols, base_cols = tube.columns(), base.columns()
+    rho_tilde = float(design.tightening.rho_tilde)
+    metrics = compute_metrics(tube_cols, scenario, rho_bound=rho_tilde if design.certified else None,
+                              extra=_run_facts(tube))
+    metrics["baseline"] = compute_metrics(base_cols, scenario, rho_bound=None, extra=_run_facts(base))
+    plot_all(out, scenario, [("tube", tube_cols), ("baseline", base_cols)], rho_tilde=rho_tilde,
+             certified=design.certified)
+    metrics["certified"] = design.certified
+    metrics["rho_tilde_used"] = rho_tilde
+    promises = check_promises(tube)
+    metrics["promises"] = [p.to_dict() for p in promises]
+    metrics["promises_kept"] = all(p.ok for p in promises)
+    metrics["max_rho_ratio"] = promises[0].observed if promises[0].name == "tube" else None
+    metrics["tube_box"] = [float(x) for x in design.tightening.tube]
+    metrics["certify_s"] = design.certify_s
+    metrics["closed_loop"] = closed_loop_notes(scenario, tube)
+    return metrics
+
+
+def _fmt(v: Any) -> str:
+    if v is None:
+        return "null"
+    if isinstance(v, bool):
+        return str(v)
+    if isinstance(v, float):
+        return f"{v:.4g}"
+    return str(v)
+
+
+def comparison_table(tube: dict[str, Any], base: dict[str, Any]) -> str:
+    """Tube against baseline, one metric per line."""
+    keys = ("min_clearance", "min_e_d", "max_input_ratio", "saturated_steps", "fallback_steps", "encirclements",
+            "tracking_rmse", "max_rho", "step_ms_median", "step_ms_p95", "wall_s")
+    lines = [f"{'metric':<18}{'tube':>12}{'baseline':>12}"]
+    lines += [f"{k:<18}{_fmt(tube.get(k)):>12}{_fmt(base.get(k)):>12}" for k in keys]
+    return "\n".join(lines)
+
+
+def log_promises(metrics: dict[str, Any], log: Log) -> None:
+    """Each promise of the certificate with its numbers; says plainly when a certified one is broken."""
+    certified = metrics["certified"]
+    head = ("promises of the certificate (certified):" if certified
+            else "figures a certificate would promise (NOT certified: nothing is claimed):")
+    log(head)
+    for p in metrics["promises"]:
+        mark = "ok  " if p["ok"] else ("BROKEN" if certified else "no  ")
+        log(f"  [{mark}] {p['name']}: {_fmt(p['observed'])} vs {_fmt(p['bound'])}  ({p['detail']})")
+    if certified and not metrics["promises_kept"]:
+        log("CERTIFIED PROMISE BROKEN: the run violates what the certificate guarantees (exit 4)")
+
+
+def log_acceptance(metrics: dict[str, Any], log: Log) -> None:
+    """The acceptance verdicts, then every e_d < ε interval and every collision."""
+    log("acceptance: " + ", ".join(f"{k}={v}" for k, v in metrics["acceptance"].items() if k != "notes"))
+    for iv in metrics["e_d_below_epsilon"]:
+        log(f"  e_d < epsilon from t={iv['t_start']:.2f} s to {iv['t_end']:.2f} s, "
+            f"min {iv['min']:.4f} m at t={iv['t_min']:.2f} s (by {iv['depth']:.4f} m)")
+    for iv in metrics["collisions"]:
+        log(f"  collision from t={iv['t_start']:.2f} s to {iv['t_end']:.2f} s, "
+            f"penetration {iv['depth']:.4f} m at t={iv['t_min']:.2f} s")
+
+
+def run_study(scenario: Scenario, out: Path, *, progress: bool = True, with_acceptance: bool = False,
+              log: Log = print) -> dict[str, Any]:
+    """Certify, run tube + baseline, write every output into ``out``; returns the metrics dict.
+
+    Raises
+    ------
+    ConfigError
+        When the scenario is shorter than one FHOCP period (nothing is written).
+    """
+    started = time.perf_counter()
+    if scenario.steps < 1:
+        raise ConfigError("duration", f"at least one FHOCP period ({scenario.controller.dt:g} s)", scenario.duration)
+    out.mkdir(parents=True, exist_ok=True)
+    write_json(out / "scenario.json", scenario.to_dict())
+    design = certify_and_write(scenario, out, log)
+    tube, base = run_tube_and_baseline(scenario, design.tightening, progress, log)
+    metrics = write_runs(out, scenario, design, tube, base)
+    total = time.perf_counter() - started
+    metrics["total_wall_s"] = total
+    if with_acceptance:
+        metrics["acceptance"] = acceptance(metrics, total)
+    write_json(out / "metrics.json", metrics)
+    log(comparison_table(metrics, metrics["baseline"]))
+    log_promises(metrics, log)
+    if with_acceptance:
+        log_acceptance(metrics, log)
+    log(f"wrote {out} in {total:.1f} s")
+    return metrics

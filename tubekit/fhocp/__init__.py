@@ -1,0 +1,26 @@
+"""The finite-horizon optimal control problem (FHOCP) of Section V and its solvers.
+
+Modules, from the contract outwards:
+
+* :mod:`~tubekit.fhocp.result` — :class:`FhocpResult`, the :class:`Status` enum,
+  :class:`FallbackWarning` and the warm-start shift: what every backend returns and shares;
+* :mod:`~tubekit.fhocp.nlp` — the discretised nonlinear program (:class:`FhocpNlp`):
+  exact step, rollout, linearisations, obstacle selection, evaluation;
+* :mod:`~tubekit.fhocp.convex` — the DPP cvxpy subproblem of one SCP iteration;
+* :mod:`~tubekit.fhocp.fastpath` — the compiled parameter-to-data map + persistent Clarabel;
+* :mod:`~tubekit.fhocp.scp` — :class:`FHOCP`: SCP loop, trust region, fallback;
+* :mod:`~tubekit.fhocp.ipopt` — :class:`IpoptFHOCP`, the CasADi + IPOPT peer (optional).
+"""
+
+from __future__ import annotations
+
+from .convex import DEFAULT_CLARABEL_SETTINGS, ConvexSubproblem
+from .fastpath import CompiledConeProgram
+from .ipopt import IpoptFHOCP
+from .nlp import FhocpNlp, NlpEvaluation
+from .result import RESULT_STATUSES, FallbackWarning, FhocpResult, Status, shifted_plan
+from .scp import FHOCP, MODES, obstacle_slots
+
+__all__ = ["FHOCP", "FhocpResult", "FallbackWarning", "MODES", "obstacle_slots", "DEFAULT_CLARABEL_SETTINGS",
+           "Status", "RESULT_STATUSES", "shifted_plan", "IpoptFHOCP", "FhocpNlp", "NlpEvaluation",
+           "ConvexSubproblem", "CompiledConeProgram"]

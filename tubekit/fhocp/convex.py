@@ -1,0 +1,397 @@
+"""The convex subproblem of one SCP iteration, built once in cvxpy with Parameters (DPP).
+
+:class:`ConvexSubproblem` convexifies :class:`tubekit.fhocp.nlp.FhocpNlp` around a plan:
+
+* dynamics linearised around the current plan (its nonlinear rollout);
+* e_d^2 and e_z^2 are exact convex quadratics in position; e_o is replaced by
+  its first-order model (Gauss-Newton);
+* e_d >= e_d_min and each ball exclusion ||p - c_j|| >= r_j + r_bar + margin
+  become the half-spaces n'(p - c) >= ... with n the unit direction at the
+  plan: the half-space lies inside the nonconvex feasible set (conservative);
+* |e_o| <= e_o_max (linearised), |e_z| <= e_z_max and the z walls (one row
+  each side), e_d <= e_d_max (the same half-space normal as e_d_min: an outer
+  approximation, exact at the linearisation point) and the nearer x and y
+  walls, all with l1 exact-penalty slacks (one per constraint family and
+  step), so a subproblem is feasible whenever the input box is non-empty
+  (unless the terminal set is "hard");
+* terminal set F = {||e_N||_P <= terminal_level} as a second-order cone,
+  "soft" (default, exact penalty), "hard" or "off";
+* a box trust region on the input step, intersected with the input box.
+
+The problem is built once; :meth:`ConvexSubproblem.linearise` writes every parameter
+into one vector, which the fast path (:class:`tubekit.fhocp.fastpath.CompiledConeProgram`)
+maps straight to Clarabel's data, and :meth:`ConvexSubproblem.push_parameters` copies
+into the cvxpy Parameters for ``problem.solve``.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Callable
+
+import cvxpy as cp
+import numpy as np
+import scipy.sparse as sp
+
+from .fastpath import CompiledConeProgram, ConeSolution
+from .nlp import FhocpNlp, eo_linearisation, rollout, step_linearisation
+from .result import Status, status_from
+
+__all__ = ["ConvexSubproblem", "DEFAULT_CLARABEL_SETTINGS", "CVXPY_STATUS"]
+
+#: Clarabel settings used by default (looser than Clarabel's 1e-8: the SCP's own tolerance is 1e-5)
+DEFAULT_CLARABEL_SETTINGS: dict = {"tol_gap_abs": 1e-7, "tol_gap_rel": 1e-7, "tol_feas": 1e-7}
+
+#: cvxpy's ``problem.status`` -> :class:`Status`; any other is SOLVER_ERROR
+CVXPY_STATUS: dict[str, Status] = {
+    cp.settings.OPTIMAL: Status.OPTIMAL,
+    cp.settings.OPTIMAL_INACCURATE: Status.OPTIMAL_INACCURATE,
+    cp.settings.INFEASIBLE: Status.INFEASIBLE,
+    cp.settings.INFEASIBLE_INACCURATE: Status.INFEASIBLE_INACCURATE,
+    cp.settings.UNBOUNDED: Status.UNBOUNDED,
+    cp.settings.UNBOUNDED_INACCURATE: Status.UNBOUNDED_INACCURATE,
+    cp.settings.INFEASIBLE_OR_UNBOUNDED: Status.INFEASIBLE_OR_UNBOUNDED,
+    cp.settings.USER_LIMIT: Status.USER_LIMIT,
+    cp.settings.SOLVER_ERROR: Status.SOLVER_ERROR,
+}
+
+_DYN_KEYS = ("ax", "bxu", "bxr", "cx", "ay", "byu", "byr", "cy")
+_SLACKS = ("e_d_min", "obstacle", "e_o", "box")
+_Par = Callable[[str, int], cp.Parameter]
+
+
+class ConvexSubproblem:
+    """The parametrised convex subproblem (DPP), built once, re-solved with new parameter values.
+
+    The variables are the samples k = 1..N in a frame translated to the measured
+    position, with the heading measured from the measured heading (the measured
+    state itself is not a variable); the translation and the heading offset move
+    into the parameters, so every datum is O(1) near the solution.
+
+    Parameters
+    ----------
+    nlp : FhocpNlp
+        The nonlinear program being convexified.
+    max_obstacles : int
+        Obstacle slots (inactive slots get a constraint 0 >= -1).
+    neutral_state : array (4,)
+        A state (m, rad) to give every parameter a first value from (a zero-input plan).
+    neutral_reference : array (N+1, 3)
+        p_d along that plan (m).
+    trust_radius : float
+        Trust radius (fraction of V-bar) of that first linearisation.
+    fast_path : bool
+        Re-solve through the compiled map + persistent Clarabel; False uses
+        ``problem.solve(solver=cp.CLARABEL)``.
+    clarabel_settings : dict, optional
+        Overrides of :data:`DEFAULT_CLARABEL_SETTINGS`.
+
+    Attributes
+    ----------
+    problem : cvxpy.Problem
+        The subproblem.
+    compiled : CompiledConeProgram or None
+        The fast path (None when ``fast_path=False``).
+    param_vector : array
+        Every parameter's value, written by :meth:`linearise`.
+    """
+
+    def __init__(self, nlp: FhocpNlp, max_obstacles: int, neutral_state: np.ndarray,
+                 neutral_reference: np.ndarray, trust_radius: float, *, fast_path: bool = True,
+                 clarabel_settings: dict | None = None) -> None:
+        self.nlp = nlp
+        self.max_obstacles = max_obstacles
+        N = nlp.n
+        # weights: dt*Q on samples 0..N-1, P on sample N (left rectangle rule + terminal cost)
+        self._weights = np.vstack([np.tile(nlp.dt * nlp.q, (N, 1)), nlp.p])   # (N+1, 3) for k = 0..N
+        self._wref = self._weights[1:, (0, 0, 1)].T  # (3, N) weights of x, y, z at k = 1..N
+        self._build()
+        self.clarabel_settings = {**DEFAULT_CLARABEL_SETTINGS, **(clarabel_settings or {})}
+        self.compiled: CompiledConeProgram | None = None
+        if fast_path:
+            self.compiled = CompiledConeProgram(self.problem, self.clarabel_settings)
+        self._layout()
+        self.linearise(neutral_state, rollout(neutral_state, np.zeros((N, 3)), nlp.dt), np.zeros((N, 3)),
+                       neutral_reference, np.zeros((0, 4)), trust_radius)
+        self.push_parameters()
+
+    # ------------------------------------------------------------- building
+    def _build(self) -> None:
+        """Build the cvxpy problem (once); creation order fixes the compiled data layout."""
+        N = self.nlp.n
+        params: dict[str, cp.Parameter] = {}
+
+        def par(name: str, size: int) -> cp.Parameter:
+            params[name] = cp.Parameter(size, name=name)
+            return params[name]
+
+        v = {n: cp.Variable(N, name=n) for n in ("x", "y", "z", "psi", "u", "w", "r")}
+        v["e_o"] = cp.Variable(N, name="e_o")
+        slack = {n: cp.Variable(N, name=f"slack_{n}") for n in _SLACKS}
+        cons = self._model_rows(par, v, slack)
+        for j in range(self.max_obstacles):
+            ox, oy, oz, ro = par(f"ox{j}", N), par(f"oy{j}", N), par(f"oz{j}", N), par(f"ro{j}", N)
+            cons.append(cp.multiply(ox, v["x"]) + cp.multiply(oy, v["y"]) + cp.multiply(oz, v["z"])
+                        + slack["obstacle"] >= ro)
+        cons += self._box_rows(par, v, slack)
+        terminal_rows, sig_t = self._terminal_rows(par, v)
+        cons += terminal_rows
+        self.problem = cp.Problem(cp.Minimize(self._objective(par, v, slack, sig_t)), cons)
+        self._params = params
+        self._vars = v
+
+    def _model_rows(self, par: _Par, v: dict, slack: dict) -> list:
+        """Linearised dynamics, the e_o model, the input box / trust region and the e_d half-spaces."""
+        N, dt = self.nlp.n, self.nlp.dt
+        x, y, z, psi, u, w, r, eo = (v[k] for k in ("x", "y", "z", "psi", "u", "w", "r", "e_o"))
+        dyn = {k: par(k, N) for k in _DYN_KEYS}
+        gx, gy, gpsi, h = par("gx", N), par("gy", N), par("gpsi", N), par("h", N)
+        nx, ny, red, rdx = par("nx", N), par("ny", N), par("red", N), par("rdx", N)
+        bounds = {k: par(k, N) for k in ("ulo", "uhi", "wlo", "whi", "rlo", "rhi")}
+        shift = sp.diags(np.ones(N - 1), -1, shape=(N, N), format="csc") if N > 1 else sp.csc_matrix((1, 1))
+        diff = sp.identity(N, format="csc") - shift   # (D s)_k = s_k - s_{k-1}, s_0 = 0 in this frame
+        return [
+            diff @ x == cp.multiply(dyn["ax"], shift @ psi) + cp.multiply(dyn["bxu"], u)
+            + cp.multiply(dyn["bxr"], r) + dyn["cx"],
+            diff @ y == cp.multiply(dyn["ay"], shift @ psi) + cp.multiply(dyn["byu"], u)
+            + cp.multiply(dyn["byr"], r) + dyn["cy"],
+            diff @ z == dt * w,
+            diff @ psi == dt * r,
+            eo == cp.multiply(gx, x) + cp.multiply(gy, y) + cp.multiply(gpsi, psi) + h,
+            u >= bounds["ulo"], u <= bounds["uhi"],
+            w >= bounds["wlo"], w <= bounds["whi"],
+            r >= bounds["rlo"], r <= bounds["rhi"],
+            cp.multiply(nx, x) + cp.multiply(ny, y) + slack["e_d_min"] >= red,
+            cp.multiply(nx, x) + cp.multiply(ny, y) - slack["box"] <= rdx,
+        ]
+
+    def _box_rows(self, par: _Par, v: dict, slack: dict) -> list:
+        """|e_o| <= e_o_max, |e_z| <= e_z_max with the z walls, the nearer x/y walls, slacks >= 0."""
+        nlp, N = self.nlp, self.nlp.n
+        eo, z, sig_box = v["e_o"], v["z"], slack["box"]
+        cons = [
+            eo <= nlp.e_o_max + slack["e_o"],
+            -eo <= nlp.e_o_max + slack["e_o"],
+            # |e_z| <= e_z_max and the z walls share a row: z <= min(zd + e_z_max, hi_z - c), etc.
+            z - sig_box <= par("zhi", N),
+            z + sig_box >= par("zlo", N),
+        ]
+        if nlp.workspace is not None:
+            # x/y walls: only the nearer wall per axis can be reached within the horizon
+            # (checked by FHOCP), so one row per axis: sgn * p <= bound.
+            cons += [cp.multiply(par("wsx", N), v["x"]) - sig_box <= par("wbx", N),
+                     cp.multiply(par("wsy", N), v["y"]) - sig_box <= par("wby", N)]
+        cons += [slack[n] >= 0 for n in _SLACKS]
+        return cons
+
+    def _terminal_rows(self, par: _Par, v: dict) -> tuple[list, cp.Variable | None]:
+        """The terminal set as a second-order cone ("soft": with its slack), or nothing ("off")."""
+        nlp, N = self.nlp, self.nlp.n
+        if nlp.terminal == "off":
+            return [], None
+        pdn = par("pdN", 3)
+        sp_ = np.sqrt(nlp.p)
+        x, y, z, eo = v["x"], v["y"], v["z"], v["e_o"]
+        terminal_vec = cp.hstack([sp_[0] * (x[N - 1] - pdn[0]), sp_[0] * (y[N - 1] - pdn[1]),
+                                  sp_[1] * (z[N - 1] - pdn[2]), sp_[2] * eo[N - 1]])
+        if nlp.terminal == "soft":
+            sig_t = cp.Variable(name="slack_terminal")
+            return [sig_t >= 0, cp.SOC(nlp.terminal_level + sig_t, terminal_vec)], sig_t
+        return [cp.SOC(cp.Constant(nlp.terminal_level), terminal_vec)], None
+
+    def _objective(self, par: _Par, v: dict, slack: dict, sig_t: cp.Variable | None) -> cp.Expression:
+        """Quadratic tracking cost + input cost + exact penalties.
+
+        (x - xd)' W (x - xd) = x' W x + lx' x + c0 with lx = -2 W xd and c0 = xd' W xd (plus
+        the constant k = 0 terms) as parameters: quad_form with a constant matrix and a bare
+        variable needs no auxiliary variables, and the objective stays DPP.
+        """
+        nlp, N, dt = self.nlp, self.nlp.n, self.nlp.dt
+        x, y, z, u, w, r, eo = (v[k] for k in ("x", "y", "z", "u", "w", "r", "e_o"))
+        lin = {k: par(k, N) for k in ("lx", "ly", "lz")}
+        c0 = par("c0", 1)
+        w1 = self._weights[1:]
+        cost = (cp.quad_form(x, np.diag(w1[:, 0])) + cp.quad_form(y, np.diag(w1[:, 0]))
+                + cp.quad_form(z, np.diag(w1[:, 1])) + cp.quad_form(eo, np.diag(w1[:, 2]))
+                + lin["lx"] @ x + lin["ly"] @ y + lin["lz"] @ z + cp.sum(c0)
+                + dt * (nlp.r[0] * cp.sum_squares(u) + nlp.r[1] * cp.sum_squares(w)
+                        + nlp.r[2] * cp.sum_squares(r))
+                + nlp.penalty * (cp.sum(slack["e_d_min"]) + cp.sum(slack["obstacle"]) + cp.sum(slack["e_o"])
+                                 + cp.sum(slack["box"])))
+        if sig_t is not None:
+            cost = cost + nlp.terminal_penalty * sig_t
+        return cost
+
+    def _layout(self) -> None:
+        """Columns of every parameter in :attr:`param_vector`, grouped as :meth:`linearise` writes them."""
+        used = {p.id for p in self.problem.parameters()}
+        if self.compiled is not None:
+            self.param_vector = self.compiled.param_vector
+            self._cols = {name: self.compiled.columns(p) for name, p in self._params.items() if p.id in used}
+            self._uwr_cols = np.stack([self.compiled.columns_of(self._vars[k]) for k in ("u", "w", "r")])
+        else:
+            live = {name: p for name, p in self._params.items() if p.id in used}
+            self.param_vector = np.zeros(sum(p.size for p in live.values()))
+            self._cols, start = {}, 0
+            for name, p in live.items():
+                self._cols[name] = np.arange(start, start + p.size)
+                start += p.size
+        nlp, M = self.nlp, self.max_obstacles
+        groups = {"dyn": list(_DYN_KEYS), "lin": ["lx", "ly", "lz"],
+                  "pdN": ["pdN"] if nlp.terminal != "off" else [],
+                  "eo": ["gx", "gy", "gpsi", "h"], "step": ["nx", "ny", "red", "rdx", "zlo", "zhi"],
+                  "bounds": ["ulo", "uhi", "wlo", "whi", "rlo", "rhi"],
+                  "obs": [f"{a}{j}" for j in range(M) for a in ("ox", "oy", "oz", "ro")],
+                  "walls": ["wsx", "wbx", "wsy", "wby"] if nlp.workspace is not None else [],
+                  "c0": ["c0"]}
+        self._gidx = {g: np.concatenate([self._cols[n] for n in names]) if names else np.zeros(0, dtype=int)
+                      for g, names in groups.items()}
+
+    def push_parameters(self) -> None:
+        """Copy :attr:`param_vector` into the cvxpy Parameters' values (for ``problem.solve``)."""
+        for name, p in self._params.items():
+            if name in self._cols:
+                p.value = self.param_vector[self._cols[name]].reshape(p.shape, order="F")
+            else:  # not in the compiled problem (unused): any value
+                p.value = np.zeros(p.shape)
+
+    # ------------------------------------------------------- linearisation
+    def linearise(self, s0: np.ndarray, s: np.ndarray, v: np.ndarray, ref: np.ndarray,
+                  obs: np.ndarray, radius: float) -> None:
+        """Write the parameters for the plan (s, v) into :attr:`param_vector`.
+
+        Parameters
+        ----------
+        s0 : array (4,)
+            Measured state (m, rad): the origin of the frame and of the heading variable.
+        s, v : array (N+1, 4), array (N, 3)
+            The plan (states, inputs) to linearise around.
+        ref : array (N+1, 3)
+            p_d at the samples (m).
+        obs : array (K, 4)
+            Obstacles [cx, cy, cz, radius] (m), K <= max_obstacles.
+        radius : float
+            Trust radius, a fraction of V-bar per input component.
+        """
+        o = s0[:3]
+        psi0 = s0[3]
+        s = s.copy()
+        s[:, :3] -= o
+        ref = ref - o
+        self._write_dynamics(s, v, psi0)
+        self._write_cost_and_eo(s, ref, psi0)
+        self._write_state_rows(s, ref[1:], o)
+        if self.max_obstacles:
+            self._write_obstacles(s, obs, o)
+        self._write_input_bounds(v, radius)
+
+    def _write_dynamics(self, s: np.ndarray, v: np.ndarray, psi0: float) -> None:
+        dyn = step_linearisation(s, v, self.nlp.dt)
+        dyn[3] += dyn[0] * psi0          # offsets for the heading variable psi - psi_0
+        dyn[7] += dyn[4] * psi0
+        self.param_vector[self._gidx["dyn"]] = dyn.ravel()
+
+    def _write_cost_and_eo(self, s: np.ndarray, ref: np.ndarray, psi0: float) -> None:
+        """Linear and constant cost terms, p_d(N) of the terminal set, the e_o model."""
+        pvec, gidx = self.param_vector, self._gidx
+        r1 = ref[1:]
+        blk = -2.0 * self._wref * r1.T
+        pvec[gidx["lin"]] = blk.ravel()
+        if self.nlp.terminal != "off":
+            pvec[gidx["pdN"]] = ref[self.nlp.n]
+        eo_all = eo_linearisation(s, ref)
+        e0 = (ref[0, 0] ** 2 + ref[0, 1] ** 2, ref[0, 2] ** 2, eo_all[4, 0] ** 2)  # k = 0 (constant)
+        pvec[gidx["c0"]] = float(np.einsum("ck,kc->", self._wref, r1 * r1) + self._weights[0] @ e0)
+        eo = eo_all[:4, 1:]
+        eo[3] += eo[2] * psi0
+        pvec[gidx["eo"]] = eo.ravel()
+
+    def _write_state_rows(self, s: np.ndarray, r1: np.ndarray, o: np.ndarray) -> None:
+        """e_d half-spaces (n'(p - p_d), n the horizontal unit error direction), e_z rows, walls."""
+        nlp, N = self.nlp, self.nlp.n
+        ex = s[1:, 0] - r1[:, 0]
+        ey = s[1:, 1] - r1[:, 1]
+        ed = np.sqrt(ex * ex + ey * ey)
+        if ed.min() < 1e-9:  # on the target: use the direction behind the heading
+            tiny = ed < 1e-9
+            ex = np.where(tiny, -np.cos(s[1:, 3]), ex)
+            ey = np.where(tiny, -np.sin(s[1:, 3]), ey)
+            ed = np.sqrt(ex * ex + ey * ey)
+        st = np.empty((6, N))
+        st[0] = ex / ed
+        st[1] = ey / ed
+        npd = st[0] * r1[:, 0] + st[1] * r1[:, 1]
+        st[2] = nlp.e_d_min + npd
+        st[3] = nlp.e_d_max + npd
+        st[4] = r1[:, 2] - nlp.e_z_max
+        st[5] = r1[:, 2] + nlp.e_z_max
+        if nlp.workspace is not None:
+            lo = nlp.workspace[0] + nlp.clearance - o
+            hi = nlp.workspace[1] - nlp.clearance - o
+            np.maximum(st[4], lo[2], out=st[4])
+            np.minimum(st[5], hi[2], out=st[5])
+            # the nearer wall per axis (the origin is the measured position)
+            walls = [1.0, hi[0], 1.0, hi[1]]
+            for i in (0, 1):
+                if -lo[i] < hi[i]:
+                    walls[2 * i], walls[2 * i + 1] = -1.0, -lo[i]
+            self.param_vector[self._gidx["walls"]] = np.repeat(walls, N)
+        self.param_vector[self._gidx["step"]] = st.ravel()
+
+    def _write_obstacles(self, s: np.ndarray, obs: np.ndarray, o: np.ndarray) -> None:
+        """n'(p - c) >= r + clearance, n the unit direction from c to the plan; empty slots 0 >= -1."""
+        ob = np.zeros((self.max_obstacles, 4, self.nlp.n))
+        ob[:, 3] = -1.0  # inactive slot: 0 >= -1
+        k = len(obs)
+        if k:
+            c = obs[:, :3] - o                       # (k, 3)
+            d = s[None, 1:, :3] - c[:, None, :]      # (k, N, 3)
+            dist = np.sqrt(np.einsum("jnc,jnc->jn", d, d))
+            if dist.min() < 1e-9:
+                bad = dist < 1e-9
+                d[bad] = (0.0, 0.0, 1.0)
+                dist[bad] = 1.0
+            n = d / dist[..., None]
+            ob[:k, :3] = n.transpose(0, 2, 1)
+            ob[:k, 3] = obs[:, 3:4] + self.nlp.clearance + np.einsum("jnc,jc->jn", n, c)
+        self.param_vector[self._gidx["obs"]] = ob.ravel()
+
+    def _write_input_bounds(self, v: np.ndarray, radius: float) -> None:
+        """The input box V-bar intersected with the trust region |v_new - v| <= radius V-bar."""
+        vmax = self.nlp.v_max
+        bd = np.empty((6, self.nlp.n))
+        bd[0::2] = np.maximum(-vmax, v - radius * vmax).T
+        bd[1::2] = np.minimum(vmax, v + radius * vmax).T
+        self.param_vector[self._gidx["bounds"]] = bd.ravel()
+
+    # ---------------------------------------------------------------- solve
+    def solve(self) -> tuple[Status, np.ndarray | None, float, float]:
+        """Solve at the current parameters: (status, inputs (N, 3) or None, model objective, solver time (s))."""
+        if self.compiled is not None:
+            sol: ConeSolution = self.compiled.solve()
+            if sol.x is None:
+                return sol.status, None, math.nan, sol.solver_time_s
+            return sol.status, sol.x[self._uwr_cols].T, sol.objective, sol.solver_time_s
+        self.push_parameters()
+        opts = {"presolve_enable": False, "chordal_decomposition_enable": False}
+        opts.update(self.clarabel_settings)
+        try:
+            self.problem.solve(solver=cp.CLARABEL, **opts)
+        except cp.error.SolverError:
+            return Status.SOLVER_ERROR, None, math.nan, 0.0
+        status = status_from(CVXPY_STATUS, self.problem.status)
+        stime = float(self.problem.solver_stats.solve_time or 0.0)
+        if not status.solved:
+            return status, None, math.nan, stime
+        v = np.stack([self._vars[k].value for k in ("u", "w", "r")], axis=1)
+        return status, v, float(self.problem.value), stime
+
+    @property
+    def parameters(self) -> dict[str, cp.Parameter]:
+        """The cvxpy Parameters by name."""
+        return dict(self._params)
+
+    @property
+    def variables(self) -> dict[str, cp.Variable]:
+        """The main cvxpy Variables (x, y, z, psi, u, w, r, e_o) by name."""
+        return dict(self._vars)

@@ -1,0 +1,110 @@
+"""Entrywise bounds of an ancillary law's gain K(e) and closed-loop gain G = J(e) K(e) over R.
+
+The sampled-data tube (:mod:`verify.sampled`) needs, over the region R,
+sup |K_jl| (the input the law can ask for) and the range of G_jl (how one
+zero-order-hold tick moves ρ). J is the derived Jacobian in polar form,
+J = [[c, 0, 0], [0, 1, 0], [-e_o c / e_d, 0, c]] with c = s sqrt(1 - e_o²)
+(s = -1 toward the target, +1 away; :func:`polar_jacobian`, pinned against
+:mod:`tubekit.derivation` by the tests). Each entry is a function of (e_d, e_o)
+only; its sup is certified by :func:`verify.intervals.maximise` (Arb
+branch-and-bound, budget in boxes). Entries that simplify to a constant are
+taken exactly.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from functools import lru_cache
+
+import numpy as np
+import sympy as sp
+
+from tubekit.ancillary import get_law
+from tubekit.exceptions import ConfigError
+
+from .intervals import Case, compile_arb, compile_numpy, maximise
+from .region import Region
+
+__all__ = ["GainBounds", "gain_bounds", "gain_entries", "polar_jacobian"]
+
+_ED, _EO = sp.symbols("e_d e_o", real=True)
+#: Relative gap the gain bounds aim for (they enter the tube linearly).
+GAIN_GAP = 0.01
+
+
+def polar_jacobian(sign: int) -> sp.Matrix:
+    """J(e_d, e_o) in the hemisphere cos(ψ - θ) = sign · sqrt(1 - e_o²)."""
+    c = sign * sp.sqrt(1 - _EO ** 2)
+    return sp.Matrix([[c, 0, 0], [0, 1, 0], [-_EO * c / _ED, 0, c]])
+
+
+@dataclass(frozen=True)
+class GainBounds:
+    """sup |K_jl|, range of G_jj and sup |G_jl| (l != j) over R (dimensionless, 1/m or m as the entry)."""
+
+    k_abs: tuple[tuple[float, float, float], ...]
+    g_lo: tuple[float, float, float]
+    g_hi: tuple[float, float, float]
+    g_off: tuple[tuple[float, float, float], ...]
+    converged: bool
+
+    def to_dict(self) -> dict:
+        """JSON-ready copy."""
+        return {"k_abs": [list(r) for r in self.k_abs], "g_lo": list(self.g_lo), "g_hi": list(self.g_hi),
+                "g_off": [list(r) for r in self.g_off], "converged": self.converged}
+
+
+@lru_cache(maxsize=32)
+def gain_entries(law: str, sign: int) -> tuple[tuple[sp.Expr, ...], tuple[sp.Expr, ...]]:
+    """Simplified K and G = J K entries (row-major) of ``law`` in one hemisphere."""
+    lw = get_law(law)
+    if lw.symbolic_gain is None:
+        raise ConfigError("law", "a law with a symbolic gain (symbolic_gain, needed to bound K(e) over R)", law)
+    J = polar_jacobian(sign)
+    K = sp.Matrix(lw.symbolic_gain(J))
+    if K.shape != (3, 3):
+        raise ConfigError("law.symbolic_gain", "a 3x3 sympy Matrix", K.shape)
+    G = (J * K).applyfunc(sp.simplify)
+    return tuple(sp.simplify(k) for k in K), tuple(G)
+
+
+def _sup(exprs: list[sp.Expr], region: Region, max_boxes: int) -> tuple[float, bool]:
+    """Certified sup of expr over the region box, over all (hemisphere) variants given."""
+    consts = [e for e in exprs if not e.free_symbols]
+    cases = []
+    for i, e in enumerate(x for x in exprs if x.free_symbols):
+        f_arb = compile_arb([e], [_ED, _EO])
+        f_np = compile_numpy([e], [_ED, _EO])
+        cases.append(Case(label=str(i), names=("e_d", "e_o"), lo=np.array([region.e_d[0], region.e_o[0]]),
+                          hi=np.array([region.e_d[1], region.e_o[1]]),
+                          interval=lambda b, f=f_arb: f(*b)[0],
+                          point=lambda X, f=f_np: np.asarray(f(X[:, 0], X[:, 1]), dtype=float).reshape(-1)))
+    best = max((float(c) for c in consts), default=-np.inf)
+    if not cases:
+        return best, True
+    res = maximise(cases, gap=GAIN_GAP, max_boxes=max_boxes)
+    return max(best, res.bound), res.converged
+
+
+def gain_bounds(law: str, region: Region, max_boxes: int = 4000) -> GainBounds:
+    """Certified entry bounds of K and G = J K for ``law`` over ``region`` (both hemispheres if 'both')."""
+    signs = region.hemisphere_signs
+    per = [gain_entries(law, s) for s in signs]
+    conv = True
+    k_abs, g_off = [[0.0] * 3 for _ in range(3)], [[0.0] * 3 for _ in range(3)]
+    g_lo, g_hi = [0.0] * 3, [0.0] * 3
+    for j in range(3):
+        for l in range(3):
+            idx = 3 * j + l
+            k_abs[j][l], ok1 = _sup([sp.Abs(K[idx]) for K, _ in per], region, max_boxes)
+            if j == l:
+                g_hi[j], ok2 = _sup([G[idx] for _, G in per], region, max_boxes)
+                neg, ok3 = _sup([-G[idx] for _, G in per], region, max_boxes)
+                g_lo[j] = -neg
+                conv = conv and ok2 and ok3
+            else:
+                g_off[j][l], ok2 = _sup([sp.Abs(G[idx]) for _, G in per], region, max_boxes)
+                conv = conv and ok2
+            conv = conv and ok1
+    return GainBounds(k_abs=tuple(map(tuple, k_abs)), g_lo=tuple(g_lo), g_hi=tuple(g_hi),
+                      g_off=tuple(map(tuple, g_off)), converged=conv)

@@ -1,0 +1,71 @@
+"""From a certificate to the :class:`tubekit.tightening.Tightening` the FHOCP and the closed loop use.
+
+Certified: V̄ = V - κ̄, the per-arc margins, the tube and the arc-rate bounds as
+certified; the FHOCP's node constraints are the largest margin plus the
+inter-node allowance rate · δ / 2 (a plan meeting them usually passes the exact
+arc check of :mod:`tubekit.plan_check`, which is what the theorem relies on).
+
+Best effort (not certified): the same construction from the best design found,
+each input limit kept at >= max(``min_input_fraction`` · V_i, the keep-up need)
+and each node constraint keeping >= a quarter of R's half-width; flagged
+``certified=False`` — it carries no guarantee.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from tubekit.tightening import Tightening
+
+__all__ = ["tightening_of", "MIN_KEPT_FRACTION"]
+
+#: Fraction of R's half-width every node constraint keeps (best effort and allowance clamp).
+MIN_KEPT_FRACTION = 0.25
+
+
+def _input_limits(cert, min_input_fraction: float) -> np.ndarray:
+    v = np.asarray(cert.limits, dtype=float)
+    d = cert.design
+    if cert.certified:
+        return np.asarray(d.v_bar, dtype=float)
+    kappa = np.asarray(d.tube.kappa, dtype=float) if d.tube.certified else np.full(3, np.inf)
+    p = d.problem
+    need = np.array([min(p.pd_xy + cert.disturbance.omega_xy, v[0]), min(p.pd_z + cert.disturbance.omega_z, v[1]),
+                     0.0])
+    floor = np.maximum(min_input_fraction * v, need)
+    return np.maximum(v - kappa, floor)
+
+
+def _node_bounds(cert, margins: np.ndarray, rates: np.ndarray) -> dict[str, float]:
+    reg = cert.region
+    allowance = 0.5 * cert.dt * rates
+    worst = margins.max(axis=0) + allowance if margins.size else allowance * 0.0
+    ed_half = 0.5 * (reg.e_d[1] - reg.e_d[0])
+    keep = MIN_KEPT_FRACTION
+    ez_half, eo_half = min(-reg.e_z[0], reg.e_z[1]), min(-reg.e_o[0], reg.e_o[1])
+    md = min(worst[0], (1 - keep) * ed_half)
+    return {"e_d_min": reg.e_d[0] + md, "e_d_max": reg.e_d[1] - md,
+            "e_z_max": ez_half - min(worst[1], (1 - keep) * ez_half),
+            "e_o_max": eo_half - min(worst[2], (1 - keep) * eo_half),
+            "obstacle_margin": float(worst[3])}
+
+
+def tightening_of(cert, min_input_fraction: float = 0.5) -> Tightening:
+    """The Tightening of ``cert`` (certified or best effort, see the module doc)."""
+    d = cert.design
+    reg = cert.region
+    has_tube = d.tube.certified and d.margins is not None
+    margins = (np.column_stack([d.margins.e_d, d.margins.e_z, d.margins.e_o, d.margins.position])
+               if has_tube else np.zeros((0, 4)))
+    if has_tube and not cert.certified:
+        margins = np.where(np.isfinite(margins), margins, np.inf)
+    rates = np.asarray(d.rates, dtype=float)
+    nodes = _node_bounds(cert, np.where(np.isfinite(margins), margins, 0.0) if margins.size else margins, rates)
+    tube = np.asarray(d.tube.rho, dtype=float) if d.tube.certified else np.zeros(3)
+    return Tightening(v_max=_input_limits(cert, min_input_fraction), rho_tilde=float(np.linalg.norm(tube)),
+                      sigma=float(d.sigma), margins=margins, rates=rates, tube=tube,
+                      region=np.array([reg.e_d[0], reg.e_d[1], min(-reg.e_z[0], reg.e_z[1]),
+                                       min(-reg.e_o[0], reg.e_o[1])]),
+                      disturbance=np.array([cert.disturbance.omega_xy, cert.disturbance.omega_z,
+                                            cert.disturbance.gamma]),
+                      certified=bool(cert.certified), **nodes)

@@ -1,0 +1,66 @@
+"""The certificate as text (``tubekit certify`` prints it)."""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+__all__ = ["certificate_text"]
+
+
+def _f(x: Any, d: int = 4) -> str:
+    if x is None:
+        return "n/a"
+    x = float(x)
+    return f"{x:.{d}g}" if math.isfinite(x) else ("inf" if x > 0 else "-inf")
+
+
+def _vec(xs: Any, d: int = 4) -> str:
+    return "[" + ", ".join(_f(x, d) for x in xs) + "]"
+
+
+def _tube_lines(cert) -> list[str]:
+    d = cert.design
+    t = d.tube
+    out = [f"sigma = {_f(d.sigma)} 1/s ({cert.sigma_source}); tried: "
+           + ", ".join(f"{_f(x['sigma'])}{'*' if x['certified'] else ''}" for x in cert.tried)
+           + "  (* = certified)"]
+    if not t.certified:
+        out.append(f"One-period tube: none ({t.reason})")
+        return out
+    out.append(f"One-period tube (box, restarts at 0 every {_f(cert.dt)} s): |rho| <= {_vec(t.rho)} "
+               f"(e_d m, e_z m, e_o);  |theta - theta_hat| <= {_f(t.theta)} rad")
+    out.append(f"  Cartesian: ||dp_xy|| <= {_f(t.p_xy)} m, |dz| <= {_f(t.p_z)} m, |dpsi| <= {_f(t.psi)} rad;"
+               f"  |kappa| <= {_vec(t.kappa)}")
+    if d.v_bar is not None:
+        out.append(f"V_bar = {_vec(d.v_bar)}")
+    if d.margins is not None:
+        m = d.margins
+        out.append(f"Per-arc margins (arc 0 .. {len(m.e_d) - 1}): e_d {_vec(m.e_d, 3)}")
+        out.append(f"  e_o {_vec(m.e_o, 3)};  position {_vec(m.position, 3)} m")
+    return out
+
+
+def certificate_text(cert) -> str:
+    """Human-readable certificate: verdict, region, disturbance, tube, conditions, premises, assumptions."""
+    n_fail = len(cert.failures)
+    status = "CERTIFIED" if cert.certified else f"NOT CERTIFIED ({n_fail} failed condition{'s' * (n_fail != 1)})"
+    dist = cert.disturbance
+    lines = [f"tubekit certificate: scenario '{cert.scenario_name}', law '{cert.law}': {status}",
+             "Theorem: the sampled-data loop as it runs (nominal reset every period, kappa held at the ancillary "
+             "rate, plans accepted by the exact arc check, the previous plan replayed otherwise).",
+             "Region R (every bound holds over it):", cert.region.describe(),
+             f"Disturbance: ||omega_xy|| <= {_f(dist.omega_xy)} m/s, |omega_z| <= {_f(dist.omega_z)} m/s "
+             f"(sway gamma_bar = {_f(dist.gamma)} m/s from the sway model over V; declared {_f(dist.declared_sway)})"]
+    lines += _tube_lines(cert)
+    lines.append("Conditions:")
+    for c in cert.conditions:
+        tag = {True: "ok  ", False: "FAIL", None: "n/a "}[c.ok]
+        lines.append(f"  [{tag}] {c.condition}: {c.inequality}: {_f(c.lhs, 6)} vs {_f(c.rhs, 6)}"
+                     + (f"  ({c.detail})" if c.detail and c.ok is not True else ""))
+    lines.append("Premises (checked in every run; a run that breaks one exits 4):")
+    lines.extend(f"  - {p}" for p in cert.premises)
+    lines.append("Assumptions (outside the model):")
+    lines.extend(f"  - {a}" for a in cert.assumptions)
+    lines.append(f"Elapsed: {cert.elapsed_s:.2f} s")
+    return "\n".join(lines)

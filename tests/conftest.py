@@ -7,8 +7,10 @@ Profiles: ``ci`` (default; derandomized, quick) and ``thorough``
 from __future__ import annotations
 
 import os
+from dataclasses import replace
 
 import matplotlib
+import pytest
 
 matplotlib.use("Agg")
 
@@ -26,3 +28,28 @@ settings.load_profile(os.environ.get("HYPOTHESIS_PROFILE", "ci"))
 
 # Tutorials and examples honour this flag to run at reduced sizes in the test suite.
 os.environ.setdefault("TUBEKIT_QUICK", "1")
+
+
+# ---- certificates shared by several test modules (computed once per session) -------------------------------
+@pytest.fixture(scope="session")
+def pc_cert():
+    """The certificate of verify/scenarios/paper_currents.toml (certified)."""
+    import verify
+    from tubekit import load_scenario
+    return verify.certify(load_scenario(verify.SCENARIOS_DIR / "paper_currents.toml"))
+
+
+@pytest.fixture(scope="session")
+def paper_cert():
+    """The certificate of the paper's Section VI scenario (not certified)."""
+    import verify
+    from tubekit import paper_scenario
+    return verify.certify(paper_scenario())
+
+
+@pytest.fixture(scope="session")
+def stationary():
+    """verify.certifiable_scenario() with a stationary target (trajectory rate 0)."""
+    import verify
+    sc = verify.certifiable_scenario()
+    return sc.with_changes(trajectory=replace(sc.trajectory, rate=0.0))

@@ -9,7 +9,7 @@ import pytest
 from tubekit.app.cli import main
 from tubekit.exceptions import ConfigError
 from tubekit.scenario import load_scenario, paper_scenario
-from verify import SCENARIOS_DIR, certify, envelope
+from verify import SCENARIOS_DIR, certify
 
 CERTIFIABLE = str(SCENARIOS_DIR / "certifiable.toml")
 KEYS = {"certified", "law", "region", "problem", "tube", "margins", "sigma", "v_bar", "horizon", "failures",

@@ -7,7 +7,6 @@ import math
 
 import numpy as np
 import pytest
-from scipy.integrate import solve_ivp
 
 from tubekit import ConfigError, SolverError, Tightening, paper_scenario
 from tubekit.closed_loop import CSV_COLUMNS, PlanMemory, nominal_arc, saturate, simulate

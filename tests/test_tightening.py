@@ -1,13 +1,12 @@
-"""Tightening: the baseline's sets and a certificate's tightened sets."""
+"""Tightening: the baseline's sets and the fields a certificate hands over."""
 
 from __future__ import annotations
 
 import numpy as np
-import pytest
 
 import verify
-from tubekit.scenario import paper_scenario
-from tubekit.tightening import Tightening
+from tubekit.scenario import load_scenario, paper_scenario
+from tubekit.tightening import MARGIN_COLUMNS, Tightening
 
 
 def test_untightened_is_the_scenario():
@@ -17,19 +16,35 @@ def test_untightened_is_the_scenario():
     assert t.e_d_min == sc.epsilon and t.e_d_max == sc.region.e_d_max
     assert t.e_o_max == sc.region.e_o_max and t.e_z_max == sc.region.e_z_max
     assert t.obstacle_margin == 0 and t.rho_tilde == 0 and t.sigma == 0
+    assert t.horizon_arcs == 0 and not t.certified
+    np.testing.assert_array_equal(t.region, [sc.epsilon, sc.region.e_d_max, sc.region.e_z_max, sc.region.e_o_max])
+    assert np.all(t.tube == 0) and np.all(t.disturbance == 0) and t.margins.shape == (0, 4)
+
+
+def test_untightened_does_not_share_the_limits_array():
+    sc = paper_scenario()
+    t = Tightening.untightened(sc)
+    t.v_max[0] = 99.0
+    assert sc.limits.vector[0] == 0.4
+
+
+def test_margin_columns():
+    assert MARGIN_COLUMNS == ("e_d", "e_z", "e_o", "position")
+
+
+def test_horizon_arcs_is_the_number_of_margin_rows():
+    t = Tightening(v_max=np.ones(3), e_d_min=0.5, e_o_max=0.4, e_z_max=0.9, e_d_max=2.9, obstacle_margin=0.1,
+                   rho_tilde=0.0, sigma=1.0, margins=np.zeros((5, 4)))
+    assert t.horizon_arcs == 5
 
 
 def test_certified_tightening_is_the_pontryagin_difference():
-    """V-bar = V - kappa-bar and E-bar = R shrunk by rho-tilde, as Lemma 1 / Section V define them."""
-    sc = verify.certifiable_scenario()
-    cert = verify.certify(sc, "corrected")
+    """V_bar = V - kappa_bar and the per-axis tube of the sampled-data certificate."""
+    sc = load_scenario(verify.SCENARIOS_DIR / "paper_currents.toml")
+    cert = verify.certify(sc)
     t = cert.tightening()
-    rho = cert.rho["rho_tilde"]
-    assert t.rho_tilde == pytest.approx(rho)
-    assert t.e_d_min == pytest.approx(sc.epsilon + rho)
-    assert t.e_d_max == pytest.approx(sc.region.e_d_max - rho)
-    assert t.e_o_max == pytest.approx(sc.region.e_o_max - rho)
-    assert np.allclose(t.v_max, sc.limits.vector - np.asarray(cert.kappa_bar), rtol=1e-9)
-    # |kappa_i| <= sigma * sup||row_i K|| * rho-tilde
-    rows = np.array([cert.bounds[f"K_row_{a}"].bound for a in "uwr"])
-    assert np.all(np.asarray(cert.kappa_bar) >= t.sigma * rows * rho * (1 - 1e-9))
+    assert t.certified and t.horizon_arcs == sc.controller.horizon_steps
+    np.testing.assert_allclose(t.v_max, sc.limits.vector - np.asarray(cert.kappa_bar), rtol=1e-12)
+    assert np.all(t.v_max > 0) and np.all(t.v_max < sc.limits.vector)
+    assert t.rho_tilde == float(np.linalg.norm(t.tube)) > 0
+    assert t.e_d_min > sc.epsilon and t.e_d_max < sc.region.e_d_max and t.e_o_max < sc.region.e_o_max

@@ -62,7 +62,8 @@ def test_disturbance_bounds_cover_the_model(amp, const, gain, samp, t, u, r, psi
     assert b.declared_sway == 1.0
     a = 2 * math.pi * t / 15.0
     vs = gain * (u * lim.u_max) * (r * lim.r_max) + samp * math.sin(2 * math.pi * t / 10.0)
-    om = (amp[0] * math.sin(a) + const[0] - vs * math.sin(psi), amp[1] * math.cos(a) + const[1] + vs * math.cos(psi),
+    om = (amp[0] * math.sin(a) + const[0] - vs * math.sin(psi),
+          amp[1] * math.cos(a) + const[1] + vs * math.cos(psi),
           amp[2] * math.sin(a) + const[2])
     assert math.hypot(om[0], om[1]) <= b.omega_xy * (1 + 1e-12) + 1e-15
     assert abs(om[2]) <= b.omega_z * (1 + 1e-12) + 1e-15

@@ -470,10 +470,10 @@ def simulate(scenario: Scenario, *, tightening: Tightening | None = None,
                 bar.close()
     loop.log.states[-1] = np.asarray(x)
     loop.log.nominal[-1] = nominal_end
-    return _result(loop, tube, wall0)
+    return _result(loop, tube, wall0, disturbance is not None)
 
 
-def _result(loop: _ClosedLoop, tube: bool, wall0: float) -> SimulationResult:
+def _result(loop: _ClosedLoop, tube: bool, wall0: float, overridden: bool) -> SimulationResult:
     """Pack the log of a finished run."""
     log, clock = loop.log, loop.clock
     omega = loop.omega_log()
@@ -488,4 +488,4 @@ def _result(loop: _ClosedLoop, tube: bool, wall0: float) -> SimulationResult:
         replaced=log.replaced, n_detected=log.n_detected, solve_ms=log.solve_ms, step_ms=log.step_ms,
         wall=log.wall, statuses=log.statuses, iterations=log.iterations, max_violation=log.max_violation,
         kappa_failures=log.kappa_failures, wall_s=wall_s, rejected=log.rejected, plan_age=log.plan_age,
-        plan_slack=log.plan_slack)
+        plan_slack=log.plan_slack, omega_overridden=overridden)

@@ -19,6 +19,8 @@ __all__ = [
     "SwayModel",
     "nominal_kinematics",
     "kinematics",
+    "sinc",
+    "unicycle_step",
 ]
 
 
@@ -127,3 +129,41 @@ def kinematics(x: np.ndarray, v: np.ndarray, omega: np.ndarray) -> np.ndarray:
     return dx + np.concatenate([omega, np.zeros(omega.shape[:-1] + (1,))], axis=-1)
 
 
+def sinc(a: np.ndarray) -> np.ndarray:
+    """S(a) = sin(a)/a with S(0) = 1 (unnormalised sinc), vectorised.
+
+    sin(a)/a has no cancellation, so the quotient is accurate to round-off for every a != 0.
+    """
+    a = np.asarray(a, dtype=float)
+    safe = np.where(a == 0.0, 1e-300, a)  # sin(1e-300)/1e-300 == 1.0
+    return np.sin(safe) / safe
+
+
+def unicycle_step(s: np.ndarray, v: np.ndarray, dt: float | np.ndarray) -> np.ndarray:
+    """Exact solution of the nominal kinematics (eq. 3) after ``dt`` under a constant input; vectorised.
+
+    x(dt) = x + dt u S(r dt / 2) [cos, sin](psi + r dt / 2), z + dt w, psi + dt r (S = :func:`sinc`):
+    exact for every r, with no division by r.
+
+    Parameters
+    ----------
+    s : array (..., 4)
+        State [x, y, z, psi] (m, m, m, rad).
+    v : array (..., 3)
+        Input [u, w, r] (m/s, m/s, rad/s), held for ``dt``.
+    dt : float or array (...)
+        Elapsed time (s), broadcast against the leading axes.
+
+    Returns
+    -------
+    array (..., 4)
+    """
+    s = np.asarray(s, dtype=float)
+    v = np.asarray(v, dtype=float)
+    dt = np.asarray(dt, dtype=float)
+    u, w, r = v[..., 0], v[..., 1], v[..., 2]
+    a = 0.5 * dt * r
+    th = s[..., 3] + a
+    k = dt * u * sinc(a)
+    return np.stack(np.broadcast_arrays(s[..., 0] + k * np.cos(th), s[..., 1] + k * np.sin(th),
+                                        s[..., 2] + dt * w, s[..., 3] + dt * r), axis=-1)

@@ -84,7 +84,7 @@ def check_plan(scenario: Scenario, tight: Tightening, t0: float, x0: np.ndarray,
     """Verify a plan (module doc). ``sign`` is the certified hemisphere (-1 toward, +1 away, 0 both)."""
     inputs = np.asarray(inputs, dtype=float)
     n = tight.horizon_arcs
-    if inputs.ndim != 2 or inputs.shape[0] < n or not np.all(np.isfinite(inputs)):
+    if inputs.ndim != 2 or inputs.shape[1] != 3 or inputs.shape[0] < n or not np.all(np.isfinite(inputs)):
         return PlanCheck(False, -math.inf, "plan shape or values")
     inputs = inputs[:n]
     over = np.max(np.abs(inputs) - np.asarray(tight.v_max)[None, :])

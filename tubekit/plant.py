@@ -25,6 +25,7 @@ from typing import Any, Callable, Sequence
 
 import numpy as np
 
+from .model import unicycle_step
 from .scenario import Disturbance, Scenario
 
 __all__ = [
@@ -181,17 +182,6 @@ def nominal_arc(x0: np.ndarray, v: np.ndarray, tau: np.ndarray) -> np.ndarray:
     array (n, 4)
         States at ``tau``.
     """
-    x0 = np.asarray(x0, dtype=float)
-    u, w, r = (float(c) for c in v)
     tau = np.asarray(tau, dtype=float)
-    psi0 = x0[3]
-    psi = psi0 + r * tau
-    if abs(r) * float(np.max(np.abs(tau), initial=0.0)) > 1e-9:
-        with np.errstate(invalid="ignore", divide="ignore"):
-            dx = u * (np.sin(psi) - np.sin(psi0)) / r
-            dy = -u * (np.cos(psi) - np.cos(psi0)) / r
-    else:  # straight line (second-order accurate in r tau, exact for r = 0)
-        mid = psi0 + 0.5 * r * tau
-        dx = u * tau * np.cos(mid)
-        dy = u * tau * np.sin(mid)
-    return np.stack([x0[0] + dx, x0[1] + dy, x0[2] + w * tau, psi], axis=-1)
+    return unicycle_step(np.asarray(x0, dtype=float), np.asarray(v, dtype=float), tau)
+

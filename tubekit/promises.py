@@ -108,10 +108,16 @@ def _geometry(run: SimulationResult) -> list[Promise]:
 def _disturbance(run: SimulationResult) -> list[Promise]:
     wxy, wz, gamma = (float(x) for x in run.tightening.disturbance)
     om = run.omega[:-1]
-    plant = Plant.of(run.scenario)
-    sway = [abs(plant.sway_velocity(float(t), x, v)) for t, x, v in zip(run.t[:-1], run.states[:-1], run.inputs[:-1])]
     tol = 1e-12
-    return [_at_most("sway", max(sway, default=0.0), gamma + tol, "max |v_s| applied (m/s) vs gamma_bar"),
+    if run.omega_overridden:
+        sway_promise = Promise("sway", math.nan, gamma, True, "not applicable: the disturbance is overridden, "
+                                                              "so the sway cannot be separated from it")
+    else:
+        plant = Plant.of(run.scenario)
+        sway = [abs(plant.sway_velocity(float(t), x, v))
+                for t, x, v in zip(run.t[:-1], run.states[:-1], run.inputs[:-1])]
+        sway_promise = _at_most("sway", max(sway, default=0.0), gamma + tol, "max |v_s| applied (m/s) vs gamma_bar")
+    return [sway_promise,
             _at_most("disturbance", float(max(np.max(np.hypot(om[:, 0], om[:, 1]) - wxy - tol),
                                               np.max(np.abs(om[:, 2]) - wz - tol))), 0.0,
                      "premise: max over the run of ||omega_xy|| - omega_bar_xy and |omega_z| - omega_bar_z")]

@@ -23,7 +23,7 @@ import numpy as np
 from .exceptions import ConfigError, ShapeError
 from .model import InputLimits, SwayModel
 from .trajectory import Circle, Trajectory, trajectory_from_dict
-from .validation import as_vector, finite, nonnegative, positive
+from .validation import as_vector, positive
 
 __all__ = [
     "Obstacle",

@@ -64,6 +64,7 @@ class SimulationResult:
     rejected: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=bool))
     plan_age: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=int))
     plan_slack: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    omega_overridden: bool = False
 
     # ---- derived -------------------------------------------------------------------
     @property

@@ -7,23 +7,23 @@
 # ---
 
 # %% [markdown]
-# # 04 — Tightened sets and the terminal set, drawn
+# # 04 — Tightened sets: V̄, the per-arc margins and the exact arc check
 #
-# Section V of the paper lets the FHOCP plan for the *nominal* system only, and makes room
-# for the tube of tutorial 03 by shrinking its sets:
+# The FHOCP plans for the *nominal* vehicle. Tutorial 03 bounded how far the real vehicle
+# drifts from the nominal within one period (the one-period tube). This tutorial turns that
+# tube into the constraints the planner must respect, in four steps:
 #
-#     Ē = E ⊖ P,      V̄ = V ⊖ [−σ ∘ P],      F = {ê ∈ Ē : ‖ê‖_P ≤ ε̄},
-#
-# with P = {‖ρ‖ ≤ ρ̃} the tube. If the nominal stays in Ē and uses inputs in V̄, the real
-# error e = ê + ρ stays in E and the real input v = v̂ + κ stays in V. On top of that the
-# nominal *position* must keep a margin from the obstacles, because between two FHOCP samples
-# the real vehicle drifts away from the nominal one.
-#
-# This tutorial takes all of these sets from a certificate and draws them: first for the
-# scenario the corrected law certifies, then — side by side — the best-effort tightening of
-# the paper's scenario, which is *not* certified and carries no guarantee.
+# 1. **V̄ = V − κ̄** — the input box left for the nominal once the ancillary feedback has
+#    taken its share, so the real input never saturates (docs/verify.md, section 3, step 7);
+# 2. **per-arc margins** M_j — how much each arc j of a plan must stay inside R and away from
+#    obstacles; they grow along the horizon because the *previous* plan may have to be replayed
+#    from the new measured state (step 8);
+# 3. **the exact arc check** `tubekit.plan_check.check_plan` — a plan is accepted only if the
+#    constraints hold along the whole continuous arcs, not only at the FHOCP's nodes (step 9);
+# 4. **the hand-off** `Certificate.tightening()` — the `Tightening` the FHOCP and the loop use.
 
 # %%
+import dataclasses
 import os
 from pathlib import Path
 
@@ -32,259 +32,246 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 import numpy as np
-from matplotlib.patches import Circle, Rectangle
+from matplotlib.patches import Circle
 
 import verify
-from tubekit import error_coordinates, paper_scenario
+from tubekit import error_coordinates, load_scenario
+from tubekit.plan_check import check_plan, plan_arcs
+from tubekit.tightening import MARGIN_COLUMNS, Tightening
+from verify.sampled import horizon_margins
 
 QUICK = os.environ.get("TUBEKIT_QUICK") == "1"
 FIGURES = Path(os.environ.get("TUBEKIT_FIGURES", Path(__file__).resolve().parent / "figures"))
 FIGURES.mkdir(parents=True, exist_ok=True)
 
 # %% [markdown]
-# ## The certified design
-# `Certificate.tightening()` is the hand-off to the FHOCP: a `tubekit.tightening.Tightening`
-# with V̄, the bounds of Ē, the obstacle margin, ρ̃ and σ. It raises `NotCertifiedError`
-# unless every condition holds.
+# ## The certificate we tighten with
+# The paper's vehicle against the paper's current (`paper_currents.toml`, tutorial 03), certified
+# with the corrected law at σ = 3.125 1/s.
 
 # %%
-easy_scenario = verify.certifiable_scenario()
-easy = verify.certify(easy_scenario)
-tight = easy.tightening()
-print(f"certified: {easy.certified}, law {easy.law!r}, sigma = {tight.sigma:g} 1/s, rho_tilde = {tight.rho_tilde:.5f}")
-print(tight)
+scenario = load_scenario(verify.SCENARIOS_DIR / "paper_currents.toml")
+cert = verify.certify(scenario)
+problem = cert.design.problem
+print(f"certified: {cert.certified}, sigma = {cert.sigma['value']:g} 1/s, "
+      f"one-period tube rho = {np.round(cert.tube['rho'], 4)} (e_d m, e_z m, e_o)")
 
 # %% [markdown]
-# ## V̄: the nominal's input box
-# The feedback κ = −σ J⁻¹ρ uses at most |κ_i| ≤ σ ρ̃ sup‖row_i K‖ of input i (`kappa_bar`).
-# V̄ is V with that much removed from each side. The nominal must still be able to follow the
-# target (keep-up): ū ≥ target speed.
+# ## Step 1: V̄ = V − κ̄
+# Within a period the feedback asks for at most |κ_j| ≤ κ̄_j (tutorial 03). If the nominal
+# plans with |v̂_j| ≤ V_j − κ̄_j, then v = v̂ + κ stays in V: the clip of the loop is never
+# active, so the input the theorem analyses is the input that is applied. Two *necessary*
+# conditions come with it: the nominal must still out-run the target plus the current
+# (`keep_up[u]`) and turn the line of sight as fast as a cross current at e_d = ε can
+# (`yaw_budget`).
 
 # %%
-V = np.array(easy.region.v_max)
-for i, (ax, unit) in enumerate((("u", "m/s"), ("w", "m/s"), ("r", "rad/s"))):
-    print(f"  |{ax}| <= {V[i]:g} {unit}  ->  |{ax}_hat| <= {tight.v_max[i]:.4f} {unit}  "
-          f"(tightened by |kappa_{ax}| <= {easy.kappa_bar[i]:.4f}, {100 * easy.kappa_bar[i] / V[i]:.0f}% of the limit)")
-print(f"keep-up: u_bar = {tight.v_max[0]:.4f} m/s >= target speed {easy.region.pd_dot_xy_max:.4f} m/s")
+V = np.array(cert.limits)
+need = np.array([problem.pd_xy + problem.omega_xy, problem.pd_z + problem.omega_z, problem.omega_xy / problem.eps])
+for j, (ax, unit, why) in enumerate((("u", "m/s", "target speed + omega_xy"), ("w", "m/s", "|zdot_d| + omega_z"),
+                                     ("r", "rad/s", "omega_xy / eps"))):
+    print(f"  {ax}: V = {V[j]:g} {unit}, kappa_bar = {cert.kappa_bar[j]:.4f}  ->  V_bar = {cert.v_bar[j]:.4f} {unit}"
+          f"   (needs >= {need[j]:.4f} = {why})")
 
 # %% [markdown]
-# ## Ē = R ⊖ P: the region shrunk by the tube
-# E here is the certificate's region R (the box every bound holds over; tutorial 03). A box
-# minus a Euclidean ball of radius ρ̃ is the box shrunk by ρ̃ on every side. ρ̃ = 0.0016 is
-# small: in the figure it needs a zoomed inset. In particular the nominal keeps
-# e_d ≥ ε + ρ̃, the paper's "stay ε away from the target" plus the tube.
-
-# %%
-R = easy.region
-for k in ("e_d", "e_z", "e_o"):
-    lo, hi = getattr(R, k)
-    print(f"  {k}: R = [{lo:+.4f}, {hi:+.4f}]   E_bar = [{easy.e_bar[k][0]:+.4f}, {easy.e_bar[k][1]:+.4f}]")
-print(f"Tightening: e_d in [{tight.e_d_min:.4f}, {tight.e_d_max:.4f}], |e_z| <= {tight.e_z_max:.4f}, "
-      f"|e_o| <= {tight.e_o_max:.4f}")
-
-# %% [markdown]
-# ## The terminal set F
-# F = {ê ∈ Ē : ‖ê‖_P ≤ ε̄} with P = diag(`controller.P`) and ε̄ = `controller.terminal_level`.
-# The certificate checks that F is non-empty: the smallest ‖ê‖_P over Ē (at e_d = ε + ρ̃,
-# e_z = e_o = 0) must not exceed ε̄. (It does not check that F is invariant — that is an
-# assumption it lists.) Because ê = 0 is excluded (e_d ≥ ε), F is the part of the ellipsoid
-# ‖ê‖_P ≤ ε̄ beyond the plane e_d = ε + ρ̃ (and inside the rest of Ē).
-
-# %%
-P = np.array(easy.terminal["P"])
-level = easy.terminal["level"]
-print(f"P = diag{tuple(float(x) for x in P)}, terminal level = {level:g}; "
-      f"min over E_bar of ||e||_P = {easy.terminal['min_norm_P_over_E_bar']:.4f} <= {level:g}: {easy.terminal['ok']}")
-print(f"F reaches e_d <= {level / np.sqrt(P[0]):.4f} m (at e_z = e_o = 0)")
-
-# %% [markdown]
-# ## The obstacle margin
-# The nominal is reset to the measured state every δt, and in between the real position p
-# drifts from the nominal p̂ by at most δt(√((κ̄_u + ū κ̄_r δt/2)² + κ̄_w²) + ω̄)
-# (`obstacle_margin`). The FHOCP keeps p̂ at least vehicle radius + margin outside each
-# obstacle; the certificate also re-checks the paper's obstacle separation (eq. obstacle_dis)
-# with the inflated radii.
-
-# %%
-r_bar = easy_scenario.vehicle_radius
-print(f"vehicle radius {r_bar:g} m + margin {easy.obstacle_margin:.4f} m")
-for o in easy_scenario.obstacles:
-    print(f"  obstacle at {o.center[:2]}, radius {o.radius:g} m: the nominal keeps its centre "
-          f"{o.radius + r_bar + easy.obstacle_margin:.4f} m away")
-for c in easy.conditions:
-    if c.condition.startswith("obstacles"):
-        print(f"  {c.condition}: {c.inequality}: {c.lhs:.4g} vs {c.rhs:.4g}")
-
-# %% [markdown]
-# ## The paper's scenario: a best-effort tightening, no guarantee
-# The paper's scenario does not certify (tutorial 03), so `tightening()` refuses:
-
-# %%
-paper = paper_scenario()
-hard = verify.certify(paper)                                  # the scenario's law: corrected
-try:
-    hard.tightening()
-except verify.NotCertifiedError as exc:
-    print("NotCertifiedError:", exc)
-
-# %% [markdown]
-# `tightening(allow_uncertified=True)` still returns *something* the FHOCP can run with, built
-# by documented rules, not by the proof: state margin min(ρ̃, ε, a quarter of the narrowest
-# region width), input tightening capped so that V̄ keeps at least half of V and the keep-up
-# speed, obstacle margin capped at the vehicle radius, σ the admissible one if any, else
-# `controller.sigma`, else 1 1/s. Compare what the certificate asked for with what the
-# best-effort sets use:
-
-# %%
-best = hard.tightening(allow_uncertified=True)
-print(best)
-print(f"certificate asked for: rho_tilde = {hard.rho_tilde:.4f}, |kappa| <= {np.round(hard.kappa_bar, 2)} "
-      f"(V = {list(hard.region.v_max)})")
-print(f"best effort uses:      rho = {best.rho_tilde:.4f}, V_bar = {np.round(best.v_max, 4)}, "
-      f"obstacle margin {best.obstacle_margin:.4f} m, sigma = {best.sigma:g}")
-best_paper_law = verify.certify(paper, "paper").tightening(allow_uncertified=True)
-print(f"with the paper's law:  rho = {best_paper_law.rho_tilde:.4f}, V_bar = {np.round(best_paper_law.v_max, 4)}, "
-      f"sigma = {best_paper_law.sigma:g} (no admissible sigma: the fallback)")
-
-# %% [markdown]
-# The best-effort V̄ keeps 0.377 m/s of surge because the target moves at 0.377 m/s — while
-# the certificate says the feedback alone would need 43 m/s. These sets are a reasonable
-# engineering guess; nothing says the real error stays in R or the real input in V.
+# ## Step 2: the per-arc margins, and why they grow
+# Each FHOCP sample, the nominal is reset to the measured state. If the new plan is rejected
+# (step 3), the loop **replays the previous accepted plan**, shifted by one period, from the new
+# state. That state is off the old plan's prediction by at most the Cartesian tube of one period
+# (‖Δp_xy‖ ≤ p_xy, |Δz| ≤ p_z, |Δψ| ≤ ψ̄). Under the same inputs the heading offset stays and the
+# position offset drifts by ū ψ̄ τ. So if arc j of a plan meets margin M_j, the replay's arc j − 1
+# meets M_j − Δ(jδ) — which must be the margin of arc j − 1:
 #
-# ## The figure
-# Top row: the certified design. Bottom row: the paper scenario's best-effort tightening
-# (red title: no guarantee). Columns: V and V̄ in the (u, r) and (u, w) planes; R, Ē and F in
-# the (e_d, e_o) plane at e_z = 0 and the (e_d, e_z) plane at e_o = 0 (since 0 lies in Ē's
-# e_z and e_o ranges, these slices of F are also its projections); the workspace seen from
-# above at t = 0.
+#     M_0 = the one-period tube,   M_j = M_{j−1} + Δ(jδ).
+#
+# `verify.sampled.horizon_margins` computes them; `cert.margins` stores them.
 
 # %%
-def draw_inputs(ax, V, Vbar, i, j, names, speed):
-    ax.add_patch(Rectangle((-V[i], -V[j]), 2 * V[i], 2 * V[j], fc="0.9", ec="k", label="V (vehicle limits)"))
-    ax.add_patch(Rectangle((-Vbar[i], -Vbar[j]), 2 * Vbar[i], 2 * Vbar[j], fc="tab:blue", alpha=0.5, ec="tab:blue",
-                           label="V_bar (nominal, FHOCP)"))
-    if i == 0:
-        ax.axvline(speed, color="tab:orange", ls="--", lw=1.2, label=f"target speed {speed:.3g} m/s")
-    ax.set_xlim(-1.15 * V[i], 1.15 * V[i]); ax.set_ylim(-1.15 * V[j], 1.45 * V[j])
-    ax.set_xlabel(names[0]); ax.set_ylabel(names[1])
-    ax.legend(fontsize=7, loc="upper left")
+tube = cert.design.tube
+margins = horizon_margins(problem, tube, scenario.controller.horizon_steps)
+assert margins.to_dict() == cert.margins
+M = np.column_stack([cert.margins[k] for k in MARGIN_COLUMNS])
+print(f"Cartesian one-period tube: p_xy = {tube.p_xy:.4f} m, p_z = {tube.p_z:.4f} m, psi = {tube.psi:.4f} rad")
+print(f"{'arc j':>6} | " + " | ".join(f"{k:>8}" for k in MARGIN_COLUMNS) + " | e_d step = p_xy + u psi j delta")
+for j, row in enumerate(M):
+    step = "" if j == 0 else f"{M[j, 0] - M[j - 1, 0]:.4f} = {tube.p_xy + problem.u_max * tube.psi * j * problem.period:.4f}"
+    print(f"{j:>6} | " + " | ".join(f"{x:8.4f}" for x in row) + f" | {step}")
+print(f"e_o margin of the last arc {M[-1, 2]:.3f} < e_o_max {problem.e_o_max:g}: condition e_bar[e_o] holds")
+
+# %% [markdown]
+# The e_o margin grows fastest: a position offset Δp seen from the target at distance ≥ ε turns
+# the bearing by up to asin(Δp/ε). This is the margin that stops larger σ in tutorial 03.
+#
+# ## Step 3: constraints between the nodes — the exact arc check
+# The FHOCP enforces its constraints at the nodes t_k + jδ only (linearised, softened). The
+# theorem needs them at *every* time. `check_plan` integrates the plan along its exact arcs
+# (`plan_arcs`), evaluates every constraint at 11 points per arc, and tightens each one further by
+# rate × spacing / 2 (with the certificate's bound on how fast that quantity can change along an
+# arc): between two evaluated points nothing can move farther than that. So the check covers the
+# whole arc.
+#
+# We build a plan by hand that passes every constraint **at its nodes** but **grazes** an
+# obstacle between two of them. The vehicle drives straight (v̂ = (ū, 0, 0)) towards where the
+# target will be, tangent to the obstacle's keep-out ball (obstacle radius + vehicle radius +
+# M_pos,7) at the middle of the last arc. A straight chord cuts a circle between two points that
+# lie on it, so the middle of the arc is closer than its ends.
+
+# %%
+obstacle = scenario.obstacles[0]
+center, dt, n_arcs = np.asarray(obstacle.center), scenario.controller.dt, scenario.controller.horizon_steps
+keep_out = obstacle.radius + scenario.vehicle_radius + M[:, 3]          # per arc (m)
+u_hat = float(cert.v_bar[0])
+t0 = 25.0 - 8.75                  # the target reaches the obstacle at t = 25 s; this plan is 8 s before
+aim = scenario.trajectory.position(t0 + (n_arcs - 0.5) * dt)             # target at the middle of the last arc
 
 
-def terminal_boundary(P, level, axis, grid):
-    """e_d on the boundary of {||e||_P <= level} in the (e_d, e_axis) plane, other coordinate 0."""
-    return np.sqrt(np.clip((level**2 - P[axis] * grid**2) / P[0], 0.0, None))
+def tangent_plan(offset):
+    """x0 and inputs of a straight plan whose closest approach (mid last arc) is keep_out[-1] + offset."""
+    d = keep_out[-1] + offset
+    to_aim = aim[:2] - center[:2]
+    angle = np.arctan2(to_aim[1], to_aim[0]) + np.arccos(d / np.linalg.norm(to_aim))
+    closest = center[:2] + d * np.array([np.cos(angle), np.sin(angle)])
+    psi = np.arctan2(*(aim[:2] - closest)[::-1])
+    start = closest - (n_arcs - 0.5) * u_hat * dt * np.array([np.cos(psi), np.sin(psi)])
+    return np.array([start[0], start[1], 0.0, psi]), np.tile([u_hat, 0.0, 0.0], (n_arcs, 1))
 
 
-def draw_errors(ax, region, tight, P, level, axis, e0, zoom=None):
-    name = ("e_d", "e_z", "e_o")[axis]
-    lo, hi = getattr(region, name)
-    half = tight.e_z_max if axis == 1 else tight.e_o_max
-    for a in ([ax] + ([zoom] if zoom is not None else [])):
-        a.add_patch(Rectangle((region.e_d[0], lo), region.e_d[1] - region.e_d[0], hi - lo, fc="0.9", ec="k",
-                              label="R (bounds hold here)"))
-        a.add_patch(Rectangle((tight.e_d_min, -half), tight.e_d_max - tight.e_d_min, 2 * half, fc="tab:blue",
-                              alpha=0.35, ec="tab:blue", label="E_bar = R ⊖ P"))
-        g = np.linspace(-half, half, 400)
-        ed_f = np.minimum(terminal_boundary(P, level, axis, g), tight.e_d_max)
-        a.fill_betweenx(g, tight.e_d_min, ed_f, where=ed_f > tight.e_d_min, color="tab:green", alpha=0.6,
-                        label=f"F = {{||e||_P <= {level:g}}} ∩ E_bar")
-        a.plot(e0[0], e0[axis], "k*", ms=10, label="e(0)")
-    ax.set_xlim(0, region.e_d[1] * 1.05)
-    ax.set_ylim(lo * 1.1, hi * 1.45)
-    ax.set_xlabel("e_d (m)"); ax.set_ylabel(name + (" (m)" if axis == 1 else " = sin(psi - theta)"))
-    ax.legend(fontsize=7, loc="upper right")
+def clearance(x0, inputs, samples):
+    """Distance to the obstacle's keep-out ball of each arc (m), (n_arcs, samples + 1)."""
+    arcs = plan_arcs(x0, inputs, dt, samples)
+    return np.linalg.norm(arcs[..., :3] - center, axis=-1) - keep_out[:, None], arcs
 
 
-def draw_workspace(ax, scenario, region, tight, zoom=None):
-    t = np.linspace(0, 2 * np.pi / abs(scenario.trajectory.rate), 400)
-    path = scenario.trajectory.position(t)
-    pd0 = scenario.trajectory.position(0.0)
-    x0 = np.array(scenario.initial_state)
-    r_bar = scenario.vehicle_radius
-    for a in ([ax] + ([zoom] if zoom is not None else [])):
-        a.plot(path[:, 0], path[:, 1], color="tab:orange", lw=1, label="target path p_d(t)")
-        for k, o in enumerate(scenario.obstacles):
-            a.add_patch(Circle(o.center[:2], o.radius + r_bar + tight.obstacle_margin, fc="tab:red", alpha=0.25,
-                               ec="tab:red", lw=0.8,
-                               label="obstacle + r_bar + margin (keep-out of p_hat)" if k == 0 else None))
-            a.add_patch(Circle(o.center[:2], o.radius + r_bar, fc="none", ec="tab:red", ls="--", lw=0.8,
-                               label="obstacle + r_bar (keep-out of p)" if k == 0 else None))
-            a.add_patch(Circle(o.center[:2], o.radius, fc="tab:red", alpha=0.8, label="obstacle" if k == 0 else None))
-        a.add_patch(Circle(pd0[:2], tight.e_d_min, fc="tab:blue", alpha=0.3, ec="tab:blue",
-                           label=f"e_d < eps + rho = {tight.e_d_min:.4g} m (excluded)"))
-        a.add_patch(Circle(pd0[:2], tight.e_d_max, fc="none", ec="tab:blue", ls=":",
-                           label=f"e_d = e_d_max - rho = {tight.e_d_max:.4g} m"))
-        a.add_patch(Circle(x0[:2], scenario.sensing_range, fc="none", ec="0.4", ls="-.", lw=0.8,
-                           label=f"sensing range {scenario.sensing_range:g} m"))
-        a.plot(*pd0[:2], "o", color="tab:orange", label="target at t = 0")
-        a.annotate("", xy=x0[:2] + 0.5 * np.array([np.cos(x0[3]), np.sin(x0[3])]), xytext=x0[:2],
-                   arrowprops=dict(arrowstyle="->", color="k"))
-        a.plot(*x0[:2], "k.", label="vehicle at t = 0 (arrow: heading)")
-    ax.set_aspect("equal"); ax.set_xlim(-4.2, 4.2); ax.set_ylim(-3.6, 6.4)
-    ax.set_xlabel("x (m)"); ax.set_ylabel("y (m)")
-    ax.legend(fontsize=7.5, loc="upper left", bbox_to_anchor=(1.02, 1.0))
+plans = {"grazing": tangent_plan(-1e-4), "3 mm wider": tangent_plan(3e-3)}
+fine = 100 if QUICK else 400
+for name, (x0, inputs) in plans.items():
+    at_nodes, _ = clearance(x0, inputs, 1)
+    on_arcs, arcs = clearance(x0, inputs, fine)
+    nodes = np.vstack([arcs[:, 0], arcs[-1:, -1]])
+    e = error_coordinates(nodes, scenario.trajectory.position(t0 + dt * np.arange(n_arcs + 1)))
+    verdict = check_plan(scenario, cert.tightening(), t0, x0, inputs, scenario.obstacles, sign=-1)
+    print(f"{name:>10}: min clearance at the nodes {1e3 * at_nodes.min():+.3f} mm, along the arcs "
+          f"{1e3 * on_arcs.min():+.3f} mm;  e_d {e[:, 0].min():.3f}..{e[:, 0].max():.3f} m, "
+          f"|e_o| <= {np.abs(e[:, 2]).max():.3f}")
+    print(f"{'':>12}check_plan: ok = {verdict.ok}, worst slack {1e3 * verdict.slack:+.2f} mm at '{verdict.where}'")
 
+# %% [markdown]
+# The grazing plan is clear at all nine nodes and cuts into the keep-out ball by 0.1 mm in the
+# middle of its last arc: `check_plan` rejects it. At δ = 0.1 s an arc is only ū δ = 3.6 cm long,
+# so what hides between the nodes is small here — but a proof about every t cannot ignore it.
+# Note the worst slack, −2.6 mm: it includes the padding ‖ṗ‖ × spacing/2 = 0.5 m/s × 0.01 s / 2 =
+# 2.5 mm that lets 11 points stand for the whole arc. A plan 3 mm wider passes. When the plan
+# of a sample is rejected, the loop replays the last accepted one (step 2), and that is why the
+# margins had to grow.
+#
+# ## Step 4: the Tightening handed to the FHOCP
+# `cert.tightening()` packs all of this into a `tubekit.tightening.Tightening`; it raises
+# `verify.NotCertifiedError` for a certificate that does not hold (pass `allow_uncertified=True`
+# for a best-effort tightening with `certified=False`, and no guarantee). Two layers:
+#
+# * the FHOCP's **node constraints** (`v_max`, `e_d_min`, `e_d_max`, `e_z_max`, `e_o_max`,
+#   `obstacle_margin`): uniform over the horizon, the largest margin plus an inter-node allowance,
+#   each keeping at least a quarter of R. They steer the solver; they prove nothing;
+# * the certificate's **per-arc data** (`margins`, `rates`, `tube`, `region`, `disturbance`): what
+#   `check_plan` accepts plans with and what the run's promises are measured against.
 
-def inset(ax, xlim, ylim, where):
-    z = ax.inset_axes(where)
-    z.set_xlim(*xlim); z.set_ylim(*ylim)
-    z.tick_params(labelsize=6)
-    ax.indicate_inset_zoom(z, edgecolor="0.3")
-    return z
+# %%
+tight = cert.tightening()
+for f in dataclasses.fields(tight):
+    value = getattr(tight, f.name)
+    shown = np.array2string(np.asarray(value), precision=4, suppress_small=True, max_line_width=110)
+    print(f"{f.name:>16} = {shown if np.ndim(value) < 2 else shown.replace(chr(10), chr(10) + ' ' * 19)}")
+baseline = Tightening.untightened(scenario)      # the no-tube baseline: V itself, no arc check
+print(f"horizon_arcs = {tight.horizon_arcs} (baseline: {baseline.horizon_arcs}, v_max = {baseline.v_max})")
 
+# %% [markdown]
+# ## The figure
 
-rows = [(easy_scenario, easy, tight, "certified (corrected law)", "k"),
-        (paper, hard, best, "paper scenario, BEST EFFORT: no guarantee", "tab:red")]
-fig, axes = plt.subplots(2, 5, figsize=(26, 10), layout="constrained",
-                         gridspec_kw=dict(width_ratios=[1, 1, 1.15, 1.15, 1.9]))
-for row, (scen, cert, tg, label, tcol) in enumerate(rows):
-    V = np.array(cert.region.v_max)
-    speed = cert.region.pd_dot_xy_max
-    e0 = error_coordinates(np.array(scen.initial_state), scen.trajectory.position(0.0))
-    P = np.array(scen.controller.P)
-    level = scen.controller.terminal_level
-    ax = axes[row, 0]
-    draw_inputs(ax, V, tg.v_max, 0, 2, ("u (m/s)", "r (rad/s)"), speed)
-    ax.set_title(f"{label}\ninputs (u, r)", color=tcol, fontsize=10)
-    ax = axes[row, 1]
-    draw_inputs(ax, V, tg.v_max, 0, 1, ("u (m/s)", "w (m/s)"), speed)
-    ax.set_title(f"inputs (u, w); sigma = {tg.sigma:g} 1/s", fontsize=10)
-    small = tg.rho_tilde < 0.02
-    for col, axis in ((2, 2), (3, 1)):
-        ax = axes[row, col]
-        name = ("e_d", "e_z", "e_o")[axis]
-        hi = getattr(cert.region, name)[1]
-        z = None
-        if small:     # zoom into the corner (epsilon, upper bound) so that rho_tilde is visible
-            w = 8 * tg.rho_tilde
-            z = inset(ax, (cert.region.e_d[0] - w / 2, cert.region.e_d[0] + w),
-                      (hi - w, hi + w / 2), [0.5, 0.08, 0.45, 0.4])
-            z.set_title(f"zoom: rho_tilde = {tg.rho_tilde:.2g}", fontsize=7)
-        draw_errors(ax, cert.region, tg, P, level, axis, e0, zoom=z)
-        other = "e_z" if axis == 2 else "e_o"
-        ax.set_title(f"(e_d, {name}) at {other} = 0; state margin {tg.rho_tilde:.3g}", fontsize=10)
-    ax = axes[row, 4]
-    o = scen.obstacles[0]
-    r_out = o.radius + scen.vehicle_radius + tg.obstacle_margin
-    z = inset(ax, (o.center[0] - r_out - 0.06, o.center[0] - r_out + 0.1), (-0.08, 0.08), [0.29, 0.12, 0.42, 0.33])
-    z.set_title(f"zoom: margin {tg.obstacle_margin:.3g} m", fontsize=7)
-    draw_workspace(ax, scen, cert.region, tg, zoom=z)
-    ax.set_title(f"workspace, top view, t = 0 ({scen.name})", fontsize=10)
+# %%
+plt.rcParams.update({"font.size": 11})
+fig, axes = plt.subplots(2, 2, figsize=(14, 10), layout="constrained")
+
+ax = axes[0, 0]                                 # inputs
+names = ["u [m/s]", "w [m/s]", "r [rad/s]"]
+y = np.arange(3)
+ax.barh(y, cert.v_bar, color="tab:blue", label="V_bar: left for the nominal (FHOCP)")
+ax.barh(y, cert.kappa_bar, left=cert.v_bar, color="tab:orange", label="kappa_bar: reserved for the feedback")
+ax.plot(need, y, "kD", ms=8, label="necessary: keep_up[u], keep_up[w], yaw_budget")
+for j in range(3):
+    ax.text(V[j] + 0.008, j, f"V = {V[j]:g}", va="center", fontsize=10)
+ax.set_yticks(y, names)
+ax.set_xlim(0, 0.62)
+ax.set_ylim(-0.5, 3.4)
+ax.set_xlabel("input limit (units per row)")
+ax.set_title("Step 1: V = V_bar + kappa_bar (never saturates)")
+ax.legend(loc="upper left", fontsize=9, ncol=2)
+
+ax = axes[0, 1]                                 # margins along the horizon
+j = np.arange(len(M))
+for k, (lab, col) in enumerate((("M_d (e_d) [m]", "tab:blue"), ("M_z (e_z) [m]", "tab:orange"),
+                                ("M_o (e_o) [-]", "tab:purple"), ("M_pos (position) [m]", "tab:gray"))):
+    ax.plot(j, M[:, k], "o-", color=col, lw=2, label=lab)
+ax.axhline(problem.e_o_max, color="tab:purple", ls=":", lw=1.5, label=f"e_o_max = {problem.e_o_max:g}")
+ax.set_xlabel("arc j of the plan (t_k + j delta to t_k + (j+1) delta)")
+ax.set_ylabel("margin")
+ax.set_ylim(0, 0.55)
+ax.set_title("Step 2: per-arc margins grow (the replayed plan)")
+ax.legend(loc="upper left", fontsize=9)
+ax.grid(alpha=0.3)
+
+ax = axes[1, 0]                                 # top view of the grazing plan
+x0, inputs = plans["grazing"]
+_, arcs = clearance(x0, inputs, fine)
+path = arcs[..., :2].reshape(-1, 2)
+nodes = np.vstack([arcs[:, 0, :2], arcs[-1:, -1, :2]])
+ax.add_patch(Circle(center[:2], obstacle.radius, color="tab:red", alpha=0.7, label="obstacle"))
+ax.add_patch(Circle(center[:2], keep_out[-1], fc="none", ec="tab:red", ls="--", lw=1.5,
+                    label="keep-out of the last arc: + r_bar + M_pos,7"))
+ax.plot(path[:, 0], path[:, 1], "-", color="k", lw=1.5, label="grazing plan (exact arcs)")
+ax.plot(nodes[:, 0], nodes[:, 1], "o", color="tab:blue", ms=5, label="FHOCP nodes")
+tt = np.linspace(t0, t0 + 12.0, 200)
+target = scenario.trajectory.position(tt)
+ax.plot(target[:, 0], target[:, 1], color="tab:orange", lw=1.5, label="target path (next 12 s)")
+ax.plot(*scenario.trajectory.position(t0)[:2], "o", color="tab:orange", ms=8, label="target at t_k")
+ax.plot(*aim[:2], "*", color="tab:orange", mec="k", ms=13, label="target when the plan ends (aimed at)")
+ax.set_aspect("equal")
+ax.set_xlim(1.9, 3.9); ax.set_ylim(-0.85, 1.75)
+ax.set_xlabel("x [m]"); ax.set_ylabel("y [m]")
+ax.set_title("Step 3: a hand-made plan, tangent to the keep-out ball")
+ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.1), ncol=2, fontsize=9)
+
+ax = axes[1, 1]                                 # clearance along the plan
+colours = {"grazing": "tab:red", "3 mm wider": "tab:green"}
+tau = np.linspace(0.0, 1.0, fine + 1)
+for name, (x0, inputs) in plans.items():
+    on_arcs, _ = clearance(x0, inputs, fine)
+    at_nodes, _ = clearance(x0, inputs, 1)
+    ok = check_plan(scenario, tight, t0, x0, inputs, scenario.obstacles, sign=-1).ok
+    ax.plot((n_arcs - 1 + tau) * dt, 1e3 * on_arcs[-1], "-", color=colours[name], lw=2,
+            label=f"{name}: exact arcs -> check_plan {'ACCEPTS' if ok else 'REJECTS'}")
+    ax.plot([(n_arcs - 1) * dt, n_arcs * dt], 1e3 * at_nodes[-1], "o", color=colours[name], ms=8)
+ax.axhline(0.0, color="k", lw=1)
+ax.axhline(1e3 * 0.5 * dt / 10 * tight.rates[3], color="0.4", ls=":", lw=1.5,
+           label="check_plan's padding (rate x spacing / 2)")
+ax.set_xlim((n_arcs - 1.05) * dt, (n_arcs + 0.05) * dt)
+ax.set_ylim(-0.5, 4.5)
+ax.set_xlabel("time along the plan [s] (dots: the last arc's two nodes)")
+ax.set_ylabel("clearance to the keep-out ball of arc 7 [mm]")
+ax.set_title("Step 3: clear at the nodes, not between them (last arc)")
+ax.legend(loc="upper right", fontsize=9)
+ax.grid(alpha=0.3)
 fig.savefig(FIGURES / "04_tightened_sets.png", dpi=100)
 print("wrote", FIGURES / "04_tightened_sets.png")
 
 # %% [markdown]
 # What the figure shows:
 #
-# * **Inputs.** Certified: V̄ keeps about half of every input, and the surge limit ū = 0.21 m/s
-#   sits just right of the target speed (dashed) — keep-up is the tightest condition. Best
-#   effort: V̄ is simply capped at half of V or the target speed; the feedback's real need
-#   (43 m/s surge, 408 rad/s yaw) is ignored.
-# * **Errors.** Certified: Ē is R shrunk by 0.0016 (visible only in the zoom); F is the part of
-#   Ē with e_d up to 0.89 m, and e(0) = [0.8, 0.2, 0] starts in Ē. Best effort: the state
-#   margin is ε = 0.1, not the certificate's ρ̃ = 0.19 — another cap.
-# * **Workspace.** The nominal keeps out of each obstacle by obstacle radius + vehicle radius +
-#   margin (0.029 m certified, zoom) and out of the disk e_d < ε + ρ̃ around the target.
+# * **Top left.** Each input limit splits into V̄ (the FHOCP's) and κ̄ (the feedback's). The
+#   black ticks are the necessary needs: V̄ must reach them, else no controller keeps up.
+# * **Top right.** The margins of the replayed plan grow arc by arc; M_o stays below e_o_max,
+#   which is condition `e_bar[e_o]`.
+# * **Bottom.** The grazing plan (red) is clear at every node (dots above 0) but dips below 0
+#   inside its last arc: rejected. Moved 3 mm out (green), it clears the padding and is accepted.
 #
-# Only the top row comes with a proof; the bottom row is what you run when you want to try
-# the paper's setup anyway. Tutorial 08 shows how to move a design from the bottom row to the top.
+# Tutorial 05 solves the FHOCP with these sets; tutorial 06 closes the loop and measures every
+# promise of the certificate on the run.

@@ -7,22 +7,23 @@
 # ---
 
 # %% [markdown]
-# # 08 — Certifying your own gains: the design search and the certifiable envelope
+# # 08 — Certify your own gains
 #
-# Tutorial 03 showed that the paper's Section VI scenario does not certify, with either law.
-# Here we ask the designer's question: *what would?* Two tools:
+# The designer's workflow, step by step:
 #
-# * `verify.envelope(scenario, law, eps=...)` finds, by bisection on certified / not certified,
-#   the largest horizontal disturbance ω̄_xy (current amplitude + sway bound) that certifies for
-#   each target speed, and puts it beside the physical-necessity frontier
-#   min(u_max − speed, r_max ε) that no controller can beat;
-# * building variants by hand — `Scenario.with_changes(...)` for top-level fields and
-#   `dataclasses.replace` for the nested settings — and certifying each one, to see which
-#   condition blocks which design.
+# 1. certify a scenario and **read** the certificate;
+# 2. fix the ancillary gain `controller.sigma` yourself and see which values certify, and why;
+# 3. see how much current the design can take at each target speed (`verify.envelope`);
+# 4. write **your own ancillary law** and certify it (`verify.certify` bounds its gains with
+#    `verify.gains`);
+# 5. hand the certificate to someone else, who **re-checks** it from its JSON alone
+#    (`verify.recheck`, `tubekit recheck`).
 
 # %%
 import dataclasses
+import json
 import os
+import tempfile
 from pathlib import Path
 
 import matplotlib
@@ -30,183 +31,124 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 import numpy as np
+import sympy as sp
 from matplotlib.colors import ListedColormap
 
 import verify
-from tubekit import load_scenario, paper_scenario
+import verify.gains
+from tubekit import AncillaryLaw, load_scenario, paper_scenario
+from tubekit.app.plots import envelope_figure
+from verify.recheck import recheck_file
 
 QUICK = os.environ.get("TUBEKIT_QUICK") == "1"
 FIGURES = Path(os.environ.get("TUBEKIT_FIGURES", Path(__file__).resolve().parent / "figures"))
 FIGURES.mkdir(parents=True, exist_ok=True)
 
+
+def num(x, digits=4):
+    """A condition's lhs or rhs: a number, or 'n/a' when the condition has none (e.g. the tube's rhs)."""
+    return "n/a" if x is None else f"{x:.{digits}g}"
+
+
 # %% [markdown]
-# ## The envelope of the paper's scenario
-# Every point of the search is a full certificate; the bisection runs a fixed number of steps
-# (a work unit). `quick=True` uses fewer speeds and steps.
+# ## Step 1: certify, and read the certificate
+# `paper_currents.toml` is the paper's vehicle, sensing, horizon and obstacles against the paper's
+# current, with the two changes physics forces (target at π/50, ε = 0.5 m; docs/verify.md section 4).
+# `cert.summary()` is what `tubekit certify FILE` prints. We read its parts one by one.
+
+# %%
+currents = load_scenario(verify.SCENARIOS_DIR / "paper_currents.toml")
+cert = verify.certify(currents)
+print("verdict:", "CERTIFIED" if cert.certified else "not certified", f"(law {cert.law!r})")
+print("sigma:", cert.sigma["value"], "1/s, because:", cert.sigma["source"])
+print("tried:", ", ".join(f"{t['sigma']:g}{'*' if t['certified'] else ''}" for t in cert.sigma["tried"]),
+      " (* = certified)")
+print("one-period tube rho (e_d m, e_z m, e_o):", np.round(cert.tube["rho"], 5))
+print("kappa_bar:", np.round(cert.kappa_bar, 4), " V_bar:", np.round(cert.v_bar, 4))
+print("\nevery condition, lhs vs rhs:")
+for c in cert.conditions:
+    print(f"  [{'ok  ' if c.ok else 'FAIL'}] {c.condition:>14}: {num(c.lhs):>8} vs {num(c.rhs):>8}   {c.inequality}")
+print("\npremises, checked in every run:", *cert.premises, sep="\n  - ")
+
+# %% [markdown]
+# Each condition is one inequality with both sides. A side can be missing (`None`): when a
+# condition could not be evaluated, or has no number to compare with; `num` prints it as n/a
+# instead of crashing on `None:.4g`. The premises are what the certificate cannot know in advance:
+# the FHOCP must produce an acceptable plan at least once every N samples, and the disturbance
+# of the run must respect ω̄ — `tubekit.promises.check_promises(run)` measures both on each run.
+#
+# ## Step 2: choose σ yourself
+# `controller.sigma = None` lets `certify` try σ ∈ {0, f/32, …, f} and keep the largest that
+# certifies. Setting it fixes σ: the certificate then judges that one value. Nested settings are
+# frozen dataclasses: `dataclasses.replace` makes a modified copy, `Scenario.with_changes` puts it back.
+
+# %%
+def with_sigma(scenario, sigma):
+    return scenario.with_changes(controller=dataclasses.replace(scenario.controller, sigma=sigma))
+
+
+sigma_values = (1.0, 3.125, 6.25, 12.5, 50.0, 100.0, 250.0)
+by_sigma = [(f"sigma = {s:g}", verify.certify(with_sigma(currents, s))) for s in sigma_values]
+print(f"{'':>14} | {'cert.':5} | {'rho_e_o':>8} | {'kappa_r':>8} | failed conditions (lhs vs rhs)")
+for name, c in by_sigma:
+    rho_o = num(c.tube["rho"][2]) if c.tube["certified"] else "-"
+    kap_r = num(c.kappa_bar[2]) if c.kappa_bar is not None else "-"
+    why = "; ".join(f"{f['condition']} {num(f['lhs'], 3)} vs {num(f['rhs'], 3)}" for f in c.failures) or "-"
+    print(f"{name:>14} | {str(c.certified):5} | {rho_o:>8} | {kap_r:>8} | {why}")
+
+# %% [markdown]
+# * `controller.sigma` must be > 0 (σ = 0, no feedback at all, is among the automatic candidates
+#   only; it certifies too: the reset alone bounds the deviation over one period, tutorial 03).
+# * σ = 1 and σ = 3.125 certify; 3.125 is the one `certify` picks (the largest that certifies).
+# * σ = 6.25: the feedback turns the heading by up to κ̄_r δ per period; carried along the
+#   horizon by the replayed plan, the e_o margin of the last arc exceeds e_o_max (`e_bar[e_o]`).
+# * σ = 12.5 to 100: the feedback also reserves so much input that the nominal can no longer
+#   keep up with target plus current (`keep_up[u]`) or turn with the current's line of sight
+#   (`yaw_budget`).
+# * σ = 250: σ h = 2.5 > 2 at 100 Hz, each held tick overshoots: no finite tube (`tube` fails,
+#   and everything after it is not evaluated).
+#
+# ## Step 3: the envelope — how much current can a design take?
+# `verify.envelope(scenario, law, eps=...)` bisects, for each target speed, the largest horizontal
+# disturbance ω̄_xy that certifies, and draws it beside the physical-necessity frontier
+# min(u_max − speed, r_max ε) that no controller can beat. Every point is a full certificate;
+# `quick=True` uses fewer speeds and bisection steps.
 
 # %%
 paper = paper_scenario()
 env_paper = verify.envelope(paper, "corrected", quick=QUICK)
 print(env_paper.summary())
+env_currents = verify.envelope(currents, "corrected", eps=0.5, quick=QUICK)
+print(env_currents.summary())
 
 # %% [markdown]
-# At ε = 0.1 m the yaw budget alone caps ω̄_xy at r_max ε = 0.05 m/s, and at the paper's
-# 0.377 m/s keep-up caps it at 0.023 m/s — about the sway bound alone. The paper's current
-# (0.1 m/s plus 0.02 m/s sway) is beyond physics there, whatever the tube.
-
-# %% [markdown]
-# ## Variants by hand
-# Starting from the paper's scenario with the corrected law, we change one thing at a time,
-# then combine. Nested settings are frozen dataclasses: `dataclasses.replace` makes a
-# modified copy, `Scenario.with_changes` puts it back.
+# At the paper's ε = 0.1 m the yaw budget caps ω̄_xy at r_max ε = 0.05 m/s: the paper's current
+# (0.1 m/s plus 0.02 m/s sway) is beyond physics there, whatever the tube. At ε = 0.5 m the
+# certified frontier follows the necessary one: the certificate loses (almost) nothing to physics.
+# `tubekit.app.plots.plot_envelope(env, path)` draws it (as `tubekit envelope FILE --plot` does).
+# Here we take the same figure from `envelope_figure` and move its legend out of the plot, so that
+# it does not hide the frontier, at a readable size.
 
 # %%
-def slower(s):            # target speed halved: circle rate pi/25 -> pi/50 (0.377 -> 0.1885 m/s)
-    return s.with_changes(trajectory=dataclasses.replace(s.trajectory, rate=s.trajectory.rate / 2))
-
-
-def weaker(s):            # current amplitude 0.1 -> 0.02 m/s per axis, sway bound 0.02 -> 0.005 m/s
-    d = s.disturbance
-    return s.with_changes(disturbance=dataclasses.replace(d, amplitude=(0.02, 0.02, 0.02),
-                                                          sway=dataclasses.replace(d.sway, bound=0.005)))
-
-
-def farther(s, move_start=True):   # epsilon 0.1 -> 0.5 m; the start e_d(0) = 0.5 m must move back
-    s = s.with_changes(epsilon=0.5)
-    return s.with_changes(initial_state=(-0.8, 3.0, 0.2, 0.0)) if move_start else s
-
-
-def narrower(s):          # region |e_o| <= 0.9 -> 0.5
-    return s.with_changes(region=dataclasses.replace(s.region, e_o_max=0.5))
-
-
-def with_sigma(s, sigma):  # fix the ancillary gain instead of letting the verifier choose
-    return s.with_changes(controller=dataclasses.replace(s.controller, sigma=sigma))
-
-
-all_four = narrower(farther(weaker(slower(paper))))
-variants = [
-    ("paper scenario", paper, "corrected"),
-    ("paper scenario, paper's law", paper, "paper"),
-    ("slower target", slower(paper), "corrected"),
-    ("weaker current", weaker(paper), "corrected"),
-    ("eps = 0.5 m, start unchanged", farther(paper, move_start=False), "corrected"),
-    ("eps = 0.5 m", farther(paper), "corrected"),
-    ("|e_o| <= 0.5", narrower(paper), "corrected"),
-    ("slower + weaker", weaker(slower(paper)), "corrected"),
-    ("slower + weaker + eps", farther(weaker(slower(paper))), "corrected"),
-    ("all four", all_four, "corrected"),
-    ("all four, paper's law", all_four, "paper"),
-    ("all four, sigma = 10", with_sigma(all_four, 10.0), "corrected"),
-    ("all four, sigma = 1", with_sigma(all_four, 1.0), "corrected"),
-    ("all four, sigma = 200", with_sigma(all_four, 200.0), "corrected"),
-]
-certs = [(name, verify.certify(s, law)) for name, s, law in variants]
-print(f"{'variant':>30} | {'law':9} | {'cert.':5} | {'sigma':>6} | {'rho_tilde':>9} | blocked by (lhs vs rhs)")
-for name, c in certs:
-    sig = "-" if c.sigma["value"] is None else f"{c.sigma['value']:g}"
-    rho = "-" if c.rho_tilde is None else f"{c.rho_tilde:.3g}"
-    blocks = "; ".join(f"{f['condition']} {f['lhs']:.3g} vs {f['rhs']:.3g}" for f in c.failures) or "-"
-    print(f"{name:>30} | {c.law:9} | {str(c.certified):5} | {sig:>6} | {rho:>9} | {blocks}")
-print("\n'all four' is verify.certifiable_scenario():",
-      all_four.with_changes(name="certifiable-corrected") == verify.certifiable_scenario())
-
-# %% [markdown]
-# Reading the table from the top:
-#
-# * Each single change shrinks ρ̃ and the input demand, but the tube feedback still needs
-#   more surge, heave and yaw than the vehicle has (`v_bar[·]` negative), and at the paper's
-#   target speed `keep_up_real[u]` fails on its own.
-# * ε = 0.5 m helps most (ξ̄, L2 and the bearing fold all scale like 1/ε) — but only if the
-#   start moves back too: the paper's start is 0.5 m behind the target, on the boundary of
-#   the new region, and `initial` fails (e(0) must lie in Ē, i.e. e_d(0) ≥ ε + ρ̃).
-# * Slower + weaker + ε leaves the yaw feedback (`v_bar[r]`) and the nominal's surge
-#   (`keep_up_nominal[u]`); narrowing |e_o| fixes both — the certifiable scenario of
-#   tutorials 03 and 04.
-# * The paper's law fails J_lower even there: Remark 1 does not depend on the numbers.
-# * σ matters: σ = 1 is below (L1 + L2)/J_lower = 1.88 (eq. sigma fails, nothing downstream
-#   is evaluated); σ = 10 is admissible but the tube is wider and the nominal can no longer
-#   keep up (tutorial 03: keep-up needs σ ≳ 16); σ = 200 gives the smallest tube but exceeds
-#   the sampled-data limit f/sup‖JK‖ = 100 1/s of the 100 Hz ancillary loop (raise
-#   `controller.ancillary_rate_hz` to allow it).
-
-# %% [markdown]
-# ## How close is the certificate to physics?
-# The envelope of the paper's vehicle against the paper's currents (`paper_currents.toml`)
-# at ε = 0.5 m and 0.3 m: the ratio certified / necessary says what the tube costs.
-
-# %%
-currents = load_scenario(verify.SCENARIOS_DIR / "paper_currents.toml")
-envs = {eps: verify.envelope(currents, "corrected", eps=eps, quick=QUICK) for eps in (0.5, 0.3)}
-for env in envs.values():
-    print(env.summary(), end="\n\n")
-
-# %% [markdown]
-# `08_envelope.png` (drawn by `tubekit.app.plots.envelope_figure`, as `tubekit envelope --plot`
-# does): both frontiers at each ε, the certified region shaded, the reference points marked.
-
-# %%
-from tubekit.app.plots import envelope_figure
-
-for eps, env in envs.items():
-    envelope_figure(env).savefig(FIGURES / f"08_envelope_eps{eps:g}.png", dpi=110)
-envelope_figure(envs[0.5]).savefig(FIGURES / "08_envelope.png", dpi=110)
+fig = envelope_figure(env_currents)
+fig.set_size_inches(12.5, 5.4)
+fig.axes[0].legend(fontsize=9, loc="upper left", bbox_to_anchor=(1.01, 1.0))
+fig.savefig(FIGURES / "08_envelope.png", dpi=110)
 print("wrote", FIGURES / "08_envelope.png")
 
 # %% [markdown]
-# `08_variants.png`: every condition of every variant — green holds, red fails, grey not
-# evaluated (needs ρ̃, which does not exist), white not checked for that variant
-# (`sigma_sampled` appears only when σ is fixed).
+# ## Step 4: your own law, certified
+# A law is κ = −σ K(J) ρ. Give it the numeric gain *and* the same map on a sympy Matrix
+# (`symbolic_gain`). `verify.certify` registers it and `verify.gains.gain_bounds` substitutes the
+# derived J in polar form, J = [[c, 0, 0], [0, 1, 0], [−e_o c/e_d, 0, c]] with c = −sqrt(1 − e_o²)
+# toward the target, then bounds every entry of K and of G = J K over R (Arb branch-and-bound).
+# The tube only needs those entry bounds: sup|K_jl| (input use) and the range of G (contraction
+# per tick).
+#
+# Our law inverts only the diagonal of J: K = diag(1/J₀₀, 1, 1/J₂₂). It ignores the coupling
+# term −e_o c/e_d, so G = J K is not the identity.
 
 # %%
-columns = []
-for _, c in certs:
-    for cond in c.conditions:
-        if cond.condition not in columns:
-            columns.append(cond.condition)
-state = np.full((len(certs), len(columns)), 3)         # 0 fail, 1 ok, 2 n/a, 3 not checked
-for i, (_, c) in enumerate(certs):
-    for cond in c.conditions:
-        state[i, columns.index(cond.condition)] = {False: 0, True: 1, None: 2}[cond.ok]
-fig, ax = plt.subplots(figsize=(14, 6.5), layout="constrained")
-ax.imshow(state, cmap=ListedColormap(["tab:red", "tab:green", "0.75", "white"]), vmin=-0.5, vmax=3.5,
-          aspect="auto")
-for i in range(state.shape[0]):
-    for j in range(state.shape[1]):
-        ax.text(j, i, ("FAIL", "ok", "n/a", "")[state[i, j]], ha="center", va="center", fontsize=7,
-                color="white" if state[i, j] == 0 else "k")
-ax.set_xticks(range(len(columns)), columns, rotation=50, ha="right", fontsize=9)
-ax.set_yticks(range(len(certs)), [f"{n}  [{'CERTIFIED' if c.certified else 'not certified'}]" for n, c in certs],
-              fontsize=9)
-ax.set_xticks(np.arange(-0.5, len(columns)), minor=True)
-ax.set_yticks(np.arange(-0.5, len(certs)), minor=True)
-ax.grid(which="minor", color="k", lw=0.5)
-ax.tick_params(which="minor", length=0)
-ax.set_title("which condition blocks which design (paper scenario + changes; corrected law unless noted)")
-fig.savefig(FIGURES / "08_variants.png", dpi=110)
-print("wrote", FIGURES / "08_variants.png")
-
-# %% [markdown]
-# To certify your own design: change the scenario (TOML or `with_changes`), run
-# `verify.certify` (or `tubekit certify my.toml`), read the failed conditions' two sides, and
-# use `verify.envelope` (`tubekit envelope my.toml --eps E`) to see how much current each target speed
-# can certify, and `tubekit certify my.toml --search-region` to find a region (e_o_max, e_d_max) that certifies.
-# Once it certifies, `certificate.tightening()` hands V̄, Ē and the obstacle margin to the
-# FHOCP (tutorial 04).
-
-# %% [markdown]
-# ## Your own law, certified
-# A law is κ = −σ K(J) ρ. Give it a numeric gain *and* the same map on a sympy Matrix
-# (`symbolic_gain`): the verifier substitutes the derived J in polar form and bounds
-# K(e) and J(e) K(e) with interval arithmetic, exactly as for the built-in laws. Here:
-# K = diag(1/J₀₀, 1, 1/J₂₂) — it inverts only the diagonal of J.
-
-# %%
-import sympy as sp
-
-from tubekit import AncillaryLaw
-
-
 def diag_inverse(J):
     K = np.zeros_like(J)
     K[..., 0, 0] = 1.0 / J[..., 0, 0]
@@ -217,17 +159,96 @@ def diag_inverse(J):
 
 mine = AncillaryLaw("diag-inverse", diag_inverse, "kappa = -sigma diag(1/J00, 1, 1/J22) rho",
                     symbolic_gain=lambda J: sp.diag(1 / J[0, 0], 1, 1 / J[2, 2]))
-for law in ("corrected", mine):
-    c = verify.certify(verify.certifiable_scenario(), law)
-    name = law if isinstance(law, str) else law.name
-    print(f"{name:>12}: {'CERTIFIED' if c.certified else 'not certified'};  J_lower = {c.bounds['J_lower'].bound:.4g}, "
-          f"rho_tilde = {c.rho['rho_tilde'] if c.rho['rho_tilde'] is not None else float('nan'):.4g}")
+law_certs = {name: verify.certify(currents, law) for name, law in
+             (("corrected", "corrected"), ("diag-inverse", mine), ("paper", "paper"))}
+K_entries, G_entries = verify.gains.gain_entries("diag-inverse", -1)        # registered by certify
+print("diag-inverse, toward the target: G = J K =")
+sp.pprint(sp.Matrix(3, 3, G_entries))
+for name, c in law_certs.items():
+    g = c.gains
+    print(f"\n{name:>12}: {'CERTIFIED' if c.certified else 'not certified'} at sigma = {c.sigma['value']:g}; "
+          f"G diagonal in [{', '.join(f'{lo:.3g}..{hi:.3g}' for lo, hi in zip(g.g_lo, g.g_hi))}], "
+          f"sup|G_od| = {g.g_off[2][0]:.3g}, sup|K| rows = {np.round(np.sum(g.k_abs, axis=1), 3)}")
+    print(f"{'':>14}tube rho = {np.round(c.tube['rho'], 4)}, kappa_bar = {np.round(c.kappa_bar, 4)}")
     for f in c.failures:
-        print(f"{'':>14}FAIL {f['condition']}: {f['lhs']:.4g} vs {f['rhs']:.4g}")
+        print(f"{'':>14}FAIL {f['condition']}: {num(f['lhs'])} vs {num(f['rhs'])}")
 
 # %% [markdown]
-# Ignoring the coupling term −e_o c/e_d of J halves J_lower (1 − |e_o|/(2 e_d) ≥ 0.5 on this
-# region instead of 1). Since σ J_lower − L1 − L2 is Lemma 1's denominator, ρ̃ grows about
-# 3.5-fold (0.0016 → 0.0058 as printed above) and so does the input the tube reserves: the
-# scenario that certifies with the inverse-Jacobian law fails here on the input conditions.
-# The certificate names them with numbers, so you know which knob to turn.
+# The three laws differ in G = J K, and the tube reads only entry bounds of K and G:
+#
+# * **corrected** (K = J⁻¹): G = I exactly, every tick contracts each axis by 1 − σh; but its yaw
+#   row of K carries the coupling term, so the yaw input it reserves (κ̄_r) grows fastest with σ.
+# * **diag-inverse** (ours): the same diagonal G_jj = 1, plus an off-diagonal G_od = −e_o/e_d (up to
+#   e_o_max/ε = 1 here) that couples the e_d deviation into e_o. Its K has smaller rows (it does
+#   not fight the coupling), so each unit of σ costs less yaw input — and here it certifies at a
+#   *larger* σ than the corrected law. Exact inversion is not automatically the best gain.
+# * **paper** (K = I): G = J, whose diagonal is c ∈ [−1, −0.87] toward the target: the feedback
+#   pushes ρ the wrong way and each tick *grows* it by 1 + σh|c|. That is Remark 1's failure, and
+#   it rules out Lemma 1's invariant tube. Under the reset, though, ρ restarts at 0 every period,
+#   so a small σ only widens the tube (its ρ̄_o is the widest of the three) and the design can
+#   still certify. The certificate judges the loop that runs, not the paper's argument.
+#
+# ## Step 5: re-check a certificate from its JSON
+# `cert.to_dict()` is strict JSON (what `tubekit certify FILE --json cert.json` writes). It holds
+# the scenario and every input of the theorem, so `verify.recheck.recheck_file` (`tubekit recheck`)
+# can confirm it without searching: it re-derives the disturbance bounds, verifies F(x) < x for the
+# stored tube, the margins and every condition, and spot-checks the gain bounds.
+
+# %%
+with tempfile.TemporaryDirectory() as tmp:
+    path = Path(tmp) / "cert.json"
+    path.write_text(json.dumps(cert.to_dict()))
+    result = recheck_file(path)
+    for line in result.summary().splitlines():      # long lines (the margins) shortened for the screen
+        print(line if len(line) <= 150 else line[:147] + "...")
+
+    forged = cert.to_dict()                       # claim a tube half as wide: it is no longer F(x) < x
+    forged["tube"]["rho"] = [0.5 * r for r in forged["tube"]["rho"]]
+    path.write_text(json.dumps(forged))
+    bad = recheck_file(path)
+    print(f"\nforged certificate: confirmed = {bad.confirmed}; failed re-checks: "
+          f"{', '.join(c['name'] for c in bad.checks if not c['ok'])}")
+
+# %% [markdown]
+# ## The figure: which condition blocks which design
+# `08_variants.png`: every condition of every design of this tutorial — green holds, red fails,
+# grey not evaluated (there is no tube to evaluate it with), white not checked for that design.
+
+# %%
+designs = by_sigma + [(f"law {name}", c) for name, c in law_certs.items()]
+columns = []
+for _, c in designs:
+    for cond in c.conditions:
+        if cond.condition not in columns:
+            columns.append(cond.condition)
+state = np.full((len(designs), len(columns)), 3)         # 0 fail, 1 ok, 2 not evaluated, 3 not checked
+for i, (_, c) in enumerate(designs):
+    for cond in c.conditions:
+        state[i, columns.index(cond.condition)] = {False: 0, True: 1, None: 2}[cond.ok]
+    for j, name in enumerate(columns):
+        if state[i, j] == 3 and not c.design.tube.certified:
+            state[i, j] = 2
+plt.rcParams.update({"font.size": 11})
+fig, ax = plt.subplots(figsize=(13, 6.5), layout="constrained")
+ax.imshow(state, cmap=ListedColormap(["tab:red", "tab:green", "0.75", "white"]), vmin=-0.5, vmax=3.5,
+          aspect="auto")
+for i in range(state.shape[0]):
+    for j in range(state.shape[1]):
+        ax.text(j, i, ("FAIL", "ok", "n/a", "")[state[i, j]], ha="center", va="center", fontsize=9,
+                color="white" if state[i, j] == 0 else "k")
+ax.set_xticks(range(len(columns)), columns, rotation=45, ha="right")
+ax.set_yticks(range(len(designs)),
+              [f"{n} [{'CERTIFIED' if c.certified else 'not certified'}]" for n, c in designs])
+ax.set_xticks(np.arange(-0.5, len(columns)), minor=True)
+ax.set_yticks(np.arange(-0.5, len(designs)), minor=True)
+ax.grid(which="minor", color="k", lw=0.5)
+ax.tick_params(which="minor", length=0)
+ax.set_title(f"{currents.name}: fixed sigma (corrected law), then each law at its own sigma")
+fig.savefig(FIGURES / "08_variants.png", dpi=110)
+print("wrote", FIGURES / "08_variants.png")
+
+# %% [markdown]
+# To certify your own design: change the scenario (TOML or `with_changes`), run `verify.certify`
+# (or `tubekit certify my.toml`), read each failed condition's two sides, and turn the knob it
+# names. Once it certifies, `cert.tightening()` hands V̄, the margins and the arc-check data to the
+# FHOCP (tutorial 04), and `tubekit simulate my.toml` measures every promise on the run (tutorial 06).

@@ -218,8 +218,9 @@ def evaluate_design(scenario: Scenario, region: Region, gains: GainBounds, sigma
     p = tube_problem(scenario, region, gains, sigma, dist)
     tube = one_period_tube(p)
     conds = [sway_condition(dist),
-             Condition("tube", "one-period tube: F(x) < x for the sampled-data map (verify.sampled)",
-                       float(tube.iterations), None, tube.certified, tube.reason or "post-fixed point verified in Arb")]
+             Condition("tube", "max_j F_j(x) / x_j < 1: the one-period box x is a strict post-fixed point of the "
+                               "sampled-data map (verify.sampled)", tube.contraction, 1.0, tube.certified,
+                       tube.reason or f"verified in Arb after {tube.iterations} fixed-point iterations")]
     if not tube.certified:
         return Design(sigma=sigma, problem=p, tube=tube, margins=None, v_bar=None, conditions=tuple(conds),
                       score=-math.inf)

@@ -36,6 +36,14 @@ def _input_limits(cert, min_input_fraction: float) -> np.ndarray:
     return np.maximum(v - kappa, floor)
 
 
+def _clamped(cert, margins: np.ndarray) -> np.ndarray:
+    """Best effort: each margin column capped so Ē keeps MIN_KEPT_FRACTION of R (plans can be accepted)."""
+    reg = cert.region
+    caps = (1 - MIN_KEPT_FRACTION) * np.array([0.5 * (reg.e_d[1] - reg.e_d[0]), min(-reg.e_z[0], reg.e_z[1]),
+                                               min(-reg.e_o[0], reg.e_o[1]), cert.design.problem.eps])
+    return np.minimum(np.where(np.isfinite(margins), margins, np.inf), caps[None, :])
+
+
 def _node_bounds(cert, margins: np.ndarray, rates: np.ndarray) -> dict[str, float]:
     reg = cert.region
     allowance = 0.5 * cert.dt * rates
@@ -58,7 +66,7 @@ def tightening_of(cert, min_input_fraction: float = 0.5) -> Tightening:
     margins = (np.column_stack([d.margins.e_d, d.margins.e_z, d.margins.e_o, d.margins.position])
                if has_tube else np.zeros((0, 4)))
     if has_tube and not cert.certified:
-        margins = np.where(np.isfinite(margins), margins, np.inf)
+        margins = _clamped(cert, margins)
     rates = np.asarray(d.rates, dtype=float)
     nodes = _node_bounds(cert, np.where(np.isfinite(margins), margins, 0.0) if margins.size else margins, rates)
     tube = np.asarray(d.tube.rho, dtype=float) if d.tube.certified else np.zeros(3)

@@ -99,6 +99,8 @@ class PeriodTube:
         Fixed-point iterations used.
     reason : str
         Why not certified ('' when certified).
+    contraction : float
+        max_j F_j(x) / x_j at the certified x (< 1 is the theorem's condition).
     """
 
     rho: tuple[float, float, float]
@@ -110,6 +112,7 @@ class PeriodTube:
     certified: bool
     iterations: int
     reason: str = ""
+    contraction: float = math.inf
 
     def to_dict(self) -> dict:
         """JSON-ready copy."""
@@ -244,14 +247,33 @@ def one_period_tube(p: TubeProblem) -> PeriodTube:
             x = new
             break
         x = new
-    cand = [v * (1 + _INFLATE) + 1e-12 for v in x]
-    fx, cart = tube_map(p, [arb(v) for v in cand])
-    ok = all(fv < arb(c) for fv, c in zip(fx, cand))
-    if not ok:
+    found = _post_fixed_point(p, x)
+    if found is None:
+        fx, _ = tube_map(p, [arb(v) for v in x])
         return _failed(p, [upper(v) for v in fx], it, "no post-fixed point F(x) < x found within the work budget")
+    cand, fx, cart = found
+    ratio = max(upper(f / arb(c)) for f, c in zip(fx, cand))
     return PeriodTube(rho=(cand[0], cand[1], cand[2]), theta=cand[3], p_xy=upper(cart["p_xy"]),
                       p_z=upper(cart["p_z"]), psi=upper(cart["psi"]),
-                      kappa=tuple(upper(k) for k in cart["kappa"]), certified=True, iterations=it)
+                      kappa=tuple(upper(k) for k in cart["kappa"]), certified=True, iterations=it,
+                      contraction=ratio)
+
+
+def _post_fixed_point(p: TubeProblem, x: list[float], attempts: int = 200):
+    """A point c with F(c) < c in Arb near the float fixed point x (attempts: a work unit).
+
+    Iterates c <- F(c) + s with the slack s = η x + floor > 0 from c = x + s. Its limit solves
+    c = F(c) + s, so F(c) = c - s < c; the iteration stops at the first c that passes in Arb.
+    (A uniform inflation of x can fail where the map couples axes, e.g. ρ̄ into the bearing.)
+    """
+    slack = [v * _INFLATE + 1e-12 for v in x]
+    cand = [v + e for v, e in zip(x, slack)]
+    for _ in range(attempts):
+        fx, cart = tube_map(p, [arb(v) for v in cand])
+        if all(fv < arb(c) for fv, c in zip(fx, cand)):
+            return cand, fx, cart
+        cand = [max(c, upper(f) + e) for c, f, e in zip(cand, fx, slack)]
+    return None
 
 
 def _failed(p: TubeProblem, x: list[float], it: int, reason: str) -> PeriodTube:

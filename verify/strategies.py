@@ -114,7 +114,7 @@ def error_states(region: Region) -> st.SearchStrategy[np.ndarray]:
 def _shrunk(region: Region, rho: float) -> tuple[tuple[float, float], ...]:
     boxes = tuple((lo + rho, hi - rho) for lo, hi in (region.e_d, region.e_z, region.e_o))
     if any(lo > hi for lo, hi in boxes):
-        raise ConfigError("rho_tilde", f"a tube radius smaller than half the narrowest region width", rho,
+        raise ConfigError("rho_tilde", "a tube radius smaller than half the narrowest region width", rho,
                           "the region shrunk by the tube is empty")
     return boxes
 

@@ -24,6 +24,8 @@ from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any, Callable
 
+import numpy as np
+
 import verify
 
 from ..closed_loop import SimulationResult, simulate
@@ -87,11 +89,22 @@ def output_dir_name(scenario_name: str) -> str:
     return keep or "scenario"
 
 
+def e_d_peaks(e_d: np.ndarray, t: np.ndarray, prominence: float = 0.2) -> list[float]:
+    """Times (s) of the e_d peaks that rise at least ``prominence`` (m) above both neighbouring valleys."""
+    from scipy.signal import find_peaks
+    idx, _ = find_peaks(np.asarray(e_d, dtype=float), prominence=prominence)
+    return [float(t[i]) for i in idx]
+
+
 def acceptance(metrics: dict[str, Any], total_wall_s: float) -> dict[str, Any]:
-    """Issue 5 item 7 on the tube run: each criterion with the number it rests on."""
+    """Issue 5 item 7 and issue 12's fidelity bar on the tube run: each criterion with the number it rests on."""
     enc, enc_d = metrics.get("encirclements"), metrics.get("desired_encirclements")
     passes = metrics.get("obstacle_passes")
+    base_rmse = metrics["baseline"]["tracking_rmse"] if "baseline" in metrics else None
+    ratio = metrics["tracking_rmse"] / base_rmse if base_rmse else None
     return {
+        "four_e_d_peaks": len(metrics.get("e_d_peaks", [])) >= 4,
+        "rmse_within_1_25_baseline": ratio is not None and ratio <= 1.25,
         "no_collision": not metrics["collision"],
         "inputs_within_V": bool(metrics["inputs_within_limits"]),
         "two_encirclements": bool(passes) and all(p >= 2 for p in passes),
@@ -102,9 +115,13 @@ def acceptance(metrics: dict[str, Any], total_wall_s: float) -> dict[str, Any]:
             "min_e_d": metrics["min_e_d"], "epsilon": metrics["epsilon"],
             "e_d_below_epsilon": metrics["e_d_below_epsilon"], "total_wall_s": total_wall_s,
             "saturated_steps": metrics["saturated_steps"],
+            "e_d_peaks_s": metrics.get("e_d_peaks"), "tracking_rmse_ratio": ratio,
             "rule": ("two_encirclements: every obstacle passed at least twice (the paper: 'two encirclements, "
                      "which means that it should avoid the obstacles twice each'); collision: clearance < 0; "
-                     "inputs_within_V: applied inputs (after any counted saturation) inside V"),
+                     "inputs_within_V: applied inputs (after any counted saturation) inside V; four_e_d_peaks: "
+                     "e_d peaks rising >= 0.2 m above both neighbouring valleys (the paper's Fig. 3: four peaks, "
+                     "e_d back down between obstacle passes); rmse_within_1_25_baseline: tube RMSE <= 1.25 x the "
+                     "nominal-only baseline's"),
         },
     }
 
@@ -172,6 +189,7 @@ def write_runs(out: Path, scenario: Scenario, design: CertifiedDesign, tube: Sim
     metrics = compute_metrics(tube_cols, scenario, rho_bound=rho_tilde if design.certified else None,
                               extra=_run_facts(tube))
     metrics["baseline"] = compute_metrics(base_cols, scenario, rho_bound=None, extra=_run_facts(base))
+    metrics["e_d_peaks"] = e_d_peaks(tube_cols["e_d"], tube_cols["t"])
     plot_all(out, scenario, [("tube", tube_cols), ("baseline", base_cols)], rho_tilde=rho_tilde,
              certified=design.certified)
     metrics["certified"] = design.certified

@@ -53,6 +53,7 @@ from typing import Sequence
 import numpy as np
 
 from ..exceptions import ConfigError, ShapeError
+from ..model import sinc, unicycle_step
 from ..scenario import Obstacle, Scenario
 from ..tightening import Tightening
 from ..validation import as_vector, positive
@@ -73,16 +74,6 @@ def _dsinc_series(a: np.ndarray, a2: np.ndarray) -> np.ndarray:
                 + a2 * (-1.0 / 3991680.0)))))
 
 
-def sinc(a: np.ndarray) -> np.ndarray:
-    """S(a) = sin(a)/a with S(0) = 1 (unnormalised sinc), vectorised.
-
-    sin(a)/a has no cancellation, so the quotient is accurate to round-off for every a != 0.
-    """
-    a = np.asarray(a, dtype=float)
-    safe = np.where(a == 0.0, 1e-300, a)  # sin(1e-300)/1e-300 == 1.0
-    return np.sin(safe) / safe
-
-
 def dsinc(a: np.ndarray) -> np.ndarray:
     """S'(a) = (a cos a - sin a)/a^2 with S'(0) = 0, vectorised.
 
@@ -99,40 +90,8 @@ def dsinc(a: np.ndarray) -> np.ndarray:
     return np.where(small, series, (safe * np.cos(safe) - np.sin(safe)) / (safe * safe))
 
 
-def discrete_step(s: np.ndarray, v: np.ndarray, dt: float) -> np.ndarray:
-    """Exact zero-order-hold step F(s, v) of the nominal kinematics; vectorised.
-
-    Parameters
-    ----------
-    s : array (..., 4)
-        State [x, y, z, psi] (m, m, m, rad).
-    v : array (..., 3)
-        Input [u, w, r] (m/s, m/s, rad/s), held for ``dt``.
-    dt : float
-        Step (s).
-
-    Returns
-    -------
-    array (..., 4)
-        The state after ``dt``; exact for constant input.
-    """
-    s = np.asarray(s, dtype=float)
-    v = np.asarray(v, dtype=float)
-    if s.ndim != 2 or v.ndim != 2 or s.shape[0] != v.shape[0]:
-        s, v = np.broadcast_arrays(s, v[..., [0, 0, 1, 2]])
-        v = v[..., [0, 2, 3]]
-        lead = s.shape[:-1]
-        return discrete_step(s.reshape(-1, 4), v.reshape(-1, 3), dt).reshape(lead + (4,))
-    u, w, r = v.T
-    a = (0.5 * dt) * r
-    th = s[:, 3] + a
-    k = (dt * u) * sinc(a)
-    out = np.empty_like(s)
-    out[:, 0] = s[:, 0] + k * np.cos(th)
-    out[:, 1] = s[:, 1] + k * np.sin(th)
-    out[:, 2] = s[:, 2] + dt * w
-    out[:, 3] = s[:, 3] + dt * r
-    return out
+#: Exact zero-order-hold step F(s, v, dt) of the nominal kinematics (the model's own exact arc).
+discrete_step = unicycle_step
 
 
 def rollout(s0: np.ndarray, inputs: np.ndarray, dt: float) -> np.ndarray:

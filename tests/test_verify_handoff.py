@@ -1,0 +1,79 @@
+"""Tests of verify.handoff: from a certificate to the Tightening the FHOCP and the loop use.
+
+The node constraints are recomputed here from the module's documented rule (largest per-arc margin plus
+the inter-node allowance rate * dt / 2, each keeping at least a quarter of R's half-width) with the arc
+rates derived by hand: |e_d'| <= u + P, |e_z'| <= w + |zdot_d|, |e_o'| <= r + (u + P) / eps, ||p'|| <= ||(u, w)||.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from tubekit.scenario import paper_scenario
+from tubekit.tightening import Tightening
+from verify import NotCertifiedError, certify
+
+P = 3.0 * math.pi / 50     # horizontal target speed of paper_currents (m/s)
+
+
+def test_certified_tightening_is_the_certificate(pc_cert):
+    c = pc_cert
+    t = c.tightening()
+    assert isinstance(t, Tightening) and t.certified
+    np.testing.assert_allclose(t.v_max, np.array([0.4, 0.3, 0.5]) - c.kappa_bar, rtol=1e-12)
+    np.testing.assert_array_equal(t.tube, np.asarray(c.tube["rho"]))
+    assert t.rho_tilde == pytest.approx(math.sqrt(sum(r * r for r in c.tube["rho"])))
+    assert t.sigma == c.sigma["value"] and t.horizon_arcs == 8
+    m = c.margins
+    np.testing.assert_array_equal(t.margins, np.column_stack([m["e_d"], m["e_z"], m["e_o"], m["position"]]))
+    np.testing.assert_allclose(t.rates, [0.4 + P, 0.3, 0.5 + (0.4 + P) / 0.5, 0.5], rtol=1e-12)
+    np.testing.assert_array_equal(t.region, [0.5, 3.0, 1.0, 0.5])
+    d = c.disturbance
+    np.testing.assert_array_equal(t.disturbance, [d.omega_xy, d.omega_z, d.gamma])
+
+
+def test_node_constraints_are_the_last_margin_plus_the_allowance(pc_cert):
+    t = pc_cert.tightening()
+    m = pc_cert.margins
+    half = 0.05     # dt / 2 (s)
+    worst = [m["e_d"][-1] + half * (0.4 + P), m["e_z"][-1] + half * 0.3,
+             m["e_o"][-1] + half * (0.5 + (0.4 + P) / 0.5), m["position"][-1] + half * 0.5]
+    assert t.e_d_min == pytest.approx(0.5 + min(worst[0], 0.75 * 1.25))
+    assert t.e_d_max == pytest.approx(3.0 - min(worst[0], 0.75 * 1.25))
+    assert t.e_z_max == pytest.approx(1.0 - min(worst[1], 0.75 * 1.0))
+    assert t.e_o_max == pytest.approx(0.5 - min(worst[2], 0.75 * 0.5))
+    assert t.obstacle_margin == pytest.approx(worst[3])
+    assert t.e_o_max >= 0.25 * 0.5 - 1e-15     # at least a quarter of R's half-width is kept
+
+
+def test_uncertified_tightening_needs_consent(paper_cert):
+    with pytest.raises(NotCertifiedError, match="is not certified .*allow_uncertified=True"):
+        paper_cert.tightening()
+
+
+@pytest.mark.parametrize("fraction", [0.5, 0.9, 1.0])
+def test_best_effort_tightening(paper_cert, fraction):
+    """Best effort: each input limit >= max(fraction V_i, keep-up need), <= V_i; nodes keep a quarter of R."""
+    t = paper_cert.tightening(allow_uncertified=True, min_input_fraction=fraction)
+    v = np.array([0.4, 0.3, 0.5])
+    need = np.array([min(3 * math.pi / 25 + 0.12, 0.4), min(0.1, 0.3), 0.0])
+    assert not t.certified
+    assert np.all(t.v_max <= v + 1e-15) and np.all(t.v_max >= np.maximum(fraction * v, need) - 1e-15)
+    assert t.v_max[0] == pytest.approx(0.4)    # the keep-up need (0.497 m/s) is above u_max
+    reg = paper_scenario().region
+    assert 0.1 < t.e_d_min <= 0.1 + 0.75 * (reg.e_d_max - 0.1) / 2 + 1e-12
+    assert t.e_o_max >= 0.25 * reg.e_o_max - 1e-12 and t.e_z_max >= 0.25 * reg.e_z_max - 1e-12
+    assert np.all(np.isfinite(t.v_max)) and math.isfinite(t.rho_tilde)
+
+
+def test_best_effort_without_a_tube():
+    """A design whose tube diverges hands over no margins and a zero tube, flagged uncertified."""
+    sc = paper_scenario()
+    huge = sc.with_changes(disturbance=type(sc.disturbance)(amplitude=(2.0, 2.0, 2.0)))
+    c = certify(huge)
+    assert not c.design.tube.certified
+    t = c.tightening(allow_uncertified=True)
+    assert t.horizon_arcs == 0 and np.all(t.tube == 0) and t.rho_tilde == 0.0 and not t.certified

@@ -1,0 +1,41 @@
+"""Tests of verify.report: the certificate as text."""
+
+from __future__ import annotations
+
+from tubekit.scenario import paper_scenario
+from verify import certify
+from verify.report import certificate_text
+
+
+def test_certified_text(pc_cert):
+    text = pc_cert.summary()
+    assert text == certificate_text(pc_cert)
+    first = text.splitlines()[0]
+    assert "'paper-currents'" in first and "'corrected'" in first and first.endswith(": CERTIFIED")
+    assert "FAIL" not in text and text.count("[ok  ]") == len(pc_cert.conditions)
+    for c in pc_cert.conditions:
+        assert f"{c.condition}: {c.inequality}" in text
+    assert "Premises" in text and "Assumptions" in text and "Elapsed:" in text
+    rho = pc_cert.tube["rho"]
+    assert f"|rho| <= [{rho[0]:.4g}, {rho[1]:.4g}, {rho[2]:.4g}]" in text
+    assert "sigma = 3.125 1/s" in text and "3.125*" in text
+
+
+def test_uncertified_text_names_every_failure(paper_cert):
+    text = paper_cert.summary()
+    n = len(paper_cert.failures)
+    assert f"NOT CERTIFIED ({n} failed conditions)" in text.splitlines()[0]
+    assert text.count("[FAIL]") == n
+    for f in paper_cert.failures:
+        line = next(ln for ln in text.splitlines() if f"] {f['condition']}:" in ln)
+        assert line.startswith("  [FAIL]") and f"{f['lhs']:.6g} vs {f['rhs']:.6g}" in line
+        assert f["detail"] in line
+
+
+def test_text_without_a_tube():
+    sc = paper_scenario()
+    c = certify(sc.with_changes(disturbance=type(sc.disturbance)(amplitude=(2.0, 2.0, 2.0))))
+    text = c.summary()
+    assert "One-period tube: none (" in text and "diverge" in text
+    assert "V_bar" not in text and "Per-arc margins" not in text
+    assert "[FAIL] tube" in text

@@ -103,3 +103,23 @@ def test_law_without_symbolic_gain_cannot_be_certified():
     register_law(AncillaryLaw("test-numeric-only", _diag_inverse, "numeric only"))
     with pytest.raises(ConfigError, match="symbolic gain"):
         verify.certify(verify.certifiable_scenario(), "test-numeric-only")
+
+
+@pytest.mark.parametrize("name", ["paper", "corrected"])
+def test_closed_form_call_equals_the_matrix_law(name):
+    """The built-in laws' closed-form kappa equals -sigma K(J) rho from J and gain_of_jacobian."""
+    law, rng = get_law(name), np.random.default_rng(7)
+    for _ in range(200):
+        state, p_d = rng.uniform(-3, 3, 4), rng.uniform(-1, 1, 3)
+        nominal = state + rng.normal(0, 0.05, 4)
+        rho = error_coordinates(state, p_d) - error_coordinates(nominal, p_d)
+        expected = -1.3 * law.gain_of_jacobian(jacobian_at(state, p_d)) @ rho
+        got = law(state, nominal, p_d, 1.3)
+        assert isinstance(got, np.ndarray) and got.shape == (3,)
+        assert np.allclose(got, expected, rtol=1e-8, atol=1e-10)
+
+
+def test_corrected_law_raises_on_singular_jacobian():
+    state = np.array([0.0, 1.0, 0.0, 0.0])  # bearing pi/2, psi = 0: cos(psi - bearing) = 0 exactly
+    with pytest.raises(ConfigError, match="state"):
+        get_law("corrected")(state, _state(1.0, 0.0, 0.1), np.zeros(3), 1.0)

@@ -46,3 +46,43 @@ def test_missing_dependency_disables_only_that_command(monkeypatch, capsys):
     err = capsys.readouterr().err
     assert "not available" in err and "_no_such_module_for_test" in err
     assert main(["audit", "--samples", "20"]) == 0  # the others still work
+
+
+@pytest.mark.parametrize("name", sorted(SUBCOMMANDS))
+def test_every_subcommand_takes_verbose_and_quiet(name, capsys):
+    with pytest.raises(SystemExit):
+        main([name, "--help"])
+    out = capsys.readouterr().out
+    assert "-v, --verbose" in out and "-q, --quiet" in out
+
+
+def _fake_certify(scenario, law=None):
+    from dataclasses import replace as dc_replace
+
+    from tubekit import Tightening
+
+    class Fake:
+        certified = False
+
+        def to_dict(self):
+            return {"certified": False, "fake": True}
+
+        def summary(self):
+            return "fake certificate"
+
+        def best_effort_tightening(self, min_input_fraction=0.5):
+            return dc_replace(Tightening.untightened(scenario), sigma=0.5, rho_tilde=0.03)
+    return Fake()
+
+
+@pytest.mark.parametrize("flag, shown", [(None, True), ("-q", False), ("-v", True)])
+def test_diagnostics_are_logged_on_stderr_results_on_stdout(flag, shown, tmp_path, monkeypatch, capsys):
+    pytest.importorskip("tubekit.fhocp")
+    import verify
+
+    monkeypatch.setattr(verify, "certify", _fake_certify, raising=False)
+    argv = ["reproduce", "--out", str(tmp_path / "r"), "--duration", "1", "--no-progress"] + ([flag] if flag else [])
+    assert main(argv) == 0
+    captured = capsys.readouterr()
+    assert ("certifying" in captured.err) is shown and "certifying" not in captured.out
+    assert "wrote" in captured.out and "min_clearance" in captured.out  # results stay on stdout

@@ -10,7 +10,8 @@ import pytest
 
 from tubekit.closed_loop import simulate
 from tubekit.metrics import rho_period_peaks
-from tubekit.app.plots import FIGURE_FILES, errors_figure, plot_all, top_view
+from tubekit.app.plots import (FIGURE_FILES, clearance_figure, errors_figure, inputs_figure, period_envelope, plot_all,
+                               top_view, view_3d)
 from tubekit.scenario import paper_scenario
 from tubekit.tightening import Tightening
 
@@ -51,3 +52,68 @@ def test_rho_period_peaks_are_the_maxima(short_run):
     m = int(np.sum(cols["step"] == cols["step"][0]))
     assert len(peaks) == (len(cols["rho_norm"]) - 1) // m
     assert peaks[0] == pytest.approx(np.max(cols["rho_norm"][1:m + 1]))
+
+
+def _tightening(sc, margin=0.1):
+    base = Tightening.untightened(sc)
+    return replace(base, obstacle_margin=margin, v_max=base.v_max * 0.8, rho_tilde=0.05)
+
+
+def test_top_view_tube_time_ticks_markers_and_outside_legend(short_run):
+    sc, cols = short_run
+    fig = top_view(sc, [("baseline", cols)], tightening=_tightening(sc))
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+
+    FigureCanvasAgg(fig).draw()
+    ax = fig.axes[0]
+    labels = [t.get_text() for t in ax.get_legend().get_texts()]
+    assert any("position tube" in s for s in labels)
+    assert any(s.startswith("start") for s in labels) and any(s.startswith("end of baseline") for s in labels)
+    assert any("sensing range" in s for s in labels)
+    assert any(t.get_text().endswith(" s") for t in ax.texts)  # time ticks on the path
+    legend_box = ax.get_legend().get_window_extent()
+    assert legend_box.x0 >= ax.get_window_extent().x1  # the legend sits outside the axes
+
+
+def test_period_envelope_is_min_max_per_period(short_run):
+    _, cols = short_run
+    t, lo, hi = period_envelope(cols, "u")
+    first = cols["step"] == cols["step"][0]
+    assert t[0] == cols["t"][0] and t[-1] == cols["t"][-1]
+    assert lo[0] == pytest.approx(np.nanmin(cols["u"][first])) and hi[0] == pytest.approx(np.nanmax(cols["u"][first]))
+    assert np.all(lo[np.isfinite(lo)] <= hi[np.isfinite(hi)])
+
+
+def test_inputs_figure_draws_v_hat_and_both_bounds(short_run):
+    sc, cols = short_run
+    fig = inputs_figure(sc, [("baseline", cols)], tightening=_tightening(sc))
+    labels = [t.get_text() for t in fig.axes[0].get_legend().get_texts()]
+    assert any("hat v" in s for s in labels) and any("min-max per period" in s for s in labels)
+    assert any("bound of $V$" in s for s in labels) and any("bar V" in s for s in labels)
+
+
+def test_clearance_axis_shows_mm_penetration(short_run):
+    sc, cols = short_run
+    fig = clearance_figure(sc, [("baseline", cols)])
+    ax = fig.axes[0]
+    assert ax.get_yscale() == "symlog" and ax.get_ylim()[0] <= -0.01
+
+
+def test_view_3d_true_aspect(short_run):
+    sc, cols = short_run
+    ax = view_3d(sc, [("baseline", cols)]).axes[0]
+    spans = np.array([np.ptp(ax.get_xlim()), np.ptp(ax.get_ylim()), np.ptp(ax.get_zlim())])
+    box = np.asarray(ax.get_box_aspect())
+    assert np.allclose(box / box[0], spans / spans[0], rtol=1e-6)
+
+
+def test_animation_gif(tmp_path, short_run):
+    from PIL import Image
+
+    from tubekit.app.animate import ANIMATION_GIF, animate_top_view
+
+    sc, cols = short_run
+    paths = animate_top_view(tmp_path, sc, [("baseline", cols)], frames=8)
+    assert paths[0].name == ANIMATION_GIF
+    with Image.open(paths[0]) as gif:
+        assert gif.n_frames == 8

@@ -5,9 +5,11 @@ from __future__ import annotations
 import dataclasses
 import json
 import math
+import os
 import subprocess
 import sys
 from pathlib import Path
+from types import SimpleNamespace
 
 import numpy as np
 import pytest
@@ -28,6 +30,8 @@ class FakeCertificate:
 
     def __init__(self, scenario, certified):
         self.scenario, self.certified = scenario, certified
+        self.failures = [] if certified else [{"condition": "fake"}]
+        self.disturbance = SimpleNamespace(gamma=0.02)  # what the dynamic part of reproduce reads
 
     def to_dict(self):
         return {"certified": self.certified, "fake": True, "rho": 0.03}
@@ -35,7 +39,7 @@ class FakeCertificate:
     def summary(self):
         return "fake certificate for tests"
 
-    def tightening(self, allow_uncertified=False):
+    def best_effort_tightening(self, min_input_fraction=0.5):
         base = Tightening.untightened(self.scenario)
         return dataclasses.replace(base, sigma=0.5, rho_tilde=0.03, e_d_min=self.scenario.epsilon + 0.03,
                                    obstacle_margin=0.02, v_max=base.v_max * 0.9)
@@ -214,7 +218,7 @@ def test_invalid_config_console_script(tmp_path):
     cfg = tmp_path / "bad.toml"
     cfg.write_text('[region]\ne_o_max = 1.5\n')
     out = subprocess.run([sys.executable, "-m", "tubekit.app.cli", "simulate", str(cfg)], capture_output=True,
-                         text=True, timeout=120)
+                         text=True, timeout=600)  # a hang guard, not a verdict
     assert out.returncode == 2
     assert "region.e_o_max" in out.stderr and "Traceback" not in out.stderr
     assert len(out.stderr.strip().splitlines()) == 1
@@ -240,6 +244,16 @@ def test_reproduce_writes_every_file_and_key(certified, tmp_path, monkeypatch):
     assert acc["e_d_at_least_epsilon"] is (metrics["min_e_d"] >= metrics["epsilon"])
     assert metrics["scenario"] == "paper-section-VI" and metrics["steps"] == 40
     assert [o["center"] for o in metrics["obstacles"]] == [[3.0, 0.0, 0.0], [-3.0, 0.0, 0.0]]
+    # issue 13: reproduce also runs the tube controller on the dynamic plant, and says what it measured
+    from tubekit.app.dynamic_study import DYNAMIC_FILES
+    for name in DYNAMIC_FILES:
+        assert (out / name).is_file() and (out / name).stat().st_size > 20, name  # the fake certificate is short
+    dyn = metrics["dynamic"]
+    assert dyn["vehicle"] == "remus100" and len(dyn["velocity_error_max"]) == 3
+    assert dyn["sway_bound"] == 0.02 and 0 < dyn["sway_max"]
+    dyn_csv = np.genfromtxt(out / "dynamic_trajectory.csv", delimiter=",", names=True)
+    assert {"u_b", "v_b", "w_b", "r_b", "X", "Z", "N"} <= set(dyn_csv.dtype.names)
+    assert dyn["sway_max"] == pytest.approx(float(np.nanmax(np.abs(dyn_csv["v_b"]))), rel=1e-9)
 
 
 def test_quick_and_law_options(tmp_path, monkeypatch):
@@ -270,3 +284,73 @@ def test_reproduce_with_real_certificate(real_reproduce):
     assert isinstance(cert, dict) and cert
     assert (metrics["rho_bound"] is None) is (not metrics["certified"])
     assert metrics["checks"]["inputs_finite"] and metrics["baseline"]["checks"]["inputs_finite"]
+
+
+# ---- atomic output: a failed or interrupted run leaves the previous results untouched ----------
+
+def _tree(root: Path) -> dict[str, bytes | None]:
+    """Every path under ``root`` (hidden staging directories included) with its bytes."""
+    return {str(p.relative_to(root)): (None if p.is_dir() else p.read_bytes()) for p in root.rglob("*")}
+
+
+@pytest.fixture
+def previous_results(tmp_path, monkeypatch):
+    """A finished reproduce run in ``tmp_path/rep`` (fake certificate), and the tree of ``tmp_path``."""
+    pytest.importorskip("tubekit.fhocp")
+    monkeypatch.setattr(verify, "certify", _fake_certify(), raising=False)
+    out = tmp_path / "rep"
+    assert main(["reproduce", "--out", str(out), "--duration", "1", "--no-progress"]) == 0
+    return out, _tree(tmp_path)
+
+
+def test_exception_mid_run_leaves_previous_results(previous_results, tmp_path, monkeypatch):
+    import tubekit.app.study as study
+
+    out, before = previous_results
+
+    def fail(*args, **kwargs):  # after the CSVs of the new run are written into the staging directory
+        raise RuntimeError("simulated failure while plotting")
+
+    monkeypatch.setattr(study, "plot_all", fail)
+    with pytest.raises(RuntimeError, match="simulated failure"):
+        main(["reproduce", "--out", str(out), "--duration", "2", "--no-progress"])
+    assert _tree(tmp_path) == before
+
+
+def test_interrupt_mid_run_leaves_previous_results(previous_results, tmp_path, monkeypatch, capsys):
+    import tubekit.app.study as study
+
+    out, before = previous_results
+    capsys.readouterr()
+
+    def interrupt(*args, **kwargs):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(study, "run_tube_and_baseline", interrupt)
+    assert main(["reproduce", "--out", str(out), "--duration", "2", "--no-progress"]) == 130
+    err = capsys.readouterr().err
+    assert "interrupted" in err and "Traceback" not in err
+    assert _tree(tmp_path) == before
+
+
+def test_rerun_replaces_the_whole_directory(previous_results, tmp_path):
+    out, _ = previous_results
+    (out / "stale.txt").write_text("from an older run\n")
+    assert main(["reproduce", "--out", str(out), "--duration", "2", "--no-progress"]) == 0
+    assert not (out / "stale.txt").exists()
+    assert json.loads((out / "metrics.json").read_text())["duration_s"] == pytest.approx(2.0)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["rep"]  # no staging or old directory left
+    umask = os.umask(0)
+    os.umask(umask)
+    assert out.stat().st_mode & 0o777 == 0o777 & ~umask  # not the 0o700 of a temporary directory
+
+
+def test_animate_writes_a_gif(tmp_path, monkeypatch):
+    pytest.importorskip("tubekit.fhocp")
+    monkeypatch.setattr(verify, "certify", _fake_certify(), raising=False)
+    out = tmp_path / "anim"
+    assert main(["reproduce", "--out", str(out), "--duration", "1", "--no-progress", "--animate", "-q"]) == 0
+    from PIL import Image
+
+    with Image.open(out / "top_view.gif") as gif:
+        assert gif.n_frames > 10

@@ -236,3 +236,30 @@ def test_plan_memory_shifts_the_last_good_plan_then_stops():
     for _ in range(len(good.inputs)):
         last = memory.replacement()
     np.testing.assert_array_equal(last, 0.0)
+
+
+def test_dynamic_plant_run_logs_body_velocities_and_thrusts(tmp_path):
+    from tubekit.simulation_result import DYNAMIC_COLUMNS
+    from tubekit.vehicles import PlantSettings
+    sc = _scenario(duration=2.0).with_changes(plant=PlantSettings("dynamic"))
+    res = simulate(sc, tightening=_tightening(sc, 1.0), solver_factory=Pursuit, progress=False)
+    assert res.body.shape == (len(res.t), 4) and res.thrust.shape == (len(res.t), 3)
+    cols = read_trajectory_csv(res.write_csv(tmp_path / "trajectory.csv"))
+    assert tuple(cols) == CSV_COLUMNS + DYNAMIC_COLUMNS
+    np.testing.assert_allclose(cols["v_b"], res.body[:, 1], rtol=1e-11, atol=1e-13)
+    assert np.all(np.abs(res.thrust) <= np.array(sc.plant.params.thrust_limits) + 1e-9)
+    # the logged omega is what moved the vehicle beyond f(x) v: current + loop error + hull sway
+    assert np.all(np.isfinite(res.omega[:-1])) and np.max(np.abs(res.body[:, 1])) > 0.0
+    kin = simulate(sc, tightening=_tightening(sc, 1.0), solver_factory=Pursuit, progress=False, plant="kinematic")
+    assert kin.body is None and np.max(np.abs(kin.states - res.states)) > 1e-4
+
+
+def test_kinematic_plant_is_the_default_and_unchanged():
+    from tubekit.vehicles import PlantSettings
+    sc = _scenario(duration=1.0)
+    a = simulate(sc, tightening=_tightening(sc, 1.0), solver_factory=Pursuit, progress=False)
+    b = simulate(sc.with_changes(plant=PlantSettings("kinematic")), tightening=_tightening(sc, 1.0),
+                 solver_factory=Pursuit, progress=False, plant="kinematic")
+    np.testing.assert_array_equal(a.states, b.states)
+    np.testing.assert_array_equal(a.omega, b.omega)
+    assert a.body is None and tuple(a.columns()) == CSV_COLUMNS

@@ -84,3 +84,34 @@ def test_error_coordinates_definition():
     assert e[0] == pytest.approx(np.sqrt(2))
     assert e[1] == pytest.approx(2.0)
     assert e[2] == pytest.approx(1 / np.sqrt(2))  # (e_x sin psi - e_y cos psi)/e_d
+
+
+def test_generated_module_equals_the_derivation():
+    """The shipped closed-form code is the derivation: same source hash, same text (same sympy), same values."""
+    import tubekit._generated_dynamics as gen
+    from tubekit.derivation import GENERATED_PATH, derivation_hash, generated_source
+
+    assert gen.DERIVATION_HASH == derivation_hash(), "run `python -m tubekit.derivation` to regenerate"
+    if gen.SYMPY_VERSION == sp.__version__:
+        assert GENERATED_PATH.read_text() == generated_source()
+    d, s = derive(), symbols()
+    args = [s[n] for n in ("e_x", "e_y", "psi")]
+    rng = np.random.default_rng(3)
+    pts = np.column_stack([rng.uniform(-3, 3, (40, 2)), rng.uniform(-4, 4, 40)])
+    reference = sp.lambdify(args, list(d.J), modules="numpy")
+    for ex, ey, psi in pts:
+        assert np.allclose(gen.jacobian_scalar(ex, ey, psi), reference(ex, ey, psi), rtol=1e-12, atol=1e-12)
+        assert np.allclose(numeric().J(ex, ey, psi).ravel(), reference(ex, ey, psi), rtol=1e-12, atol=1e-12)
+        e = gen.error_scalar(ex, ey, 0.4, psi)
+        assert np.allclose(e, error_coordinates(np.array([ex, ey, 0.4, psi]), np.zeros(3)), rtol=1e-12)
+        rho, sigma = rng.normal(size=3), 2.5
+        kappa = -sigma * np.linalg.solve(numeric().J(ex, ey, psi), rho)
+        assert np.allclose(gen.corrected_kappa(ex, ey, psi, *rho, sigma), kappa, rtol=1e-9, atol=1e-9)
+
+
+def test_generated_scalars_raise_where_undefined():
+    import tubekit._generated_dynamics as gen
+    with pytest.raises(ZeroDivisionError):
+        gen.error_scalar(0.0, 0.0, 0.0, 0.3)
+    with pytest.raises(ZeroDivisionError):  # bearing pi/2, psi = 0: cos(psi - bearing) = 0, J singular
+        gen.corrected_kappa(0.0, 1.0, 0.0, 0.1, 0.1, 0.1, 1.0)

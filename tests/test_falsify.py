@@ -64,7 +64,7 @@ def test_closed_loop_certified_finds_nothing(currents):
 
 def test_closed_loop_shrunk_tube_is_found(currents):
     scenario, cert = currents
-    tight = cert.tightening()
+    tight = cert.tightening
     small = replace(tight, tube=np.asarray(tight.tube) / 2)
     res = falsify_closed_loop(scenario, budget=2, seed=0, duration=2.0, certificate=cert, tightening=small)
     assert res.found and not res.check() and res.ratio > 1.0

@@ -76,3 +76,20 @@ def test_missing_casadi_raises_not_available(monkeypatch):
     from tubekit.fhocp.ipopt import IpoptFHOCP
     with pytest.raises(NotAvailableError, match="pip install"):
         IpoptFHOCP(SC, tightening())
+
+
+def test_sqpmethod_peer_solves_the_same_nlp():
+    """The sqpmethod + qrqp peer (benchmark v2) reaches IPOPT's merit on a state it solves."""
+    pytest.importorskip("casadi")
+    from tubekit.exceptions import ConfigError
+    from tubekit.fhocp.ipopt import IpoptFHOCP
+    with pytest.raises(ConfigError, match="nlp_solver"):
+        IpoptFHOCP(SC, tightening(), nlp_solver="snopt")
+    t, state = STATES[0]
+    N = SC.controller.horizon_steps
+    sqp = IpoptFHOCP(SC, tightening(), nlp_solver="sqpmethod", warm_start_duals=True)
+    a = sqp.solve(t, np.array(state), SC.obstacles, initial_inputs=np.zeros((N, 3)))
+    b = IpoptFHOCP(SC, tightening()).solve(t, np.array(state), SC.obstacles, initial_inputs=np.zeros((N, 3)))
+    assert not a.fallback and a.status in ("optimal", "optimal_inaccurate")
+    assert abs(a.merit - b.merit) <= 1e-2 * max(1.0, abs(b.merit))
+    assert not sqp.solve(t + SC.controller.dt, np.array(state), SC.obstacles).fallback  # dual warm start

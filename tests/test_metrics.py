@@ -10,6 +10,7 @@ import pytest
 from tubekit import Circle, Line, Obstacle, paper_scenario
 from tubekit.metrics import (METRIC_KEYS, clearance, compute_metrics, encirclements, input_ratio, intervals_below,
                              obstacle_passes, read_trajectory_csv, tracking_rmse)
+from tubekit.plant import Plant
 
 
 def _circle_xy(radius, angle):
@@ -143,3 +144,19 @@ def test_read_trajectory_csv(tmp_path):
     assert list(cols) == ["t", "x", "u"]
     np.testing.assert_array_equal(cols["x"], [1.5, 2.0])
     assert np.isnan(cols["u"][0])
+
+
+def test_sway_max_from_the_log_and_sway_bound_recorded():
+    sc = paper_scenario().with_changes(duration=50.0)
+    cols = _handmade_log()
+    m = compute_metrics(cols, sc, sway_bound=0.02)
+    assert m["sway_max"] is None and m["sway_bound"] == 0.02  # no omega columns: nothing to measure
+    t = cols["t"]
+    psi = 0.3 * t
+    current = Plant.of(sc).current(t)
+    sway = 0.01 * np.sin(t)
+    cols = {**cols, "psi": psi, "omega_1": current[:, 0] - sway * np.sin(psi),
+            "omega_2": current[:, 1] + sway * np.cos(psi)}
+    assert compute_metrics(cols, sc)["sway_max"] == pytest.approx(np.max(np.abs(sway)), abs=1e-12)
+    dynamic = {**cols, "v_b": np.full(len(t), -0.03)}
+    assert compute_metrics(dynamic, sc)["sway_max"] == pytest.approx(0.03)

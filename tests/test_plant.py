@@ -134,3 +134,17 @@ def test_plant_of_scenario():
     sc = paper_scenario()
     plant = Plant.of(sc)
     assert plant.disturbance is sc.disturbance and plant.override is None
+
+
+def test_omega_series_matches_omega_per_tick_and_skips_nan_inputs():
+    plant = _plant()
+    rng = np.random.default_rng(5)
+    t = np.arange(6) * 0.01
+    states = rng.uniform(-1, 1, (6, 4))
+    inputs = rng.uniform(-0.4, 0.4, (6, 3))
+    inputs[-1] = np.nan
+    out = plant.omega_series(t, states, inputs)
+    for i in range(5):
+        np.testing.assert_array_equal(out[i], plant.omega(t[i], states[i], inputs[i]))
+    assert np.all(np.isnan(out[-1]))
+    assert plant.current_at(0.3) == tuple(plant.current(0.3))

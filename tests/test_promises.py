@@ -17,6 +17,7 @@ import pytest
 from tubekit.promises import Promise, check_promises
 from tubekit.simulation_result import SimulationResult
 from tubekit.tightening import Tightening
+from tubekit.vehicles import PlantSettings
 
 TICKS, STEPS = 10, 3
 TUBE = np.array([0.01, 0.01, 0.02])
@@ -138,3 +139,23 @@ def test_disturbance_and_sway_are_checked(stationary):
     low = replace(run, inputs=inputs, tightening=_tight(disturbance=np.array([0.04, 0.02, 0.01])))
     p = _promise(low, "sway")
     assert not p.ok and p.observed == pytest.approx(0.02)
+
+
+def test_dynamic_runs_check_hull_sway_and_the_velocity_loop(stationary):
+    sc = replace(stationary, plant=PlantSettings("dynamic", tracking_bound=(0.05, 0.02, 0.1)))
+    run = _run(stationary, scenario=sc)
+    rows = len(run.t)
+    body = np.zeros((rows, 4))
+    thrust = np.zeros((rows, 3))
+    clean = replace(run, body=body, thrust=thrust)
+    assert all(p.ok for p in check_promises(clean))
+    assert _promise(clean, "velocity_loop").observed == 0.0
+    off = body.copy()
+    off[4] = [0.06, 0.0, 0.0, 0.05]     # |u_b - u| = 0.06 > 0.05: ratio 1.2
+    p = _promise(replace(run, body=off, thrust=thrust), "velocity_loop")
+    assert not p.ok and p.observed == pytest.approx(1.2)
+    off = body.copy()
+    off[7, 1] = 0.03                    # hull sway 0.03 m/s > gamma_bar = 0.02
+    p = _promise(replace(run, body=off, thrust=thrust), "sway")
+    assert not p.ok and p.observed == pytest.approx(0.03)
+    assert "velocity_loop" not in {p.name for p in check_promises(run)}  # kinematic: no such promise

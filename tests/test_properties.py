@@ -117,7 +117,7 @@ def test_closed_loop_containment(certified):
     from tubekit.derivation import error_coordinates
 
     scenario, cert = certified
-    tight = cert.tightening()
+    tight = cert.tightening
     tube = np.asarray(tight.tube)
     eo, ez = min(0.3, tight.e_o_max), min(0.3, tight.e_z_max)  # starts in E-bar
     start_region = cert.region.replace(e_d=(tight.e_d_min, min(tight.e_d_min + 0.5, tight.e_d_max)),
@@ -147,7 +147,7 @@ def fhocp_solver(certified):
     from tubekit.fhocp import FHOCP
 
     scenario, cert = certified
-    return FHOCP(scenario, cert.tightening(), mode="converged")
+    return FHOCP(scenario, cert.tightening, mode="converged")
 
 
 def test_fhocp_plans_and_shifted_candidate(certified, fhocp_solver):
@@ -159,7 +159,7 @@ def test_fhocp_plans_and_shifted_candidate(certified, fhocp_solver):
     from tubekit.sensing import detected_obstacles
 
     scenario, cert = certified
-    tight = cert.tightening()
+    tight = cert.tightening
     dt, n = scenario.controller.dt, scenario.controller.horizon_steps
     eo, ez = min(0.3, tight.e_o_max), min(0.3, tight.e_z_max)  # starts in E-bar
     start_region = cert.region.replace(e_d=(tight.e_d_min, tight.e_d_min + 1.0), e_o=(-eo, eo), e_z=(-ez, ez))

@@ -42,7 +42,7 @@ def test_certified_tightening_is_the_pontryagin_difference():
     """V_bar = V - kappa_bar and the per-axis tube of the sampled-data certificate."""
     sc = load_scenario(verify.SCENARIOS_DIR / "paper_currents.toml")
     cert = verify.certify(sc)
-    t = cert.tightening()
+    t = cert.tightening
     assert t.certified and t.horizon_arcs == sc.controller.horizon_steps
     np.testing.assert_allclose(t.v_max, sc.limits.vector - np.asarray(cert.kappa_bar), rtol=1e-12)
     assert np.all(t.v_max > 0) and np.all(t.v_max < sc.limits.vector)

@@ -97,7 +97,7 @@ def test_paper_scenario_is_not_certified_with_named_inequalities(paper_cert):
         assert set(f) == {"condition", "inequality", "lhs", "rhs", "detail"}
         assert f["lhs"] is not None and f["rhs"] is not None
     with pytest.raises(NotCertifiedError, match="not certified.*keep_up"):
-        c.tightening()
+        c.tightening
 
 
 @pytest.mark.parametrize("fixture", ["pc_cert", "ok_cert", "paper_cert"])
@@ -151,7 +151,6 @@ def test_json_is_identical_under_cpu_load(pc_cert):
     """Issue 11 item 4: the budgets are work units, so three CPU-bound processes change nothing but time."""
     idle = _strict_json(pc_cert)
     procs = []
-    t0 = time.monotonic()
     try:
         for _ in range(3):
             procs.append(subprocess.Popen([sys.executable, "-c", "while True: pass"]))
@@ -163,7 +162,6 @@ def test_json_is_identical_under_cpu_load(pc_cert):
             p.kill()
         for p in procs:
             p.wait(timeout=10)
-    assert time.monotonic() - t0 < 60.0
     assert loaded == idle
 
 
@@ -201,7 +199,7 @@ def _adversarial_run(sc, duration=5.0):
         return cert, None
     wxy, wz = cert.disturbance.omega_xy * (1 - 1e-9), cert.disturbance.omega_z * (1 - 1e-9)
     # d e_o / dt = sqrt(1 - e_o^2) omega . n_t / e_d with n_t = (-sin theta, cos theta) = (0, -1)
-    run = simulate(sc, tightening=cert.tightening(), progress=False, disturbance=lambda t: np.array([0.0, -wxy, wz]))
+    run = simulate(sc, tightening=cert.tightening, progress=False, disturbance=lambda t: np.array([0.0, -wxy, wz]))
     return cert, run
 
 
@@ -291,7 +289,7 @@ def test_certify_errors(args, kwargs, match):
 @pytest.mark.parametrize("fraction", [0.0, -0.1, 1.5])
 def test_tightening_fraction_is_validated(pc_cert, fraction):
     with pytest.raises(ConfigError, match="min_input_fraction: expected a number in"):
-        pc_cert.tightening(min_input_fraction=fraction)
+        pc_cert.best_effort_tightening(min_input_fraction=fraction)
 
 
 def test_controller_defaults_are_the_papers():

@@ -74,7 +74,7 @@ def test_disturbance_bounds_of_paper_currents(pc):
     assert dist.omega_xy == pytest.approx(0.1 + 0.1 * 0.4 * 0.5) and dist.omega_z == pytest.approx(0.1)
     assert dist.gamma == pytest.approx(0.02) and dist.declared_sway == 0.02
     assert dist.to_dict() == {"omega_xy": dist.omega_xy, "omega_z": dist.omega_z, "gamma": dist.gamma,
-                              "declared_sway": 0.02}
+                              "declared_sway": 0.02, "yaw_rate_error": 0.0}  # kinematic plant: psi_dot = r
 
 
 # --------------------------------------------------------------------------- the theorem's inputs

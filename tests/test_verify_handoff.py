@@ -21,7 +21,7 @@ P = 3.0 * math.pi / 50     # horizontal target speed of paper_currents (m/s)
 
 def test_certified_tightening_is_the_certificate(pc_cert):
     c = pc_cert
-    t = c.tightening()
+    t = c.tightening
     assert isinstance(t, Tightening) and t.certified
     np.testing.assert_allclose(t.v_max, np.array([0.4, 0.3, 0.5]) - c.kappa_bar, rtol=1e-12)
     np.testing.assert_array_equal(t.tube, np.asarray(c.tube["rho"]))
@@ -36,7 +36,7 @@ def test_certified_tightening_is_the_certificate(pc_cert):
 
 
 def test_node_constraints_are_the_last_margin_plus_the_allowance(pc_cert):
-    t = pc_cert.tightening()
+    t = pc_cert.tightening
     m = pc_cert.margins
     half = 0.05     # dt / 2 (s)
     worst = [m["e_d"][-1] + half * (0.4 + P), m["e_z"][-1] + half * 0.3,
@@ -50,14 +50,14 @@ def test_node_constraints_are_the_last_margin_plus_the_allowance(pc_cert):
 
 
 def test_uncertified_tightening_needs_consent(paper_cert):
-    with pytest.raises(NotCertifiedError, match="is not certified .*allow_uncertified=True"):
-        paper_cert.tightening()
+    with pytest.raises(NotCertifiedError, match="is not certified .*best_effort_tightening"):
+        paper_cert.tightening
 
 
 @pytest.mark.parametrize("fraction", [0.5, 0.9, 1.0])
 def test_best_effort_tightening(paper_cert, fraction):
     """Best effort: each input limit >= max(fraction V_i, keep-up need), <= V_i; nodes keep a quarter of R."""
-    t = paper_cert.tightening(allow_uncertified=True, min_input_fraction=fraction)
+    t = paper_cert.best_effort_tightening(min_input_fraction=fraction)
     v = np.array([0.4, 0.3, 0.5])
     need = np.array([min(3 * math.pi / 25 + 0.12, 0.4), min(0.1, 0.3), 0.0])
     assert not t.certified
@@ -75,5 +75,5 @@ def test_best_effort_without_a_tube():
     huge = sc.with_changes(disturbance=type(sc.disturbance)(amplitude=(2.0, 2.0, 2.0)))
     c = certify(huge)
     assert not c.design.tube.certified
-    t = c.tightening(allow_uncertified=True)
+    t = c.best_effort_tightening()
     assert t.horizon_arcs == 0 and np.all(t.tube == 0) and t.rho_tilde == 0.0 and not t.certified

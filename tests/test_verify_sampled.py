@@ -300,3 +300,11 @@ def test_margins_of_the_shipped_certificate(certs):
     assert all(len(v) == sc.controller.horizon_steps for v in m.values())
     assert m["e_d"][0] == cert.tube["rho"][0] and m["e_o"][0] == cert.tube["rho"][2]
     assert isinstance(cert.design.tube, PeriodTube)
+
+
+def test_a_yaw_rate_error_turns_the_heading_tube():
+    """On the dynamic plant psi_dot = r_cmd + (velocity-loop error): the heading bound grows by dr * delta."""
+    base = one_period_tube(_problem(sigma=0.0))
+    t = one_period_tube(_problem(sigma=0.0, yaw_rate_error=0.1))
+    assert base.psi == 0.0 and t.psi >= 0.1 * 0.1
+    assert t.rho[2] > base.rho[2] and t.p_xy > base.p_xy

@@ -9,17 +9,22 @@
   |kappa_i| <= sigma ||row_i(J^-1)|| ||rho||, which the verifier bounds.
 
 J is always the *derived* J of :mod:`tubekit.derivation`, evaluated at the real
-state (the real state is measured; the law is full-state feedback).
+state (the real state is measured; the law is full-state feedback). For the
+built-in laws, :meth:`AncillaryLaw.__call__` on one state evaluates κ as closed-form
+scalars generated from that derivation (:mod:`tubekit._generated_dynamics`); other
+laws and batched states go through J and ``gain_of_jacobian``.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
+import math
 from typing import Callable
 
 import numpy as np
 import sympy as sp
 
+from . import _generated_dynamics as generated
 from .derivation import error_coordinates, numeric
 from .exceptions import ConfigError
 
@@ -32,6 +37,16 @@ def _identity_gain(J: np.ndarray) -> np.ndarray:
 
 def _inverse_gain(J: np.ndarray) -> np.ndarray:
     return np.linalg.inv(J)
+
+
+#: Closed-form kappa of a law: (e_x, e_y, psi, rho_d, rho_z, rho_o, sigma) -> (3 floats).
+ClosedFormKappa = Callable[[float, float, float, float, float, float, float], tuple[float, float, float]]
+
+
+def _paper_kappa(e_x: float, e_y: float, psi: float, rho_d: float, rho_z: float, rho_o: float,
+                 sigma: float) -> tuple[float, float, float]:
+    """kappa = -sigma rho (K = I); the arguments are floats (m, rad, 1/s)."""
+    return (-sigma * rho_d, -sigma * rho_z, -sigma * rho_o)
 
 
 @dataclass(frozen=True)
@@ -50,12 +65,17 @@ class AncillaryLaw:
         The same map on a sympy Matrix, J -> K. Needed for :func:`verify.certify`,
         which bounds K(e) and J(e) K(e) with interval arithmetic; a law without it
         can be simulated and falsified, not certified.
+    closed_form : callable, optional
+        kappa as scalars, (e_x, e_y, psi, rho_d, rho_z, rho_o, sigma) -> 3 floats, raising
+        ZeroDivisionError where the law is undefined; used by ``__call__`` on a single state. It must
+        equal ``-sigma K(J) rho`` (the built-in ones are tested against it).
     """
 
     name: str
     gain_of_jacobian: Callable[[np.ndarray], np.ndarray]
     description: str
     symbolic_gain: Callable[[sp.Matrix], sp.Matrix] | None = None
+    closed_form: ClosedFormKappa | None = None
 
     def gain(self, state: np.ndarray, p_d: np.ndarray) -> np.ndarray:
         """K(e) at the real state (..., 4) w.r.t. p_d (..., 3)."""
@@ -78,6 +98,8 @@ class AncillaryLaw:
         sigma : float
             Gain (1/s).
         """
+        if self.closed_form is not None and np.shape(state) == (4,) and np.shape(state_hat) == (4,):
+            return self._closed_form_call(state, state_hat, p_d, sigma)
         rho = error_coordinates(state, p_d) - error_coordinates(state_hat, p_d)
         with np.errstate(invalid="ignore", divide="ignore"):
             try:
@@ -86,9 +108,29 @@ class AncillaryLaw:
                 K = np.full((3, 3), np.nan)
             out = -sigma * (K @ rho)
         if not np.all(np.isfinite(out)):
-            raise ConfigError("state", "a state with e_d > 0 and |e_o| < 1 (J non-singular)",
-                              np.asarray(state).tolist())
+            raise _undefined(state)
         return out
+
+    def _closed_form_call(self, state: np.ndarray, state_hat: np.ndarray, p_d: np.ndarray,
+                          sigma: float) -> np.ndarray:
+        """kappa (3,) by the closed-form scalars: no arrays until the result."""
+        x, y, z, psi = state.tolist() if isinstance(state, np.ndarray) else map(float, state)
+        xh, yh, zh, psih = state_hat.tolist() if isinstance(state_hat, np.ndarray) else map(float, state_hat)
+        xd, yd, zd = p_d.tolist() if isinstance(p_d, np.ndarray) else map(float, p_d)
+        try:
+            e_d, e_z, e_o = generated.error_scalar(x - xd, y - yd, z - zd, psi)
+            h_d, h_z, h_o = generated.error_scalar(xh - xd, yh - yd, zh - zd, psih)
+            out = self.closed_form(x - xd, y - yd, psi, e_d - h_d, e_z - h_z, e_o - h_o, float(sigma))
+        except (ZeroDivisionError, OverflowError, ValueError):
+            raise _undefined(state) from None
+        if not (math.isfinite(out[0]) and math.isfinite(out[1]) and math.isfinite(out[2])):
+            raise _undefined(state)
+        return np.array(out, dtype=float)
+
+
+def _undefined(state: np.ndarray) -> ConfigError:
+    """The error for a state where e_o or J^-1 is undefined."""
+    return ConfigError("state", "a state with e_d > 0 and |e_o| < 1 (J non-singular)", np.asarray(state).tolist())
 
 
 def jacobian_at(state: np.ndarray, p_d: np.ndarray) -> np.ndarray:
@@ -102,10 +144,11 @@ def jacobian_at(state: np.ndarray, p_d: np.ndarray) -> np.ndarray:
 #: The law registry: the two built-in laws plus any added with :func:`register_law`.
 LAWS: dict[str, AncillaryLaw] = {
     "paper": AncillaryLaw("paper", _identity_gain, "kappa = -sigma (e - e_hat)   [paper, eq. kappa_law]",
-                          symbolic_gain=lambda J: sp.eye(3)),
+                          symbolic_gain=lambda J: sp.eye(3), closed_form=_paper_kappa),
     "corrected": AncillaryLaw("corrected", _inverse_gain,
                               "kappa = -sigma J(e)^-1 (e - e_hat)   [inverse-Jacobian law]",
-                              symbolic_gain=lambda J: J.inv().applyfunc(sp.simplify)),
+                              symbolic_gain=lambda J: J.adjugate() / J.det(),
+                              closed_form=generated.corrected_kappa),
 }
 
 

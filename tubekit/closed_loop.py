@@ -11,9 +11,10 @@ Timeline (dt = FHOCP period, h = 1 / ancillary_rate_hz, m = dt / h ticks):
 * at every tick t_i = i h the ancillary law gives κ(e, ê) (zero-order hold over
   [t_i, t_i + h)), the applied input is v = v̂ + κ; only when v leaves V is it
   clipped to V (saturation, counted per tick and per sampling period);
-* the plant ẋ = f(x) v + ω(t, x, v) (eq. 11, :class:`tubekit.plant.Plant`) is
-  integrated with classical RK4 at a fixed step h / plant_substeps
-  (5 ms by default: 100 Hz ticks, 2 substeps).
+* the plant ẋ = f(x) v + ω(t, x, v) (eq. 11, :class:`tubekit.plant.Plant`), or the
+  4-DOF vehicle whose velocity loop tracks v (``[plant] kind = "dynamic"``,
+  :class:`tubekit.dynamics.DynamicPlant`), is integrated with classical RK4 at a
+  fixed step h / plant_substeps (5 ms by default: 100 Hz ticks, 2 substeps).
 
 :func:`simulate` is a pipeline of named steps: :func:`validate_inputs` →
 :func:`build_solver` → per sampling period (:meth:`_ClosedLoop.run_period`):
@@ -49,6 +50,7 @@ import numpy as np
 from .ancillary import AncillaryLaw, get_law
 from .exceptions import ConfigError, SolverError
 from .plan_check import check_plan
+from .dynamics import DynamicPlant, make_plant
 from .plant import OmegaOverride, Plant, nominal_arc, plant_rhs, rk4_hold
 from .scenario import Obstacle, Scenario
 from .sensing import ObstacleMap
@@ -112,7 +114,7 @@ def validate_inputs(scenario: Scenario, tightening: Tightening | None, law: str 
         raise ConfigError("duration", f"at least one FHOCP period (dt = {ctrl.dt:g} s)", scenario.duration)
     if tightening is None:
         if tube:
-            raise ConfigError("tightening", "a Tightening (e.g. verify.certify(...).tightening()) for the tube run",
+            raise ConfigError("tightening", "a Tightening (e.g. verify.certify(...).tightening) for the tube run",
                               None)
         tightening = Tightening.untightened(scenario)
     law_obj = law if isinstance(law, AncillaryLaw) else get_law(law if law is not None else ctrl.law)
@@ -294,7 +296,7 @@ class _ClosedLoop:
     """One run's fixed context (scenario, sets, clock, solver, law, plant, map) and its log."""
 
     def __init__(self, scenario: Scenario, tightening: Tightening, clock: _Clock, solver: FhocpSolver,
-                 law: AncillaryLaw, sigma: float, plant: Plant, obstacle_map: ObstacleMap) -> None:
+                 law: AncillaryLaw, sigma: float, plant: Plant | DynamicPlant, obstacle_map: ObstacleMap) -> None:
         self.scenario, self.tightening, self.clock, self.solver = scenario, tightening, clock, solver
         self.law, self.sigma, self.plant, self.map = law, sigma, plant, obstacle_map
         self.desired = np.asarray(scenario.trajectory.position(clock.t), dtype=float)
@@ -400,19 +402,16 @@ class _ClosedLoop:
         return x, period.arc[m]
 
     def omega_log(self) -> np.ndarray:
-        """ω (m/s) at the start of every tick (NaN where the input is NaN)."""
-        log, out = self.log, np.full((len(self.clock.t), 3), np.nan)
-        for i, ti in enumerate(self.clock.t):
-            if np.isfinite(log.inputs[i, 0]) and np.isfinite(log.inputs[i, 2]):
-                out[i] = self.plant.omega(float(ti), log.states[i], log.inputs[i])
-        return out
+        """ω = ẋ − f(x) v (m/s) at the start of every tick (NaN where the input is NaN)."""
+        return self.plant.omega_series(self.clock.t, self.log.states, self.log.inputs)
 
 
 def simulate(scenario: Scenario, *, tightening: Tightening | None = None,
              law: str | AncillaryLaw | None = None, sigma: float | None = None, tube: bool = True,
              progress: bool = True, solver_factory: SolverFactory | None = None,
              mode: str | None = None, plant_substeps: int = 2, remember_obstacles: bool = True,
-             label: str | None = None, disturbance: OmegaOverride | None = None) -> SimulationResult:
+             label: str | None = None, disturbance: OmegaOverride | None = None,
+             plant: str | None = None) -> SimulationResult:
     """Run the closed loop on ``scenario`` for ``scenario.duration`` seconds.
 
     Parameters
@@ -443,7 +442,10 @@ def simulate(scenario: Scenario, *, tightening: Tightening | None = None,
         Progress-bar label.
     disturbance : callable, optional
         ``disturbance(t) -> omega`` (3,) replacing the scenario's current + sway
-        (e.g. a :class:`verify.strategies.DisturbanceSignal` in property tests).
+        (e.g. a :class:`verify.strategies.DisturbanceSignal` in property tests);
+        on the dynamic plant it replaces the current (the sway is the hull's).
+    plant : str, optional
+        ``"kinematic"`` or ``"dynamic"``; default ``scenario.plant.kind``.
 
     Returns
     -------
@@ -453,7 +455,7 @@ def simulate(scenario: Scenario, *, tightening: Tightening | None = None,
     tightening, law_obj, sig = validate_inputs(scenario, tightening, law, sigma, tube, plant_substeps)
     solver = build_solver(scenario, tightening, solver_factory, mode)
     clock = _Clock.of(scenario, plant_substeps)
-    loop = _ClosedLoop(scenario, tightening, clock, solver, law_obj, sig, Plant.of(scenario, disturbance),
+    loop = _ClosedLoop(scenario, tightening, clock, solver, law_obj, sig, make_plant(scenario, disturbance, plant),
                        ObstacleMap(scenario.obstacles, scenario.sensing_range, remember=remember_obstacles))
     x = tuple(float(c) for c in scenario.initial_state)
     nominal_end = np.asarray(x)
@@ -480,6 +482,7 @@ def _result(loop: _ClosedLoop, tube: bool, wall0: float, overridden: bool) -> Si
     wall_s = time.perf_counter() - wall0
     log.wall[-1] = wall_s
     step_idx = np.minimum(np.arange(len(clock.t)) // clock.ticks, clock.steps)
+    body, thrust = loop.plant.history() if isinstance(loop.plant, DynamicPlant) else (None, None)
     return SimulationResult(
         scenario=loop.scenario, tube=tube, law=loop.law.name if tube else "none", sigma=loop.sigma,
         tightening=loop.tightening, plant_step_s=clock.plant_step, ticks_per_step=clock.ticks,
@@ -488,4 +491,4 @@ def _result(loop: _ClosedLoop, tube: bool, wall0: float, overridden: bool) -> Si
         replaced=log.replaced, n_detected=log.n_detected, solve_ms=log.solve_ms, step_ms=log.step_ms,
         wall=log.wall, statuses=log.statuses, iterations=log.iterations, max_violation=log.max_violation,
         kappa_failures=log.kappa_failures, wall_s=wall_s, rejected=log.rejected, plan_age=log.plan_age,
-        plan_slack=log.plan_slack, omega_overridden=overridden)
+        plan_slack=log.plan_slack, omega_overridden=overridden, body=body, thrust=thrust)

@@ -9,14 +9,21 @@ nothing is typed in from the paper. The result is decomposed as
 * ``xi = e_dot |_(v=0, p_d_dot=0)``          (disturbance term).
 
 All expressions use the symbols of :data:`SYMBOL_NAMES`; ``e_x = x - x_d`` etc.
-Numeric versions (lambdify with common-subexpression elimination) are
-vectorised over any broadcastable arrays.
+Numeric versions are vectorised over any broadcastable arrays. They are *generated
+once* from this derivation (sympy printing with common-subexpression elimination)
+into the shipped module :mod:`tubekit._generated_dynamics`, so that no sympy work
+runs at import or at run time; ``python -m tubekit.derivation`` regenerates it and
+``tests/test_derivation.py`` checks that the shipped code equals the derivation
+(source hash, text and values).
 """
 
 from __future__ import annotations
 
+import hashlib
+import inspect
 from dataclasses import dataclass
 from functools import lru_cache
+from pathlib import Path
 from typing import Callable
 
 import numpy as np
@@ -31,7 +38,13 @@ __all__ = [
     "NumericDynamics",
     "error_coordinates",
     "bearing",
+    "derivation_hash",
+    "generated_source",
+    "GENERATED_PATH",
 ]
+
+#: The shipped module holding the generated closed-form code.
+GENERATED_PATH = Path(__file__).with_name("_generated_dynamics.py")
 
 SYMBOL_NAMES: tuple[str, ...] = (
     "e_x", "e_y", "e_z", "psi", "u", "w", "r",
@@ -98,11 +111,8 @@ def derive() -> DerivedDynamics:
     return DerivedDynamics(e=e, e_dot=e_dot, J=J, zeta=zeta, xi=xi, residual=residual)
 
 
-def _lambdify(expr: sp.Matrix, args: list[sp.Symbol]) -> Callable[..., np.ndarray]:
-    """Lambdify a matrix with CSE into a function returning a broadcast array."""
-    shape = expr.shape
-    flat = list(expr)
-    fn = sp.lambdify(args, flat, modules="numpy", cse=True)
+def _vectorised(fn: Callable[..., list], shape: tuple[int, int]) -> Callable[..., np.ndarray]:
+    """Wrap a generated function returning a flat list into one returning a broadcast array."""
 
     def call(*values: np.ndarray) -> np.ndarray:
         arrays = [np.asarray(v, dtype=float) for v in values]
@@ -137,19 +147,64 @@ class NumericDynamics:
 
 @lru_cache(maxsize=1)
 def numeric() -> NumericDynamics:
-    """Build (once) the numeric callables from the sympy derivation."""
-    d = derive()
-    s = symbols()
-    ex, ey, psi = s["e_x"], s["e_y"], s["psi"]
+    """The numeric callables, from the generated module (no sympy work)."""
+    from . import _generated_dynamics as gen
+
+    return NumericDynamics(J=_vectorised(gen.J, (3, 3)), zeta=_vectorised(gen.zeta, (3, 1)),
+                           xi=_vectorised(gen.xi, (3, 1)), e_dot=_vectorised(gen.e_dot, (3, 1)))
+
+
+def derivation_hash() -> str:
+    """sha256 (hex) of the source of :func:`derive` and of the code generator: the cache key of the
+    generated module, together with the sympy version."""
+    parts = [inspect.getsource(f) for f in (derive, generated_source, _emit_function)]
+    return hashlib.sha256("\n".join(parts).encode()).hexdigest()
+
+
+def _emit_function(name: str, exprs: list[sp.Expr], args: list[sp.Symbol], scalar: bool, doc: str) -> str:
+    """Python source of ``name(*args)`` returning ``exprs`` (a list, or a tuple if ``scalar``) with CSE.
+
+    ``scalar`` prints with :mod:`math` (plain floats; a zero division raises), otherwise with numpy.
+    """
+    from sympy.printing.numpy import NumPyPrinter
+    from sympy.printing.pycode import PythonCodePrinter
+
+    printer = PythonCodePrinter({"fully_qualified_modules": True}) if scalar else NumPyPrinter()
+    replacements, reduced = sp.cse(exprs, symbols=sp.numbered_symbols("_x"))
+    lines = [f"def {name}({', '.join(a.name for a in args)}):", f'    """{doc}"""']
+    lines += [f"    {lhs} = {printer.doprint(rhs)}" for lhs, rhs in replacements]
+    items = ", ".join(printer.doprint(e) for e in reduced)
+    lines.append(f"    return ({items})" if scalar else f"    return [{items}]")
+    return "\n".join(lines) + "\n"
+
+
+def generated_source() -> str:
+    """The text of :mod:`tubekit._generated_dynamics`, printed from :func:`derive`."""
+    d, s = derive(), symbols()
+    ex, ey, ez, psi = s["e_x"], s["e_y"], s["e_z"], s["psi"]
     om = [s["omega_1"], s["omega_2"], s["omega_3"]]
     pdd = [s["xdot_d"], s["ydot_d"], s["zdot_d"]]
     v = [s["u"], s["w"], s["r"]]
-    return NumericDynamics(
-        J=_lambdify(d.J, [ex, ey, psi]),
-        zeta=_lambdify(d.zeta, [ex, ey, psi, *pdd]),
-        xi=_lambdify(d.xi, [ex, ey, psi, *om]),
-        e_dot=_lambdify(d.e_dot, [ex, ey, psi, *v, *om, *pdd]),
-    )
+    rho = list(sp.symbols("rho_d rho_z rho_o", real=True))
+    sigma = sp.Symbol("sigma", positive=True)
+    K = d.J.inv(method="ADJ").applyfunc(sp.simplify)
+    kappa = -sigma * K * sp.Matrix(rho)
+    blocks = [
+        _emit_function("J", list(d.J), [ex, ey, psi], False, "J (9 entries, row-major), numpy."),
+        _emit_function("zeta", list(d.zeta), [ex, ey, psi, *pdd], False, "zeta (3 entries), numpy."),
+        _emit_function("xi", list(d.xi), [ex, ey, psi, *om], False, "xi (3 entries), numpy."),
+        _emit_function("e_dot", list(d.e_dot), [ex, ey, psi, *v, *om, *pdd], False, "e_dot (3 entries), numpy."),
+        _emit_function("error_scalar", list(d.e), [ex, ey, ez, psi], True, "e = (e_d, e_z, e_o), floats."),
+        _emit_function("jacobian_scalar", list(d.J), [ex, ey, psi], True, "J (9 entries, row-major), floats."),
+        _emit_function("corrected_kappa", list(kappa), [ex, ey, psi, *rho, sigma], True,
+                       "kappa = -sigma J^-1 rho (3 entries), floats; ZeroDivisionError where J is singular."),
+    ]
+    header = (f'"""Generated by tubekit.derivation.generated_source(): do not edit; run\n'
+              f'``python -m tubekit.derivation`` after changing the derivation.\n"""\n'
+              f"# ruff: noqa\nimport math\n\nimport numpy\n\n"
+              f"__all__ = ['J', 'zeta', 'xi', 'e_dot', 'error_scalar', 'jacobian_scalar', 'corrected_kappa']\n\n"
+              f"SYMPY_VERSION = {sp.__version__!r}\nDERIVATION_HASH = {derivation_hash()!r}\n")
+    return header + "\n\n" + "\n\n".join(blocks)
 
 
 def bearing(e_x: np.ndarray, e_y: np.ndarray) -> np.ndarray:
@@ -169,3 +224,8 @@ def error_coordinates(state: np.ndarray, p_d: np.ndarray) -> np.ndarray:
     with np.errstate(invalid="ignore", divide="ignore"):
         eo = (ex * np.sin(psi) - ey * np.cos(psi)) / ed
     return np.stack([ed, ez, eo], axis=-1)
+
+
+if __name__ == "__main__":
+    GENERATED_PATH.write_text(generated_source())
+    print(f"wrote {GENERATED_PATH}")

@@ -18,6 +18,9 @@ centre), so each can be recomputed from the two files. Definitions (units m, s):
   circle centre (see :func:`obstacle_passes`); null like ``encirclements``.
 * ``tracking_rmse``: sqrt(mean ‖p − p_d‖²) over samples (3-D position error).
 * ``max_rho``: max over samples of ‖ρ‖ = ‖e − ê‖ (error units, see closed_loop).
+* ``sway_max``: max over samples of |sway| (m/s): the hull's v_b on the dynamic plant (column
+  ``v_b``), else the component of ω − δ(t) normal to the heading (the sway model's v_s);
+  ``sway_bound``: the certificate's γ̄ (null when none was given).
 * ``fhocp_max_violation``: largest nonlinear-constraint violation of the
   nominal plans the FHOCP returned (its ``max_violation``; 0 when every plan
   is feasible for the tightened problem).
@@ -36,6 +39,7 @@ from typing import Any, Mapping, Sequence
 
 import numpy as np
 
+from .plant import Plant
 from .scenario import Obstacle, Scenario
 from .trajectory import Circle
 
@@ -48,6 +52,7 @@ __all__ = [
     "tracking_rmse",
     "intervals_below",
     "percentile_ms",
+    "sway_series",
     "compute_metrics",
     "read_trajectory_csv",
     "METRIC_KEYS",
@@ -57,7 +62,7 @@ __all__ = [
 METRIC_KEYS: tuple[str, ...] = (
     "scenario", "duration_s", "steps", "obstacles", "vehicle_radius", "min_clearance", "min_e_d",
     "epsilon", "max_input_ratio", "saturated_steps", "encirclements", "tracking_rmse", "max_rho",
-    "rho_bound", "step_ms_median", "step_ms_p95", "wall_s",
+    "rho_bound", "step_ms_median", "step_ms_p95", "wall_s", "sway_max", "sway_bound",
 )
 
 
@@ -182,8 +187,30 @@ def _finite_or_none(x: float) -> float | None:
     return float(x) if math.isfinite(x) else None
 
 
+def sway_series(columns: Mapping[str, np.ndarray], scenario: Scenario) -> np.ndarray | None:
+    """Sway (m/s) per sample: column ``v_b`` if logged, else (ω − δ(t)) · (−sin ψ, cos ψ); None without ω."""
+    if "v_b" in columns:
+        return np.asarray(columns["v_b"], dtype=float)
+    if not all(k in columns for k in ("psi", "omega_1", "omega_2")):
+        return None
+    t, psi = np.asarray(columns["t"], dtype=float), np.asarray(columns["psi"], dtype=float)
+    current = Plant.of(scenario).current(t)
+    d1 = np.asarray(columns["omega_1"], dtype=float) - current[:, 0]
+    d2 = np.asarray(columns["omega_2"], dtype=float) - current[:, 1]
+    return -d1 * np.sin(psi) + d2 * np.cos(psi)
+
+
+def _sway_metrics(columns: Mapping[str, np.ndarray], scenario: Scenario,
+                  sway_bound: float | None) -> dict[str, float | None]:
+    """``sway_max`` (m/s, :func:`sway_series`) and ``sway_bound`` (γ̄, m/s, or None)."""
+    sway = sway_series(columns, scenario)
+    return {"sway_max": _nanmax_or_none(None if sway is None else np.abs(sway)),
+            "sway_bound": None if sway_bound is None else float(sway_bound)}
+
+
 def compute_metrics(columns: Mapping[str, np.ndarray], scenario: Scenario, *,
-                    rho_bound: float | None = None, extra: Mapping[str, Any] | None = None) -> dict[str, Any]:
+                    rho_bound: float | None = None, sway_bound: float | None = None,
+                    extra: Mapping[str, Any] | None = None) -> dict[str, Any]:
     """All metrics of one run from its logged columns (see module doc for definitions).
 
     Parameters
@@ -192,8 +219,8 @@ def compute_metrics(columns: Mapping[str, np.ndarray], scenario: Scenario, *,
         The columns of ``trajectory.csv`` (:meth:`SimulationResult.columns`).
     scenario : Scenario
         Supplies the constants (recorded in the output too).
-    rho_bound : float, optional
-        Certified tube radius ρ̃; ``None`` when not certified.
+    rho_bound, sway_bound : float, optional
+        Certified tube radius ρ̃ (``None`` when not certified) and sway bound γ̄ (m/s, ``None``: none).
     extra : mapping, optional
         Added verbatim (e.g. law, sigma, tube flag).
     """
@@ -256,6 +283,7 @@ def compute_metrics(columns: Mapping[str, np.ndarray], scenario: Scenario, *,
         "fhocp_max_violation": _nanmax_or_none(c.get("plan_violation")),
         "wall_s": float(np.nanmax(c["wall_s"])),
     }
+    m.update(_sway_metrics(c, scenario, sway_bound))
     if extra:
         m.update(extra)
     return m

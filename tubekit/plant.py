@@ -106,6 +106,18 @@ class Plant:
         return (u * math.cos(psi) + o1, u * math.sin(psi) + o2, w + o3, r)
 
     # ---- public API ---------------------------------------------------------------------
+    def current_at(self, t: float) -> Floats3:
+        """δ(t) (m/s) as three floats; ``t`` in s."""
+        return self._current(t)
+
+    def omega_series(self, t: np.ndarray, states: np.ndarray, inputs: np.ndarray) -> np.ndarray:
+        """ω (m/s) at every logged tick (len(t), 3); NaN where the input is NaN."""
+        out = np.full((len(t), 3), np.nan)
+        for i, ti in enumerate(t):
+            if np.isfinite(inputs[i, 0]) and np.isfinite(inputs[i, 2]):
+                out[i] = self.omega(float(ti), states[i], inputs[i])
+        return out
+
     def current(self, t: float | np.ndarray) -> np.ndarray:
         """Current δ(t) (m/s), shape ``np.shape(t) + (3,)``; ``t`` in s."""
         t = np.asarray(t, dtype=float)

@@ -9,7 +9,9 @@ Each :class:`Promise` compares an observed figure with the certificate's bound:
 * ``inputs`` — v in V and never clipped (V̄ = V - κ̄ makes saturation impossible);
 * ``clearance`` — min vehicle-ball clearance to every obstacle at the ticks, minus the distance the
   vehicle can move in half a tick, >= 0 (so it holds between ticks too); ``workspace`` likewise;
-* ``sway`` — max |v_s| applied <= γ̄;
+* ``sway`` — max |v_s| applied <= γ̄ (on the dynamic plant: max |v_b| of the hull, γ̄ its ISS bound);
+* ``velocity_loop`` (dynamic plant only) — the assumption of ``docs/plant.md``: max |u_b - u|,
+  |w_b - w|, |r_b - r| within ``scenario.plant.tracking_bound`` (observed = the largest ratio, <= 1);
 * the premises: ``disturbance`` (‖ω_xy‖ <= ω̄_xy, |ω_z| <= ω̄_z) and ``recursive_feasibility``
   (a plan accepted at t = 0, and the replayed candidate never older than N - 1 periods).
 
@@ -109,7 +111,11 @@ def _disturbance(run: SimulationResult) -> list[Promise]:
     wxy, wz, gamma = (float(x) for x in run.tightening.disturbance)
     om = run.omega[:-1]
     tol = 1e-12
-    if run.omega_overridden:
+    if run.body is not None:
+        vb = np.abs(run.body[:, 1])
+        sway_promise = _at_most("sway", float(np.nanmax(vb)) if len(vb) else 0.0, gamma + tol,
+                                "max |v_b| of the 4-DOF hull (m/s) vs gamma_bar (ISS bound of the sway dynamics)")
+    elif run.omega_overridden:
         sway_promise = Promise("sway", math.nan, gamma, True, "not applicable: the disturbance is overridden, "
                                                               "so the sway cannot be separated from it")
     else:
@@ -121,6 +127,20 @@ def _disturbance(run: SimulationResult) -> list[Promise]:
             _at_most("disturbance", float(max(np.max(np.hypot(om[:, 0], om[:, 1]) - wxy - tol),
                                               np.max(np.abs(om[:, 2]) - wz - tol))), 0.0,
                      "premise: max over the run of ||omega_xy|| - omega_bar_xy and |omega_z| - omega_bar_z")]
+
+
+def _velocity_loop(run: SimulationResult) -> list[Promise]:
+    """The velocity loop's error against its assumed bound (dynamic plant only)."""
+    err = run.velocity_error
+    if err is None:
+        return []
+    bound = np.asarray(run.scenario.plant.tracking_bound, dtype=float)
+    worst = np.nanmax(np.abs(err[:-1]), axis=0) if len(err) > 1 else np.zeros(3)
+    ratio = float(np.max(np.where(bound > 0, worst / np.where(bound > 0, bound, 1.0),
+                                  np.where(worst > 0, np.inf, 0.0))))
+    return [_at_most("velocity_loop", ratio, 1.0,
+                     f"assumption: max |u_b - u|, |w_b - w|, |r_b - r| = {np.round(worst, 6).tolist()} vs "
+                     f"plant.tracking_bound = {bound.tolist()} (observed = largest ratio)")]
 
 
 def _feasibility(run: SimulationResult) -> Promise:
@@ -136,4 +156,5 @@ def _feasibility(run: SimulationResult) -> Promise:
 
 def check_promises(run: SimulationResult) -> list[Promise]:
     """Every promise of the module doc measured on ``run`` (a tube run with a certificate's Tightening)."""
-    return [_tube(run), *_region(run), _inputs(run), *_geometry(run), *_disturbance(run), _feasibility(run)]
+    return [_tube(run), *_region(run), _inputs(run), *_geometry(run), *_disturbance(run), *_velocity_loop(run),
+            _feasibility(run)]

@@ -24,6 +24,7 @@ from .exceptions import ConfigError, ShapeError
 from .model import InputLimits, SwayModel
 from .trajectory import Circle, Trajectory, trajectory_from_dict
 from .validation import as_vector, positive
+from .vehicles import PlantSettings
 
 __all__ = [
     "Obstacle",
@@ -232,6 +233,8 @@ class Scenario:
         Verification region.
     workspace : tuple of two (3,) arrays or None
         Axis-aligned workspace box [lower, upper] (m).
+    plant : PlantSettings
+        ``[plant]``: kinematic (default) or the dynamic 4-DOF vehicle (``docs/plant.md``).
     """
 
     name: str = "paper-section-VI"
@@ -248,6 +251,7 @@ class Scenario:
     region: RegionSettings = field(default_factory=RegionSettings)
     workspace: tuple[tuple[float, float, float], tuple[float, float, float]] | None = (
         (-10.0, -10.0, -5.0), (10.0, 10.0, 5.0))
+    plant: PlantSettings = field(default_factory=PlantSettings)
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "vehicle_radius", positive("vehicle_radius", self.vehicle_radius))
@@ -314,6 +318,8 @@ class Scenario:
         }
         if self.workspace is not None:
             d["workspace"] = [list(self.workspace[0]), list(self.workspace[1])]
+        if self.plant != PlantSettings():  # the default kinematic plant leaves the dict as before
+            d["plant"] = self.plant.to_dict()
         return d
 
 
@@ -325,7 +331,7 @@ def paper_scenario() -> Scenario:
 
 
 _TOP_KEYS = {"name", "trajectory", "obstacles", "limits", "vehicle_radius", "sensing_range", "epsilon",
-             "duration", "initial_state", "disturbance", "controller", "region", "workspace"}
+             "duration", "initial_state", "disturbance", "controller", "region", "workspace", "plant"}
 
 
 @contextmanager
@@ -411,6 +417,8 @@ def scenario_from_dict(d: dict) -> Scenario:
         if ws is not None and (not isinstance(ws, list) or len(ws) != 2):
             raise ConfigError("workspace", "[[x_lo, y_lo, z_lo], [x_hi, y_hi, z_hi]]", ws)
         kw["workspace"] = None if ws is None else (tuple(ws[0]), tuple(ws[1]))
+    if "plant" in d:
+        kw["plant"] = PlantSettings.from_dict(d["plant"])
     return replace(base, **kw)
 
 
@@ -420,7 +428,11 @@ def load_scenario(path: str | Path) -> Scenario:
     if not p.is_file():
         raise ConfigError("CONFIG", "a path to an existing TOML file", str(p))
     try:
-        data = tomllib.loads(p.read_text())
+        data = tomllib.loads(p.read_text(encoding="utf-8"))
     except tomllib.TOMLDecodeError as exc:
         raise ConfigError("CONFIG", "valid TOML", str(p), str(exc)) from None
+    except UnicodeDecodeError:
+        raise ConfigError("CONFIG", "a UTF-8 text (TOML) file", str(p), "it looks binary") from None
+    except OSError as exc:
+        raise ConfigError("CONFIG", "a readable file", str(p), exc.strerror or str(exc)) from None
     return scenario_from_dict(data)

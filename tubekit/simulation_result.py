@@ -14,6 +14,7 @@ from .tightening import Tightening
 __all__ = [
     "SimulationResult",
     "CSV_COLUMNS",
+    "DYNAMIC_COLUMNS",
 ]
 
 #: Column order of ``trajectory.csv`` (see :meth:`SimulationResult.columns`).
@@ -24,6 +25,10 @@ CSV_COLUMNS: tuple[str, ...] = (
     "saturated", "fallback", "replaced", "n_detected", "solve_ms", "step_ms", "plan_violation", "wall_s",
 )
 
+#: Columns appended to ``trajectory.csv`` by a dynamic-plant run (absent for the kinematic plant):
+#: body velocities reached (m/s, m/s, m/s, rad/s) and thrusts (N, N, N m) at the start of each tick.
+DYNAMIC_COLUMNS: tuple[str, ...] = ("u_b", "v_b", "w_b", "r_b", "X", "Z", "N")
+
 
 @dataclass
 class SimulationResult:
@@ -31,6 +36,7 @@ class SimulationResult:
 
     Per-tick arrays have K + 1 rows (K = steps * ticks per step; the last row is
     the final state at t = duration with NaN inputs). Units: m, rad, s, m/s, rad/s.
+    ``body`` (u_b, v_b, w_b, r_b) and ``thrust`` (X, Z, N) are set by the dynamic plant only.
     """
 
     scenario: Scenario
@@ -65,6 +71,8 @@ class SimulationResult:
     plan_age: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=int))
     plan_slack: np.ndarray = field(default_factory=lambda: np.zeros(0))
     omega_overridden: bool = False
+    body: np.ndarray | None = None
+    thrust: np.ndarray | None = None
 
     # ---- derived -------------------------------------------------------------------
     @property
@@ -81,6 +89,13 @@ class SimulationResult:
     def rho(self) -> np.ndarray:
         """ρ = e - ê, (K+1, 3)."""
         return self.errors - self.nominal_errors
+
+    @property
+    def velocity_error(self) -> np.ndarray | None:
+        """Velocity-loop error (u_b - u, w_b - w, r_b - r) per tick (K+1, 3); None on the kinematic plant."""
+        if self.body is None:
+            return None
+        return self.body[:, [0, 2, 3]] - self.inputs
 
     @property
     def steps(self) -> int:
@@ -154,7 +169,12 @@ class SimulationResult:
         pv[0:-1:self.ticks_per_step] = self.max_violation
         c["plan_violation"] = pv
         c["wall_s"] = self.wall
-        return {k: np.asarray(c[k]) for k in CSV_COLUMNS}
+        names = CSV_COLUMNS
+        if self.body is not None and self.thrust is not None:
+            for i, n in enumerate(DYNAMIC_COLUMNS):
+                c[n] = self.body[:, i] if i < 4 else self.thrust[:, i - 4]
+            names = CSV_COLUMNS + DYNAMIC_COLUMNS
+        return {k: np.asarray(c[k]) for k in names}
 
     def write_csv(self, path: str | Path) -> Path:
         """Write :meth:`columns` as CSV (header row, ``nan`` for missing values)."""
@@ -163,6 +183,26 @@ class SimulationResult:
         data = np.column_stack([np.asarray(v, dtype=float) for v in cols.values()])
         np.savetxt(path, data, delimiter=",", header=",".join(cols), comments="", fmt="%.12g")
         return path
+
+    def to_csv(self, path: str | Path) -> Path:
+        """Write the log as CSV (the columns of ``trajectory.csv``); alias of :meth:`write_csv`."""
+        return self.write_csv(path)
+
+    @property
+    def metrics(self) -> dict:
+        """The run's metrics (:func:`tubekit.metrics.compute_metrics`; units in ``docs/reproduce.md``)."""
+        from .metrics import compute_metrics
+        certified = bool(self.tightening.certified)
+        return compute_metrics(self.columns(), self.scenario,
+                               rho_bound=self.tightening.rho_tilde if certified else None,
+                               sway_bound=float(self.tightening.disturbance[2]) if certified else None,
+                               extra={"tube": self.tube, "law": self.law if self.tube else None, "sigma": self.sigma})
+
+    def plot(self):
+        """The top view of the run (a matplotlib Figure; plotting lives in :mod:`tubekit.app.plots`)."""
+        from .app.plots import top_view  # the one delegation from the core to the app layer
+        return top_view(self.scenario, [("tube" if self.tube else "baseline", self.columns())],
+                        tightening=self.tightening if self.tube else None)
 
     def summary(self) -> str:
         """A few lines for the terminal."""

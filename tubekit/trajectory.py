@@ -8,7 +8,7 @@ max|zdot_d|] plus ``horizontal_speed_bound()`` used by the verifier.
 from __future__ import annotations
 
 from abc import ABC, abstractmethod
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, fields
 
 import numpy as np
 
@@ -240,14 +240,22 @@ def trajectory_from_dict(d: dict) -> Trajectory:
         raise ConfigError("trajectory", "a table with a 'kind' key", d)
     d = dict(d)
     kind = d.pop("kind", None)
+    if kind == "line" and "velocity" in d:
+        d["direction_velocity"] = d.pop("velocity")
+    classes = {"circle": Circle, "helix": Helix, "line": Line, "waypoints": Waypoints}
+    if kind in classes:
+        allowed = sorted(f.name for f in fields(classes[kind]) if f.init)
+        for key in sorted(d):
+            if key not in allowed:
+                raise ConfigError(f"trajectory.{key}", f"one of the keys {allowed} of a {kind} trajectory", key,
+                                  "a top-level key written after the [trajectory] header belongs above the "
+                                  "first table")
     try:
         if kind == "circle":
             return Circle(**d)
         if kind == "helix":
             return Helix(**d)
         if kind == "line":
-            if "velocity" in d:
-                d["direction_velocity"] = d.pop("velocity")
             return Line(**d)
         if kind == "waypoints":
             return Waypoints(**d)

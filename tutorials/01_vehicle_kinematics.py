@@ -20,11 +20,13 @@
 
 # %%
 import os
+import sys
 from pathlib import Path
 
 import matplotlib
 
-matplotlib.use("Agg")
+if "ipykernel" not in sys.modules:  # a script draws off-screen; a notebook keeps its inline figures
+    matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 import numpy as np
 
@@ -32,7 +34,8 @@ from tubekit import Disturbance, SwayModel, kinematics, nominal_kinematics, pape
 from tubekit.plant import Plant
 
 QUICK = os.environ.get("TUBEKIT_QUICK") == "1"
-FIGURES = Path(os.environ.get("TUBEKIT_FIGURES", Path(__file__).resolve().parent / "figures"))
+FIGURES = (Path(os.environ["TUBEKIT_FIGURES"]) if "TUBEKIT_FIGURES" in os.environ
+           else Path(__file__).resolve().parent / "figures")
 FIGURES.mkdir(parents=True, exist_ok=True)
 
 # %% [markdown]

@@ -20,16 +20,18 @@
 #    from the new measured state (step 8);
 # 3. **the exact arc check** `tubekit.plan_check.check_plan` — a plan is accepted only if the
 #    constraints hold along the whole continuous arcs, not only at the FHOCP's nodes (step 9);
-# 4. **the hand-off** `Certificate.tightening()` — the `Tightening` the FHOCP and the loop use.
+# 4. **the hand-off** `Certificate.tightening` — the `Tightening` the FHOCP and the loop use.
 
 # %%
 import dataclasses
 import os
+import sys
 from pathlib import Path
 
 import matplotlib
 
-matplotlib.use("Agg")
+if "ipykernel" not in sys.modules:  # a script draws off-screen; a notebook keeps its inline figures
+    matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 import numpy as np
 from matplotlib.patches import Circle
@@ -41,7 +43,8 @@ from tubekit.tightening import MARGIN_COLUMNS, Tightening
 from verify.sampled import horizon_margins
 
 QUICK = os.environ.get("TUBEKIT_QUICK") == "1"
-FIGURES = Path(os.environ.get("TUBEKIT_FIGURES", Path(__file__).resolve().parent / "figures"))
+FIGURES = (Path(os.environ["TUBEKIT_FIGURES"]) if "TUBEKIT_FIGURES" in os.environ
+           else Path(__file__).resolve().parent / "figures")
 FIGURES.mkdir(parents=True, exist_ok=True)
 
 # %% [markdown]
@@ -149,7 +152,7 @@ for name, (x0, inputs) in plans.items():
     on_arcs, arcs = clearance(x0, inputs, fine)
     nodes = np.vstack([arcs[:, 0], arcs[-1:, -1]])
     e = error_coordinates(nodes, scenario.trajectory.position(t0 + dt * np.arange(n_arcs + 1)))
-    verdict = check_plan(scenario, cert.tightening(), t0, x0, inputs, scenario.obstacles, sign=-1)
+    verdict = check_plan(scenario, cert.tightening, t0, x0, inputs, scenario.obstacles, sign=-1)
     print(f"{name:>10}: min clearance at the nodes {1e3 * at_nodes.min():+.3f} mm, along the arcs "
           f"{1e3 * on_arcs.min():+.3f} mm;  e_d {e[:, 0].min():.3f}..{e[:, 0].max():.3f} m, "
           f"|e_o| <= {np.abs(e[:, 2]).max():.3f}")
@@ -165,9 +168,9 @@ for name, (x0, inputs) in plans.items():
 # margins had to grow.
 #
 # ## Step 4: the Tightening handed to the FHOCP
-# `cert.tightening()` packs all of this into a `tubekit.tightening.Tightening`; it raises
-# `verify.NotCertifiedError` for a certificate that does not hold (pass `allow_uncertified=True`
-# for a best-effort tightening with `certified=False`, and no guarantee). Two layers:
+# `cert.tightening` packs all of this into a `tubekit.tightening.Tightening`; it raises
+# `verify.NotCertifiedError` for a certificate that does not hold (`cert.best_effort_tightening()`
+# gives a best-effort tightening with `certified=False`, and no guarantee). Two layers:
 #
 # * the FHOCP's **node constraints** (`v_max`, `e_d_min`, `e_d_max`, `e_z_max`, `e_o_max`,
 #   `obstacle_margin`): uniform over the horizon, the largest margin plus an inter-node allowance,
@@ -176,7 +179,7 @@ for name, (x0, inputs) in plans.items():
 #   `check_plan` accepts plans with and what the run's promises are measured against.
 
 # %%
-tight = cert.tightening()
+tight = cert.tightening
 for f in dataclasses.fields(tight):
     value = getattr(tight, f.name)
     shown = np.array2string(np.asarray(value), precision=4, suppress_small=True, max_line_width=110)

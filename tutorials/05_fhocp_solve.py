@@ -26,12 +26,14 @@
 
 # %%
 import os
+import sys
 import time
 from pathlib import Path
 
 import matplotlib
 
-matplotlib.use("Agg")
+if "ipykernel" not in sys.modules:  # a script draws off-screen; a notebook keeps its inline figures
+    matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 import numpy as np
 from matplotlib.patches import Circle
@@ -42,19 +44,20 @@ from tubekit.fhocp import FHOCP
 from tubekit.sensing import detected_obstacles, surface_distance
 
 QUICK = os.environ.get("TUBEKIT_QUICK") == "1"
-FIGURES = Path(os.environ.get("TUBEKIT_FIGURES", Path(__file__).resolve().parent / "figures"))
+FIGURES = (Path(os.environ["TUBEKIT_FIGURES"]) if "TUBEKIT_FIGURES" in os.environ
+           else Path(__file__).resolve().parent / "figures")
 FIGURES.mkdir(parents=True, exist_ok=True)
 
 # %% [markdown]
 # ## The problem data: the paper's scenario and its (best-effort) tightening
-# The paper's scenario does not certify (tutorial 03), so `tightening(allow_uncertified=True)`
+# The paper's scenario does not certify (tutorial 03), so `best_effort_tightening()`
 # hands over a *best-effort* set of constraints: usable, but without a guarantee.
 # V̄_u is capped from below at the target's speed 0.377 m/s so that the nominal can follow.
 
 # %%
 scenario = paper_scenario()
 cert = verify.certify(scenario, "corrected")
-tight = cert.tightening(allow_uncertified=True)
+tight = cert.best_effort_tightening()
 dt, N = scenario.controller.dt, scenario.controller.horizon_steps
 print(f"certified: {cert.certified}  (best-effort tightening, no guarantee)")
 print(f"V     = {scenario.limits.vector}   (u, w, r)")

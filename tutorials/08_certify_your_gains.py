@@ -23,12 +23,14 @@
 import dataclasses
 import json
 import os
+import sys
 import tempfile
 from pathlib import Path
 
 import matplotlib
 
-matplotlib.use("Agg")
+if "ipykernel" not in sys.modules:  # a script draws off-screen; a notebook keeps its inline figures
+    matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 import numpy as np
 import sympy as sp
@@ -41,7 +43,8 @@ from tubekit.app.plots import envelope_figure
 from verify.recheck import recheck_file
 
 QUICK = os.environ.get("TUBEKIT_QUICK") == "1"
-FIGURES = Path(os.environ.get("TUBEKIT_FIGURES", Path(__file__).resolve().parent / "figures"))
+FIGURES = (Path(os.environ["TUBEKIT_FIGURES"]) if "TUBEKIT_FIGURES" in os.environ
+           else Path(__file__).resolve().parent / "figures")
 FIGURES.mkdir(parents=True, exist_ok=True)
 
 
@@ -250,5 +253,5 @@ print("wrote", FIGURES / "08_variants.png")
 # %% [markdown]
 # To certify your own design: change the scenario (TOML or `with_changes`), run `verify.certify`
 # (or `tubekit certify my.toml`), read each failed condition's two sides, and turn the knob it
-# names. Once it certifies, `cert.tightening()` hands V̄, the margins and the arc-check data to the
+# names. Once it certifies, `cert.tightening` hands V̄, the margins and the arc-check data to the
 # FHOCP (tutorial 04), and `tubekit simulate my.toml` measures every promise on the run (tutorial 06).

@@ -195,20 +195,34 @@ class Certificate:
         return certificate_text(self)
 
     # ------------------------------------------------------------------ hand-off to the FHOCP
-    def tightening(self, allow_uncertified: bool = False, min_input_fraction: float = 0.5) -> Tightening:
-        """The FHOCP's tightened sets and the certificate's tube (see :mod:`verify.handoff`).
+    @property
+    def tightening(self) -> Tightening:
+        """The certified :class:`tubekit.tightening.Tightening` (see :mod:`verify.handoff`).
 
-        Raises :class:`NotCertifiedError` unless certified or ``allow_uncertified`` (a best-effort
-        tightening that carries no guarantee, flagged ``certified=False``).
+        Raises :class:`NotCertifiedError` when the design is not certified: use
+        :meth:`best_effort_tightening` for a run that carries no guarantee.
         """
         from .handoff import tightening_of
-        if not self.certified and not allow_uncertified:
+        if not self.certified:
             names = ", ".join(f["condition"] for f in self.failures) or ", ".join(self.not_evaluated)
             raise NotCertifiedError(f"scenario '{self.scenario_name}' with law '{self.law}' is not certified "
-                                    f"(failed: {names}); pass allow_uncertified=True for a best-effort tightening")
-        if not (0 < min_input_fraction <= 1):
+                                    f"(failed: {names}); use best_effort_tightening() for a run without a "
+                                    "guarantee")
+        return tightening_of(self)
+
+    def best_effort_tightening(self, min_input_fraction: float = 0.5) -> Tightening:
+        """The certified tightening when certified; otherwise a best-effort one, flagged ``certified=False``.
+
+        Parameters
+        ----------
+        min_input_fraction : float
+            In (0, 1]: each best-effort input limit keeps at least this fraction of V.
+        """
+        from .handoff import tightening_of
+        if isinstance(min_input_fraction, bool) or not isinstance(min_input_fraction, (int, float)) \
+                or not (0 < min_input_fraction <= 1):
             raise ConfigError("min_input_fraction", "a number in (0, 1]", min_input_fraction)
-        return tightening_of(self, min_input_fraction)
+        return tightening_of(self, float(min_input_fraction))
 
 
 # --------------------------------------------------------------------------- certify
@@ -236,6 +250,22 @@ def _resolve_law(scenario: Scenario, law: str | AncillaryLaw | None) -> str:
         law = register_law(law).name
     get_law(law)
     return law
+
+
+def _is_dynamic(scenario: Scenario) -> bool:
+    plant = getattr(scenario, "plant", None)
+    return getattr(plant, "kind", "kinematic") == "dynamic"
+
+
+def _dynamic_assumptions(scenario: Scenario, dist: DisturbanceBounds) -> tuple[str, ...]:
+    """What the certificate assumes of the dynamic plant (each checked in every run by tubekit.promises)."""
+    du, dw, dr = scenario.plant.tracking_bound
+    return (f"Dynamic plant: the velocity loop tracks the command within |u_b - u| <= {du:g} m/s, "
+            f"|w_b - w| <= {dw:g} m/s, |r_b - r| <= {dr:g} rad/s (plant.tracking_bound: assumed, not derived; "
+            "checked in every run as the promise velocity_loop). Surge and heave errors enter omega, the yaw "
+            "error the heading bound of the tube.",
+            f"Dynamic plant: the hull's sway stays within gamma_bar = {dist.gamma:.4g} m/s, the ISS bound of the "
+            "sway dynamics over the body velocities the loop allows (verify.design.hull_sway_bound).")
 
 
 def certify(scenario: Scenario, law: str | AncillaryLaw | None = None, *, region: Region | None = None,
@@ -275,7 +305,8 @@ def certify(scenario: Scenario, law: str | AncillaryLaw | None = None, *, region
     tried = tuple({"sigma": d.sigma, "certified": d.certified, "score": d.score if math.isfinite(d.score) else None,
                    "failed": [c.condition for c in d.failures]} for d in designs)
     ctrl = scenario.controller
+    assumptions = ASSUMPTIONS + (_dynamic_assumptions(scenario, dist) if _is_dynamic(scenario) else ())
     return Certificate(scenario_name=scenario.name, law=law, region=region, gains=gains, disturbance=dist,
                        design=best, tried=tried, sigma_source=source, elapsed_s=time.perf_counter() - t0,
                        horizon_steps=ctrl.horizon_steps, dt=ctrl.dt, limits=tuple(scenario.limits.vector),
-                       scenario_data=scenario.to_dict())
+                       scenario_data=scenario.to_dict(), assumptions=assumptions)

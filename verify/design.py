@@ -3,7 +3,8 @@
 :func:`evaluate_design` is the pipeline for one σ:
 
 1. :func:`disturbance_bounds` — ω̄_xy, ω̄_z from the current and the sway model over V
-   (γ̄ = gain ū r̄ + amplitude: the sway the model produces, no clip);
+   (γ̄ = gain ū r̄ + amplitude: the sway the model produces, no clip); on the dynamic
+   plant γ̄ is the hull's ISS sway bound and the velocity loop's error enters ω̄;
 2. :func:`verify.sampled.one_period_tube` — the one-period tube under the reset;
 3. :func:`verify.sampled.horizon_margins` — per-arc margins of the replayed candidate;
 4. :func:`input_tightening` — V̄ = V - κ̄ and the necessary feasibility conditions
@@ -26,13 +27,14 @@ from flint import arb
 
 from tubekit.derivation import error_coordinates
 from tubekit.scenario import Scenario
+from tubekit.vehicles import VehicleParams
 
 from .gains import GainBounds
 from .intervals import lower, upper
 from .region import Region
 from .sampled import HorizonMargins, PeriodTube, TubeProblem, horizon_margins, one_period_tube
 
-__all__ = ["Condition", "Design", "DisturbanceBounds", "disturbance_bounds", "tube_problem",
+__all__ = ["Condition", "Design", "DisturbanceBounds", "disturbance_bounds", "hull_sway_bound", "tube_problem",
            "evaluate_design", "arc_rates", "sway_condition", "input_tightening", "state_conditions"]
 
 
@@ -63,20 +65,58 @@ class DisturbanceBounds:
     omega_z: float
     gamma: float
     declared_sway: float
+    yaw_rate_error: float = 0.0
 
     def to_dict(self) -> dict:
         """JSON-ready copy."""
         return dict(self.__dict__)
 
 
+def hull_sway_bound(params: VehicleParams, u_bar: float, r_bar: float) -> arb:
+    """γ̄ (m/s): ISS bound of the hull's sway for |u| <= u_bar, |r| <= r_bar (body velocities), v(0) = 0.
+
+    Sway row of M ν̇ + C(ν)ν + D(ν)ν = τ (no sway force) for q = m22 v + m24 r:
+    q̇ = (Y_ur_lift − m11) u r + Y_rr r|r| + (Y_v + Y_uv u) v + Y_vv v|v|. With
+    F = |Y_ur_lift − m11| ū r̄ + |Y_rr| r̄² and b = −Y_v − |Y_uv| ū, q q̇ < 0 whenever
+    |v| > v*, the positive root of |Y_vv| v² + b v − F = 0; |v| >= v* whenever
+    |q| >= q* = m22 v* + |m24| r̄. So |q| <= q* (q(0) = m24 r(0)) and
+    |v| <= (q* + |m24| r̄) / m22 = v* + 2 |m24| r̄ / m22. Infinite when nothing damps sway.
+    """
+    p = params
+    m11, m22, _, _, m24, _ = (arb(x) for x in p.mass_entries)
+    ub, rb = arb(u_bar), arb(r_bar)
+    force = abs(arb(p.Y_ur_lift) - m11) * ub * rb + abs(arb(p.Y_rr)) * rb * rb
+    a, b = abs(arb(p.Y_vv)), -arb(p.Y_v) - abs(arb(p.Y_uv)) * ub
+    if p.Y_vv < 0:
+        v_star = (-b + (b * b + 4 * a * force).sqrt()) / (2 * a)
+    elif b > 0:
+        v_star = force / b
+    else:
+        return arb(math.inf)
+    return v_star + 2 * abs(m24) * rb / m22
+
+
 def disturbance_bounds(scenario: Scenario) -> DisturbanceBounds:
-    """ω̄_xy = max(a_x, a_y) + ‖c_xy‖ + γ̄, ω̄_z = a_z + |c_z|, γ̄ = gain ū r̄ + amplitude (over V)."""
+    """ω̄_xy = max(a_x, a_y) + ‖c_xy‖ + γ̄, ω̄_z = a_z + |c_z|, γ̄ = gain ū r̄ + amplitude (over V).
+
+    On the dynamic plant (``[plant] kind = "dynamic"``) ω = δ + R(ψ)(u_b − u, v_b) in the
+    plane and δ_z + w_b − w in heave, so with the assumed velocity-loop bound
+    (Δu, Δw, Δr) = ``plant.tracking_bound``: γ̄ = :func:`hull_sway_bound` over
+    |u_b| <= ū + Δu, |r_b| <= r̄ + Δr, ω̄_xy = max(a_x, a_y) + ‖c_xy‖ + ‖(Δu, γ̄)‖,
+    ω̄_z = a_z + |c_z| + Δw. The sway table is unused there (declared = γ̄).
+    """
     d, lim = scenario.disturbance, scenario.limits
     a, c = d.amplitude, d.constant
-    gamma = arb(d.sway.gain) * arb(lim.u_max) * arb(lim.r_max) + arb(d.sway.amplitude)
     cxy = (arb(c[0]) ** 2 + arb(c[1]) ** 2).sqrt()
-    wxy = arb(max(a[0], a[1])) + cxy + gamma
     wz = arb(a[2]) + abs(arb(c[2]))
+    if scenario.plant.dynamic:
+        du, dw, dr = (arb(x) for x in scenario.plant.tracking_bound)
+        gamma = hull_sway_bound(scenario.plant.params, upper(arb(lim.u_max) + du), upper(arb(lim.r_max) + dr))
+        wxy = arb(max(a[0], a[1])) + cxy + (du * du + gamma * gamma).sqrt()
+        return DisturbanceBounds(omega_xy=upper(wxy), omega_z=upper(wz + dw), gamma=upper(gamma),
+                                 declared_sway=upper(gamma), yaw_rate_error=upper(dr))
+    gamma = arb(d.sway.gain) * arb(lim.u_max) * arb(lim.r_max) + arb(d.sway.amplitude)
+    wxy = arb(max(a[0], a[1])) + cxy + gamma
     return DisturbanceBounds(omega_xy=upper(wxy), omega_z=upper(wz), gamma=upper(gamma),
                              declared_sway=float(d.sway.bound))
 
@@ -90,6 +130,7 @@ def tube_problem(scenario: Scenario, region: Region, gains: GainBounds, sigma: f
     return TubeProblem(eps=region.e_d[0], e_o_max=max(-region.e_o[0], region.e_o[1]), u_max=v[0], w_max=v[1],
                        r_max=v[2], omega_xy=dist.omega_xy, omega_z=dist.omega_z, pd_xy=region.pd_dot_xy_max,
                        pd_z=region.pd_dot_max[2], sigma=float(sigma), tick=ctrl.dt / ticks, ticks=ticks,
+                       yaw_rate_error=dist.yaw_rate_error,
                        k_abs=gains.k_abs, g_lo=gains.g_lo, g_hi=gains.g_hi, g_off=gains.g_off)
 
 

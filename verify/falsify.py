@@ -82,7 +82,7 @@ def search_space(scenario: Scenario, law: str | None = None, *, sigma: float | N
     law = scenario.controller.law if law is None else law
     get_law(law)
     cert = certificate if certificate is not None else certify(scenario, law)
-    tight = cert.tightening(allow_uncertified=True)
+    tight = cert.best_effort_tightening()
     tube = tuple(float(x) for x in cert.tube["rho"])
     if not all(math.isfinite(x) and x > 0 for x in tube):
         raise ConfigError("tube", "a certificate with a finite one-period tube", list(tube),

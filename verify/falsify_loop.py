@@ -253,7 +253,8 @@ class _Attack:
             sequence: tuple | None = None) -> LoopRun:
         """Simulate from ``start`` under ``disturbance`` and measure the promises."""
         law = self.law if tap is None else _StateTap(self.law.name, self.law.gain_of_jacobian,
-                                                      self.law.description, self.law.symbolic_gain, tap)
+                                                      self.law.description, self.law.symbolic_gain,
+                                                      self.law.closed_form, tap=tap)
         sc = replace(self.scenario, initial_state=start)
         result = simulate(sc, tightening=self.tightening, law=law, progress=False, disturbance=disturbance)
         promises = tuple(check_promises(result))
@@ -275,7 +276,7 @@ def _setup(scenario: Scenario, law: str | None, duration: float, certificate: An
     if not (isinstance(duration, (int, float)) and math.isfinite(duration) and duration > 0):
         raise ConfigError("duration", "a number of seconds > 0", duration)
     cert = certificate if certificate is not None else certify(scenario, name)
-    tight = tightening if tightening is not None else cert.tightening(allow_uncertified=True)
+    tight = tightening if tightening is not None else cert.best_effort_tightening()
     if not np.all(np.asarray(tight.tube) > 0):
         raise ConfigError("tube", "a certificate with a finite one-period tube", list(tight.tube),
                           "the design has no tube to attack")

@@ -28,7 +28,6 @@ from typing import Callable, Sequence
 import numpy as np
 import sympy as sp
 from flint import arb, arb_mat
-from scipy.optimize import minimize
 
 __all__ = [
     "enclose",
@@ -333,6 +332,7 @@ def _sample(case: Case, n: int, rng: np.random.Generator) -> tuple[float, np.nda
 
     for k in order:
         try:
+            from scipy.optimize import minimize  # imported here: costly, and only the sampling uses it
             res = minimize(neg, X[k], method="L-BFGS-B", bounds=list(zip(case.lo, case.hi)),
                            options={"maxiter": 60})
         except (ValueError, FloatingPointError):

@@ -28,6 +28,9 @@ def _tube_lines(cert) -> list[str]:
     if not t.certified:
         out.append(f"One-period tube: none ({t.reason})")
         return out
+    p = d.problem
+    out.append(f"Sampled data: kappa held at f = {_f(1.0 / p.tick)} Hz (h = {_f(p.tick)} s), {p.ticks} ticks per "
+               f"FHOCP period delta = {_f(p.period)} s, nominal input held over each period")
     out.append(f"One-period tube (box, restarts at 0 every {_f(cert.dt)} s): |rho| <= {_vec(t.rho)} "
                f"(e_d m, e_z m, e_o);  |theta - theta_hat| <= {_f(t.theta)} rad")
     out.append(f"  Cartesian: ||dp_xy|| <= {_f(t.p_xy)} m, |dz| <= {_f(t.p_z)} m, |dpsi| <= {_f(t.psi)} rad;"

@@ -47,7 +47,9 @@ _MAX_ITER = 400
 class TubeProblem:
     """Everything the one-period theorem takes (plain floats; stored in the certificate).
 
-    Units: m, m/s, rad/s, s, 1/s. ``k_abs[j][l]`` >= sup |K_jl| over R;
+    Units: m, m/s, rad/s, s, 1/s. ``yaw_rate_error`` bounds |ψ̇ - r_cmd| (rad/s): 0 on the kinematic
+    plant, the velocity loop's yaw error on the dynamic one (its surge and heave errors enter ω).
+    ``k_abs[j][l]`` >= sup |K_jl| over R;
     ``g_lo[j] <= (J K)_jj <= g_hi[j]`` and ``g_off[j][l]`` >= sup |(J K)_jl| (l != j) over R.
     """
 
@@ -67,6 +69,7 @@ class TubeProblem:
     g_lo: tuple[float, float, float]
     g_hi: tuple[float, float, float]
     g_off: tuple[tuple[float, float, float], ...]
+    yaw_rate_error: float = 0.0
 
     @property
     def period(self) -> float:
@@ -128,7 +131,7 @@ def _lipschitz(p: TubeProblem) -> dict[str, arb]:
     c_min = (1 - o * o).sqrt()
     q = o * c_min if p.e_o_max <= math.sqrt(0.5) else arb(0.5)    # sup |e_o c|
     ed_rate = arb(p.u_max) + arb(p.omega_xy) + arb(p.pd_xy)
-    eo_rate = arb(p.r_max) + (arb(p.u_max) * o + arb(p.omega_xy) + arb(p.pd_xy)) / eps
+    eo_rate = arb(p.r_max) + arb(p.yaw_rate_error) + (arb(p.u_max) * o + arb(p.omega_xy) + arb(p.pd_xy)) / eps
     return {"Lc": o / c_min,                  # |dc/de_o|
             "La_o": 1 / (c_min * eps),        # |da/de_o| = |1 - 2 e_o²| / (|c| e_d)
             "La_d": q / (eps * eps),          # |da/de_d| = |e_o c| / e_d²
@@ -154,7 +157,8 @@ def _rest_rates(p: TubeProblem, rho: list[arb], theta: arb, kap: list[arb], L: d
            + P * (L["Lc"] * ro / eps + theta / eps + rd / (eps * eps))   # Δζ_o
            + u * (L["La_o"] * ro + L["La_d"] * rd) + r * L["Lc"] * ro     # (J(e) - J(ê)) v̂, row o
            + h * (L["La_o"] * L["eo_rate"] + L["La_d"] * L["ed_rate"]) * kap[0]  # ZOH, a(e) - a(e_i)
-           + L["Lc"] * h * L["eo_rate"] * kap[2])                          # ZOH, (c - c_i) κ_r
+           + L["Lc"] * h * L["eo_rate"] * kap[2]                           # ZOH, (c - c_i) κ_r
+           + arb(p.yaw_rate_error))                                        # c (ψ̇ - r_cmd), |c| <= 1
     return [b_d, b_z, b_o]
 
 
@@ -187,7 +191,7 @@ def _tick_recursion(p: TubeProblem, b: list[arb]) -> list[arb]:
 def _cartesian(p: TubeProblem, kap: list[arb]) -> tuple[arb, arb, arb]:
     """(sup ‖Δp_xy‖, sup |Δz|, sup |Δψ|) over the period with |κ| <= κ̄."""
     d = arb(p.period)
-    psi = kap[2] * d
+    psi = (kap[2] + arb(p.yaw_rate_error)) * d
     pxy = (kap[0] + arb(p.omega_xy)) * d + arb(p.u_max) * psi * d / 2
     pz = (kap[1] + arb(p.omega_z)) * d
     return pxy, pz, psi

@@ -7,12 +7,19 @@ optional dependency disables only the commands that use it.
 
 Exit codes: 0 success / certified, 1 failure (a command not available),
 2 bad input (one message, no traceback), 3 not certified / counterexample found,
-4 a certified promise broken in a run (simulate, reproduce).
+4 a certified promise broken in a run (simulate, reproduce), 130 interrupted (Ctrl-C).
+
+Every command takes ``-v`` (debug diagnostics) and ``-q`` (warnings and errors
+only): diagnostics go through :mod:`logging` to stderr; results are printed on
+stdout. Every file-system error (an unreadable or binary CONFIG, an ``--out``
+naming a file or an unwritable place) is one line naming the option, exit 2.
 """
 
 from __future__ import annotations
 
 import argparse
+import logging
+import os
 import sys
 from dataclasses import dataclass
 from pathlib import Path
@@ -25,7 +32,7 @@ from ..scenario import Scenario, load_scenario, paper_scenario
 from ..validation import positive
 
 __all__ = ["main", "build_parser", "Subcommand", "SUBCOMMANDS", "EXIT_OK", "EXIT_FAILURE", "EXIT_BAD_INPUT",
-           "EXIT_NOT_CERTIFIED", "EXIT_PROMISE_BROKEN"]
+           "EXIT_NOT_CERTIFIED", "EXIT_PROMISE_BROKEN", "EXIT_INTERRUPTED", "configure_logging"]
 
 EXIT_OK = 0
 EXIT_FAILURE = 1
@@ -34,6 +41,8 @@ EXIT_BAD_INPUT = 2
 EXIT_NOT_CERTIFIED = 3
 #: ``simulate``/``reproduce``: a certified scenario's run broke a promise of its certificate.
 EXIT_PROMISE_BROKEN = 4
+#: Interrupted (Ctrl-C); an interrupted study leaves ``--out`` as it was.
+EXIT_INTERRUPTED = 130
 
 
 @dataclass(frozen=True)
@@ -48,7 +57,7 @@ class Subcommand:
 # ---- shared option groups and helpers -------------------------------------------------------------------
 
 def _study_options(parser: argparse.ArgumentParser, default_out: str | None) -> None:
-    from .study import QUICK_DURATION_S
+    from . import QUICK_S as QUICK_DURATION_S
 
     parser.add_argument("--out", metavar="DIR", default=default_out,
                         help="output directory" + (f" (default: {default_out})" if default_out else
@@ -61,6 +70,8 @@ def _study_options(parser: argparse.ArgumentParser, default_out: str | None) -> 
     parser.add_argument("--law", choices=("paper", "corrected"), default=None,
                         help="ancillary law (default: the scenario's controller.law)")
     parser.add_argument("--no-progress", action="store_true", help="no progress bar")
+    parser.add_argument("--animate", action="store_true",
+                        help="also write top_view.gif (and top_view.mp4 where ffmpeg exists)")
 
 
 def _verify_options(parser: argparse.ArgumentParser) -> None:
@@ -71,8 +82,30 @@ def _verify_options(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--json", default=None, metavar="FILE", help="write the result as JSON ('-' = stdout)")
 
 
+def _load_config(config: str) -> Scenario:
+    """:func:`load_scenario`, with an unreadable or non-text file reported as ``CONFIG``."""
+    try:
+        return load_scenario(config)
+    except UnicodeDecodeError:
+        raise ConfigError("CONFIG", "a UTF-8 text TOML file", config, "It is binary or not UTF-8.") from None
+    except OSError as exc:
+        raise ConfigError("CONFIG", "a readable TOML file", config, exc.strerror or str(exc)) from None
+
+
 def _scenario(config: str | None) -> Scenario:
-    return paper_scenario() if config is None else load_scenario(config)
+    return paper_scenario() if config is None else _load_config(config)
+
+
+def _check_file_target(option: str, path: str) -> None:
+    """A file ``path`` that ``option`` may create: not a directory, under a writable directory."""
+    target = Path(path)
+    if target.is_dir():
+        raise ConfigError(option, "a file path", path, "It names a directory.")
+    ancestor = target.parent
+    while not ancestor.exists():
+        ancestor = ancestor.parent
+    if not ancestor.is_dir() or not os.access(ancestor, os.W_OK | os.X_OK):
+        raise ConfigError(option, "a file in a writable directory", path)
 
 
 def _law(args: argparse.Namespace, scenario: Scenario) -> str:
@@ -95,13 +128,16 @@ def _emit_json(path: str, data: Any) -> None:
     try:
         write_json(target, data)
     except OSError as exc:
-        raise ConfigError("--json", "a writable file", path, str(exc)) from None
+        raise ConfigError("--json", "a writable file", path, exc.strerror or str(exc)) from None
 
 
 def _write_json_creating_dirs(path: str, data: Any) -> None:
-    """``--json FILE`` of audit/falsify: strict JSON to FILE, creating its directory."""
-    Path(path).parent.mkdir(parents=True, exist_ok=True)
-    write_json(path, data)
+    """``--json FILE`` of audit/falsify/recheck: strict JSON to FILE, creating its directory."""
+    try:
+        Path(path).parent.mkdir(parents=True, exist_ok=True)
+        write_json(path, data)
+    except OSError as exc:
+        raise ConfigError("--json", "a writable file", path, exc.strerror or str(exc)) from None
 
 
 # ---- reproduce / simulate -------------------------------------------------------------------------------
@@ -115,17 +151,14 @@ def _configure_simulate(parser: argparse.ArgumentParser) -> None:
     _study_options(parser, None)
 
 
-def _log(message: str) -> None:
-    print(message, flush=True)
-
-
 def _run_reproduce(args: argparse.Namespace) -> int:
     """Section VI of the paper, tube against baseline, with the acceptance criteria."""
     from .study import apply_overrides, run_study
 
     scenario = apply_overrides(paper_scenario(), duration=args.duration, quick=args.quick, law=args.law)
     out = Path(args.out or "results/reproduce")
-    metrics = run_study(scenario, out, progress=not args.no_progress, with_acceptance=True, log=_log)
+    metrics = run_study(scenario, out, progress=not args.no_progress, with_acceptance=True, animate=args.animate,
+                        dynamic=True, echo=_echo)
     return _study_exit(metrics)
 
 
@@ -133,15 +166,24 @@ def _run_simulate(args: argparse.Namespace) -> int:
     """The same study on a scenario from TOML."""
     from .study import apply_overrides, output_dir_name, run_study
 
-    scenario = apply_overrides(load_scenario(args.config), duration=args.duration, quick=args.quick, law=args.law)
+    scenario = apply_overrides(_load_config(args.config), duration=args.duration, quick=args.quick, law=args.law)
     out = Path(args.out) if args.out else Path("results") / output_dir_name(scenario.name)
-    metrics = run_study(scenario, out, progress=not args.no_progress, with_acceptance=False, log=_log)
+    metrics = run_study(scenario, out, progress=not args.no_progress, with_acceptance=False, animate=args.animate,
+                        echo=_echo)
     return _study_exit(metrics)
+
+
+def _echo(message: str) -> None:
+    """A result line on stdout, flushed (the study's table, promises, ``wrote ...``)."""
+    print(message, flush=True)
 
 
 def _study_exit(metrics: dict) -> int:
     """4 when a certified scenario's tube run broke a promise, else 0."""
-    return EXIT_PROMISE_BROKEN if metrics["certified"] and not metrics["promises_kept"] else EXIT_OK
+    broken = metrics["certified"] and not metrics["promises_kept"]
+    dyn = metrics.get("dynamic")
+    broken = broken or bool(dyn and dyn["certified"] and not dyn["promises_kept"])
+    return EXIT_PROMISE_BROKEN if broken else EXIT_OK
 
 
 # ---- audit ----------------------------------------------------------------------------------------------
@@ -158,6 +200,8 @@ def _run_audit(args: argparse.Namespace) -> int:
 
     if args.samples < 10:
         raise ConfigError("--samples", "an integer >= 10", args.samples)
+    if args.json:
+        _check_file_target("--json", args.json)
     report = audit(samples=args.samples, seed=args.seed)
     print(report.table())
     if args.json:
@@ -173,7 +217,6 @@ def _configure_certify(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--max-boxes", type=int, default=4000, metavar="N",
                         help="branch-and-bound budget per gain entry, in boxes (a work unit: the verdict does not "
                              "depend on machine load; default 4000)")
-    parser.add_argument("--quiet", action="store_true", help="do not print the summary")
     parser.add_argument("--search-region", action="store_true",
                         help="certify on a fixed grid of (region.e_o_max, region.e_d_max) and report every "
                              "verdict; exit 0 if any certifies (the best is printed), else 3")
@@ -185,6 +228,10 @@ def _run_certify(args: argparse.Namespace) -> int:
 
     scenario = _scenario(args.config)
     law = _law(args, scenario)
+    if args.json not in (None, "-"):
+        if not Path(args.json).parent.exists():
+            raise ConfigError("--json", "a file in an existing directory", args.json)
+        _check_file_target("--json", args.json)
     if args.search_region:
         from verify.region_search import search_region
 
@@ -222,6 +269,10 @@ def _run_envelope(args: argparse.Namespace) -> int:
     law = _law(args, scenario)
     if args.plot is not None and not Path(args.plot).parent.exists():
         raise ConfigError("--plot", "a file in an existing directory", args.plot)
+    if args.plot is not None:
+        _check_file_target("--plot", args.plot)
+    if args.json not in (None, "-"):
+        _check_file_target("--json", args.json)
     eps = None if args.eps is None else positive("--eps", args.eps)
     result = envelope(scenario, law, eps=eps, quick=args.quick)
     if args.json != "-":
@@ -229,7 +280,10 @@ def _run_envelope(args: argparse.Namespace) -> int:
     if args.json is not None:
         _emit_json(args.json, result.to_dict())
     if args.plot is not None:
-        plot_envelope(result, args.plot)
+        try:
+            plot_envelope(result, args.plot)
+        except OSError as exc:
+            raise ConfigError("--plot", "a writable file", args.plot, exc.strerror or str(exc)) from None
         if args.json != "-":
             print(f"plot written to {args.plot}")
     return EXIT_OK
@@ -244,7 +298,14 @@ def _run_recheck(args: argparse.Namespace) -> int:
     """0 when the certificate is confirmed, 3 when it is not certified or the recheck disagrees."""
     from verify.recheck import recheck_file
 
-    result = recheck_file(args.cert)
+    if args.json:
+        _check_file_target("--json", args.json)
+    try:
+        result = recheck_file(args.cert)
+    except UnicodeDecodeError:
+        raise ConfigError("CERT", "a UTF-8 JSON file", args.cert, "It is binary or not UTF-8.") from None
+    except OSError as exc:
+        raise ConfigError("CERT", "a readable JSON file", args.cert, exc.strerror or str(exc)) from None
     print(result.summary())
     if args.json:
         _write_json_creating_dirs(args.json, result.to_dict())
@@ -276,6 +337,8 @@ def _run_falsify(args: argparse.Namespace) -> int:
     if args.sigma is not None:
         positive("--sigma", args.sigma)
     positive("--duration", args.duration)
+    if args.json:
+        _check_file_target("--json", args.json)
     if args.closed_loop:
         budget = 20 if args.budget is None else args.budget
         result = falsify_closed_loop(scenario, args.law, budget=budget, seed=args.seed, duration=args.duration)
@@ -307,6 +370,34 @@ SUBCOMMANDS: dict[str, Subcommand] = {
 }
 
 
+def _verbosity_options() -> argparse.ArgumentParser:
+    """``-v`` / ``-q``, shared by every subcommand (a parent parser)."""
+    parent = argparse.ArgumentParser(add_help=False)
+    group = parent.add_mutually_exclusive_group()
+    group.add_argument("-v", "--verbose", action="store_true", help="debug diagnostics on stderr")
+    group.add_argument("-q", "--quiet", action="store_true",
+                       help="warnings and errors only on stderr (certify: no summary either)")
+    return parent
+
+
+def configure_logging(verbose: bool = False, quiet: bool = False) -> None:
+    """Send the ``tubekit`` and ``verify`` loggers to the current stderr, one plain line per record.
+
+    Level: DEBUG with ``verbose``, WARNING with ``quiet``, else INFO.
+    """
+    level = logging.DEBUG if verbose else logging.WARNING if quiet else logging.INFO
+    handler = logging.StreamHandler(sys.stderr)
+    handler.setFormatter(logging.Formatter("%(message)s"))
+    for name in ("tubekit", "verify"):
+        logger = logging.getLogger(name)
+        for old in list(logger.handlers):
+            if getattr(old, "_tubekit_cli", False):
+                logger.removeHandler(old)
+        handler._tubekit_cli = True  # type: ignore[attr-defined]
+        logger.addHandler(handler)
+        logger.setLevel(level)
+
+
 def build_parser() -> argparse.ArgumentParser:
     """The ``tubekit`` parser with every subcommand of :data:`SUBCOMMANDS`.
 
@@ -316,8 +407,9 @@ def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(prog="tubekit", description="Robust tube-based NMPC for underactuated AUVs.")
     parser.add_argument("--version", action="version", version=f"tubekit {__version__}")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND")
+    verbosity = _verbosity_options()
     for name, command in SUBCOMMANDS.items():
-        subparser = sub.add_parser(name, help=command.help, description=command.help)
+        subparser = sub.add_parser(name, help=command.help, description=command.help, parents=[verbosity])
         try:
             command.configure(subparser)
         except ImportError as exc:
@@ -342,6 +434,7 @@ def main(argv: list[str] | None = None) -> int:
         return EXIT_BAD_INPUT
     if getattr(args, "_unavailable", None):
         return _not_available(args.command, args._unavailable)
+    configure_logging(getattr(args, "verbose", False), getattr(args, "quiet", False))
     try:
         return int(args._run(args))
     except ImportError as exc:  # a dependency of this command only
@@ -352,6 +445,12 @@ def main(argv: list[str] | None = None) -> int:
     except BrokenPipeError:  # e.g. `tubekit certify | head`
         sys.stderr.close()
         return EXIT_OK
+    except OSError as exc:  # any other file-system error: one line naming the file
+        print(f"tubekit {args.command}: error: {exc.filename or 'a file'}: {exc.strerror or exc}", file=sys.stderr)
+        return EXIT_BAD_INPUT
+    except KeyboardInterrupt:
+        print(f"tubekit {args.command}: interrupted (outputs of a study are left as they were)", file=sys.stderr)
+        return EXIT_INTERRUPTED
 
 
 if __name__ == "__main__":  # pragma: no cover

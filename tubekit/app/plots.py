@@ -11,12 +11,15 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Mapping, Sequence
 
 import numpy as np
+from matplotlib.collections import PatchCollection
 from matplotlib.figure import Figure
 from matplotlib.patches import Circle as CirclePatch
+from matplotlib.ticker import MaxNLocator
 
 from ..exceptions import ConfigError
 from ..metrics import clearance, rho_period_peaks
 from ..scenario import Scenario
+from ..tightening import Tightening
 
 if TYPE_CHECKING:  # verify is imported for its type only; plotting needs no certificate code
     from verify.envelope import EnvelopeResult
@@ -24,8 +27,12 @@ if TYPE_CHECKING:  # verify is imported for its type only; plotting needs no cer
 __all__ = [
     "Run",
     "top_view",
+    "draw_scene_xy",
+    "fit_canvas",
+    "run_style",
     "errors_figure",
     "inputs_figure",
+    "period_envelope",
     "rho_figure",
     "view_3d",
     "clearance_figure",
@@ -41,9 +48,13 @@ FIGURE_FILES: tuple[str, ...] = ("fig2_top_view.png", "fig3_errors.png", "fig4_i
 
 Run = tuple[str, Mapping[str, np.ndarray]]  # (label, columns)
 _STYLE = {0: dict(color="tab:blue", lw=1.4), 1: dict(color="tab:orange", lw=1.0, alpha=0.85)}
+_LEGEND_OUTSIDE = dict(loc="upper left", bbox_to_anchor=(1.01, 1.0), borderaxespad=0.0, fontsize=8)
+#: Clearance (m) below which the clearance axis is linear (symlog): mm-scale penetrations stay visible.
+CLEARANCE_LINEAR_M = 0.01
 
 
-def _style(i: int) -> dict:
+def run_style(i: int) -> dict:
+    """Line style of the ``i``-th run (0: the tube run, 1: the baseline)."""
     return dict(_STYLE.get(i, dict(lw=1.0)))
 
 
@@ -51,35 +62,120 @@ def _desired_curve(scenario: Scenario, t_end: float) -> np.ndarray:
     return np.asarray(scenario.trajectory.position(np.linspace(0.0, t_end, 2000)))
 
 
-def top_view(scenario: Scenario, runs: Sequence[Run]) -> Figure:
-    """Fig. 2: path(s), desired trajectory, obstacles (and inflated by r̄), sensing circle at t = 0."""
-    fig = Figure(figsize=(6.4, 6.2), layout="constrained")
-    ax = fig.add_subplot()
-    t_end = float(runs[0][1]["t"][-1]) if runs else scenario.duration
+def _t_end(scenario: Scenario, runs: Sequence[Run]) -> float:
+    return float(runs[0][1]["t"][-1]) if runs else scenario.duration
+
+
+def _tick_interval(t_end: float, ticks: int = 8) -> float:
+    """A round time step (s) giving at most about ``ticks`` marks over ``t_end`` seconds."""
+    for step in (0.5, 1, 2, 5, 10, 20, 25, 50, 100, 200, 500, 1000):
+        if t_end / step <= ticks:
+            return float(step)
+    return float(10 ** np.ceil(np.log10(max(t_end, 1.0) / ticks)))
+
+
+def _tick_rows(t: np.ndarray, every_s: float) -> np.ndarray:
+    """Row indices of the first samples at or after each multiple of ``every_s`` (s), t = 0 excluded."""
+    marks = np.arange(every_s, float(t[-1]) + 1e-9, every_s)
+    return np.unique(np.searchsorted(t, marks - 1e-9))
+
+
+def _position_tube(tightening: Tightening | None) -> float:
+    """Half-width (m) of the position tube: the margin the FHOCP keeps between p̂ and the inflated obstacles."""
+    return float(tightening.obstacle_margin) if tightening is not None else 0.0
+
+
+def draw_scene_xy(ax, scenario: Scenario, t_end: float, *, start_target: bool = True) -> None:
+    """The static part of the top view: desired path, obstacles, obstacles inflated by r̄, target at t = 0."""
     pd = _desired_curve(scenario, t_end)
-    ax.plot(pd[:, 0], pd[:, 1], "--", color="tab:green", lw=1.2, label="desired $p_d(t)$")
+    ax.plot(pd[:, 0], pd[:, 1], "--", color="tab:green", lw=1.1, label="desired $p_d(t)$")
     for k, o in enumerate(scenario.obstacles):
         ax.add_patch(CirclePatch(o.center[:2], o.radius, color="0.35", alpha=0.8,
                                  label="obstacle" if k == 0 else None))
         ax.add_patch(CirclePatch(o.center[:2], o.radius + scenario.vehicle_radius, fill=False, ls=":",
-                                 color="0.35", label=r"obstacle + $\bar r$" if k == 0 else None))
-    for i, (label, c) in enumerate(runs):
-        ax.plot(c["x"], c["y"], label=label, **_style(i))
-    x0 = np.asarray(scenario.initial_state)
-    ax.add_patch(CirclePatch(x0[:2], scenario.sensing_range, fill=False, color="tab:blue", lw=1.0,
-                             label=r"sensing range $\bar R$ at $t=0$"))
-    ax.add_patch(CirclePatch(x0[:2], scenario.vehicle_radius, color="tab:blue", alpha=0.3,
-                             label=r"vehicle ball $\bar r$"))
-    ax.annotate("", xy=(x0[0] + 0.6 * np.cos(x0[3]), x0[1] + 0.6 * np.sin(x0[3])), xytext=(x0[0], x0[1]),
-                arrowprops=dict(arrowstyle="->", color="tab:blue"))
-    p0 = pd[0]
-    ax.plot([p0[0]], [p0[1]], "*", color="tab:blue", ms=12, label="target at $t=0$")
-    ax.set_aspect("equal")
+                                 color="0.35", label=r"obstacle + $\bar r$ (vehicle centre must stay out)"
+                                 if k == 0 else None))
+    if start_target:
+        ax.plot([pd[0, 0]], [pd[0, 1]], "*", color="tab:green", ms=11, mec="k", mew=0.5, label="target at $t=0$")
     ax.set_xlabel("x (m)")
     ax.set_ylabel("y (m)")
-    ax.set_title(f"Top view ({scenario.name})")
     ax.grid(alpha=0.3)
-    ax.legend(fontsize=7, loc="center", framealpha=0.8)
+
+
+def _draw_tube_band(ax, columns: Mapping[str, np.ndarray], half_width: float, label: str) -> None:
+    """The position tube: discs of radius ``half_width`` (m) around the nominal p̂ (their union is the band)."""
+    xy = np.column_stack([columns["x_hat"], columns["y_hat"]])
+    xy = xy[np.all(np.isfinite(xy), axis=1)]
+    xy = xy[:: max(1, len(xy) // 3000)]
+    discs = [CirclePatch(p, half_width) for p in xy]
+    ax.add_collection(PatchCollection(discs, facecolor="#b8d4ee", edgecolor="none", zorder=1))
+    ax.fill([], [], color="#b8d4ee", label=label)  # legend proxy
+    ax.plot(xy[:, 0], xy[:, 1], color="tab:blue", lw=0.6, ls=(0, (1, 2)), zorder=2, label=r"nominal $\hat p$ (tube run)")
+
+
+def _draw_path_with_time(ax, scenario: Scenario, runs: Sequence[Run], every_s: float) -> None:
+    """Each run's path with start/end markers; the first run with time ticks and the sensing range."""
+    for i, (label, c) in enumerate(runs):
+        style = run_style(i)
+        ax.plot(c["x"], c["y"], label=label, zorder=3, **style)
+        ax.plot([c["x"][-1]], [c["y"][-1]], "s", color=style.get("color"), mec="k", ms=7, zorder=5,
+                label=f"end of {label} (t = {float(c['t'][-1]):g} s)")
+    if not runs:
+        return
+    c = runs[0][1]
+    rows = _tick_rows(np.asarray(c["t"]), every_s)
+    ax.plot(c["x"][rows], c["y"][rows], "o", color="k", ms=3, zorder=5, label=f"{runs[0][0]} every {every_s:g} s")
+    for j in rows:
+        ax.annotate(f"{float(c['t'][j]):g} s", (c["x"][j], c["y"][j]), xytext=(4, 4), textcoords="offset points",
+                    fontsize=7, color="0.15", zorder=6)
+    for n, j in enumerate(np.r_[0, rows[1::2]]):
+        ax.add_patch(CirclePatch((c["x"][j], c["y"][j]), scenario.sensing_range, fill=False, lw=0.7,
+                                 ls="--", color="tab:purple", alpha=0.55, zorder=2,
+                                 label=rf"sensing range $\bar R$ = {scenario.sensing_range:g} m, "
+                                       rf"every {2 * every_s:g} s" if n == 0 else None))
+    x0 = np.asarray(scenario.initial_state)
+    ax.add_patch(CirclePatch(x0[:2], scenario.vehicle_radius, fc="none", ec="k", lw=1.0, zorder=4,
+                             label=rf"vehicle ball $\bar r$ = {scenario.vehicle_radius:g} m"))
+    ax.plot([x0[0]], [x0[1]], "o", color="white", mec="k", ms=7, zorder=5, label="start (t = 0)")
+    ax.annotate("", xy=(x0[0] + 0.6 * np.cos(x0[3]), x0[1] + 0.6 * np.sin(x0[3])), xytext=(x0[0], x0[1]),
+                arrowprops=dict(arrowstyle="->", color="k"), zorder=5)
+
+
+def fit_canvas(fig: Figure, ax, legend_in: float = 2.9, longest_in: float = 6.2) -> None:
+    """Size the figure to the data's aspect (equal scales, no empty half canvas) plus the legend's width."""
+    ax.autoscale_view()
+    (x0, x1), (y0, y1) = ax.get_xlim(), ax.get_ylim()
+    dx, dy = max(x1 - x0, 1e-6), max(y1 - y0, 1e-6)
+    scale = longest_in / max(dx, dy)
+    width, height = max(dx * scale, 2.5), max(dy * scale, 2.5)
+    fig.set_size_inches(width + legend_in + 0.9, height + 0.9)
+    ax.set_aspect("equal", adjustable="datalim")
+
+
+def top_view(scenario: Scenario, runs: Sequence[Run], *, tightening: Tightening | None = None) -> Figure:
+    """Fig. 2: paths with time ticks, the position tube around the nominal, sensing range at intervals.
+
+    Parameters
+    ----------
+    runs : sequence of (label, columns)
+        The first run gets the time ticks, the sensing circles and the tube.
+    tightening : Tightening, optional
+        Its ``obstacle_margin`` (m) is the half-width of the position tube drawn
+        around the first run's nominal path (none when 0 or absent).
+    """
+    fig = Figure(figsize=(9.0, 6.2), layout="constrained")
+    ax = fig.add_subplot()
+    t_end = _t_end(scenario, runs)
+    draw_scene_xy(ax, scenario, t_end)
+    half = _position_tube(tightening)
+    if runs and half > 0:
+        certified = bool(getattr(tightening, "certified", False))
+        _draw_tube_band(ax, runs[0][1], half, rf"position tube: $\hat p$ $\pm$ obstacle margin {half:.3g} m "
+                                              f"({'certified' if certified else 'best effort, NOT certified'})")
+    _draw_path_with_time(ax, scenario, runs, _tick_interval(t_end))
+    ax.set_title(f"Top view ({scenario.name})")
+    fit_canvas(fig, ax)
+    ax.legend(**_LEGEND_OUTSIDE)
     return fig
 
 
@@ -90,7 +186,7 @@ def errors_figure(scenario: Scenario, runs: Sequence[Run]) -> Figure:
     names = (("e_d", "$e_d$ (m)"), ("e_z", "$e_z$ (m)"), ("e_o", "$e_o$ (-)"))
     for ax, (key, lab) in zip(axes, names):
         for i, (label, c) in enumerate(runs):
-            ax.plot(c["t"], c[key], label=label, **_style(i))
+            ax.plot(c["t"], c[key], label=label, **run_style(i))
         ax.set_ylabel(lab)
         ax.grid(alpha=0.3)
     axes[0].axhline(scenario.epsilon, color="tab:red", ls="--", lw=1.0, label=rf"$\epsilon$ = {scenario.epsilon:g} m")
@@ -101,23 +197,49 @@ def errors_figure(scenario: Scenario, runs: Sequence[Run]) -> Figure:
     return fig
 
 
-def inputs_figure(scenario: Scenario, runs: Sequence[Run]) -> Figure:
-    """Fig. 4: u, w, r against time, with the bounds of V."""
-    fig = Figure(figsize=(7.5, 6.5), layout="constrained")
+def period_envelope(columns: Mapping[str, np.ndarray], key: str) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Per FHOCP period: start time (s), min and max of column ``key``; the times end with the last sample's."""
+    step = np.asarray(columns["step"])
+    values = np.asarray(columns[key], dtype=float)
+    starts = np.flatnonzero(np.r_[True, step[1:] != step[:-1]])
+    ends = np.r_[starts[1:], len(step)]
+    lo, hi = np.full(len(starts), np.nan), np.full(len(starts), np.nan)
+    for n, (a, b) in enumerate(zip(starts, ends)):
+        chunk = values[a:b][np.isfinite(values[a:b])]
+        if chunk.size:
+            lo[n], hi[n] = chunk.min(), chunk.max()
+    t = np.asarray(columns["t"], dtype=float)
+    return np.r_[t[starts], t[-1]], np.r_[lo, lo[-1:]], np.r_[hi, hi[-1:]]
+
+
+def inputs_figure(scenario: Scenario, runs: Sequence[Run], *, tightening: Tightening | None = None) -> Figure:
+    """Fig. 4: per axis, v̂ as a line, the per-period min/max envelope of the applied v, bounds of V and V̄."""
+    fig = Figure(figsize=(8.8, 6.8), layout="constrained")
     axes = fig.subplots(3, 1, sharex=True)
     lim = scenario.limits.vector
+    tight = None if tightening is None else np.asarray(tightening.v_max, dtype=float)
     names = (("u", "u (m/s)"), ("w", "w (m/s)"), ("r", "r (rad/s)"))
-    for ax, (key, lab), b in zip(axes, names, lim):
+    for n, (ax, (key, lab), b) in enumerate(zip(axes, names, lim)):
         for i, (label, c) in enumerate(runs):
-            ax.plot(c["t"], c[key], label=label, **_style(i))
-        ax.axhline(b, color="tab:red", ls="--", lw=1.0, label="bound of V")
+            colour = run_style(i).get("color")
+            t_edges, lo, hi = period_envelope(c, key)
+            ax.fill_between(t_edges, lo, hi, step="post", color=colour, alpha=0.25 if i == 0 else 0.15, lw=0,
+                            label=f"{label}: applied v, min-max per period")
+            ax.plot(c["t"], c[f"{key}_hat"], drawstyle="steps-post", color=colour, lw=1.2 if i == 0 else 0.9,
+                    label=rf"{label}: $\hat v$ (FHOCP)")
+        ax.axhline(b, color="tab:red", ls="--", lw=1.0, label=r"bound of $V$")
         ax.axhline(-b, color="tab:red", ls="--", lw=1.0)
+        if tight is not None and tight[n] < b - 1e-12:
+            ax.axhline(tight[n], color="tab:purple", ls=":", lw=1.2, label=r"bound of $\bar V$ (tightened, for $\hat v$)")
+            ax.axhline(-tight[n], color="tab:purple", ls=":", lw=1.2)
+        elif tight is not None:
+            ax.plot([], [], ls="none", label=r"$\bar V = V$ on this axis (no tightening)")
         ax.set_ylim(-1.15 * b, 1.15 * b)
         ax.set_ylabel(lab)
         ax.grid(alpha=0.3)
-    axes[0].legend(fontsize=8, ncol=3)
+    axes[0].legend(**_LEGEND_OUTSIDE)
     axes[-1].set_xlabel("t (s)")
-    fig.suptitle("Control inputs (applied, v = v̂ + κ)")
+    fig.suptitle(r"Control inputs: nominal $\hat v$ and applied $v = \hat v + \kappa$")
     return fig
 
 
@@ -127,7 +249,7 @@ def rho_figure(runs: Sequence[Run], rho_tilde: float | None, certified: bool) ->
     ax = fig.add_subplot()
     for i, (label, c) in enumerate(runs):
         tt, peak = rho_period_peaks(c)
-        ax.plot(tt, peak, label=rf"$\max\|\rho\|$ per period, {label}", **_style(i))
+        ax.plot(tt, peak, label=rf"$\max\|\rho\|$ per period, {label}", **run_style(i))
     if rho_tilde is not None and np.isfinite(rho_tilde) and rho_tilde > 0:
         lab = (rf"$\tilde\rho$ = {rho_tilde:.3g} (certified)" if certified
                else rf"$\tilde\rho$ = {rho_tilde:.3g} (best effort, NOT certified)")
@@ -140,55 +262,87 @@ def rho_figure(runs: Sequence[Run], rho_tilde: float | None, certified: bool) ->
     return fig
 
 
+def _sphere(ax, center: Sequence[float], radius: float, **style) -> None:
+    """A sphere surface of ``radius`` (m) at ``center``."""
+    uu, vv = np.meshgrid(np.linspace(0, 2 * np.pi, 28), np.linspace(0, np.pi, 14))
+    cx, cy, cz = center
+    ax.plot_surface(cx + radius * np.cos(uu) * np.sin(vv), cy + radius * np.sin(uu) * np.sin(vv),
+                    cz + radius * np.cos(vv), linewidth=0, antialiased=True, shade=True, **style)
+
+
 def view_3d(scenario: Scenario, runs: Sequence[Run]) -> Figure:
-    """3-D view: path(s), desired trajectory, obstacle spheres."""
+    """3-D view at true aspect: path(s), desired trajectory, obstacle spheres, the vehicle ball at the end."""
     from mpl_toolkits.mplot3d import Axes3D  # noqa: F401  (registers the projection)
 
-    fig = Figure(figsize=(7.0, 6.0), layout="constrained")
+    fig = Figure(figsize=(8.4, 5.6), layout="constrained")
     ax = fig.add_subplot(projection="3d")
-    t_end = float(runs[0][1]["t"][-1]) if runs else scenario.duration
-    pd = _desired_curve(scenario, t_end)
-    ax.plot(pd[:, 0], pd[:, 1], pd[:, 2], "--", color="tab:green", lw=1.0, label="desired")
+    pd = _desired_curve(scenario, _t_end(scenario, runs))
+    ax.plot(pd[:, 0], pd[:, 1], pd[:, 2], "--", color="tab:green", lw=1.0, label="desired $p_d(t)$")
+    points = [pd]
     for i, (label, c) in enumerate(runs):
-        ax.plot(c["x"], c["y"], c["z"], label=label, **_style(i))
-    uu, vv = np.meshgrid(np.linspace(0, 2 * np.pi, 24), np.linspace(0, np.pi, 12))
-    for o in scenario.obstacles:
-        cx, cy, cz = o.center
-        ax.plot_wireframe(cx + o.radius * np.cos(uu) * np.sin(vv), cy + o.radius * np.sin(uu) * np.sin(vv),
-                          cz + o.radius * np.cos(vv), color="0.4", lw=0.4)
+        ax.plot(c["x"], c["y"], c["z"], label=label, **run_style(i))
+        end = (float(c["x"][-1]), float(c["y"][-1]), float(c["z"][-1]))
+        _sphere(ax, end, scenario.vehicle_radius, color=run_style(i).get("color"), alpha=0.6)
+        points.append(np.column_stack([c["x"], c["y"], c["z"]]))
+    for k, o in enumerate(scenario.obstacles):
+        _sphere(ax, o.center, o.radius, color="0.45", alpha=0.55)
+        points.append(np.asarray(o.center) + np.array([[-1, -1, -1], [1, 1, 1]]) * o.radius)
+    ax.plot([], [], "o", color="0.45", ms=9, label="obstacle")
+    ax.plot([], [], "o", color="tab:blue", alpha=0.6, ms=6, label=r"vehicle ball $\bar r$ at the end")
+    allp = np.vstack([p[np.all(np.isfinite(p), axis=1)] for p in points])
+    lo, hi = allp.min(axis=0), allp.max(axis=0)
+    ax.set_xlim(lo[0], hi[0]), ax.set_ylim(lo[1], hi[1]), ax.set_zlim(lo[2], hi[2])
+    ax.set_box_aspect(np.maximum(hi - lo, 1e-3))
+    ax.zaxis.set_major_locator(MaxNLocator(3))
+    ax.view_init(elev=35, azim=-60)
     ax.set_xlabel("x (m)")
     ax.set_ylabel("y (m)")
     ax.set_zlabel("z (m)")
-    ax.set_title("3-D view (z axis stretched; spheres drawn to the same scale)")
-    ax.legend(fontsize=8)
+    ax.set_title("3-D view, true aspect (equal scale on x, y and z)")
+    ax.legend(fontsize=8, loc="upper left")
     return fig
 
 
 def clearance_figure(scenario: Scenario, runs: Sequence[Run]) -> Figure:
-    """Vehicle-ball to nearest-obstacle-surface distance against time."""
-    fig = Figure(figsize=(7.5, 3.4), layout="constrained")
+    """Vehicle-ball to nearest-obstacle-surface distance; symlog axis so mm-scale penetrations show."""
+    fig = Figure(figsize=(8.5, 3.8), layout="constrained")
     ax = fig.add_subplot()
+    lowest = 0.0
     for i, (label, c) in enumerate(runs):
         pos = np.column_stack([c["x"], c["y"], c["z"]])
-        ax.plot(c["t"], clearance(pos, scenario.obstacles, scenario.vehicle_radius), label=label, **_style(i))
+        gap = clearance(pos, scenario.obstacles, scenario.vehicle_radius)
+        ax.plot(c["t"], gap, label=label, **run_style(i))
+        if np.any(np.isfinite(gap)):
+            j = int(np.nanargmin(gap))
+            lowest = min(lowest, float(gap[j]))
+            ax.plot([c["t"][j]], [gap[j]], "v", color=run_style(i).get("color"), mec="k", ms=7,
+                    label=f"{label}: min {1e3 * gap[j]:+.1f} mm at t = {float(c['t'][j]):.1f} s")
     ax.axhline(0.0, color="tab:red", ls="--", lw=1.0, label="contact")
-    ax.set_xlabel("t (s)")
-    ax.set_ylabel("clearance (m)")
     if scenario.obstacles:
-        ax.set_ylim(-0.2, min(3.0, ax.get_ylim()[1]))
+        ax.set_yscale("symlog", linthresh=CLEARANCE_LINEAR_M, linscale=1.0)
+        bottom = -max(0.02, 2.0 * abs(lowest))
+        ax.axhspan(bottom, 0.0, color="tab:red", alpha=0.08, label="penetration (collision)")
+        ax.set_ylim(bottom, None)
+    ax.set_xlabel("t (s)")
+    ax.set_ylabel(f"clearance (m, symlog: linear within ±{CLEARANCE_LINEAR_M * 1e3:g} mm)", fontsize=9)
     ax.set_title(r"Clearance: $\|p - c_m\| - r_m - \bar r$ (nearest obstacle)")
-    ax.grid(alpha=0.3)
-    ax.legend(fontsize=8)
+    ax.grid(alpha=0.3, which="both")
+    ax.legend(**_LEGEND_OUTSIDE)
     return fig
 
 
 def plot_all(out_dir: str | Path, scenario: Scenario, runs: Sequence[Run], *,
-             rho_tilde: float | None = None, certified: bool = False, dpi: int = 110) -> list[Path]:
-    """Write every figure of :data:`FIGURE_FILES` into ``out_dir``; returns the paths."""
+             rho_tilde: float | None = None, certified: bool = False, dpi: int = 110,
+             tightening: Tightening | None = None) -> list[Path]:
+    """Write every figure of :data:`FIGURE_FILES` into ``out_dir``; returns the paths.
+
+    ``tightening`` (optional) adds the position tube to the top view and the bounds of V̄ to the inputs.
+    """
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
-    figs = (top_view(scenario, runs), errors_figure(scenario, runs), inputs_figure(scenario, runs),
-            rho_figure(runs, rho_tilde, certified), view_3d(scenario, runs), clearance_figure(scenario, runs))
+    figs = (top_view(scenario, runs, tightening=tightening), errors_figure(scenario, runs),
+            inputs_figure(scenario, runs, tightening=tightening), rho_figure(runs, rho_tilde, certified),
+            view_3d(scenario, runs), clearance_figure(scenario, runs))
     paths = []
     for name, fig in zip(FIGURE_FILES, figs):
         p = out / name

@@ -11,14 +11,25 @@ the output directory:
 * ``metrics.json`` (tube metrics at the top level, ``baseline`` nested,
   ``acceptance`` for ``reproduce``),
 * ``certificate.json`` and ``certificate.txt``, ``scenario.json``,
-* the figures of :data:`tubekit.app.plots.FIGURE_FILES`.
+* the figures of :data:`tubekit.app.plots.FIGURE_FILES` (and, with
+  ``animate=True``, the animation of :func:`tubekit.app.animate.animate_top_view`).
 
-:func:`run_study` is the pipeline; each step is a function of its own.
+:func:`run_study` is the pipeline; each step is a function of its own. Every
+input is checked first (:func:`tubekit.checks.check_run_inputs` and the output
+path), then everything is written into a temporary directory next to ``out``
+that replaces ``out`` in one rename at the end (:class:`StagedOutput`): a failed
+or interrupted run leaves the previous results untouched. Diagnostics go to the
+``logging`` logger of this module; the results (comparison table, promises,
+acceptance, ``wrote ...``) are printed on stdout.
 """
 
 from __future__ import annotations
 
+import logging
 import math
+import os
+import shutil
+import tempfile
 import time
 from dataclasses import dataclass, replace
 from pathlib import Path
@@ -28,6 +39,7 @@ import numpy as np
 
 import verify
 
+from ..checks import check_run_inputs
 from ..closed_loop import SimulationResult, simulate
 from ..exceptions import ConfigError
 from ..jsonable import write_json, write_text
@@ -35,6 +47,7 @@ from ..metrics import compute_metrics
 from ..promises import check_promises
 from ..scenario import Scenario
 from ..tightening import Tightening
+from . import QUICK_S
 from .plots import plot_all
 
 __all__ = [
@@ -44,15 +57,19 @@ __all__ = [
     "output_dir_name",
     "QUICK_DURATION_S",
     "OUTPUT_FILES",
+    "StagedOutput",
+    "check_output_dir",
 ]
 
+LOGGER = logging.getLogger(__name__)
+
 #: Simulated seconds of ``--quick``.
-QUICK_DURATION_S = 10.0
+QUICK_DURATION_S = QUICK_S  # re-exported; the parser reads it from tubekit.app without importing the study
 #: Files (besides figures) every study writes.
 OUTPUT_FILES: tuple[str, ...] = ("trajectory.csv", "baseline_trajectory.csv", "metrics.json", "certificate.json",
                                  "certificate.txt", "scenario.json")
 
-Log = Callable[[str], None]
+Echo = Callable[[str], None]
 
 
 def apply_overrides(scenario: Scenario, *, duration: float | None = None, quick: bool = False,
@@ -135,31 +152,32 @@ class CertifiedDesign:
     certify_s: float
 
 
-def certify_and_write(scenario: Scenario, out: Path, log: Log) -> CertifiedDesign:
+def certify_and_write(scenario: Scenario, out: Path) -> CertifiedDesign:
     """Certify with :func:`verify.certify`; write ``certificate.json`` and ``certificate.txt``."""
-    log(f"certifying {scenario.name!r} (law {scenario.controller.law}) ...")
+    LOGGER.info("certifying %r (law %s) ...", scenario.name, scenario.controller.law)
     started = time.perf_counter()
     cert = verify.certify(scenario, law=scenario.controller.law)
     certify_s = time.perf_counter() - started
     certified = bool(cert.certified)
     write_json(out / "certificate.json", cert.to_dict())
     write_text(out / "certificate.txt", str(cert.summary()) + "\n")
-    tightening: Tightening = cert.tightening(allow_uncertified=True)
-    log(f"  {'certified' if certified else 'NOT certified (best-effort tightening used)'} in {certify_s:.1f} s; "
-        f"sigma = {tightening.sigma:.4g}, rho_tilde = {tightening.rho_tilde:.4g}")
+    tightening: Tightening = cert.best_effort_tightening()
+    LOGGER.info("  %s in %.1f s; sigma = %.4g, rho_tilde = %.4g",
+                "certified" if certified else "NOT certified (best-effort tightening used)", certify_s,
+                tightening.sigma, tightening.rho_tilde)
     return CertifiedDesign(tightening, certified, certify_s)
 
 
-def run_tube_and_baseline(scenario: Scenario, tightening: Tightening, progress: bool,
-                          log: Log) -> tuple[SimulationResult, SimulationResult]:
+def run_tube_and_baseline(scenario: Scenario, tightening: Tightening,
+                          progress: bool) -> tuple[SimulationResult, SimulationResult]:
     """The tube controller with ``tightening``, then the baseline (untightened, no κ) under the same disturbance."""
-    log(f"tube run ({scenario.duration:g} s simulated) ...")
+    LOGGER.info("tube run (%g s simulated) ...", scenario.duration)
     tube = simulate(scenario, tightening=tightening, tube=True, progress=progress, label="tube")
-    log(f"  {tube.summary()}")
-    log("baseline run (nominal MPC alone) ...")
+    LOGGER.info("  %s", tube.summary())
+    LOGGER.info("baseline run (nominal MPC alone) ...")
     base = simulate(scenario, tightening=Tightening.untightened(scenario), tube=False, progress=progress,
                     label="baseline")
-    log(f"  {base.summary()}")
+    LOGGER.info("  %s", base.summary())
     return tube, base
 
 
@@ -191,7 +209,7 @@ def write_runs(out: Path, scenario: Scenario, design: CertifiedDesign, tube: Sim
     metrics["baseline"] = compute_metrics(base_cols, scenario, rho_bound=None, extra=_run_facts(base))
     metrics["e_d_peaks"] = e_d_peaks(tube_cols["e_d"], tube_cols["t"])
     plot_all(out, scenario, [("tube", tube_cols), ("baseline", base_cols)], rho_tilde=rho_tilde,
-             certified=design.certified)
+             certified=design.certified, tightening=design.tightening)
     metrics["certified"] = design.certified
     metrics["rho_tilde_used"] = rho_tilde
     promises = check_promises(tube)
@@ -223,7 +241,7 @@ def comparison_table(tube: dict[str, Any], base: dict[str, Any]) -> str:
     return "\n".join(lines)
 
 
-def log_promises(metrics: dict[str, Any], log: Log) -> None:
+def log_promises(metrics: dict[str, Any], log: Echo = print) -> None:
     """Each promise of the certificate with its numbers; says plainly when a certified one is broken."""
     certified = metrics["certified"]
     head = ("promises of the certificate (certified):" if certified
@@ -236,7 +254,7 @@ def log_promises(metrics: dict[str, Any], log: Log) -> None:
         log("CERTIFIED PROMISE BROKEN: the run violates what the certificate guarantees (exit 4)")
 
 
-def log_acceptance(metrics: dict[str, Any], log: Log) -> None:
+def log_acceptance(metrics: dict[str, Any], log: Echo = print) -> None:
     """The acceptance verdicts, then every e_d < ε interval and every collision."""
     log("acceptance: " + ", ".join(f"{k}={v}" for k, v in metrics["acceptance"].items() if k != "notes"))
     for iv in metrics["e_d_below_epsilon"]:
@@ -247,31 +265,142 @@ def log_acceptance(metrics: dict[str, Any], log: Log) -> None:
             f"penetration {iv['depth']:.4f} m at t={iv['t_min']:.2f} s")
 
 
-def run_study(scenario: Scenario, out: Path, *, progress: bool = True, with_acceptance: bool = False,
-              log: Log = print) -> dict[str, Any]:
-    """Certify, run tube + baseline, write every output into ``out``; returns the metrics dict.
+class StagedOutput:
+    """An output directory written atomically: a temporary directory next to it, then one rename.
 
-    Raises
-    ------
-    ConfigError
-        When the scenario is shorter than one FHOCP period (nothing is written).
+    Use as a context manager; :attr:`path` is the staging directory to write into.
+    On a clean exit it replaces ``target`` (the previous contents are removed only
+    after the new ones are in place); on any exception, ``KeyboardInterrupt``
+    included, the staging directory is removed and ``target`` is untouched.
     """
-    started = time.perf_counter()
-    if scenario.steps < 1:
-        raise ConfigError("duration", f"at least one FHOCP period ({scenario.controller.dt:g} s)", scenario.duration)
-    out.mkdir(parents=True, exist_ok=True)
-    write_json(out / "scenario.json", scenario.to_dict())
-    design = certify_and_write(scenario, out, log)
-    tube, base = run_tube_and_baseline(scenario, design.tightening, progress, log)
-    metrics = write_runs(out, scenario, design, tube, base)
+
+    def __init__(self, target: Path) -> None:
+        self.target = Path(target)
+        self.path = self.target
+
+    def __enter__(self) -> "StagedOutput":
+        parent = self.target.parent
+        try:
+            parent.mkdir(parents=True, exist_ok=True)
+            self.path = Path(tempfile.mkdtemp(prefix=f".{self.target.name}.tmp-", dir=parent))
+            umask = os.umask(0)
+            os.umask(umask)
+            self.path.chmod(0o777 & ~umask)
+        except OSError as exc:
+            raise ConfigError("--out", "a directory that can be created and written", str(self.target),
+                              exc.strerror or str(exc)) from None
+        return self
+
+    def __exit__(self, kind: type | None, error: BaseException | None, trace: Any) -> None:
+        if kind is not None:
+            shutil.rmtree(self.path, ignore_errors=True)
+            return
+        self._commit()
+
+    def _commit(self) -> None:
+        """Swap the staging directory in; the old ``target`` goes only after the new one is in place."""
+        old = None
+        try:
+            if self.target.exists():
+                old = self.target.with_name(f".{self.target.name}.old-{os.getpid()}-{time.time_ns()}")
+                os.replace(self.target, old)
+            os.replace(self.path, self.target)
+        except OSError as exc:
+            if old is not None and not self.target.exists():
+                os.replace(old, self.target)
+            shutil.rmtree(self.path, ignore_errors=True)
+            raise ConfigError("--out", "a directory that can be replaced", str(self.target),
+                              exc.strerror or str(exc)) from None
+        if old is not None:
+            shutil.rmtree(old, ignore_errors=True)
+
+
+def check_output_dir(out: Path) -> None:
+    """Raise ``ConfigError('--out', ...)`` unless ``out`` can become a results directory; creates nothing.
+
+    ``out`` must be a directory or not exist; its nearest existing ancestor must be a
+    writable directory (the staging directory is created next to ``out``).
+    """
+    out = Path(out)
+    if out.exists() and not out.is_dir():
+        raise ConfigError("--out", "a directory (or a path that does not exist yet)", str(out),
+                          "It names an existing file.")
+    ancestor = out.parent
+    while not ancestor.exists():
+        ancestor = ancestor.parent
+    if not ancestor.is_dir():
+        raise ConfigError("--out", "a path under a directory", str(out), f"{ancestor} is a file.")
+    if not os.access(ancestor, os.W_OK | os.X_OK):
+        raise ConfigError("--out", "a path in a writable directory", str(out), f"{ancestor} is not writable.")
+    if out.exists() and not os.access(out, os.W_OK | os.X_OK):
+        raise ConfigError("--out", "a writable directory", str(out), "permission denied")
+
+
+def _write_study(scenario: Scenario, out: Path, staging: Path, progress: bool, with_acceptance: bool,
+                 animate: bool, started: float, dynamic: bool = False) -> dict[str, Any]:
+    """Certify, run, and write every file of the study into ``staging``; returns the metrics."""
+    write_json(staging / "scenario.json", scenario.to_dict())
+    design = certify_and_write(scenario, staging)
+    tube, base = run_tube_and_baseline(scenario, design.tightening, progress)
+    metrics = write_runs(staging, scenario, design, tube, base)
+    if dynamic:
+        from .dynamic_study import run_dynamic
+
+        LOGGER.info("tube run on the dynamic plant (%s) ...", scenario.plant.vehicle)
+        metrics["dynamic"] = run_dynamic(scenario, staging, tube, progress)
+    if animate:
+        from .animate import animate_top_view
+
+        for path in animate_top_view(staging, scenario, [("tube", tube.columns()), ("baseline", base.columns())]):
+            LOGGER.info("animation written: %s", out / path.name)
     total = time.perf_counter() - started
     metrics["total_wall_s"] = total
     if with_acceptance:
         metrics["acceptance"] = acceptance(metrics, total)
-    write_json(out / "metrics.json", metrics)
-    log(comparison_table(metrics, metrics["baseline"]))
-    log_promises(metrics, log)
+    write_json(staging / "metrics.json", metrics)
+    return metrics
+
+
+def run_study(scenario: Scenario, out: Path, *, progress: bool = True, with_acceptance: bool = False,
+              animate: bool = False, dynamic: bool = False, echo: Echo = print) -> dict[str, Any]:
+    """Check every input, certify, run tube + baseline, write every output into ``out``; returns the metrics.
+
+    Parameters
+    ----------
+    out : Path
+        Results directory; replaced atomically at the end (see :class:`StagedOutput`).
+    animate : bool
+        Also write the top-view animation (GIF; MP4 where ffmpeg exists).
+    dynamic : bool
+        Also run the tube controller on the 4-DOF dynamic plant (:mod:`tubekit.app.dynamic_study`).
+    echo : callable
+        Receives the result lines (comparison table, promises, acceptance, ``wrote ...``).
+
+    Raises
+    ------
+    ConfigError
+        Any input that cannot run (see :func:`tubekit.checks.check_run_inputs`) or an unusable
+        ``out`` (field ``--out``); nothing is written.
+    """
+    started = time.perf_counter()
+    if scenario.steps < 1:
+        raise ConfigError("duration", f"at least one FHOCP period ({scenario.controller.dt:g} s)", scenario.duration)
+    check_run_inputs(scenario)
+    out = Path(out)
+    check_output_dir(out)
+    with StagedOutput(out) as staged:
+        metrics = _write_study(scenario, out, staged.path, progress, with_acceptance, animate, started, dynamic)
+    echo(comparison_table(metrics, metrics["baseline"]))
+    log_promises(metrics, echo)
+    if "dynamic" in metrics:
+        dyn = metrics["dynamic"]
+        echo(f"dynamic plant ({dyn['vehicle']}): {'certified' if dyn['certified'] else 'NOT certified'}"
+             + (f" (failed: {', '.join(dyn['failures'])})" if dyn["failures"] else "")
+             + f"; min clearance {_fmt(dyn['min_clearance'])} m, min e_d {_fmt(dyn['min_e_d'])} m, "
+               f"sway max {_fmt(dyn.get('sway_max'))} vs {_fmt(dyn.get('sway_bound'))} m/s, velocity-loop error max "
+               f"{dyn.get('velocity_error_max')}")
+        log_promises(dyn, echo)
     if with_acceptance:
-        log_acceptance(metrics, log)
-    log(f"wrote {out} in {total:.1f} s")
+        log_acceptance(metrics, echo)
+    echo(f"wrote {out} in {time.perf_counter() - started:.1f} s")
     return metrics

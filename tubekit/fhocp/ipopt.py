@@ -29,7 +29,16 @@ from ..validation import as_vector, finite
 from .nlp import SINC_SERIES_THRESHOLD, FhocpNlp, rollout, select_obstacles
 from .result import FhocpResult, Status, shifted_plan, status_from
 
-__all__ = ["IpoptFHOCP", "import_casadi", "IPOPT_STATUS"]
+__all__ = ["IpoptFHOCP", "import_casadi", "IPOPT_STATUS", "SQP_OPTIONS", "NLP_SOLVERS"]
+
+#: The CasADi ``nlpsol`` plugins this backend can use.
+NLP_SOLVERS = ("ipopt", "sqpmethod")
+#: The ``sqpmethod`` peer: exact Hessian, eigenvalue clipping, ``qrqp`` as the QP solver, quiet.
+SQP_OPTIONS: dict[str, Any] = {
+    "qpsol": "qrqp", "convexify_strategy": "eigen-clip", "max_iter": 100, "tol_pr": 1e-8, "tol_du": 1e-8,
+    "print_header": False, "print_iteration": False, "print_status": False,
+    "qpsol_options": {"print_iter": False, "print_header": False, "print_info": False, "error_on_fail": False},
+}
 
 #: IPOPT's return status (CasADi ``stats()["return_status"]``) -> :class:`Status`; any other is SOLVER_ERROR
 IPOPT_STATUS: dict[str, Status] = {
@@ -124,12 +133,19 @@ class IpoptFHOCP:
         Also pass the previous multipliers and IPOPT's warm-start options.
     ipopt_options : dict, optional
         Extra ``ipopt.*`` options (keys without the prefix).
+    nlp_solver : {"ipopt", "sqpmethod"}
+        CasADi plugin. ``"sqpmethod"`` uses :data:`SQP_OPTIONS` updated by ``ipopt_options`` (keys as
+        CasADi's sqpmethod takes them); its warm start passes the previous multipliers.
     """
 
     def __init__(self, scenario: Scenario, tightening: Tightening, *, max_obstacles: int = 4,
                  terminal: str = "soft", penalty: float = 1e3, terminal_penalty: float | None = None,
-                 warm_start_duals: bool = False, ipopt_options: dict | None = None) -> None:
+                 warm_start_duals: bool = False, ipopt_options: dict | None = None,
+                 nlp_solver: str = "ipopt") -> None:
         ca = import_casadi()
+        if nlp_solver not in NLP_SOLVERS:
+            raise ConfigError("nlp_solver", f"one of {NLP_SOLVERS}", nlp_solver)
+        self.nlp_solver = nlp_solver
         t0 = time.perf_counter()
         if not isinstance(max_obstacles, int) or isinstance(max_obstacles, bool) or max_obstacles < 0:
             raise ConfigError("max_obstacles", "an integer >= 0", max_obstacles)
@@ -162,8 +178,8 @@ class IpoptFHOCP:
         cost = self._terminal(ca, sym, states[N], rows, cost)
         x = ca.vertcat(ca.vec(sym["V"]), ca.vec(sym["S"]), ca.vec(sym["sig"]), sym["sig_t"])
         p = ca.vertcat(sym["s0"], ca.vec(sym["ref"]), ca.vec(sym["obs"]))
-        self._solver = ca.nlpsol("fhocp_ipopt", "ipopt", {"x": x, "p": p, "f": cost, "g": ca.vertcat(*rows.g)},
-                                 self._options(extra))
+        self._solver = ca.nlpsol(f"fhocp_{self.nlp_solver}", self.nlp_solver,
+                                 {"x": x, "p": p, "f": cost, "g": ca.vertcat(*rows.g)}, self._options(extra))
         nx = x.shape[0]
         self._lbx = np.full(nx, -np.inf)
         self._ubx = np.full(nx, np.inf)
@@ -227,6 +243,8 @@ class IpoptFHOCP:
 
     def _options(self, extra: dict) -> dict:
         """CasADi/IPOPT options: quiet, tol 1e-8, optional dual warm start, then ``extra``."""
+        if self.nlp_solver == "sqpmethod":
+            return {"print_time": False, **SQP_OPTIONS, **extra}
         opts = {"print_time": False, "ipopt.print_level": 0, "ipopt.sb": "yes", "ipopt.tol": 1e-8,
                 "ipopt.max_iter": 500}
         if self.warm_start_duals:

@@ -1,0 +1,76 @@
+"""The short Python API: ``tubekit.simulate(scenario, certificate)``.
+
+A certificate (from :func:`verify.certify`) is accepted directly; its certified
+:class:`~tubekit.tightening.Tightening` is used, or :class:`tubekit.exceptions.ConfigError`
+says what to do when it is not certified. With no certificate the nominal MPC alone runs
+(no tightening, no ancillary feedback): the baseline of ``tubekit reproduce``.
+
+>>> import tubekit, verify                                          # doctest: +SKIP
+>>> sc = tubekit.load_scenario("verify/scenarios/paper_currents.toml")  # doctest: +SKIP
+>>> run = tubekit.simulate(sc, verify.certify(sc), duration=20.0)    # doctest: +SKIP
+>>> run.metrics["min_clearance"], all(p.ok for p in tubekit.check_promises(run))  # doctest: +SKIP
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+from .checks import check_run_inputs
+from .closed_loop import simulate as _simulate
+from .exceptions import ConfigError, TubekitError
+from .scenario import Scenario
+from .simulation_result import SimulationResult
+from .tightening import Tightening
+
+__all__ = ["simulate"]
+
+
+def _tightening_of(certificate: Any) -> Tightening:
+    """The Tightening of a certificate (or a Tightening given directly)."""
+    if isinstance(certificate, Tightening):
+        return certificate
+    if not hasattr(type(certificate), "tightening"):
+        raise ConfigError("certificate", "a verify.Certificate or a tubekit.Tightening",
+                          type(certificate).__name__)
+    try:
+        tight = certificate.tightening
+    except TubekitError as exc:
+        raise ConfigError("certificate", "a certified certificate (or pass certificate.best_effort_tightening() "
+                          "for a run without a guarantee)", "not certified", str(exc)) from None
+    if not isinstance(tight, Tightening):
+        raise ConfigError("certificate.tightening", "a tubekit.Tightening", type(tight).__name__)
+    return tight
+
+
+def simulate(scenario: Scenario, certificate: Any = None, duration: float | None = None,
+             progress: bool = True) -> SimulationResult:
+    """Run the closed loop of ``scenario`` (the tube controller when a certificate is given).
+
+    Parameters
+    ----------
+    scenario : Scenario
+        What to simulate.
+    certificate : verify.Certificate or Tightening, optional
+        The certified design; ``None`` runs the nominal MPC alone (no tube).
+    duration : float, optional
+        Simulated time (s); default the scenario's.
+    progress : bool
+        A progress bar on a terminal.
+
+    Returns
+    -------
+    SimulationResult
+        With ``metrics``, ``plot()`` and ``to_csv(path)``; :func:`tubekit.check_promises` measures it.
+    """
+    if not isinstance(scenario, Scenario):
+        raise ConfigError("scenario", "a tubekit.Scenario", type(scenario).__name__)
+    if duration is not None:
+        if isinstance(duration, bool) or not isinstance(duration, (int, float)) or not math.isfinite(duration) \
+                or duration <= 0:
+            raise ConfigError("duration", "a number of seconds > 0", duration)
+        scenario = scenario.with_changes(duration=float(duration))
+    check_run_inputs(scenario)
+    if certificate is None:
+        return _simulate(scenario, tube=False, progress=progress, label="baseline")
+    return _simulate(scenario, tightening=_tightening_of(certificate), tube=True, progress=progress, label="tube")

@@ -1,0 +1,94 @@
+"""The dynamic-plant part of ``tubekit reproduce`` (issue 13): the tube controller on the 4-DOF vehicle.
+
+:func:`run_dynamic` certifies the scenario with ``[plant] kind = "dynamic"`` (the velocity
+loop's tracking bound and the hull's sway bound enter ω; usually not certified, and then the
+best-effort sets are used and flagged), runs the tube controller on the dynamic plant under
+the same current, measures every promise, and writes ``dynamic_trajectory.csv``,
+``dynamic_certificate.txt`` and ``dynamic_vs_kinematic.png``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import replace
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from matplotlib.figure import Figure
+from matplotlib.patches import Circle as CirclePatch
+
+import verify
+
+from ..closed_loop import SimulationResult, simulate
+from ..jsonable import write_text
+from ..metrics import compute_metrics
+from ..promises import check_promises
+from ..scenario import Scenario
+
+__all__ = ["run_dynamic", "comparison_figure", "DYNAMIC_FILES"]
+
+#: Files the dynamic part writes.
+DYNAMIC_FILES: tuple[str, ...] = ("dynamic_trajectory.csv", "dynamic_certificate.txt", "dynamic_vs_kinematic.png")
+
+
+def _dynamic_scenario(scenario: Scenario) -> Scenario:
+    if scenario.plant.kind == "dynamic":
+        return scenario
+    return scenario.with_changes(plant=replace(scenario.plant, kind="dynamic"))
+
+
+def comparison_figure(scenario: Scenario, kinematic: SimulationResult, dynamic: SimulationResult,
+                      gamma: float) -> Figure:
+    """Path, e_d, sway against γ̄ and thrust against its limits: kinematic and dynamic tube runs."""
+    fig = Figure(figsize=(12, 8.5), layout="constrained")
+    ax = fig.subplots(2, 2)
+    runs = (("kinematic plant", kinematic, "tab:blue"), ("dynamic plant (REMUS 100)", dynamic, "tab:purple"))
+    for label, run, colour in runs:
+        ax[0, 0].plot(run.states[:, 0], run.states[:, 1], color=colour, lw=1.2, label=label)
+        ax[0, 1].plot(run.t, run.errors[:, 0], color=colour, lw=1.2, label=label)
+    pd = scenario.trajectory.position(np.linspace(0.0, kinematic.t[-1], 800))
+    ax[0, 0].plot(pd[:, 0], pd[:, 1], "--", color="tab:green", lw=1.0, label="desired")
+    for o in scenario.obstacles:
+        ax[0, 0].add_patch(CirclePatch(o.center[:2], o.radius, color="0.45"))
+    ax[0, 0].set(aspect="equal", xlabel="x (m)", ylabel="y (m)", title="path")
+    ax[0, 1].axhline(scenario.epsilon, color="tab:red", ls="--", lw=1.0, label=f"ε = {scenario.epsilon:g} m")
+    ax[0, 1].set(yscale="log", xlabel="t (s)", ylabel="e_d (m)", title="distance error")
+    sway = dynamic.body[:, 1] if dynamic.body is not None else np.full(len(dynamic.t), np.nan)
+    ax[1, 0].plot(dynamic.t, sway, color="tab:purple", lw=1.0, label="sway v_b (dynamic plant)")
+    for s in (gamma, -gamma):
+        ax[1, 0].axhline(s, color="tab:red", ls="--", lw=1.0, label="±γ̄ (certificate)" if s > 0 else None)
+    ax[1, 0].set(xlabel="t (s)", ylabel="m/s", title="sway against its bound")
+    limits = np.asarray(scenario.plant.params.thrust_limits, dtype=float)
+    if dynamic.thrust is not None:
+        for k, (name, colour) in enumerate((("X / X_max", "tab:blue"), ("Z / Z_max", "tab:orange"),
+                                             ("N / N_max", "tab:green"))):
+            ax[1, 1].plot(dynamic.t, dynamic.thrust[:, k] / limits[k], color=colour, lw=0.9, label=name)
+    ax[1, 1].axhline(1.0, color="tab:red", ls="--", lw=1.0, label="limit")
+    ax[1, 1].axhline(-1.0, color="tab:red", ls="--", lw=1.0)
+    ax[1, 1].set(xlabel="t (s)", ylabel="thrust / limit", title="thrust against its limits")
+    for a in ax.flat:
+        a.grid(alpha=0.3)
+        a.legend(fontsize=9, loc="best")
+    fig.suptitle(f"{scenario.name}: tube controller, kinematic vs dynamic plant", fontsize=13)
+    return fig
+
+
+def run_dynamic(scenario: Scenario, staging: Path, kinematic: SimulationResult, progress: bool) -> dict[str, Any]:
+    """Certify and run the dynamic plant; write its files into ``staging``; return its metrics."""
+    scd = _dynamic_scenario(scenario)
+    cert = verify.certify(scd, law=scd.controller.law)
+    write_text(staging / "dynamic_certificate.txt", cert.summary() + "\n")
+    tight = cert.best_effort_tightening()
+    run = simulate(scd, tightening=tight, tube=True, progress=progress, label="dynamic", plant="dynamic")
+    run.write_csv(staging / "dynamic_trajectory.csv")
+    gamma = float(cert.disturbance.gamma)
+    metrics = compute_metrics(run.columns(), scd, rho_bound=tight.rho_tilde if cert.certified else None,
+                              sway_bound=gamma, extra={"tube": True, "law": run.law, "sigma": run.sigma})
+    promises = check_promises(run)
+    metrics.update(certified=bool(cert.certified), failures=[f["condition"] for f in cert.failures],
+                   promises=[p.to_dict() for p in promises], promises_kept=all(p.ok for p in promises),
+                   vehicle=scd.plant.vehicle, tracking_bound=list(scd.plant.tracking_bound))
+    if run.velocity_error is not None:
+        metrics["velocity_error_max"] = [float(x) for x in np.nanmax(np.abs(run.velocity_error), axis=0)]
+    comparison_figure(scd, kinematic, run, gamma).savefig(staging / "dynamic_vs_kinematic.png", dpi=100)
+    return metrics

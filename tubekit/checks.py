@@ -1,0 +1,146 @@
+"""Pre-run validation: everything a run needs is checked before any work or output (issue 16).
+
+:func:`check_run_inputs` raises :class:`~tubekit.exceptions.ConfigError` naming
+the field to fix, before certification, simulation or any file is written:
+
+* geometry of the start: clear of every obstacle inflated by the vehicle
+  radius r̄, inside the workspace box, and at e_d(0) >= ε (e_o is undefined at
+  e_d = 0 and the certified region starts at ε);
+* size: the per-tick log of a run (:func:`log_bytes`) fits
+  :data:`MEMORY_BUDGET_BYTES`;
+* horizon and limits: N <= :data:`MAX_HORIZON_STEPS`, and the farthest
+  horizontal travel of one horizon, u_max N δt, leaves room between the walls
+  of the workspace (the FHOCP keeps one wall row per axis). When that fails
+  the error names the field whose paper value would make it fit
+  (``controller.horizon_steps``, then ``limits.u_max``), else ``workspace``.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from .derivation import error_coordinates
+from .exceptions import ConfigError
+from .scenario import ControllerSettings, Scenario, paper_scenario
+
+__all__ = ["check_run_inputs", "check_start", "check_log_size", "check_horizon_and_limits", "log_bytes",
+           "MEMORY_BUDGET_BYTES", "LOG_BYTES_PER_TICK", "RUNS_PER_STUDY", "MAX_HORIZON_STEPS"]
+
+#: Memory a study may spend on its per-tick logs (bytes): 2 GiB.
+MEMORY_BUDGET_BYTES = 2 * 1024 ** 3
+#: Bytes per ancillary tick of one run: the loop's log (about 25 numbers), the result's
+#: derived columns (40) and the copies made for metrics and CSV, rounded up.
+LOG_BYTES_PER_TICK = 1024
+#: Runs held in memory together by a study (tube and baseline).
+RUNS_PER_STUDY = 2
+#: Largest FHOCP horizon N accepted (the convex subproblem grows linearly in N; beyond this
+#: one build takes minutes and the horizon dwarfs any workspace).
+MAX_HORIZON_STEPS = 500
+
+
+def _fmt_bytes(n: float) -> str:
+    """``n`` bytes in the largest binary unit that keeps it >= 1."""
+    for unit in ("B", "KiB", "MiB", "GiB", "TiB", "PiB"):
+        if n < 1024 or unit == "PiB":
+            return f"{n:.3g} {unit}"
+        n /= 1024
+    return f"{n:.3g} PiB"  # pragma: no cover
+
+
+def log_bytes(scenario: Scenario, duration: float | None = None) -> float:
+    """Estimated bytes of the per-tick logs of one study (tube + baseline) of ``duration`` s.
+
+    ``duration`` defaults to ``scenario.duration``; ticks = duration x ancillary rate + 1.
+    """
+    seconds = scenario.duration if duration is None else float(duration)
+    ticks = seconds * scenario.controller.ancillary_rate_hz + 1
+    return RUNS_PER_STUDY * LOG_BYTES_PER_TICK * ticks
+
+
+def check_log_size(scenario: Scenario, duration: float | None = None) -> None:
+    """Raise ``ConfigError('duration', ...)`` when the logs would exceed :data:`MEMORY_BUDGET_BYTES`."""
+    need = log_bytes(scenario, duration)
+    if need > MEMORY_BUDGET_BYTES:
+        rate = scenario.controller.ancillary_rate_hz
+        longest = (MEMORY_BUDGET_BYTES / (RUNS_PER_STUDY * LOG_BYTES_PER_TICK) - 1) / rate
+        raise ConfigError("duration", f"at most {longest:.6g} s at {rate:g} Hz (the per-tick log must fit "
+                          f"{_fmt_bytes(MEMORY_BUDGET_BYTES)})",
+                          scenario.duration if duration is None else duration,
+                          f"It would need about {_fmt_bytes(need)}")
+
+
+def check_start(scenario: Scenario) -> None:
+    """The start: clear of every inflated obstacle, inside the workspace, e_d(0) >= epsilon."""
+    x0 = np.asarray(scenario.initial_state, dtype=float)
+    position = x0[:3]
+    for index, obstacle in enumerate(scenario.obstacles):
+        gap = float(np.linalg.norm(position - np.asarray(obstacle.center))) - obstacle.radius
+        if gap <= scenario.vehicle_radius:
+            raise ConfigError("initial_state", f"a start clear of obstacles[{index}] inflated by vehicle_radius "
+                              f"(distance to its surface > {scenario.vehicle_radius:g} m)",
+                              [float(v) for v in x0], f"It is {gap:.4g} m from the surface")
+    if scenario.workspace is not None:
+        lower, upper = (np.asarray(side, dtype=float) for side in scenario.workspace)
+        if np.any(position < lower) or np.any(position > upper):
+            raise ConfigError("initial_state", f"a position inside the workspace {[lower.tolist(), upper.tolist()]} m",
+                              [float(v) for v in x0])
+    target = np.asarray(scenario.trajectory.position(np.array([0.0])), dtype=float).reshape(-1, 3)[0]
+    e_d0 = float(error_coordinates(x0, target)[0])
+    if not e_d0 >= scenario.epsilon:
+        raise ConfigError("initial_state", f"a start at horizontal distance e_d(0) >= epsilon = "
+                          f"{scenario.epsilon:g} m from the target p_d(0)", [float(v) for v in x0],
+                          f"e_d(0) = {e_d0:.4g} m")
+
+
+def _reach(scenario: Scenario, u_max: float, horizon_steps: int) -> float:
+    """Farthest horizontal travel within one horizon (m)."""
+    return u_max * scenario.controller.dt * horizon_steps
+
+
+def _fits_workspace(scenario: Scenario, u_max: float, horizon_steps: int) -> bool:
+    """Whether both horizontal workspace extents exceed 2 (r̄ + u_max N δt)."""
+    lower, upper = (np.asarray(side, dtype=float) for side in scenario.workspace)  # type: ignore[union-attr]
+    width = upper[:2] - lower[:2] - 2 * scenario.vehicle_radius
+    return bool(np.all(width > 2 * _reach(scenario, u_max, horizon_steps)))
+
+
+def check_horizon_and_limits(scenario: Scenario) -> None:
+    """N within :data:`MAX_HORIZON_STEPS`; one horizon's travel fits the workspace, blaming its own field."""
+    steps = scenario.controller.horizon_steps
+    if steps > MAX_HORIZON_STEPS:
+        raise ConfigError("controller.horizon_steps", f"an integer in [1, {MAX_HORIZON_STEPS}]", steps)
+    if scenario.workspace is None:
+        return
+    u_max = scenario.limits.u_max
+    if _fits_workspace(scenario, u_max, steps):
+        return
+    need = 2 * (scenario.vehicle_radius + _reach(scenario, u_max, steps))
+    rule = (f"u_max N dt small enough that the workspace's x and y extents exceed 2 (vehicle_radius + "
+            f"u_max N dt) = {need:.4g} m")
+    default_steps = ControllerSettings().horizon_steps
+    if steps > default_steps and _fits_workspace(scenario, u_max, default_steps):
+        raise ConfigError("controller.horizon_steps", f"a smaller horizon: {rule}", steps)
+    if _fits_workspace(scenario, paper_scenario().limits.u_max, steps):
+        raise ConfigError("limits.u_max", f"a smaller speed: {rule}", u_max)
+    extents = np.subtract(scenario.workspace[1], scenario.workspace[0])[:2]
+    raise ConfigError("workspace", rule, f"x, y extents {extents[0]:.4g} m, {extents[1]:.4g} m")
+
+
+def check_run_inputs(scenario: Scenario, duration: float | None = None) -> None:
+    """Every check of this module, cheapest first; raises the first :class:`ConfigError`.
+
+    Parameters
+    ----------
+    scenario : Scenario
+        The scenario to run.
+    duration : float, optional
+        Simulated time (s) if it differs from ``scenario.duration``.
+    """
+    seconds = scenario.duration if duration is None else duration
+    if not (isinstance(seconds, (int, float)) and math.isfinite(seconds) and seconds > 0):
+        raise ConfigError("duration", "a number of seconds > 0", seconds)
+    check_log_size(scenario, duration)
+    check_horizon_and_limits(scenario)
+    check_start(scenario)

@@ -1,0 +1,54 @@
+"""Build executed Jupyter notebooks from the percent-format tutorials (the `.py` files are the source).
+
+    python tutorials/build_notebooks.py            # full sizes, into tutorials/notebooks/
+    TUBEKIT_QUICK=1 python tutorials/build_notebooks.py --out /tmp/nb   # reduced sizes
+
+Each tutorial is converted with jupytext and executed with nbclient in a fresh kernel, so a
+student opening a notebook sees the prose, the printed results and the figures inline.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+from pathlib import Path
+
+import jupytext
+import nbformat
+from jupyter_client import KernelManager
+from nbclient import NotebookClient
+
+HERE = Path(__file__).resolve().parent
+
+
+def build(tutorial: Path, out_dir: Path, figures: Path, timeout_s: int = 900) -> Path:
+    """Execute ``tutorial`` as a notebook; write ``out_dir/<name>.ipynb``; return its path."""
+    nb = jupytext.read(tutorial)
+    os.environ.setdefault("TUBEKIT_FIGURES", str(figures))
+    figures.mkdir(parents=True, exist_ok=True)
+    km = KernelManager(kernel_name="python3", ip="127.0.0.1")  # the kernel listens on loopback only
+    NotebookClient(nb, km=km, timeout=timeout_s, kernel_name="python3",
+                   resources={"metadata": {"path": str(figures)}}).execute()
+    out_dir.mkdir(parents=True, exist_ok=True)
+    target = out_dir / f"{tutorial.stem}.ipynb"
+    tmp = out_dir / f".{tutorial.stem}.partial.ipynb"
+    nbformat.write(nb, str(tmp))
+    os.replace(tmp, target)
+    return target
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--out", type=Path, default=HERE / "notebooks", help="output directory")
+    parser.add_argument("names", nargs="*", help="tutorial stems (default: all)")
+    args = parser.parse_args()
+    files = sorted(HERE.glob("[0-9][0-9]_*.py"))
+    if args.names:
+        files = [f for f in files if f.stem in args.names]
+    for f in files:
+        print(f"building {f.stem} ...", flush=True)
+        print(f"  wrote {build(f, args.out, HERE / 'figures')}")
+
+
+if __name__ == "__main__":
+    main()

@@ -31,7 +31,7 @@ from typing import Sequence
 import numpy as np
 
 from .exceptions import ConfigError
-from .plant import OmegaOverride, Plant
+from .plant import OmegaOverride, Plant, rk4_tuple
 from .scenario import Scenario
 from .vehicles import VehicleParams
 
@@ -145,15 +145,7 @@ class DynamicPlant:
         if self.state is None:
             self.state = self._start(v)
         self._log.append(self.state[:7])
-        y = (*x, *self.state)
-        f = self._rhs
-        for _ in range(n):
-            k1 = f(t, y, v)
-            k2 = f(t + 0.5 * h, tuple(a + 0.5 * h * b for a, b in zip(y, k1)), v)
-            k3 = f(t + 0.5 * h, tuple(a + 0.5 * h * b for a, b in zip(y, k2)), v)
-            k4 = f(t + h, tuple(a + h * b for a, b in zip(y, k3)), v)
-            y = tuple(a + h / 6.0 * (b + 2.0 * c + 2.0 * d + e) for a, b, c, d, e in zip(y, k1, k2, k3, k4))
-            t += h
+        y = rk4_tuple(self._rhs, t, (*x, *self.state), v, h, n)
         self.state = y[4:]
         return y[0], y[1], y[2], y[3]
 

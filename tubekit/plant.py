@@ -34,6 +34,7 @@ __all__ = [
     "nominal_arc",
     "plant_rhs",
     "rk4_hold",
+    "rk4_tuple",
     "sway_velocity_term",
 ]
 
@@ -148,15 +149,19 @@ class Plant:
 
     def step_tuple(self, t: float, x: Sequence[float], v: Sequence[float], h: float, n: int) -> Floats4:
         """:meth:`step` on float tuples, without arrays (the closed loop's inner loop)."""
-        f = self._rhs
-        for _ in range(n):
-            k1 = f(t, x, v)
-            k2 = f(t + 0.5 * h, tuple(xi + 0.5 * h * ki for xi, ki in zip(x, k1)), v)
-            k3 = f(t + 0.5 * h, tuple(xi + 0.5 * h * ki for xi, ki in zip(x, k2)), v)
-            k4 = f(t + h, tuple(xi + h * ki for xi, ki in zip(x, k3)), v)
-            x = tuple(xi + h / 6.0 * (a + 2.0 * b + 2.0 * c + d) for xi, a, b, c, d in zip(x, k1, k2, k3, k4))
-            t += h
-        return x
+        return rk4_tuple(self._rhs, t, tuple(x), v, h, n)
+
+
+def rk4_tuple(f: Callable, t: float, y: tuple, v: Sequence[float], h: float, n: int) -> tuple:
+    """``n`` classical RK4 steps of ``h`` (s) of ``y' = f(t, y, v)`` on float tuples, ``v`` held (both plants)."""
+    for _ in range(n):
+        k1 = f(t, y, v)
+        k2 = f(t + 0.5 * h, tuple(a + 0.5 * h * b for a, b in zip(y, k1)), v)
+        k3 = f(t + 0.5 * h, tuple(a + 0.5 * h * b for a, b in zip(y, k2)), v)
+        k4 = f(t + h, tuple(a + h * b for a, b in zip(y, k3)), v)
+        y = tuple(a + h / 6.0 * (b + 2.0 * c + 2.0 * d + e) for a, b, c, d, e in zip(y, k1, k2, k3, k4))
+        t += h
+    return y
 
 
 def sway_velocity_term(x: np.ndarray, v_sway: float) -> np.ndarray:

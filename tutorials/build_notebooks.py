@@ -21,6 +21,18 @@ from nbclient import NotebookClient
 HERE = Path(__file__).resolve().parent
 
 
+def relative_paths(nb, root: Path = HERE.parent) -> None:
+    """Print paths relative to the repository in every text output (a notebook carries no machine's paths)."""
+    prefix = str(root) + "/"
+    for cell in nb.cells:
+        for out in cell.get("outputs", []):
+            if "text" in out:
+                out["text"] = out["text"].replace(prefix, "")
+            data = out.get("data", {})
+            if "text/plain" in data:
+                data["text/plain"] = data["text/plain"].replace(prefix, "")
+
+
 def build(tutorial: Path, out_dir: Path, figures: Path, timeout_s: int = 900) -> Path:
     """Execute ``tutorial`` as a notebook; write ``out_dir/<name>.ipynb``; return its path."""
     nb = jupytext.read(tutorial)
@@ -29,6 +41,7 @@ def build(tutorial: Path, out_dir: Path, figures: Path, timeout_s: int = 900) ->
     km = KernelManager(kernel_name="python3", ip="127.0.0.1")  # the kernel listens on loopback only
     NotebookClient(nb, km=km, timeout=timeout_s, kernel_name="python3",
                    resources={"metadata": {"path": str(figures)}}).execute()
+    relative_paths(nb)
     out_dir.mkdir(parents=True, exist_ok=True)
     target = out_dir / f"{tutorial.stem}.ipynb"
     tmp = out_dir / f".{tutorial.stem}.partial.ipynb"

@@ -109,25 +109,30 @@ def _figures_of(run: Any, promises: list) -> dict[str, Any]:
 def simulate_task(task: RunTask) -> dict[str, Any]:
     """Run ``task`` and return its row (without the sampled values); ``wall_s`` is the only timing."""
     started = time.perf_counter()
-    row: dict[str, Any] = {"run": task.run, "seed": task.seed, "certified": task.certificate.certified}
     try:
-        figures = [_figures_of(run, promises) for run, promises in _simulate_all(task)]
+        sims = _simulate_all(task)
     except TubekitError as exc:  # a run that cannot be simulated is recorded, not retried
-        row.update(max_rho_ratio=None, min_clearance=None, min_e_d=None, tracking_rmse=None,
-                   saturated_steps=None, violated=False, premises_held=False, broken="", worst_sequence=-1,
-                   error=str(exc).splitlines()[0], wall_s=time.perf_counter() - started)
-        return row
+        return {"run": task.run, "seed": task.seed, "certified": task.certificate.certified,
+                "max_rho_ratio": None, "min_clearance": None, "min_e_d": None, "tracking_rmse": None,
+                "saturated_steps": None, "violated": False, "premises_held": False, "broken": "",
+                "worst_sequence": -1, "error": str(exc).splitlines()[0], "wall_s": time.perf_counter() - started}
+    return _row_of(task, sims, started)
+
+
+def _row_of(task: RunTask, sims: list[tuple[Any, list]], started: float) -> dict[str, Any]:
+    """The row of a run: the worst figure of each metric over its simulations."""
+    figures = [_figures_of(run, promises) for run, promises in sims]
     worst = int(np.argmax([f["max_rho_ratio"] for f in figures]))
-    row.update(max_rho_ratio=figures[worst]["max_rho_ratio"],
-               min_clearance=min(f["min_clearance"] for f in figures),
-               min_e_d=min(f["min_e_d"] for f in figures),
-               tracking_rmse=max(f["tracking_rmse"] for f in figures),
-               saturated_steps=max(f["saturated_steps"] for f in figures),
-               violated=any(f["broken"] for f in figures),
-               premises_held=all(f["premises_held"] for f in figures),
-               broken=",".join(sorted({n for f in figures for n in f["broken"]})),
-               worst_sequence=worst, error="", wall_s=time.perf_counter() - started)
-    return row
+    return {"run": task.run, "seed": task.seed, "certified": task.certificate.certified,
+            "max_rho_ratio": figures[worst]["max_rho_ratio"],
+            "min_clearance": min(f["min_clearance"] for f in figures),
+            "min_e_d": min(f["min_e_d"] for f in figures),
+            "tracking_rmse": max(f["tracking_rmse"] for f in figures),
+            "saturated_steps": max(f["saturated_steps"] for f in figures),
+            "violated": any(f["broken"] for f in figures),
+            "premises_held": all(f["premises_held"] for f in figures),
+            "broken": ",".join(sorted({n for f in figures for n in f["broken"]})),
+            "worst_sequence": worst, "error": "", "wall_s": time.perf_counter() - started}
 
 
 # ---- certificates and the cluster (client side) ---------------------------------------------------------
@@ -379,16 +384,16 @@ def replay_run(campaign_dir: str | Path, run: int) -> tuple[dict, dict | None, A
     except (OSError, ValueError):
         raise ConfigError("--from-campaign", "a campaign directory (with campaign.json)", str(folder)) from None
     spec = spec_from_stored(stored["spec"])
-    if isinstance(run, bool) or not isinstance(run, int) or not 0 <= run < max(spec.runs, 1 + max(_finished(folder),
-                                                                                               default=-1)):
+    if isinstance(run, bool) or not isinstance(run, int) or not 0 <= run < spec.runs:
         raise ConfigError("--run", f"a run number in [0, {spec.runs - 1}]", run)
     plan = spec.plan(run)
     cert = certify_plans([plan])[certificate_key(plan.scenario)]
     task = RunTask(run, plan.seed, plan.scenario, cert, spec.falsify_sequences)
+    started = time.perf_counter()
     sims = _simulate_all(task)
-    row = simulate_task(task)
+    row = _row_of(task, sims, started)
     row = {"run": run, "seed": plan.seed, **_flat_values(plan.values), **{k: row[k] for k in METRIC_COLUMNS}}
-    worst = sims[row["worst_sequence"]][0] if row["worst_sequence"] >= 0 else sims[0][0]
+    worst = sims[row["worst_sequence"]][0]
     path = _run_file(folder, run)
     previous = json.loads(path.read_text(encoding="utf-8")) if path.exists() else None
     return row, previous, worst

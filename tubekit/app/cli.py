@@ -147,8 +147,12 @@ def _configure_reproduce(parser: argparse.ArgumentParser) -> None:
 
 
 def _configure_simulate(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("config", metavar="CONFIG", help="scenario TOML file (schema: docs/scenario.md)")
+    parser.add_argument("config", metavar="CONFIG", nargs="?", default=None,
+                        help="scenario TOML file (schema: docs/scenario.md); not with --from-campaign")
     _study_options(parser, None)
+    parser.add_argument("--from-campaign", metavar="DIR", default=None,
+                        help="replay one run of a `tubekit campaign` output DIR exactly (with --run K)")
+    parser.add_argument("--run", metavar="K", type=int, default=None, help="the run of --from-campaign to replay")
 
 
 def _run_reproduce(args: argparse.Namespace) -> int:
@@ -163,9 +167,32 @@ def _run_reproduce(args: argparse.Namespace) -> int:
 
 
 def _run_simulate(args: argparse.Namespace) -> int:
-    """The same study on a scenario from TOML."""
+    """The same study on a scenario from TOML; or, with ``--from-campaign DIR --run K``, a campaign run replayed."""
     from .study import apply_overrides, output_dir_name, run_study
 
+    if args.from_campaign is not None or args.run is not None:
+        from .campaign import replay_run
+        from .study import check_output_dir
+
+        if args.from_campaign is None or args.run is None or args.config is not None:
+            raise ConfigError("--from-campaign", "--from-campaign DIR together with --run K (and no CONFIG)",
+                              args.from_campaign)
+        out = Path(args.out) if args.out else Path(args.from_campaign) / f"replay_{args.run:06d}"
+        check_output_dir(out)
+        row, stored, run = replay_run(args.from_campaign, args.run)
+        out.mkdir(parents=True, exist_ok=True)
+        run.write_csv(out / "trajectory.csv")
+        same = stored is not None and dumps({**stored, "wall_s": 0}) == dumps({**row, "wall_s": 0})
+        write_json(out / "replay.json", {"replayed": row, "stored": stored, "identical": same})
+        for key in ("max_rho_ratio", "min_clearance", "min_e_d", "tracking_rmse", "saturated_steps", "violated"):
+            _echo(f"{key:16s} replayed {row[key]!s:24s} campaign {None if stored is None else stored[key]!s}")
+        _echo(f"run {args.run} (seed {row['seed']}): {'identical to' if same else 'DIFFERS from'} the campaign's "
+              f"row; wrote {out}")
+        if row["certified"] and row["violated"]:
+            return EXIT_PROMISE_BROKEN
+        return EXIT_OK if same else EXIT_FAILURE
+    if args.config is None:
+        raise ConfigError("CONFIG", "a scenario TOML file (or --from-campaign DIR --run K)", None)
     scenario = apply_overrides(_load_config(args.config), duration=args.duration, quick=args.quick, law=args.law)
     out = Path(args.out) if args.out else Path("results") / output_dir_name(scenario.name)
     metrics = run_study(scenario, out, progress=not args.no_progress, with_acceptance=False, animate=args.animate,

@@ -36,7 +36,7 @@ from .campaign_spec import CampaignSpec, RunPlan, certificate_key, spec_from_sto
 from .study import check_output_dir
 
 __all__ = ["RunTask", "Certified", "simulate_task", "certify_plans", "open_client", "run_campaign",
-           "read_rows", "replay_run", "METRIC_COLUMNS", "FIGURES"]
+           "read_rows", "replay_run", "replay_into", "summarise", "write_figures", "METRIC_COLUMNS", "FIGURES"]
 
 LOGGER = logging.getLogger("tubekit.campaign")
 #: Per-run metric columns of ``runs.parquet`` (after run, seed and the sampled values).
@@ -397,3 +397,24 @@ def replay_run(campaign_dir: str | Path, run: int) -> tuple[dict, dict | None, A
     path = _run_file(folder, run)
     previous = json.loads(path.read_text(encoding="utf-8")) if path.exists() else None
     return row, previous, worst
+
+
+def replay_into(campaign_dir: str | Path, run: int, out: str | Path | None, echo: Callable = print) -> dict:
+    """``tubekit simulate --from-campaign DIR --run K``: replay, write ``trajectory.csv`` and ``replay.json``.
+
+    Returns ``{"identical": replayed row == stored row (wall_s aside), "broken": certified and violated}``.
+    """
+    from ..jsonable import dumps
+
+    target = Path(out) if out else Path(campaign_dir) / f"replay_{run:06d}"
+    check_output_dir(target)
+    row, stored, result = replay_run(campaign_dir, run)
+    target.mkdir(parents=True, exist_ok=True)
+    result.write_csv(target / "trajectory.csv")
+    same = stored is not None and dumps({**stored, "wall_s": 0}) == dumps({**row, "wall_s": 0})
+    write_json(target / "replay.json", {"replayed": row, "stored": stored, "identical": same})
+    for key in ("max_rho_ratio", "min_clearance", "min_e_d", "tracking_rmse", "saturated_steps", "violated"):
+        echo(f"{key:16s} replayed {row[key]!s:24s} campaign {None if stored is None else stored[key]!s}")
+    echo(f"run {run} (seed {row['seed']}): {'identical to' if same else 'DIFFERS from'} the campaign's row; "
+         f"wrote {target}")
+    return {"identical": same, "broken": bool(row["certified"] and row["violated"])}

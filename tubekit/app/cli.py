@@ -171,26 +171,13 @@ def _run_simulate(args: argparse.Namespace) -> int:
     from .study import apply_overrides, output_dir_name, run_study
 
     if args.from_campaign is not None or args.run is not None:
-        from .campaign import replay_run
-        from .study import check_output_dir
+        from .campaign import replay_into
 
         if args.from_campaign is None or args.run is None or args.config is not None:
             raise ConfigError("--from-campaign", "--from-campaign DIR together with --run K (and no CONFIG)",
                               args.from_campaign)
-        out = Path(args.out) if args.out else Path(args.from_campaign) / f"replay_{args.run:06d}"
-        check_output_dir(out)
-        row, stored, run = replay_run(args.from_campaign, args.run)
-        out.mkdir(parents=True, exist_ok=True)
-        run.write_csv(out / "trajectory.csv")
-        same = stored is not None and dumps({**stored, "wall_s": 0}) == dumps({**row, "wall_s": 0})
-        write_json(out / "replay.json", {"replayed": row, "stored": stored, "identical": same})
-        for key in ("max_rho_ratio", "min_clearance", "min_e_d", "tracking_rmse", "saturated_steps", "violated"):
-            _echo(f"{key:16s} replayed {row[key]!s:24s} campaign {None if stored is None else stored[key]!s}")
-        _echo(f"run {args.run} (seed {row['seed']}): {'identical to' if same else 'DIFFERS from'} the campaign's "
-              f"row; wrote {out}")
-        if row["certified"] and row["violated"]:
-            return EXIT_PROMISE_BROKEN
-        return EXIT_OK if same else EXIT_FAILURE
+        replay = replay_into(args.from_campaign, args.run, args.out, echo=_echo)
+        return EXIT_PROMISE_BROKEN if replay["broken"] else EXIT_OK if replay["identical"] else EXIT_FAILURE
     if args.config is None:
         raise ConfigError("CONFIG", "a scenario TOML file (or --from-campaign DIR --run K)", None)
     scenario = apply_overrides(_load_config(args.config), duration=args.duration, quick=args.quick, law=args.law)
@@ -378,6 +365,30 @@ def _run_falsify(args: argparse.Namespace) -> int:
     return EXIT_NOT_CERTIFIED if result.found else EXIT_OK
 
 
+# ---- campaign -------------------------------------------------------------------------------------------
+
+def _configure_campaign(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("spec", metavar="SPEC", help="campaign TOML (schema: docs/campaign.md)")
+    parser.add_argument("--out", metavar="DIR", required=True, help="campaign directory (a rerun resumes it)")
+    parser.add_argument("--workers", type=int, default=2, metavar="N", help="local worker processes (default 2)")
+    parser.add_argument("--scheduler", metavar="ADDRESS", help="an existing dask scheduler, tcp://HOST:PORT")
+    parser.add_argument("--no-progress", action="store_true", help="no progress bar")
+
+
+def _run_campaign(args: argparse.Namespace) -> int:
+    """Monte Carlo closed-loop runs on dask; 0 done, 4 when a certified run broke a promise."""
+    from .campaign import run_campaign
+    from .campaign_spec import load_spec
+
+    summary = run_campaign(load_spec(args.spec), args.out, workers=args.workers, scheduler=args.scheduler,
+                           progress=not args.no_progress)
+    top = summary["largest_max_rho_ratio"] or {}
+    _echo(f"{summary['runs']} runs ({summary['computed_runs']} computed), {summary['certified_runs']} certified; "
+          f"largest max_rho_ratio {top.get('max_rho_ratio')} (run {top.get('run')}, seed {top.get('seed')}) vs "
+          f"certified radius 1; violations {summary['violations']}; wrote {args.out}")
+    return EXIT_PROMISE_BROKEN if summary["violations_certified"] else EXIT_OK
+
+
 # ---- the parser and the entry point ---------------------------------------------------------------------
 
 SUBCOMMANDS: dict[str, Subcommand] = {
@@ -386,14 +397,16 @@ SUBCOMMANDS: dict[str, Subcommand] = {
     "simulate": Subcommand("simulate any scenario given as TOML", _configure_simulate, _run_simulate),
     "audit": Subcommand("audit the paper's printed error dynamics against the sympy derivation",
                         _configure_audit, _run_audit),
-    "certify": Subcommand("certify a scenario: bounds, sigma, tube radius, tightened sets",
+    "certify": Subcommand("certify the loop that runs: sampled-data tube, sigma, tightened sets, named conditions",
                           _configure_certify, _run_certify),
-    "envelope": Subcommand("design search: the certifiable envelope of a scenario", _configure_envelope,
+    "envelope": Subcommand("the certified frontier beside physical necessity", _configure_envelope,
                            _run_envelope),
     "recheck": Subcommand("re-check a certificate JSON: every condition from its stored numbers, no search",
                           _configure_recheck, _run_recheck),
     "falsify": Subcommand("search for a run or period that breaks the certified tube", _configure_falsify,
                           _run_falsify),
+    "campaign": Subcommand("many closed-loop runs on dask: Monte Carlo and falsification, resumable",
+                           _configure_campaign, _run_campaign),
 }
 
 

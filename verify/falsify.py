@@ -97,8 +97,8 @@ def search_space(scenario: Scenario, law: str | None = None, *, sigma: float | N
         start=((float(tight.e_d_min), float(tight.e_d_max)), (-float(tight.e_z_max), float(tight.e_z_max)),
                (-float(tight.e_o_max), float(tight.e_o_max))),
         tick=ctrl.dt / ticks, ticks=ticks, certified=bool(cert.certified))
-    if not space.sigma > 0:
-        raise ConfigError("sigma", "a number > 0", space.sigma)
+    if not (math.isfinite(space.sigma) and space.sigma >= 0):
+        raise ConfigError("sigma", "a finite number >= 0 (0: no ancillary feedback)", space.sigma)
     return space
 
 
@@ -203,8 +203,9 @@ def falsify(scenario: Scenario, law: str | None = None, *, budget: int = 500, se
     evaluate = _Evaluator(space, controller if controller is not None else get_law(space.law))
 
     def result(found: bool, counterexample: TubeConfiguration | None, value: float, stage: str) -> FalsifyResult:
+        elapsed_s = time.perf_counter() - t0  # reported, never part of a verdict
         return FalsifyResult(found, counterexample, value, evaluate.worst, evaluate.worst_value, stage,
-                             evaluate.count, space, time.perf_counter() - t0)
+                             evaluate.count, space, elapsed_s)
 
     counterexample = _hypothesis_stage(space, evaluate, budget, seed)
     if counterexample is not None:

@@ -36,7 +36,7 @@ from .campaign_spec import CampaignSpec, RunPlan, certificate_key, spec_from_sto
 from .study import check_output_dir
 
 __all__ = ["RunTask", "Certified", "simulate_task", "certify_plans", "open_client", "run_campaign",
-           "read_rows", "replay_run", "replay_into", "summarise", "write_figures", "METRIC_COLUMNS", "FIGURES"]
+           "read_rows", "replay_run", "replay_into", "summarise", "summary_line", "write_figures", "METRIC_COLUMNS", "FIGURES"]
 
 LOGGER = logging.getLogger("tubekit.campaign")
 #: Per-run metric columns of ``runs.parquet`` (after run, seed and the sampled values).
@@ -178,8 +178,8 @@ def _run_file(out: Path, run: int) -> Path:
     return out / "runs" / f"run_{run:06d}.json"
 
 
-def _prepare_dir(out: Path, spec: CampaignSpec) -> None:
-    """Create ``out/runs``; an existing campaign must have the same fingerprint (else ``--out`` is refused)."""
+def _check_campaign_dir(out: Path, spec: CampaignSpec) -> None:
+    """Read only: ``out`` is new, empty, or holds this campaign (same fingerprint); else ``--out`` is refused."""
     stored = out / "campaign.json"
     if stored.exists():
         try:
@@ -191,8 +191,12 @@ def _prepare_dir(out: Path, spec: CampaignSpec) -> None:
                               "It holds another campaign's runs.")
     elif out.exists() and any(out.iterdir()):
         raise ConfigError("--out", "a new or empty directory (or this campaign's)", str(out), "It is not empty.")
+
+
+def _prepare_dir(out: Path, spec: CampaignSpec) -> None:
+    """Create ``out/runs`` and record the spec in ``out/campaign.json``."""
     (out / "runs").mkdir(parents=True, exist_ok=True)
-    write_json(stored, {"fingerprint": spec.fingerprint, "spec": spec.to_dict()})
+    write_json(out / "campaign.json", {"fingerprint": spec.fingerprint, "spec": spec.to_dict()})
 
 
 def _finished(out: Path) -> set[int]:
@@ -278,6 +282,15 @@ def summarise(rows: list[dict], spec: CampaignSpec, certs: dict[str, Certified],
     }
 
 
+def summary_line(summary: dict, out: str | Path) -> str:
+    """The result line of ``tubekit campaign``: runs, the largest max_rho_ratio beside the radius, violations."""
+    top = summary["largest_max_rho_ratio"] or {}
+    return (f"{summary['runs']} runs ({summary['computed_runs']} computed), {summary['certified_runs']} certified; "
+            f"largest max_rho_ratio {top.get('max_rho_ratio')} (run {top.get('run')}, seed {top.get('seed')}) vs "
+            f"certified radius 1; violations {summary['violations']} ({summary['violations_certified']} of a "
+            f"certified run with its premises held); wrote {out}")
+
+
 def write_figures(out: Path, rows: list[dict], epsilon: float) -> list[Path]:
     """``figures/ecdf.png`` (one ECDF per metric, its bound dashed) and ``figures/worst_runs.png``."""
     from matplotlib.figure import Figure
@@ -290,7 +303,7 @@ def write_figures(out: Path, rows: list[dict], epsilon: float) -> list[Path]:
     fig = Figure(figsize=(11, 6.5), layout="constrained")
     for ax, (key, bound, label) in zip(fig.subplots(2, 3).ravel(), panels):
         x = np.sort([float(r[key]) for r in rows if r.get(key) is not None and np.isfinite(float(r[key]))])
-        ax.step(x, np.arange(1, x.size + 1) / max(x.size, 1), where="post", color="C0")
+        ax.step(np.r_[x[:1], x], np.arange(x.size + 1) / max(x.size, 1), where="post", color="C0")
         if bound is not None:
             ax.axvline(bound, color="C3", ls="--", label=label)
             ax.legend(loc="lower right", fontsize=8)
@@ -354,17 +367,20 @@ def run_campaign(spec: CampaignSpec, out: str | Path, *, workers: int = 2, sched
     if isinstance(workers, bool) or not isinstance(workers, int) or workers < 1:
         raise ConfigError("--workers", "an integer >= 1", workers)
     check_output_dir(out)
+    _check_campaign_dir(out, spec)
     plans = {k: spec.plan(k) for k in range(spec.runs)}  # every sample is validated before anything is written
     certs = certify_plans(list(plans.values()))
     done = _finished(out) if (out / "campaign.json").exists() else set()
-    with open_client(workers, scheduler) as client:
-        _prepare_dir(out, spec)
-        todo = [RunTask(k, p.seed, p.scenario, certs[certificate_key(p.scenario)], spec.falsify_sequences)
-                for k, p in plans.items() if k not in done]
-        LOGGER.info("campaign: %d runs (%d already finished), %d distinct certificates, %s", spec.runs,
-                    spec.runs - len(todo), len(certs), scheduler or f"LocalCluster of {workers} workers")
-        _execute(client, todo, plans, out, spec.fingerprint[:12], progress)
-        nworkers = len(client.scheduler_info().get("workers", {}))
+    todo = [RunTask(k, p.seed, p.scenario, certs[certificate_key(p.scenario)], spec.falsify_sequences)
+            for k, p in plans.items() if k not in done]
+    LOGGER.info("campaign: %d runs (%d already finished), %d distinct certificates, %s", spec.runs,
+                spec.runs - len(todo), len(certs), scheduler or f"LocalCluster of {workers} workers")
+    nworkers = 0
+    with open_client(workers, scheduler) if todo else contextlib.nullcontext() as client:
+        _prepare_dir(out, spec)  # after the scheduler answered: a bad --scheduler writes nothing
+        if todo:
+            _execute(client, todo, plans, out, spec.fingerprint[:12], progress)
+            nworkers = len(client.scheduler_info().get("workers", {}))
     rows = [r for r in read_rows(out) if r["run"] < spec.runs]
     _write_parquet(out, rows)
     facts = {"computed_runs": len(todo), "skipped_runs": spec.runs - len(todo), "workers": nworkers,

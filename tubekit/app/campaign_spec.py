@@ -25,6 +25,7 @@ Every error is a :class:`~tubekit.exceptions.ConfigError` naming the spec field.
 from __future__ import annotations
 
 import hashlib
+import importlib.util
 import json
 import math
 import tomllib
@@ -38,7 +39,7 @@ from ..exceptions import ConfigError, TubekitError
 from ..scenario import Scenario, load_scenario, paper_scenario, scenario_from_dict
 
 __all__ = ["Distribution", "CampaignSpec", "RunPlan", "load_spec", "spec_from_dict", "run_seed",
-           "certificate_key", "spec_from_stored", "NOT_CERTIFICATE_INPUTS", "SPEC_KEYS"]
+           "certificate_key", "spec_from_stored", "require_dependencies", "NOT_CERTIFICATE_INPUTS", "SPEC_KEYS"]
 
 #: Top-level keys of a spec.
 SPEC_KEYS = ("scenario", "runs", "seed", "duration", "sample", "falsify")
@@ -99,9 +100,11 @@ class CampaignSpec:
 
     @property
     def fingerprint(self) -> str:
-        """sha256 of the spec without ``runs`` (a rerun with more runs extends the same campaign)."""
+        """sha256 of the spec without ``runs`` (a rerun with more runs extends the same campaign) and without
+        the scenario's path (its content, ``base``, counts: a moved checkout resumes)."""
         data = self.to_dict()
         data.pop("runs")
+        data.pop("scenario_source")
         return hashlib.sha256(json.dumps(data, sort_keys=True).encode()).hexdigest()
 
     def plan(self, run: int) -> RunPlan:
@@ -122,6 +125,13 @@ class CampaignSpec:
                 raise ConfigError("sample", "values the scenario accepts", values, str(exc)) from None
             raise ConfigError(f"sample.{field}", "a value the scenario accepts", values[field], str(exc)) from None
         return RunPlan(run, seed, values, scenario)
+
+
+def require_dependencies() -> None:
+    """Raise ImportError naming the extra when dask.distributed or pyarrow is missing (cheap: nothing imported)."""
+    for module in ("distributed", "pyarrow"):
+        if importlib.util.find_spec(module) is None:
+            raise ImportError(f"No module named '{module}' (pip install -e '.[campaign]')")
 
 
 def run_seed(seed: int, run: int) -> int:
@@ -250,16 +260,12 @@ def spec_from_dict(data: Any, spec_dir: Path | None = None) -> CampaignSpec:
 def load_spec(path: str | Path) -> CampaignSpec:
     """Read and validate ``SPEC.toml`` (:func:`spec_from_dict`); every error names its field."""
     p = Path(path)
-    if not p.is_file():
-        raise ConfigError("SPEC", "a path to an existing TOML file", str(p))
     try:
-        data = tomllib.loads(p.read_text(encoding="utf-8"))
-    except tomllib.TOMLDecodeError as exc:
-        raise ConfigError("SPEC", "valid TOML", str(p), str(exc)) from None
-    except UnicodeDecodeError:
-        raise ConfigError("SPEC", "a UTF-8 text TOML file", str(p), "It is binary or not UTF-8.") from None
-    except OSError as exc:
-        raise ConfigError("SPEC", "a readable file", str(p), exc.strerror or str(exc)) from None
+        data = tomllib.loads(p.read_bytes().decode("utf-8"))
+    except (OSError, UnicodeDecodeError, tomllib.TOMLDecodeError) as exc:
+        why = getattr(exc, "strerror", None) or ("It is binary or not UTF-8." if isinstance(exc, UnicodeDecodeError)
+                                                 else str(exc))
+        raise ConfigError("SPEC", "a readable UTF-8 TOML file", str(p), why) from None
     return spec_from_dict(data, p.resolve().parent)
 
 

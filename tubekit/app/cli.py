@@ -368,6 +368,9 @@ def _run_falsify(args: argparse.Namespace) -> int:
 # ---- campaign -------------------------------------------------------------------------------------------
 
 def _configure_campaign(parser: argparse.ArgumentParser) -> None:
+    from .campaign_spec import require_dependencies
+
+    require_dependencies()
     parser.add_argument("spec", metavar="SPEC", help="campaign TOML (schema: docs/campaign.md)")
     parser.add_argument("--out", metavar="DIR", required=True, help="campaign directory (a rerun resumes it)")
     parser.add_argument("--workers", type=int, default=2, metavar="N", help="local worker processes (default 2)")
@@ -377,15 +380,12 @@ def _configure_campaign(parser: argparse.ArgumentParser) -> None:
 
 def _run_campaign(args: argparse.Namespace) -> int:
     """Monte Carlo closed-loop runs on dask; 0 done, 4 when a certified run broke a promise."""
-    from .campaign import run_campaign
+    from .campaign import run_campaign, summary_line
     from .campaign_spec import load_spec
 
     summary = run_campaign(load_spec(args.spec), args.out, workers=args.workers, scheduler=args.scheduler,
                            progress=not args.no_progress)
-    top = summary["largest_max_rho_ratio"] or {}
-    _echo(f"{summary['runs']} runs ({summary['computed_runs']} computed), {summary['certified_runs']} certified; "
-          f"largest max_rho_ratio {top.get('max_rho_ratio')} (run {top.get('run')}, seed {top.get('seed')}) vs "
-          f"certified radius 1; violations {summary['violations']}; wrote {args.out}")
+    _echo(summary_line(summary, args.out))
     return EXIT_PROMISE_BROKEN if summary["violations_certified"] else EXIT_OK
 
 

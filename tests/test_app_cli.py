@@ -61,8 +61,12 @@ def _fake_certify(scenario, law=None):
 
     from tubekit import Tightening
 
+    from types import SimpleNamespace
+
     class Fake:
         certified = False
+        failures = [{"condition": "fake"}]
+        disturbance = SimpleNamespace(gamma=0.02)  # read by the dynamic-plant part of reproduce
 
         def to_dict(self):
             return {"certified": False, "fake": True}

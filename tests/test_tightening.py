@@ -40,7 +40,10 @@ def test_horizon_arcs_is_the_number_of_margin_rows():
 
 def test_certified_tightening_is_the_pontryagin_difference():
     """V_bar = V - kappa_bar and the per-axis tube of the sampled-data certificate."""
-    sc = load_scenario(verify.SCENARIOS_DIR / "paper_currents.toml")
+    from dataclasses import replace
+    free = load_scenario(verify.SCENARIOS_DIR / "paper_currents.toml")
+    assert np.array_equal(verify.certify(free).tightening.v_max, free.limits.vector)  # sigma = 0: no kappa
+    sc = free.with_changes(controller=replace(free.controller, sigma=3.125))
     cert = verify.certify(sc)
     t = cert.tightening
     assert t.certified and t.horizon_arcs == sc.controller.horizon_steps

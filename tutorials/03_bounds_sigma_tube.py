@@ -213,7 +213,8 @@ for r in rows:
 #   σ h = 2 there is no contraction left: the tube blows up, and beyond that `one_period_tube`
 #   reports no finite tube at all (`certified=False`, with the reason).
 #
-# `certify` tries σ ∈ {0, f/32, …, f} and keeps the largest certified one (3.125 1/s here).
+# `certify` tries σ ∈ {0, f/32, …, f} and keeps the certified one with the most slack left in V̄ and Ē
+# (σ = 0 here: 0 and 3.125 certify, and no feedback leaves the FHOCP the most room).
 #
 # ## The figure
 

@@ -102,7 +102,8 @@ for name, c in by_sigma:
 # %% [markdown]
 # * `controller.sigma` must be > 0 (σ = 0, no feedback at all, is among the automatic candidates
 #   only; it certifies too: the reset alone bounds the deviation over one period, tutorial 03).
-# * σ = 1 and σ = 3.125 certify; 3.125 is the one `certify` picks (the largest that certifies).
+# * σ = 1 and σ = 3.125 certify. Left to choose, `certify` picks σ = 0 (also certified): the one with
+#   the most slack in V̄ and Ē, which keeps the most plans acceptable.
 # * σ = 6.25: the feedback turns the heading by up to κ̄_r δ per period; carried along the
 #   horizon by the replayed plan, the e_o margin of the last arc exceeds e_o_max (`e_bar[e_o]`).
 # * σ = 12.5 to 100: the feedback also reserves so much input that the nominal can no longer

@@ -33,6 +33,10 @@ def certs() -> dict:
     for name in SHIPPED:
         sc = load_scenario(verify.SCENARIOS_DIR / name)
         out[name] = (sc, verify.certify(sc))
+    # paper_currents chooses sigma = 0; its sigma = 3.125 design (also certified) exercises the feedback
+    sc = out["paper_currents.toml"][0]
+    sc = sc.with_changes(controller=replace(sc.controller, sigma=3.125))
+    out["paper_currents.toml@3.125"] = (sc, verify.certify(sc))
     return out
 
 
@@ -115,7 +119,9 @@ def simulate_period(sc, cert, x0, t0, v_hat, mode, angle=(0.0,), zsign=1.0, subs
         pd = sc.trajectory.position(t)
         rho = _errors(x, pd) - _errors(xh, pd)
         kappa = law(x, xh, pd, sigma)
-        kworst = max(kworst, float(np.max(np.abs(kappa) / kbar)))
+        # |kappa_i| <= kappa_bar_i; where kappa_bar_i = 0 (sigma = 0) kappa_i must be exactly 0
+        ratio = np.where(kbar > 0, np.abs(kappa) / np.where(kbar > 0, kbar, 1.0), np.where(kappa == 0, 0.0, np.inf))
+        kworst = max(kworst, float(np.max(ratio)))
         om = _omega(mode, x, pd, rho, tube, wxy, wz, angle, zsign, i)
         v = np.asarray(v_hat) + kappa
         for s in range(substeps):
@@ -169,6 +175,12 @@ def _check_case(certs, case):
 def test_one_period_tube_is_sound_paper_currents(certs, case):
     """Property: over one period of the sampled-data loop (paper_currents), every adversary at the
     disturbance bound keeps max_j |e_j - e_hat_j| / tube_j <= 1 and |kappa_i| <= kappa_bar_i."""
+    _check_case(certs, case)
+
+
+@given(case=period_cases("paper_currents.toml@3.125"))
+def test_one_period_tube_is_sound_paper_currents_with_feedback(certs, case):
+    """Property: the same for paper_currents with sigma = 3.125 1/s fixed (certified too; feedback on)."""
     _check_case(certs, case)
 
 

@@ -52,7 +52,7 @@ from .exceptions import ConfigError, SolverError
 from .plan_check import check_plan
 from .dynamics import DynamicPlant, make_plant
 from .plant import OmegaOverride, Plant, nominal_arc, plant_rhs, rk4_hold
-from .scenario import Obstacle, Scenario
+from .scenario import HEMISPHERE_SIGN, Obstacle, Scenario
 from .sensing import ObstacleMap
 from .simulation_result import CSV_COLUMNS, SimulationResult
 from .tightening import Tightening
@@ -86,9 +86,6 @@ class FhocpSolver(Protocol):
 
 #: ``factory(scenario, tightening)`` returning a :class:`FhocpSolver`.
 SolverFactory = Callable[[Scenario, Tightening], FhocpSolver]
-
-#: Sign of cos(psi - theta) in each certified hemisphere (0: either).
-HEMISPHERE: dict[str, int] = {"toward": -1, "away": 1, "both": 0}
 
 _ZERO_INPUT = np.zeros(3)
 _ZERO_INPUT.setflags(write=False)
@@ -303,7 +300,7 @@ class _ClosedLoop:
         self.limits = tuple(float(c) for c in scenario.limits.vector)
         self.memory = PlanMemory()
         self.log = _Log.allocate(clock)
-        self.sign = HEMISPHERE.get(scenario.region.heading, 0)
+        self.sign = HEMISPHERE_SIGN[scenario.region.heading]
 
     def sense(self, xk: np.ndarray) -> tuple[Obstacle, ...]:
         """Obstacles known after sensing at the position of ``xk``."""

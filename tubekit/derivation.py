@@ -30,6 +30,7 @@ import numpy as np
 import sympy as sp
 
 __all__ = [
+    "heading_cosine",
     "SYMBOL_NAMES",
     "symbols",
     "DerivedDynamics",
@@ -224,6 +225,13 @@ def error_coordinates(state: np.ndarray, p_d: np.ndarray) -> np.ndarray:
     with np.errstate(invalid="ignore", divide="ignore"):
         eo = (ex * np.sin(psi) - ey * np.cos(psi)) / ed
     return np.stack([ed, ez, eo], axis=-1)
+
+
+def heading_cosine(state: np.ndarray, p_d: np.ndarray) -> np.ndarray:
+    """c = cos(psi - theta), theta = atan2(e_y, e_x): its sign is the heading hemisphere (< 0: toward)."""
+    state = np.asarray(state, dtype=float)
+    p_d = np.asarray(p_d, dtype=float)
+    return np.cos(state[..., 3] - np.arctan2(state[..., 1] - p_d[..., 1], state[..., 0] - p_d[..., 0]))
 
 
 if __name__ == "__main__":

@@ -26,7 +26,7 @@ from typing import Sequence
 
 import numpy as np
 
-from .derivation import error_coordinates
+from .derivation import error_coordinates, heading_cosine
 from .plant import nominal_arc
 from .scenario import Obstacle, Scenario
 from .tightening import Tightening
@@ -95,8 +95,7 @@ def check_plan(scenario: Scenario, tight: Tightening, t0: float, x0: np.ndarray,
     times = t0 + dt * (np.arange(n)[:, None] + np.linspace(0.0, 1.0, samples + 1)[None, :])
     desired = np.asarray(scenario.trajectory.position(times.reshape(-1)), dtype=float).reshape(n, samples + 1, 3)
     e = error_coordinates(arcs, desired)
-    rel = arcs[..., :2] - desired[..., :2]
-    cos_rel = np.cos(arcs[..., 3] - np.arctan2(rel[..., 1], rel[..., 0]))
+    cos_rel = heading_cosine(arcs, desired)
     pad = 0.5 * (dt / samples) * np.asarray(tight.rates, dtype=float)
     m = np.asarray(tight.margins, dtype=float)
     slacks = _error_slacks(tight, e, cos_rel, m, pad, sign)

@@ -26,7 +26,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .derivation import heading_cosine
 from .plant import Plant
+from .scenario import HEMISPHERE_SIGN
 from .simulation_result import SimulationResult
 
 __all__ = ["Promise", "check_promises"]
@@ -71,9 +73,8 @@ def _region(run: SimulationResult) -> list[Promise]:
     e = run.errors
     slack = np.min(np.column_stack([e[:, 0] - eps, ed_max - e[:, 0], ez_max - np.abs(e[:, 1]),
                                     eo_max - np.abs(e[:, 2])]))
-    rel = run.states[:, :2] - run.desired[:, :2]
-    cos_rel = np.cos(run.states[:, 3] - np.arctan2(rel[:, 1], rel[:, 0]))
-    sign = {"toward": -1, "away": 1}.get(run.scenario.region.heading, 0)
+    cos_rel = heading_cosine(run.states, run.desired)
+    sign = HEMISPHERE_SIGN.get(run.scenario.region.heading, 0)
     hem = float(np.min(sign * cos_rel)) if sign else 1.0
     return [_at_least("region", float(min(slack, hem if hem <= 0 else slack)), 0.0,
                       "smallest slack of e in R (e_d, |e_z|, |e_o| bounds, heading hemisphere)"),

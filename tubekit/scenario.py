@@ -33,6 +33,8 @@ __all__ = [
     "RegionSettings",
     "Scenario",
     "paper_scenario",
+    "read_toml",
+    "HEMISPHERE_SIGN",
     "load_scenario",
     "scenario_from_dict",
     "LAW_NAMES",
@@ -41,6 +43,8 @@ __all__ = [
 
 LAW_NAMES = ("paper", "corrected")
 HEADINGS = ("toward", "away", "both")
+#: Sign of cos(psi - theta) in each heading hemisphere (0: either).
+HEMISPHERE_SIGN: dict[str, int] = {"toward": -1, "away": 1, "both": 0}
 
 
 @dataclass(frozen=True)
@@ -422,17 +426,21 @@ def scenario_from_dict(d: dict) -> Scenario:
     return replace(base, **kw)
 
 
-def load_scenario(path: str | Path) -> Scenario:
-    """Load a scenario from a TOML file (see :func:`scenario_from_dict`)."""
+def read_toml(path: str | Path, field: str) -> dict:
+    """The table of a TOML file; every failure is a :class:`ConfigError` naming ``field`` (e.g. ``CONFIG``)."""
     p = Path(path)
     if not p.is_file():
-        raise ConfigError("CONFIG", "a path to an existing TOML file", str(p))
+        raise ConfigError(field, "a path to an existing TOML file", str(p))
     try:
-        data = tomllib.loads(p.read_text(encoding="utf-8"))
+        return tomllib.loads(p.read_text(encoding="utf-8"))
     except tomllib.TOMLDecodeError as exc:
-        raise ConfigError("CONFIG", "valid TOML", str(p), str(exc)) from None
+        raise ConfigError(field, "valid TOML", str(p), str(exc)) from None
     except UnicodeDecodeError:
-        raise ConfigError("CONFIG", "a UTF-8 text (TOML) file", str(p), "it looks binary") from None
+        raise ConfigError(field, "a UTF-8 text (TOML) file", str(p), "It is binary or not UTF-8.") from None
     except OSError as exc:
-        raise ConfigError("CONFIG", "a readable file", str(p), exc.strerror or str(exc)) from None
-    return scenario_from_dict(data)
+        raise ConfigError(field, "a readable file", str(p), exc.strerror or str(exc)) from None
+
+
+def load_scenario(path: str | Path) -> Scenario:
+    """Load a scenario from a TOML file (see :func:`scenario_from_dict`)."""
+    return scenario_from_dict(read_toml(path, "CONFIG"))

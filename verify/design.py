@@ -25,7 +25,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from flint import arb
 
-from tubekit.derivation import error_coordinates
+from tubekit.derivation import error_coordinates, heading_cosine
 from tubekit.scenario import Scenario
 from tubekit.vehicles import VehicleParams
 
@@ -233,7 +233,7 @@ def _initial_condition(scenario: Scenario, region: Region, m: HorizonMargins) ->
            (region.e_z[0] + m.e_z[0], region.e_z[1] - m.e_z[0]),
            (region.e_o[0] + m.e_o[0], region.e_o[1] - m.e_o[0]))
     viol = max(max(lo - e0[k], e0[k] - hi) for k, (lo, hi) in enumerate(box))
-    cos_rel = math.cos(x0[3] - math.atan2(x0[1] - p0[1], x0[0] - p0[0]))
+    cos_rel = float(heading_cosine(x0, p0))
     hem = any(s * cos_rel > 0 for s in region.hemisphere_signs)
     clear = min((float(np.linalg.norm(x0[:3] - np.asarray(o.center))) - o.radius - scenario.vehicle_radius
                  - m.position[0] for o in scenario.obstacles), default=math.inf)

@@ -31,7 +31,7 @@ from tubekit.closed_loop import simulate
 from tubekit.derivation import error_coordinates, numeric
 from tubekit.exceptions import ConfigError
 from tubekit.promises import Promise, check_promises
-from tubekit.scenario import Scenario
+from tubekit.scenario import HEMISPHERE_SIGN, Scenario
 from tubekit.tightening import Tightening
 
 from .strategies import state_from_error
@@ -169,7 +169,7 @@ def start_state(scenario: Scenario, tightening: Tightening, unit: np.ndarray) ->
     e = box[:, 0] + (box[:, 1] - box[:, 0]) * u[1:4]
     face = min(int(u[0] * 6), 5)
     e[face // 2] = box[face // 2, face % 2]
-    sign = {"toward": -1, "away": 1}.get(scenario.region.heading, -1 if u[4] < 0.5 else 1)
+    sign = HEMISPHERE_SIGN[scenario.region.heading] or (-1 if u[4] < 0.5 else 1)
     rel = state_from_error(e[0], e[1], e[2], 2 * math.pi * u[4], sign)
     target = np.asarray(scenario.trajectory.position(np.array([0.0]))[0], dtype=float)
     return tuple(float(x) for x in (rel + np.append(target, 0.0)))

@@ -23,13 +23,11 @@ from dataclasses import asdict, dataclass, replace
 from typing import Any
 
 from tubekit.exceptions import ConfigError
-from tubekit.scenario import HEADINGS, Scenario
+from tubekit.scenario import HEADINGS, HEMISPHERE_SIGN, Scenario
 from tubekit.validation import interval, nonnegative, nonnegative_triple, positive_triple
 
 __all__ = ["Region", "HEMISPHERE_SIGN"]
 
-#: cos(psi - theta) = s * sqrt(1 - e_o^2) in each hemisphere.
-HEMISPHERE_SIGN: dict[str, int] = {"toward": -1, "away": +1}
 
 
 @dataclass(frozen=True)

@@ -30,6 +30,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import asdict, dataclass
+from functools import lru_cache
 
 from flint import arb
 
@@ -125,8 +126,13 @@ class PeriodTube:
 
 
 # --------------------------------------------------------------------------- the map F
+@lru_cache(maxsize=64)
 def _lipschitz(p: TubeProblem) -> dict[str, arb]:
-    """Constants of the derived J over R: c = s sqrt(1 - e_o²), a = e_o c / e_d (J_od = -a)."""
+    """Constants of the derived J over R: c = s sqrt(1 - e_o²), a = e_o c / e_d (J_od = -a).
+
+    Computed once per problem (the fixed-point iteration calls :func:`tube_map` up to 400 times);
+    callers only read the returned dict.
+    """
     o, eps = arb(p.e_o_max), arb(p.eps)
     c_min = (1 - o * o).sqrt()
     q = o * c_min if p.e_o_max <= math.sqrt(0.5) else arb(0.5)    # sup |e_o c|

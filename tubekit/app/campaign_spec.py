@@ -28,7 +28,6 @@ import hashlib
 import importlib.util
 import json
 import math
-import tomllib
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -36,7 +35,7 @@ from typing import Any
 import numpy as np
 
 from ..exceptions import ConfigError, TubekitError
-from ..scenario import Scenario, load_scenario, paper_scenario, scenario_from_dict
+from ..scenario import Scenario, load_scenario, paper_scenario, read_toml, scenario_from_dict
 
 __all__ = ["Distribution", "CampaignSpec", "RunPlan", "load_spec", "spec_from_dict", "run_seed",
            "certificate_key", "spec_from_stored", "require_dependencies", "NOT_CERTIFICATE_INPUTS", "SPEC_KEYS"]
@@ -260,13 +259,7 @@ def spec_from_dict(data: Any, spec_dir: Path | None = None) -> CampaignSpec:
 def load_spec(path: str | Path) -> CampaignSpec:
     """Read and validate ``SPEC.toml`` (:func:`spec_from_dict`); every error names its field."""
     p = Path(path)
-    try:
-        data = tomllib.loads(p.read_bytes().decode("utf-8"))
-    except (OSError, UnicodeDecodeError, tomllib.TOMLDecodeError) as exc:
-        why = getattr(exc, "strerror", None) or ("It is binary or not UTF-8." if isinstance(exc, UnicodeDecodeError)
-                                                 else str(exc))
-        raise ConfigError("SPEC", "a readable UTF-8 TOML file", str(p), why) from None
-    return spec_from_dict(data, p.resolve().parent)
+    return spec_from_dict(read_toml(p, "SPEC"), p.resolve().parent)
 
 
 def spec_from_stored(data: dict) -> CampaignSpec:

@@ -82,18 +82,8 @@ def _verify_options(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--json", default=None, metavar="FILE", help="write the result as JSON ('-' = stdout)")
 
 
-def _load_config(config: str) -> Scenario:
-    """:func:`load_scenario`, with an unreadable or non-text file reported as ``CONFIG``."""
-    try:
-        return load_scenario(config)
-    except UnicodeDecodeError:
-        raise ConfigError("CONFIG", "a UTF-8 text TOML file", config, "It is binary or not UTF-8.") from None
-    except OSError as exc:
-        raise ConfigError("CONFIG", "a readable TOML file", config, exc.strerror or str(exc)) from None
-
-
 def _scenario(config: str | None) -> Scenario:
-    return paper_scenario() if config is None else _load_config(config)
+    return paper_scenario() if config is None else load_scenario(config)
 
 
 def _check_file_target(option: str, path: str) -> None:
@@ -180,7 +170,7 @@ def _run_simulate(args: argparse.Namespace) -> int:
         return EXIT_PROMISE_BROKEN if replay["broken"] else EXIT_OK if replay["identical"] else EXIT_FAILURE
     if args.config is None:
         raise ConfigError("CONFIG", "a scenario TOML file (or --from-campaign DIR --run K)", None)
-    scenario = apply_overrides(_load_config(args.config), duration=args.duration, quick=args.quick, law=args.law)
+    scenario = apply_overrides(load_scenario(args.config), duration=args.duration, quick=args.quick, law=args.law)
     out = Path(args.out) if args.out else Path("results") / output_dir_name(scenario.name)
     metrics = run_study(scenario, out, progress=not args.no_progress, with_acceptance=False, animate=args.animate,
                         echo=_echo)

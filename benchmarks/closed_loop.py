@@ -25,9 +25,9 @@ import numpy as np
 
 import verify
 from tubekit import paper_scenario
-from tubekit.ancillary import get_law
-from tubekit.closed_loop import saturate, simulate
-from tubekit.plant import Plant
+from tubekit.model.ancillary import get_law
+from tubekit.loop.closed_loop import saturate, simulate
+from tubekit.plant.kinematic import Plant
 
 __all__ = ["measure", "main"]
 

@@ -57,8 +57,8 @@ import numpy as np
 
 from tubekit import Tightening, paper_scenario
 from tubekit.fhocp import FHOCP, IpoptFHOCP
-from tubekit.model import kinematics
-from tubekit.plant import Plant
+from tubekit.model.kinematics import kinematics
+from tubekit.plant.kinematic import Plant
 from tubekit.scenario import Obstacle, Scenario
 
 REQUIRED_KEYS = ("rt_step_ms_median", "rt_step_ms_p99", "converged_ms_median", "ipopt_ms_median",

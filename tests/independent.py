@@ -4,9 +4,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from tubekit.derivation import error_coordinates
-from tubekit.model import kinematics
-from verify.invariance import applied_input
+from tubekit.model.errors import error_coordinates
+from tubekit.model.kinematics import kinematics
+from verify.falsify.invariance import applied_input
 
 
 def fd_rho_dot_inner(cfg, law, sigma, h=1e-6):

@@ -8,8 +8,8 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from tubekit.closed_loop import simulate
-from tubekit.metrics import rho_period_peaks
+from tubekit.loop.closed_loop import simulate
+from tubekit.loop.metrics import rho_period_peaks
 from tubekit.app.plots import (FIGURE_FILES, clearance_figure, errors_figure, inputs_figure, period_envelope, plot_all,
                                top_view, view_3d)
 from tubekit.scenario import paper_scenario

@@ -18,7 +18,7 @@ import verify
 from tubekit import Tightening
 from tubekit.app.cli import main
 from tubekit.app.study import OUTPUT_FILES, QUICK_DURATION_S
-from tubekit.metrics import METRIC_KEYS, read_trajectory_csv
+from tubekit.loop.metrics import METRIC_KEYS, read_trajectory_csv
 from tubekit.app.plots import FIGURE_FILES
 
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples"

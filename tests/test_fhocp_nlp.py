@@ -5,9 +5,10 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from tubekit.fhocp.nlp import (FhocpNlp, discrete_step, dsinc, eo_linearisation, obstacle_array, rollout,
+from tubekit.model.kinematics import dsinc
+from tubekit.fhocp.nlp import (FhocpNlp, discrete_step, eo_linearisation, obstacle_array, rollout,
                                select_obstacles, sinc, step_linearisation)
-from tubekit.model import nominal_kinematics
+from tubekit.model.kinematics import nominal_kinematics
 from tubekit.scenario import Obstacle, paper_scenario
 from tubekit.tightening import Tightening
 

@@ -6,8 +6,8 @@ import numpy as np
 import pytest
 import sympy as sp
 
-from tubekit.derivation import SYMBOL_NAMES, symbols
-from tubekit.paper_equations import TERM_NAMES, printed_terms
+from tubekit.model.derivation import SYMBOL_NAMES, symbols
+from tubekit.paper.equations import TERM_NAMES, printed_terms
 
 
 def test_fifteen_names_in_order():

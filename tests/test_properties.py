@@ -3,7 +3,7 @@
 Every test here is marked ``property`` (``pytest -m property``) and documents its
 property in a docstring starting with "Property:". Expected behaviour is checked
 with computations independent of the code under test: the Cartesian derivation
-(tubekit.derivation.numeric), finite quotients, and direct simulation.
+(tubekit.model.errors.numeric), finite quotients, and direct simulation.
 """
 
 from __future__ import annotations
@@ -16,11 +16,11 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 import verify
-from tubekit.ancillary import LAWS
-from tubekit.derivation import numeric
-from verify import strategies as vs
-from verify.falsify import falsify, search_space
-from verify.invariance import one_period_ratio
+from tubekit.model.ancillary import LAWS
+from tubekit.model.errors import numeric
+from verify.falsify import strategies as vs
+from verify.falsify.one_period import falsify, search_space
+from verify.falsify.invariance import one_period_ratio
 
 
 pytestmark = pytest.mark.property
@@ -113,8 +113,8 @@ def test_closed_loop_containment(certified):
     certified scenario, the closed loop keeps max_j |rho_j(t)| / tube_j <= 1 and v(t) in V at every tick."""
     from dataclasses import replace
 
-    from tubekit.closed_loop import simulate
-    from tubekit.derivation import error_coordinates
+    from tubekit.loop.closed_loop import simulate
+    from tubekit.model.errors import error_coordinates
 
     scenario, cert = certified
     tight = cert.tightening
@@ -155,8 +155,8 @@ def test_fhocp_plans_and_shifted_candidate(certified, fhocp_solver):
     (V-bar, e_d >= epsilon + rho_tilde, inflated obstacles, |e_o|, |e_z|, e_d_max, dynamics) within 1e-6,
     and the shifted plan (tube MPC's candidate) is feasible at the next step w.r.t. the same constraints.
     Checked by an independent rollout with fine RK4 and direct distance computations."""
-    from tubekit.model import nominal_kinematics
-    from tubekit.sensing import detected_obstacles
+    from tubekit.model.kinematics import nominal_kinematics
+    from tubekit.loop.sensing import detected_obstacles
 
     scenario, cert = certified
     tight = cert.tightening

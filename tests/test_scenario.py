@@ -8,7 +8,7 @@ from pathlib import Path
 import pytest
 
 from tubekit import ConfigError, TubekitError, load_scenario, paper_scenario, scenario_from_dict
-from tubekit.trajectory import Circle, Helix, Line, Waypoints
+from tubekit.model.trajectory import Circle, Helix, Line, Waypoints
 
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
 

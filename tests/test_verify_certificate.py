@@ -18,11 +18,11 @@ import numpy as np
 import pytest
 
 import verify
-from tubekit.ancillary import LAWS
+from tubekit.model.ancillary import LAWS
 from tubekit.app.cli import main as cli_main
-from tubekit.closed_loop import simulate
+from tubekit.loop.closed_loop import simulate
 from tubekit.exceptions import ConfigError
-from tubekit.promises import check_promises
+from tubekit.loop.promises import check_promises
 from tubekit.scenario import ControllerSettings, load_scenario, paper_scenario
 from verify import Certificate, NotCertifiedError, Region, certify
 from verify.certificate import choose_design, sigma_candidates

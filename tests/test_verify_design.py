@@ -15,7 +15,7 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 import verify
-from tubekit.model import InputLimits, SwayModel
+from tubekit.model.kinematics import InputLimits, SwayModel
 from tubekit.scenario import Disturbance, load_scenario
 from verify.design import (Condition, Design, arc_rates, disturbance_bounds, evaluate_design, tube_problem)
 from verify.gains import gain_bounds

@@ -18,7 +18,7 @@ from hypothesis import assume, given
 from hypothesis import strategies as st
 
 import verify
-from tubekit.ancillary import LAWS, AncillaryLaw, jacobian_at
+from tubekit.model.ancillary import LAWS, AncillaryLaw, jacobian_at
 from tubekit.exceptions import ConfigError
 from verify.gains import GAIN_GAP, GainBounds, gain_bounds, polar_jacobian
 from verify.region import Region

@@ -9,7 +9,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from tubekit.derivation import error_coordinates
+from tubekit.model.errors import error_coordinates
 from tubekit.exceptions import ConfigError
 from tubekit.scenario import paper_scenario
 from verify.region import Region

@@ -1,7 +1,7 @@
 """Tests of verify.sampled: the one-period tube under the nominal reset, and the per-arc margins.
 
 The soundness test simulates one FHOCP period of the real sampled-data loop with an integrator
-written here (not tubekit.closed_loop): reset x_hat = x at t_k, the nominal arc under a constant
+written here (not tubekit.loop.closed_loop): reset x_hat = x at t_k, the nominal arc under a constant
 v_hat in V_bar, kappa from the law held over each tick of 1/f s, the plant x_dot = f(x) v + omega with
 omega at the certificate's bound and chosen adversarially tick by tick. The closed forms (sigma = 0,
 the decoupled e_z channel) are derived by hand in the docstrings.
@@ -18,7 +18,7 @@ from hypothesis import assume, given
 from hypothesis import strategies as st
 
 import verify
-from tubekit.ancillary import get_law
+from tubekit.model.ancillary import get_law
 from tubekit.scenario import load_scenario
 from verify.sampled import HorizonMargins, PeriodTube, TubeProblem, horizon_margins, one_period_tube
 

@@ -1,20 +1,28 @@
-"""tubekit: reproducible, verifiable tube-based NMPC for underactuated AUVs."""
+"""tubekit: reproducible, verifiable tube-based NMPC for underactuated AUVs.
+
+Role subpackages (``docs/architecture.md``): :mod:`tubekit.model` (kinematics, error geometry,
+laws, trajectories, vehicles), :mod:`tubekit.plant` (the simulated vehicle), :mod:`tubekit.fhocp`
+(the FHOCP and its solvers), :mod:`tubekit.loop` (the closed loop, its result, metrics and
+promises), :mod:`tubekit.paper` (the printed equations and their audit) and :mod:`tubekit.app`
+(the command line, files and figures). ``import tubekit`` loads neither sympy nor matplotlib.
+"""
 
 from __future__ import annotations
 
-from .ancillary import LAWS, AncillaryLaw, get_law, register_law
-from .api import simulate
-from .derivation import derive, error_coordinates, numeric
-from .exceptions import ConfigError, NotAvailableError, ShapeError, SolverError, TubekitError
-from .model import InputLimits, SwayModel, kinematics, nominal_kinematics
-from .scenario import (ControllerSettings, Disturbance, Obstacle, RegionSettings, Scenario,
-                       load_scenario, paper_scenario, scenario_from_dict)
-from .promises import Promise, check_promises
-from .simulation_result import SimulationResult
-from .tightening import Tightening
-from .trajectory import Circle, Helix, Line, Trajectory, Waypoints
+from typing import Any
 
-__version__ = "0.1.0"
+from tubekit.api import simulate
+from tubekit.exceptions import ConfigError, NotAvailableError, ShapeError, SolverError, TubekitError
+from tubekit.loop.promises import Promise, check_promises
+from tubekit.loop.result import SimulationResult
+from tubekit.model.ancillary import LAWS, AncillaryLaw, get_law, register_law
+from tubekit.model.errors import error_coordinates, numeric
+from tubekit.model.kinematics import InputLimits, SwayModel, kinematics, nominal_kinematics
+from tubekit.model.trajectory import Circle, Helix, Line, Trajectory, Waypoints
+from tubekit.scenario import (ControllerSettings, Disturbance, Obstacle, RegionSettings, Scenario,
+                              load_scenario, paper_scenario, scenario_from_dict)
+from tubekit.tightening import Tightening
+from tubekit.version import __version__
 
 __all__ = [
     "__version__",
@@ -28,3 +36,12 @@ __all__ = [
     "Tightening",
     "simulate", "SimulationResult", "Promise", "check_promises",
 ]
+
+
+def __getattr__(name: str) -> Any:
+    """``tubekit.derive``: the sympy derivation, imported on first use (``import tubekit`` stays sympy-free)."""
+    if name == "derive":
+        from tubekit.model.derivation import derive
+
+        return derive
+    raise AttributeError(f"module 'tubekit' has no attribute {name!r}")

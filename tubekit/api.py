@@ -16,12 +16,12 @@ from __future__ import annotations
 import math
 from typing import Any
 
-from .checks import check_run_inputs
-from .closed_loop import simulate as _simulate
-from .exceptions import ConfigError, TubekitError
-from .scenario import Scenario
-from .simulation_result import SimulationResult
-from .tightening import Tightening
+from tubekit.checks import check_run_inputs
+from tubekit.loop.closed_loop import simulate as _simulate
+from tubekit.exceptions import ConfigError, TubekitError
+from tubekit.scenario import Scenario
+from tubekit.loop.result import SimulationResult
+from tubekit.tightening import Tightening
 
 __all__ = ["simulate"]
 

@@ -21,9 +21,9 @@ import math
 
 import numpy as np
 
-from .derivation import error_coordinates
-from .exceptions import ConfigError
-from .scenario import ControllerSettings, Scenario, paper_scenario
+from tubekit.model.errors import error_coordinates
+from tubekit.exceptions import ConfigError
+from tubekit.scenario import ControllerSettings, Scenario, paper_scenario
 
 __all__ = ["check_run_inputs", "check_start", "check_log_size", "check_horizon_and_limits", "log_bytes",
            "MEMORY_BUDGET_BYTES", "LOG_BYTES_PER_TICK", "RUNS_PER_STUDY", "MAX_HORIZON_STEPS"]

@@ -5,7 +5,7 @@ or built in Python. Values the paper leaves out are chosen here and documented:
 
 * obstacle radius 0.4 m, vehicle radius 0.2 m (the paper gives neither);
 * initial pose 0.5 m behind the target, 0.2 m above it, heading along the path;
-* sway ``v_s = clip(0.1 u r, +-0.02 m/s)`` (:class:`tubekit.model.SwayModel`);
+* sway ``v_s = clip(0.1 u r, +-0.02 m/s)`` (:class:`tubekit.model.kinematics.SwayModel`);
 * FHOCP weights Q, R, P (diagonal) and the verification region.
 """
 
@@ -20,11 +20,11 @@ from typing import Any
 
 import numpy as np
 
-from .exceptions import ConfigError, ShapeError
-from .model import InputLimits, SwayModel
-from .trajectory import Circle, Trajectory, trajectory_from_dict
-from .validation import as_vector, positive
-from .vehicles import PlantSettings
+from tubekit.exceptions import ConfigError, ShapeError
+from tubekit.model.kinematics import InputLimits, SwayModel
+from tubekit.model.trajectory import Circle, Trajectory, trajectory_from_dict
+from tubekit.validation import as_vector, positive
+from tubekit.model.vehicles import PlantSettings
 
 __all__ = [
     "Obstacle",
@@ -65,7 +65,7 @@ class Disturbance:
 
     ``delta(t) = amplitude * [sin(a), cos(a), sin(a)] + constant``,
     ``a = 2 pi t / period``; the paper uses amplitude 0.1 m/s, period 15 s.
-    Evaluated by :class:`tubekit.plant.Plant` (this class only holds the settings
+    Evaluated by :class:`tubekit.plant.kinematic.Plant` (this class only holds the settings
     and their bounds).
 
     Parameters
@@ -120,7 +120,7 @@ class ControllerSettings:
     Q, R, P : array (3,)
         Diagonals of the stage, input and terminal weights.
     law : str
-        Ancillary law: a name in :data:`tubekit.ancillary.LAWS` (built-in: :data:`LAW_NAMES`).
+        Ancillary law: a name in :data:`tubekit.model.ancillary.LAWS` (built-in: :data:`LAW_NAMES`).
     sigma : float or None
         Ancillary gain; ``None`` lets the verifier choose it.
     ancillary_rate_hz : float
@@ -156,7 +156,7 @@ class ControllerSettings:
                 raise ConfigError(f"controller.{name}", "three numbers > 0 (a positive diagonal)",
                                   getattr(self, name))
             object.__setattr__(self, name, tuple(float(x) for x in vec))
-        from .ancillary import LAWS  # the registry: built-in laws plus registered ones
+        from tubekit.model.ancillary import LAWS  # the registry: built-in laws plus registered ones
         if self.law not in LAWS:
             raise ConfigError("controller.law", f"one of {tuple(LAWS)}", self.law)
         if self.sigma is not None:

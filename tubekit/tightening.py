@@ -10,7 +10,7 @@ Two layers of data:
   inter-node allowance, so a plan meeting them usually passes the arc check);
 * the certificate's per-arc margins ``margins`` (N, 4) (columns e_d, e_z, e_o,
   position), its nominal-arc rate bounds ``rates`` (4,) and its one-period tube
-  ``tube`` (3,) per axis, used by :mod:`tubekit.plan_check` to accept a plan
+  ``tube`` (3,) per axis, used by :mod:`tubekit.loop.plan_check` to accept a plan
   exactly along its arcs and by the run's promise checks.
 """
 
@@ -20,7 +20,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .scenario import Scenario
+from tubekit.scenario import Scenario
 
 __all__ = ["Tightening", "MARGIN_COLUMNS"]
 

@@ -7,7 +7,7 @@ from typing import Any
 
 import numpy as np
 
-from .exceptions import ConfigError, ShapeError
+from tubekit.exceptions import ConfigError, ShapeError
 
 __all__ = ["as_vector", "positive", "nonnegative", "finite", "interval", "positive_triple", "nonnegative_triple"]
 

@@ -31,7 +31,7 @@ import matplotlib.pyplot as plt
 import numpy as np
 
 from tubekit import Disturbance, SwayModel, kinematics, nominal_kinematics, paper_scenario
-from tubekit.plant import Plant
+from tubekit.plant.kinematic import Plant
 
 QUICK = os.environ.get("TUBEKIT_QUICK") == "1"
 FIGURES = (Path(os.environ["TUBEKIT_FIGURES"]) if "TUBEKIT_FIGURES" in os.environ

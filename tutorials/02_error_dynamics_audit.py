@@ -30,8 +30,9 @@ import matplotlib.pyplot as plt
 import numpy as np
 import sympy as sp
 
-from tubekit.audit import audit
-from tubekit.derivation import derive, numeric
+from tubekit.paper.audit import audit
+from tubekit.model.derivation import derive
+from tubekit.model.errors import numeric
 
 QUICK = os.environ.get("TUBEKIT_QUICK") == "1"
 FIGURES = (Path(os.environ["TUBEKIT_FIGURES"]) if "TUBEKIT_FIGURES" in os.environ

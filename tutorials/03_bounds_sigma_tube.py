@@ -19,7 +19,7 @@
 #    in continuous time, using four numbers: L1, L2 (Lipschitz constants), J_lower (Remark 1)
 #    and ξ̄ (Remark 2). `verify.compute_bounds` still computes them, rigorously. We use them
 #    to show that both remarks are false.
-# 2. **The tube of the loop that runs.** `tubekit.closed_loop` resets the nominal to the
+# 2. **The tube of the loop that runs.** `tubekit.loop.closed_loop` resets the nominal to the
 #    measured state every δ = `controller.dt` and holds the ancillary input at its rate. The
 #    certificate (`verify.certify`) proves a *one-period* box tube for exactly that loop
 #    (`verify.sampled`). We compute it for a range of gains σ and see what σ buys and costs.

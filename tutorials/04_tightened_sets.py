@@ -18,7 +18,7 @@
 # 2. **per-arc margins** M_j — how much each arc j of a plan must stay inside R and away from
 #    obstacles; they grow along the horizon because the *previous* plan may have to be replayed
 #    from the new measured state (step 8);
-# 3. **the exact arc check** `tubekit.plan_check.check_plan` — a plan is accepted only if the
+# 3. **the exact arc check** `tubekit.loop.plan_check.check_plan` — a plan is accepted only if the
 #    constraints hold along the whole continuous arcs, not only at the FHOCP's nodes (step 9);
 # 4. **the hand-off** `Certificate.tightening` — the `Tightening` the FHOCP and the loop use.
 
@@ -39,7 +39,7 @@ from matplotlib.patches import Circle
 
 import verify
 from tubekit import error_coordinates, load_scenario
-from tubekit.plan_check import check_plan, plan_arcs
+from tubekit.loop.plan_check import check_plan, plan_arcs
 from tubekit.tightening import MARGIN_COLUMNS, Tightening
 from verify.sampled import horizon_margins
 

@@ -41,7 +41,7 @@ from matplotlib.patches import Circle
 import verify
 from tubekit import NotAvailableError, error_coordinates, paper_scenario
 from tubekit.fhocp import FHOCP
-from tubekit.sensing import detected_obstacles, surface_distance
+from tubekit.loop.sensing import detected_obstacles, surface_distance
 
 QUICK = os.environ.get("TUBEKIT_QUICK") == "1"
 FIGURES = (Path(os.environ["TUBEKIT_FIGURES"]) if "TUBEKIT_FIGURES" in os.environ
@@ -73,7 +73,7 @@ print(f"horizon: N = {N} steps of dt = {dt:g} s (T = {N * dt:g} s)")
 # The target runs clockwise on the circle of radius 3 m at π/25 rad/s and passes the
 # obstacle at (3, 0, 0) at t = 12.5 s. We put the vehicle at t = 12 s on the circle 0.6 m
 # behind the target, 0.2 m above it, heading along the circle — the pose it has at t = 0,
-# a little further behind. `tubekit.sensing` decides what the FHOCP gets to know: an
+# a little further behind. `tubekit.loop.sensing` decides what the FHOCP gets to know: an
 # obstacle is detected when its **surface** is within R̄ = 1.5 m of the vehicle centre.
 
 # %%

@@ -14,7 +14,7 @@
 # holds the first nominal input v̂; at 100 Hz the ancillary law adds κ = −σ J⁻¹(e − ê), and
 # the plant (eq. 11, with the paper's currents and a sway term) is integrated with RK4.
 #
-# We run two controllers under the same disturbance, with `tubekit.closed_loop.simulate`:
+# We run two controllers under the same disturbance, with `tubekit.loop.closed_loop.simulate`:
 #
 # * **tube**: the FHOCP on the tightened sets (V̄, e_d ≥ ε + ρ̃, obstacle margin) plus κ;
 # * **baseline**: the same FHOCP on the untightened sets (V, e_d ≥ ε, no margin), no κ.
@@ -39,11 +39,11 @@ from matplotlib.patches import Circle
 
 import verify
 from tubekit import Tightening, paper_scenario
-from tubekit.closed_loop import simulate
-from tubekit.promises import check_promises
+from tubekit.loop.closed_loop import simulate
+from tubekit.loop.promises import check_promises
 from tubekit.fhocp import FHOCP
-from tubekit.metrics import clearance as vehicle_clearance
-from tubekit.metrics import compute_metrics, rho_period_peaks
+from tubekit.loop.metrics import clearance as vehicle_clearance
+from tubekit.loop.metrics import compute_metrics, rho_period_peaks
 
 QUICK = os.environ.get("TUBEKIT_QUICK") == "1"
 FIGURES = (Path(os.environ["TUBEKIT_FIGURES"]) if "TUBEKIT_FIGURES" in os.environ
@@ -295,7 +295,7 @@ print("wrote", FIGURES / "06_paper_figures.png")
 # currents, ε = 0.5 m and |e_o| ≤ 0.5. It certifies: the sampled-data theorem gives a box
 # tube ρ̄ (per axis, over one FHOCP period, restarting at the reset) and V̄ leaves room for κ.
 # The claim to watch is |e_j(t) − ê_j(t)| ≤ ρ̄_j for every axis and all t — with every other
-# promise of the certificate (`tubekit.promises.check_promises`). We run the tube controller
+# promise of the certificate (`tubekit.loop.promises.check_promises`). We run the tube controller
 # and — for contrast — the baseline, whose ρ is the drift of the uncontrolled vehicle from its
 # nominal over one period. The figure draws ‖ρ‖ against ‖ρ̄‖₂, which the box implies.
 

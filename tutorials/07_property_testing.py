@@ -14,9 +14,9 @@
 # state at every sample (ρ = e − ê = 0 at t_k), v̂ is held over the period, κ is held over
 # each tick of the ancillary rate, and for every disturbance with ‖ω_xy‖ ≤ ω̄_xy,
 # |ω_z| ≤ ω̄_z the deviation stays in the box max_j |ρ_j| / tube_j ≤ 1 for the whole period.
-# `verify.strategies` generates exactly the starts of such a period (valid by construction,
-# never filtered), `verify.invariance.one_period_ratio` runs the period with the loop's own
-# plant and law, and `verify.falsify` hunts for a ratio above 1.
+# `verify.falsify.strategies` generates exactly the starts of such a period (valid by construction,
+# never filtered), `verify.falsify.invariance.one_period_ratio` runs the period with the loop's own
+# plant and law, and `verify.falsify.one_period` hunts for a ratio above 1.
 #
 # We test three ancillary laws κ = −σ K(J) ρ: the paper's (K = I), tubekit's corrected
 # law (K = J⁻¹), and "your own" — here a hand-made sign-flipped law K = sign(c)·I,
@@ -37,9 +37,9 @@ from hypothesis import given, settings
 
 import verify
 from tubekit import LAWS, AncillaryLaw
-from verify import strategies as vs
-from verify.falsify import falsify, falsify_closed_loop, search_space
-from verify.invariance import one_period_ratio
+from verify.falsify import strategies as vs
+from verify.falsify.one_period import falsify, falsify_closed_loop, search_space
+from verify.falsify.invariance import one_period_ratio
 
 QUICK = os.environ.get("TUBEKIT_QUICK") == "1"
 FIGURES = (Path(os.environ["TUBEKIT_FIGURES"]) if "TUBEKIT_FIGURES" in os.environ
@@ -143,7 +143,7 @@ print("wrote", FIGURES / "07_property_testing.png")
 
 # %% [markdown]
 # ## The whole loop: disturbance sequences
-# `falsify_closed_loop` runs `tubekit.closed_loop.simulate` itself (FHOCP, plan check,
+# `falsify_closed_loop` runs `tubekit.loop.closed_loop.simulate` itself (FHOCP, plan check,
 # reset, ZOH) from starts on the faces of Ē, with a greedy ω that pushes the largest
 # |ρ_j| / tube_j at every tick and with piecewise-constant sequences tuned by a (1 + λ)
 # evolution strategy, and checks every promise of the run. The largest ratio it finds is the

@@ -78,7 +78,7 @@ print("\npremises, checked in every run:", *cert.premises, sep="\n  - ")
 # condition could not be evaluated, or has no number to compare with; `num` prints it as n/a
 # instead of crashing on `None:.4g`. The premises are what the certificate cannot know in advance:
 # the FHOCP must produce an acceptable plan at least once every N samples, and the disturbance
-# of the run must respect ω̄ — `tubekit.promises.check_promises(run)` measures both on each run.
+# of the run must respect ω̄ — `tubekit.loop.promises.check_promises(run)` measures both on each run.
 #
 # ## Step 2: choose σ yourself
 # `controller.sigma = None` lets `certify` try σ ∈ {0, f/32, …, f} and keep the largest that

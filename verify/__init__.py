@@ -8,31 +8,38 @@ arithmetic and with budgets in work units (the same verdict on any machine). See
 the certified frontier beside physical necessity; ``search_region`` looks for a region that
 certifies.
 
-Submodules for property-based testing: :mod:`verify.strategies` (hypothesis strategies),
-:mod:`verify.invariance` (one period of the sampled-data loop from a reset state) and
-:mod:`verify.falsify` (the one-period and closed-loop falsifiers behind ``tubekit falsify``).
+Role subpackages: :mod:`verify.lemma1` (the paper's Lemma-1 quantities, a reference) and
+:mod:`verify.falsify` (hypothesis strategies, one period from a reset state, the one-period and
+closed-loop falsifiers behind ``tubekit falsify``).
 
-verify imports the tubekit core only: no argparse, no matplotlib. The envelope plot is
+verify imports the tubekit core only (only :mod:`verify.falsify` runs the loop): no argparse, no
+matplotlib. ``import verify`` loads no sympy either: the names below are imported on first use. The envelope plot is
 :func:`tubekit.app.plots.plot_envelope` (it was ``verify.plot_envelope``).
 """
 
 from __future__ import annotations
 
+import importlib
 from pathlib import Path
+from typing import Any
 
 from tubekit.scenario import Scenario, load_scenario
-
-from .bounds import BOUND_NAMES, BoundResult, Bounds, compute_bounds
-from .certificate import Certificate, Condition, NotCertifiedError, certify
-from .envelope import EnvelopeResult, envelope
-from .recheck import RecheckResult, recheck, recheck_file
-from .region import Region
-from .region_search import RegionSearchResult, search_region
-
-__version__ = "0.1.0"
+from tubekit.version import __version__
 
 #: Directory of the scenarios shipped with verify.
 SCENARIOS_DIR = Path(__file__).resolve().parent / "scenarios"
+
+#: Public name -> the module that defines it, imported on first access (PEP 562).
+_LAZY: dict[str, str] = {
+    "certify": "verify.certificate", "Certificate": "verify.certificate", "Condition": "verify.certificate",
+    "NotCertifiedError": "verify.certificate",
+    "Region": "verify.region",
+    "compute_bounds": "verify.lemma1.bounds", "Bounds": "verify.lemma1.bounds",
+    "BoundResult": "verify.lemma1.bounds", "BOUND_NAMES": "verify.lemma1.bounds",
+    "envelope": "verify.envelope", "EnvelopeResult": "verify.envelope",
+    "recheck": "verify.recheck", "recheck_file": "verify.recheck", "RecheckResult": "verify.recheck",
+    "search_region": "verify.region_search", "RegionSearchResult": "verify.region_search",
+}
 
 
 def certifiable_scenario() -> Scenario:
@@ -40,32 +47,20 @@ def certifiable_scenario() -> Scenario:
     return load_scenario(SCENARIOS_DIR / "certifiable.toml")
 
 
-__all__ = [
-    "__version__",
-    "certify",
-    "Certificate",
-    "Condition",
-    "NotCertifiedError",
-    "Region",
-    "compute_bounds",
-    "Bounds",
-    "BoundResult",
-    "BOUND_NAMES",
-    "envelope",
-    "EnvelopeResult",
-    "recheck",
-    "recheck_file",
-    "RecheckResult",
-    "search_region",
-    "RegionSearchResult",
-    "SCENARIOS_DIR",
-    "certifiable_scenario",
-]
+__all__ = ["__version__", *_LAZY, "SCENARIOS_DIR", "certifiable_scenario"]
 
 
-def __getattr__(name: str):
-    """Point the moved ``plot_envelope`` at its new home instead of a bare AttributeError."""
+def __getattr__(name: str) -> Any:
+    """Import a public name's module on first use; point the moved ``plot_envelope`` at its new home."""
+    if name in _LAZY:
+        value = getattr(importlib.import_module(_LAZY[name]), name)
+        globals()[name] = value
+        return value
     if name == "plot_envelope":
         raise AttributeError("verify.plot_envelope moved to tubekit.app.plots.plot_envelope "
                              "(verify imports no plotting library)")
     raise AttributeError(f"module 'verify' has no attribute {name!r}")
+
+
+def __dir__() -> list[str]:
+    return sorted(set(globals()) | set(_LAZY))

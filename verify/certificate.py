@@ -10,9 +10,9 @@
    (or, when none certifies, the best uncertified one, for a best-effort run).
 
 The theorem (``docs/verify.md``, "The sampled-data theorem"): if every condition
-holds, then in the loop of :mod:`tubekit.closed_loop` — reset at every sample,
+holds, then in the loop of :mod:`tubekit.loop.closed_loop` — reset at every sample,
 κ held at the ancillary rate, v̂ held over each period, plans accepted only when
-:mod:`tubekit.plan_check` verifies their arcs against the per-arc margins and the
+:mod:`tubekit.loop.plan_check` verifies their arcs against the per-arc margins and the
 previous accepted plan replayed otherwise — the real error stays in R, e_d >= ε,
 the input stays in V (never saturates), the vehicle ball never touches an
 obstacle, and |e_j - ê_j| <= tube_j within every period, provided the two
@@ -27,32 +27,32 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from tubekit.ancillary import AncillaryLaw, get_law, register_law
+from tubekit.model.ancillary import AncillaryLaw, get_law, register_law
 from tubekit.exceptions import ConfigError, TubekitError
 from tubekit.jsonable import to_jsonable
 from tubekit.scenario import Scenario
 from tubekit.tightening import Tightening
 
-from .design import Condition, Design, DisturbanceBounds, disturbance_bounds, evaluate_design
-from .gains import GainBounds, gain_bounds
-from .region import Region
+from verify.design import Condition, Design, DisturbanceBounds, disturbance_bounds, evaluate_design
+from verify.gains import GainBounds, gain_bounds
+from verify.region import Region
 
 __all__ = ["Condition", "Certificate", "NotCertifiedError", "certify", "sigma_candidates", "choose_design",
            "ASSUMPTIONS", "PREMISES", "THEOREM"]
 
 THEOREM = ("sampled-data tube under the nominal reset: one-period box tube (verify.sampled), per-arc margins of "
-           "the replayed candidate (verify.sampled.horizon_margins), exact arc acceptance (tubekit.plan_check)")
+           "the replayed candidate (verify.sampled.horizon_margins), exact arc acceptance (tubekit.loop.plan_check)")
 
 #: Outside the model: what no certificate about eq. (11) can check.
 ASSUMPTIONS = (
     "The plant is the kinematic model eq. (11) with omega = current + sway term; the error dynamics are the sympy "
-    "derivation of tubekit.derivation (not the printed eqs. 15-18). A real vehicle's dynamics are not covered.",
+    "derivation of tubekit.model.derivation (not the printed eqs. 15-18). A real vehicle's dynamics are not covered.",
     "The simulator integrates eq. (11) with RK4 at a fixed step; the certificate bounds the exact solution, not "
     "the integration error (below 1e-9 m at the default 5 ms step).",
     "Sensing is exact: obstacle centres and radii, the state and the target trajectory are known without noise.",
 )
 
-#: Premises of the theorem that depend on the run, checked in every run (tubekit.promises).
+#: Premises of the theorem that depend on the run, checked in every run (tubekit.loop.promises).
 PREMISES = (
     "recursive_feasibility: an accepted FHOCP plan at t = 0 and at least one in every N consecutive samples "
     "(the replayed candidate covers N - 1 samples; past that no terminal set is certified).",
@@ -191,7 +191,7 @@ class Certificate:
 
     def summary(self) -> str:
         """Human-readable certificate."""
-        from .report import certificate_text  # plain text, no plotting
+        from verify.report import certificate_text  # plain text, no plotting
         return certificate_text(self)
 
     # ------------------------------------------------------------------ hand-off to the FHOCP
@@ -202,7 +202,7 @@ class Certificate:
         Raises :class:`NotCertifiedError` when the design is not certified: use
         :meth:`best_effort_tightening` for a run that carries no guarantee.
         """
-        from .handoff import tightening_of
+        from verify.handoff import tightening_of
         if not self.certified:
             names = ", ".join(f["condition"] for f in self.failures) or ", ".join(self.not_evaluated)
             raise NotCertifiedError(f"scenario '{self.scenario_name}' with law '{self.law}' is not certified "
@@ -218,7 +218,7 @@ class Certificate:
         min_input_fraction : float
             In (0, 1]: each best-effort input limit keeps at least this fraction of V.
         """
-        from .handoff import tightening_of
+        from verify.handoff import tightening_of
         if isinstance(min_input_fraction, bool) or not isinstance(min_input_fraction, (int, float)) \
                 or not (0 < min_input_fraction <= 1):
             raise ConfigError("min_input_fraction", "a number in (0, 1]", min_input_fraction)
@@ -264,7 +264,7 @@ def _is_dynamic(scenario: Scenario) -> bool:
 
 
 def _dynamic_assumptions(scenario: Scenario, dist: DisturbanceBounds) -> tuple[str, ...]:
-    """What the certificate assumes of the dynamic plant (each checked in every run by tubekit.promises)."""
+    """What the certificate assumes of the dynamic plant (each checked in every run by tubekit.loop.promises)."""
     du, dw, dr = scenario.plant.tracking_bound
     return (f"Dynamic plant: the velocity loop tracks the command within |u_b - u| <= {du:g} m/s, "
             f"|w_b - w| <= {dw:g} m/s, |r_b - r| <= {dr:g} rad/s (plant.tracking_bound: assumed, not derived; "

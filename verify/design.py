@@ -25,14 +25,14 @@ from dataclasses import dataclass, field
 import numpy as np
 from flint import arb
 
-from tubekit.derivation import error_coordinates, heading_cosine
+from tubekit.model.errors import error_coordinates, heading_cosine
 from tubekit.scenario import Scenario
-from tubekit.vehicles import VehicleParams
+from tubekit.model.vehicles import VehicleParams
 
-from .gains import GainBounds
-from .intervals import lower, upper
-from .region import Region
-from .sampled import HorizonMargins, PeriodTube, TubeProblem, horizon_margins, one_period_tube
+from verify.gains import GainBounds
+from verify.intervals import lower, upper
+from verify.region import Region
+from verify.sampled import HorizonMargins, PeriodTube, TubeProblem, horizon_margins, one_period_tube
 
 __all__ = ["Condition", "Design", "DisturbanceBounds", "disturbance_bounds", "hull_sway_bound", "tube_problem",
            "evaluate_design", "arc_rates", "sway_condition", "input_tightening", "state_conditions"]

@@ -36,11 +36,11 @@ import numpy as np
 from tubekit.exceptions import ConfigError
 from tubekit.jsonable import to_jsonable
 from tubekit.scenario import Scenario
-from tubekit.trajectory import Circle, Line, Trajectory
+from tubekit.model.trajectory import Circle, Line, Trajectory
 from tubekit.validation import finite, positive
 
-from .certificate import _resolve_law, certify
-from .design import disturbance_bounds
+from verify.certificate import _resolve_law, certify
+from verify.design import disturbance_bounds
 
 __all__ = ["EnvelopeResult", "envelope", "necessary_omega", "scenario_at", "REFERENCE_POINTS",
            "BISECTION_STEPS"]

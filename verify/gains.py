@@ -5,7 +5,7 @@ sup |K_jl| (the input the law can ask for) and the range of G_jl (how one
 zero-order-hold tick moves ρ). J is the derived Jacobian in polar form,
 J = [[c, 0, 0], [0, 1, 0], [-e_o c / e_d, 0, c]] with c = s sqrt(1 - e_o²)
 (s = -1 toward the target, +1 away; :func:`polar_jacobian`, pinned against
-:mod:`tubekit.derivation` by the tests). Each entry is a function of (e_d, e_o)
+:mod:`tubekit.model.derivation` by the tests). Each entry is a function of (e_d, e_o)
 only; its sup is certified by :func:`verify.intervals.maximise` (Arb
 branch-and-bound, budget in boxes). Entries that simplify to a constant are
 taken exactly.
@@ -19,11 +19,11 @@ from functools import lru_cache
 import numpy as np
 import sympy as sp
 
-from tubekit.ancillary import get_law
+from tubekit.model.ancillary import get_law
 from tubekit.exceptions import ConfigError
 
-from .intervals import Case, compile_arb, compile_numpy, maximise
-from .region import Region
+from verify.intervals import Case, compile_arb, compile_numpy, maximise
+from verify.region import Region
 
 __all__ = ["GainBounds", "gain_bounds", "gain_entries", "polar_jacobian"]
 

@@ -3,7 +3,7 @@
 Certified: V̄ = V - κ̄, the per-arc margins, the tube and the arc-rate bounds as
 certified; the FHOCP's node constraints are the largest margin plus the
 inter-node allowance rate · δ / 2 (a plan meeting them usually passes the exact
-arc check of :mod:`tubekit.plan_check`, which is what the theorem relies on).
+arc check of :mod:`tubekit.loop.plan_check`, which is what the theorem relies on).
 
 Best effort (not certified): the same construction from the best design found,
 each input limit kept at >= max(``min_input_fraction`` · V_i, the keep-up need)

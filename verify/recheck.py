@@ -33,11 +33,11 @@ from flint import arb
 from tubekit.exceptions import ConfigError
 from tubekit.scenario import scenario_from_dict
 
-from .design import disturbance_bounds, input_tightening, state_conditions, sway_condition
-from .gains import gain_entries
-from .intervals import upper
-from .region import Region
-from .sampled import HorizonMargins, PeriodTube, TubeProblem, horizon_margins, tube_map
+from verify.design import disturbance_bounds, input_tightening, state_conditions, sway_condition
+from verify.gains import gain_entries
+from verify.intervals import upper
+from verify.region import Region
+from verify.sampled import HorizonMargins, PeriodTube, TubeProblem, horizon_margins, tube_map
 
 __all__ = ["RecheckResult", "recheck", "recheck_file"]
 

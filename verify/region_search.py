@@ -21,7 +21,7 @@ from tubekit.exceptions import ConfigError
 from tubekit.jsonable import to_jsonable
 from tubekit.scenario import Scenario
 
-from .certificate import _resolve_law, certify
+from verify.certificate import _resolve_law, certify
 
 __all__ = ["RegionTrial", "RegionSearchResult", "search_region", "E_O_MAX_GRID", "E_D_MAX_GRID"]
 

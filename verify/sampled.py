@@ -1,6 +1,6 @@
 """The sampled-data tube of one FHOCP period under the nominal reset.
 
-This is the tube of the loop that runs (:mod:`tubekit.closed_loop`): at every
+This is the tube of the loop that runs (:mod:`tubekit.loop.closed_loop`): at every
 sample t_k the nominal is reset to the measured state (ê(t_k) = e(t_k),
 eq. diff_mpc), the nominal input v̂ is held for one period δ = ``dt``, and the
 ancillary law κ_i = -σ K(e_i) ρ_i is applied with a zero-order hold at the
@@ -34,7 +34,7 @@ from functools import lru_cache
 
 from flint import arb
 
-from .intervals import upper
+from verify.intervals import upper
 
 __all__ = ["TubeProblem", "PeriodTube", "tube_map", "one_period_tube", "horizon_margins", "HorizonMargins"]
 

@@ -19,8 +19,8 @@ from matplotlib.animation import FFMpegWriter, PillowWriter
 from matplotlib.figure import Figure
 from matplotlib.patches import Circle as CirclePatch
 
-from ..scenario import Scenario
-from .plots import Run, draw_scene_xy, fit_canvas, run_style
+from tubekit.scenario import Scenario
+from tubekit.app.plots import Run, draw_scene_xy, fit_canvas, run_style
 
 __all__ = ["animate_top_view", "ANIMATION_GIF", "ANIMATION_MP4", "frame_rows"]
 

@@ -8,7 +8,7 @@ the moment it completes → assemble ``DIR/runs.parquet`` atomically → ``summa
 
 Worker side (:func:`simulate_task`): the run's scenario under the shipped tightening, plus
 ``falsify.sequences`` runs where the current is replaced by a random piecewise-constant disturbance
-within the certificate's bounds (:func:`verify.falsify_loop.piecewise_disturbance`, one ω per FHOCP
+within the certificate's bounds (:func:`verify.falsify.closed_loop.piecewise_disturbance`, one ω per FHOCP
 period, drawn from the run's seed); the row keeps the worst figure of each metric over those runs.
 Nothing in a row depends on the worker, the order or the scheduler except ``wall_s``.
 """
@@ -28,12 +28,12 @@ from typing import Any, Callable, Iterator
 
 import numpy as np
 
-from ..exceptions import ConfigError, TubekitError
-from ..jsonable import write_json
-from ..scenario import Scenario
-from ..tightening import Tightening
-from .campaign_spec import CampaignSpec, RunPlan, certificate_key, spec_from_stored
-from .study import check_output_dir
+from tubekit.exceptions import ConfigError, TubekitError
+from tubekit.jsonable import write_json
+from tubekit.scenario import Scenario
+from tubekit.tightening import Tightening
+from tubekit.app.campaign_spec import CampaignSpec, RunPlan, certificate_key, spec_from_stored
+from tubekit.app.study import check_output_dir
 
 __all__ = ["RunTask", "Certified", "simulate_task", "certify_plans", "open_client", "run_campaign",
            "read_rows", "replay_run", "replay_into", "summarise", "summary_line", "write_figures", "METRIC_COLUMNS", "FIGURES"]
@@ -74,7 +74,7 @@ def _disturbances(task: RunTask) -> list[Callable | None]:
     """None (the scenario's current), then ``sequences`` piecewise-constant ω within the certificate's bounds."""
     if task.sequences == 0:
         return [None]
-    from verify.falsify_loop import piecewise_disturbance
+    from verify.falsify.closed_loop import piecewise_disturbance
 
     omega_xy, omega_z = (float(x) for x in task.certificate.tightening.disturbance[:2])
     rng = np.random.default_rng([task.seed, 1])
@@ -85,8 +85,8 @@ def _disturbances(task: RunTask) -> list[Callable | None]:
 
 def _simulate_all(task: RunTask) -> list[tuple[Any, list]]:
     """Each simulation of the run with its promises: [(SimulationResult, [Promise])]."""
-    from ..closed_loop import simulate
-    from ..promises import check_promises
+    from tubekit.loop.closed_loop import simulate
+    from tubekit.loop.promises import check_promises
 
     out = []
     for disturbance in _disturbances(task):
@@ -420,7 +420,7 @@ def replay_into(campaign_dir: str | Path, run: int, out: str | Path | None, echo
 
     Returns ``{"identical": replayed row == stored row (wall_s aside), "broken": certified and violated}``.
     """
-    from ..jsonable import dumps
+    from tubekit.jsonable import dumps
 
     target = Path(out) if out else Path(campaign_dir) / f"replay_{run:06d}"
     check_output_dir(target)

@@ -34,8 +34,8 @@ from typing import Any
 
 import numpy as np
 
-from ..exceptions import ConfigError, TubekitError
-from ..scenario import Scenario, load_scenario, paper_scenario, read_toml, scenario_from_dict
+from tubekit.exceptions import ConfigError, TubekitError
+from tubekit.scenario import Scenario, load_scenario, paper_scenario, read_toml, scenario_from_dict
 
 __all__ = ["Distribution", "CampaignSpec", "RunPlan", "load_spec", "spec_from_dict", "run_seed",
            "certificate_key", "spec_from_stored", "require_dependencies", "NOT_CERTIFICATE_INPUTS", "SPEC_KEYS"]

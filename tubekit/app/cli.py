@@ -25,11 +25,11 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Callable
 
-from .. import __version__
-from ..exceptions import ConfigError, TubekitError
-from ..jsonable import dumps, write_json
-from ..scenario import Scenario, load_scenario, paper_scenario
-from ..validation import positive
+from tubekit import __version__
+from tubekit.exceptions import ConfigError, TubekitError
+from tubekit.jsonable import dumps, write_json
+from tubekit.scenario import Scenario, load_scenario, paper_scenario
+from tubekit.validation import positive
 
 __all__ = ["main", "build_parser", "Subcommand", "SUBCOMMANDS", "EXIT_OK", "EXIT_FAILURE", "EXIT_BAD_INPUT",
            "EXIT_NOT_CERTIFIED", "EXIT_PROMISE_BROKEN", "EXIT_INTERRUPTED", "configure_logging"]
@@ -57,7 +57,7 @@ class Subcommand:
 # ---- shared option groups and helpers -------------------------------------------------------------------
 
 def _study_options(parser: argparse.ArgumentParser, default_out: str | None) -> None:
-    from . import QUICK_S as QUICK_DURATION_S
+    from tubekit.app import QUICK_S as QUICK_DURATION_S
 
     parser.add_argument("--out", metavar="DIR", default=default_out,
                         help="output directory" + (f" (default: {default_out})" if default_out else
@@ -100,7 +100,7 @@ def _check_file_target(option: str, path: str) -> None:
 
 def _law(args: argparse.Namespace, scenario: Scenario) -> str:
     """The ``--law`` option, else the scenario's; unknown names raise :class:`ConfigError`."""
-    from ..ancillary import get_law
+    from tubekit.model.ancillary import get_law
 
     law = args.law if args.law is not None else scenario.controller.law
     get_law(law)
@@ -147,7 +147,7 @@ def _configure_simulate(parser: argparse.ArgumentParser) -> None:
 
 def _run_reproduce(args: argparse.Namespace) -> int:
     """Section VI of the paper, tube against baseline, with the acceptance criteria."""
-    from .study import apply_overrides, run_study
+    from tubekit.app.study import apply_overrides, run_study
 
     scenario = apply_overrides(paper_scenario(), duration=args.duration, quick=args.quick, law=args.law)
     out = Path(args.out or "results/reproduce")
@@ -158,10 +158,10 @@ def _run_reproduce(args: argparse.Namespace) -> int:
 
 def _run_simulate(args: argparse.Namespace) -> int:
     """The same study on a scenario from TOML; or, with ``--from-campaign DIR --run K``, a campaign run replayed."""
-    from .study import apply_overrides, output_dir_name, run_study
+    from tubekit.app.study import apply_overrides, output_dir_name, run_study
 
     if args.from_campaign is not None or args.run is not None:
-        from .campaign import replay_into
+        from tubekit.app.campaign import replay_into
 
         if args.from_campaign is None or args.run is None or args.config is not None:
             raise ConfigError("--from-campaign", "--from-campaign DIR together with --run K (and no CONFIG)",
@@ -200,7 +200,7 @@ def _configure_audit(parser: argparse.ArgumentParser) -> None:
 
 def _run_audit(args: argparse.Namespace) -> int:
     """Run the audit, print the table, optionally write JSON."""
-    from ..audit import audit
+    from tubekit.paper.audit import audit
 
     if args.samples < 10:
         raise ConfigError("--samples", "an integer >= 10", args.samples)
@@ -267,7 +267,7 @@ def _run_envelope(args: argparse.Namespace) -> int:
     """Certified and physical-necessity frontiers at one epsilon; print the table and the ratio; JSON, plot."""
     from verify import envelope
 
-    from .plots import plot_envelope
+    from tubekit.app.plots import plot_envelope
 
     scenario = _scenario(args.config)
     law = _law(args, scenario)
@@ -335,7 +335,7 @@ def _configure_falsify(parser: argparse.ArgumentParser) -> None:
 
 def _run_falsify(args: argparse.Namespace) -> int:
     """3 when a counterexample is found (ratio > 1 or a promise broken), 0 when none within the budget."""
-    from verify.falsify import falsify, falsify_closed_loop
+    from verify.falsify.one_period import falsify, falsify_closed_loop
 
     scenario = _scenario(args.config)
     if args.sigma is not None:
@@ -358,7 +358,7 @@ def _run_falsify(args: argparse.Namespace) -> int:
 # ---- campaign -------------------------------------------------------------------------------------------
 
 def _configure_campaign(parser: argparse.ArgumentParser) -> None:
-    from .campaign_spec import require_dependencies
+    from tubekit.app.campaign_spec import require_dependencies
 
     require_dependencies()
     parser.add_argument("spec", metavar="SPEC", help="campaign TOML (schema: docs/campaign.md)")
@@ -370,8 +370,8 @@ def _configure_campaign(parser: argparse.ArgumentParser) -> None:
 
 def _run_campaign(args: argparse.Namespace) -> int:
     """Monte Carlo closed-loop runs on dask; 0 done, 4 when a certified run broke a promise."""
-    from .campaign import run_campaign, summary_line
-    from .campaign_spec import load_spec
+    from tubekit.app.campaign import run_campaign, summary_line
+    from tubekit.app.campaign_spec import load_spec
 
     summary = run_campaign(load_spec(args.spec), args.out, workers=args.workers, scheduler=args.scheduler,
                            progress=not args.no_progress)

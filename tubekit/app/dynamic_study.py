@@ -19,11 +19,12 @@ from matplotlib.patches import Circle as CirclePatch
 
 import verify
 
-from ..closed_loop import SimulationResult, simulate
-from ..jsonable import write_text
-from ..metrics import compute_metrics
-from ..promises import check_promises
-from ..scenario import Scenario
+from tubekit.loop.closed_loop import simulate
+from tubekit.loop.result import SimulationResult
+from tubekit.jsonable import write_text
+from tubekit.loop.metrics import compute_metrics
+from tubekit.loop.promises import check_promises
+from tubekit.scenario import Scenario
 
 __all__ = ["run_dynamic", "comparison_figure", "DYNAMIC_FILES"]
 

@@ -16,10 +16,10 @@ from matplotlib.figure import Figure
 from matplotlib.patches import Circle as CirclePatch
 from matplotlib.ticker import MaxNLocator
 
-from ..exceptions import ConfigError
-from ..metrics import clearance, rho_period_peaks
-from ..scenario import Scenario
-from ..tightening import Tightening
+from tubekit.exceptions import ConfigError
+from tubekit.loop.metrics import clearance, rho_period_peaks
+from tubekit.scenario import Scenario
+from tubekit.tightening import Tightening
 
 if TYPE_CHECKING:  # verify is imported for its type only; plotting needs no certificate code
     from verify.envelope import EnvelopeResult

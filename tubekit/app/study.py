@@ -7,7 +7,7 @@ MPC alone: no κ, no tightening) under the same disturbance, then write into
 the output directory:
 
 * ``trajectory.csv`` / ``baseline_trajectory.csv`` (columns: see
-  :data:`tubekit.closed_loop.CSV_COLUMNS`),
+  :data:`tubekit.loop.closed_loop.CSV_COLUMNS`),
 * ``metrics.json`` (tube metrics at the top level, ``baseline`` nested,
   ``acceptance`` for ``reproduce``),
 * ``certificate.json`` and ``certificate.txt``, ``scenario.json``,
@@ -39,16 +39,17 @@ import numpy as np
 
 import verify
 
-from ..checks import check_run_inputs
-from ..closed_loop import SimulationResult, simulate
-from ..exceptions import ConfigError
-from ..jsonable import write_json, write_text
-from ..metrics import compute_metrics
-from ..promises import check_promises
-from ..scenario import Scenario
-from ..tightening import Tightening
-from . import QUICK_S
-from .plots import plot_all
+from tubekit.checks import check_run_inputs
+from tubekit.loop.closed_loop import simulate
+from tubekit.loop.result import SimulationResult
+from tubekit.exceptions import ConfigError
+from tubekit.jsonable import write_json, write_text
+from tubekit.loop.metrics import compute_metrics
+from tubekit.loop.promises import check_promises
+from tubekit.scenario import Scenario
+from tubekit.tightening import Tightening
+from tubekit.app import QUICK_S
+from tubekit.app.plots import plot_all
 
 __all__ = [
     "run_study",
@@ -344,12 +345,12 @@ def _write_study(scenario: Scenario, out: Path, staging: Path, progress: bool, w
     tube, base = run_tube_and_baseline(scenario, design.tightening, progress)
     metrics = write_runs(staging, scenario, design, tube, base)
     if dynamic:
-        from .dynamic_study import run_dynamic
+        from tubekit.app.dynamic_study import run_dynamic
 
         LOGGER.info("tube run on the dynamic plant (%s) ...", scenario.plant.vehicle)
         metrics["dynamic"] = run_dynamic(scenario, staging, tube, progress)
     if animate:
-        from .animate import animate_top_view
+        from tubekit.app.animate import animate_top_view
 
         for path in animate_top_view(staging, scenario, [("tube", tube.columns()), ("baseline", base.columns())]):
             LOGGER.info("animation written: %s", out / path.name)

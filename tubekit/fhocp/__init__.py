@@ -14,12 +14,12 @@ Modules, from the contract outwards:
 
 from __future__ import annotations
 
-from .convex import DEFAULT_CLARABEL_SETTINGS, ConvexSubproblem
-from .fastpath import CompiledConeProgram
-from .ipopt import IpoptFHOCP
-from .nlp import FhocpNlp, NlpEvaluation
-from .result import RESULT_STATUSES, FallbackWarning, FhocpResult, Status, shifted_plan
-from .scp import FHOCP, MODES, obstacle_slots
+from tubekit.fhocp.convex import DEFAULT_CLARABEL_SETTINGS, ConvexSubproblem
+from tubekit.fhocp.fastpath import CompiledConeProgram
+from tubekit.fhocp.ipopt import IpoptFHOCP
+from tubekit.fhocp.nlp import FhocpNlp, NlpEvaluation
+from tubekit.fhocp.result import RESULT_STATUSES, FallbackWarning, FhocpResult, Status, shifted_plan
+from tubekit.fhocp.scp import FHOCP, MODES, obstacle_slots
 
 __all__ = ["FHOCP", "FhocpResult", "FallbackWarning", "MODES", "obstacle_slots", "DEFAULT_CLARABEL_SETTINGS",
            "Status", "RESULT_STATUSES", "shifted_plan", "IpoptFHOCP", "FhocpNlp", "NlpEvaluation",

@@ -33,9 +33,9 @@ import cvxpy as cp
 import numpy as np
 import scipy.sparse as sp
 
-from .fastpath import CompiledConeProgram, ConeSolution
-from .nlp import FhocpNlp, eo_linearisation, rollout, step_linearisation
-from .result import Status, status_from
+from tubekit.fhocp.fastpath import CompiledConeProgram, ConeSolution
+from tubekit.fhocp.nlp import FhocpNlp, eo_linearisation, rollout, step_linearisation
+from tubekit.fhocp.result import Status, status_from
 
 __all__ = ["ConvexSubproblem", "DEFAULT_CLARABEL_SETTINGS", "CVXPY_STATUS"]
 

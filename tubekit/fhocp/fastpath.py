@@ -31,8 +31,8 @@ import numpy as np
 import scipy.sparse as sp
 from cvxpy.lin_ops.lin_op import CONSTANT_ID
 
-from ..exceptions import SolverError
-from .result import Status, status_from
+from tubekit.exceptions import SolverError
+from tubekit.fhocp.result import Status, status_from
 
 __all__ = ["CompiledConeProgram", "ConeSolution", "clarabel_settings", "CLARABEL_STATUS"]
 

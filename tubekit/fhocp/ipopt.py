@@ -22,12 +22,13 @@ from typing import Any, Sequence
 
 import numpy as np
 
-from ..exceptions import ConfigError, NotAvailableError
-from ..scenario import Obstacle, Scenario
-from ..tightening import Tightening
-from ..validation import as_vector, finite
-from .nlp import SINC_SERIES_THRESHOLD, FhocpNlp, rollout, select_obstacles
-from .result import FhocpResult, Status, shifted_plan, status_from
+from tubekit.exceptions import ConfigError, NotAvailableError
+from tubekit.scenario import Obstacle, Scenario
+from tubekit.tightening import Tightening
+from tubekit.validation import as_vector, finite
+from tubekit.fhocp.nlp import FhocpNlp, rollout, select_obstacles
+from tubekit.model.kinematics import SINC_SERIES_THRESHOLD
+from tubekit.fhocp.result import FhocpResult, Status, shifted_plan, status_from
 
 __all__ = ["IpoptFHOCP", "import_casadi", "IPOPT_STATUS", "SQP_OPTIONS", "NLP_SOLVERS"]
 

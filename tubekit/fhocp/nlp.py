@@ -52,42 +52,18 @@ from typing import Sequence
 
 import numpy as np
 
-from ..exceptions import ConfigError, ShapeError
-from ..model import sinc, unicycle_step
-from ..scenario import Obstacle, Scenario
-from ..tightening import Tightening
-from ..validation import as_vector, positive
+from tubekit.exceptions import ConfigError, ShapeError
+from tubekit.model.kinematics import dsinc, sinc, unicycle_step
+from tubekit.scenario import Obstacle, Scenario
+from tubekit.tightening import Tightening
+from tubekit.validation import as_vector, positive
 
-__all__ = ["TERMINAL_MODES", "SINC_SERIES_THRESHOLD", "sinc", "dsinc", "discrete_step", "rollout",
+__all__ = ["TERMINAL_MODES", "discrete_step", "rollout",
            "step_linearisation", "STEP_LINEARISATION_ROWS", "eo_linearisation", "obstacle_array",
            "select_obstacles", "FhocpNlp", "NlpEvaluation"]
 
 TERMINAL_MODES: tuple[str, ...] = ("soft", "hard", "off")
-#: below this |a| = |r| dt / 2 the derivative of sin(a)/a uses its Taylor series (error < 1e-19)
-SINC_SERIES_THRESHOLD = 0.1
 _ED_FLOOR = 1e-9  # guards e_o = (...)/e_d against e_d = 0 (m)
-
-
-def _dsinc_series(a: np.ndarray, a2: np.ndarray) -> np.ndarray:
-    """d/da sin(a)/a by its Taylor series to a^9 (error < 1e-19 for |a| < 0.1)."""
-    return a * (-1.0 / 3.0 + a2 * (1.0 / 30.0 + a2 * (-1.0 / 840.0 + a2 * (1.0 / 45360.0
-                + a2 * (-1.0 / 3991680.0)))))
-
-
-def dsinc(a: np.ndarray) -> np.ndarray:
-    """S'(a) = (a cos a - sin a)/a^2 with S'(0) = 0, vectorised.
-
-    The quotient cancels for small a, so |a| < :data:`SINC_SERIES_THRESHOLD` uses the
-    Taylor series (error < 1e-19 there).
-    """
-    a = np.asarray(a, dtype=float)
-    a2 = a * a
-    series = _dsinc_series(a, a2)
-    if a.size == 0 or a2.max() < SINC_SERIES_THRESHOLD ** 2:
-        return series
-    small = a2 < SINC_SERIES_THRESHOLD ** 2
-    safe = np.where(small, 1.0, a)
-    return np.where(small, series, (safe * np.cos(safe) - np.sin(safe)) / (safe * safe))
 
 
 #: Exact zero-order-hold step F(s, v, dt) of the nominal kinematics (the model's own exact arc).

@@ -22,14 +22,18 @@ from __future__ import annotations
 import enum
 import math
 from dataclasses import dataclass, field
-from typing import Mapping
+from typing import TYPE_CHECKING, Callable, Mapping, Protocol, Sequence
 
 import numpy as np
 
-from ..exceptions import SolverError
+from tubekit.exceptions import SolverError
+
+if TYPE_CHECKING:
+    from tubekit.scenario import Obstacle, Scenario
+    from tubekit.tightening import Tightening
 
 __all__ = ["Status", "RESULT_STATUSES", "status_from", "FhocpResult", "FallbackWarning",
-           "shift_steps", "shifted_plan"]
+           "shift_steps", "shifted_plan", "FhocpSolver", "SolverFactory"]
 
 
 class Status(str, enum.Enum):
@@ -181,3 +185,15 @@ def shifted_plan(plan_inputs: np.ndarray | None, plan_t: float | None, t: float,
     if shift:
         v = np.vstack([v[shift:], np.repeat(v[-1:], shift, axis=0)])
     return v.copy(), True
+
+
+class FhocpSolver(Protocol):
+    """What the closed loop needs from a FHOCP solver (e.g. :class:`tubekit.fhocp.FHOCP`)."""
+
+    def solve(self, t: float, state: np.ndarray, obstacles: Sequence[Obstacle]) -> FhocpResult:
+        """Plan from ``state`` [x, y, z, psi] (m, rad) at time ``t`` (s) around the known ``obstacles``."""
+        ...
+
+
+#: ``factory(scenario, tightening)`` returning a :class:`FhocpSolver`.
+SolverFactory = Callable[["Scenario", "Tightening"], FhocpSolver]

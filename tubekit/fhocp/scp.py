@@ -35,14 +35,14 @@ from typing import Sequence
 import cvxpy as cp
 import numpy as np
 
-from ..exceptions import ConfigError
-from ..scenario import Obstacle, Scenario
-from ..tightening import Tightening
-from ..validation import as_vector, finite, positive
-from .convex import ConvexSubproblem
-from .fastpath import CompiledConeProgram
-from .nlp import TERMINAL_MODES, FhocpNlp, NlpEvaluation, rollout, select_obstacles
-from .result import FallbackWarning, FhocpResult, Status, shift_steps, shifted_plan
+from tubekit.exceptions import ConfigError
+from tubekit.scenario import Obstacle, Scenario
+from tubekit.tightening import Tightening
+from tubekit.validation import as_vector, finite, positive
+from tubekit.fhocp.convex import ConvexSubproblem
+from tubekit.fhocp.fastpath import CompiledConeProgram
+from tubekit.fhocp.nlp import TERMINAL_MODES, FhocpNlp, NlpEvaluation, rollout, select_obstacles
+from tubekit.fhocp.result import FallbackWarning, FhocpResult, Status, shift_steps, shifted_plan
 
 __all__ = ["FHOCP", "MODES", "TAIL_GRID", "obstacle_slots", "search_tail"]
 

@@ -1,0 +1,267 @@
+"""Closed loop: plant integration, nominal propagation, fallback path, saturation counting, rho log."""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+
+import numpy as np
+import pytest
+
+from tubekit import ConfigError, SolverError, Tightening, paper_scenario
+from tubekit.loop.closed_loop import PlanMemory, saturate, simulate
+from tubekit.loop.result import CSV_COLUMNS
+from tubekit.plant.kinematic import nominal_arc
+from tubekit.fhocp import FhocpResult
+from tubekit.loop.metrics import read_trajectory_csv
+from tubekit.model.kinematics import SwayModel
+from tubekit.scenario import Disturbance
+
+
+def _scenario(duration=5.0, **dist):
+    sc = paper_scenario().with_changes(duration=duration)
+    if dist:
+        sc = sc.with_changes(disturbance=Disturbance(**dist))
+    return sc
+
+
+class Pursuit:
+    """Stand-in FHOCP: pursue a point 1 s ahead on p_d; optional injected failures.
+
+    ``nan_at``: steps whose result has a NaN first input (flagged fallback);
+    ``raise_at``: steps that raise SolverError; ``flag_at``: finite fallback results.
+    """
+
+    def __init__(self, sc, tg, nan_at=(), raise_at=(), flag_at=(), u=0.3):
+        self.sc, self.tg, self.k, self.u = sc, tg, -1, u
+        self.nan_at, self.raise_at, self.flag_at = set(nan_at), set(raise_at), set(flag_at)
+        self.plans = {}
+
+    def solve(self, t, state, obstacles):
+        self.k += 1
+        if self.k in self.raise_at:
+            raise SolverError("injected")
+        pd = self.sc.trajectory.position(t + 1.0)
+        bearing = math.atan2(pd[1] - state[1], pd[0] - state[0])
+        err = math.atan2(math.sin(bearing - state[3]), math.cos(bearing - state[3]))
+        n = self.sc.controller.horizon_steps
+        plan = np.column_stack([np.full(n, self.u), 0.1 * np.arange(n) / n - 0.05,
+                                np.clip(1.5 * err + 0.01 * np.arange(n), -0.45, 0.45)])
+        self.plans[self.k] = plan
+        inputs = plan.copy()
+        if self.k in self.nan_at:
+            inputs[0] = np.nan  # the first input is not finite
+        fallback = self.k in self.nan_at or self.k in self.flag_at
+        return FhocpResult(status="fallback" if fallback else "optimal", states=np.zeros((n + 1, 4)),
+                           inputs=inputs, cost=1.0, iterations=1, solve_time_s=2e-5, setup_time_s=0.0,
+                           max_violation=0.0, fallback=fallback, t=t)
+
+
+def _tightening(sc, sigma):
+    return dataclasses.replace(Tightening.untightened(sc), sigma=sigma)
+
+
+# ---- closed loop ---------------------------------------------------------------------
+
+def test_no_disturbance_means_no_deviation_from_nominal():
+    sc = _scenario(amplitude=(0.0, 0.0, 0.0), sway=SwayModel(gain=0.0, amplitude=0.0, bound=0.0))
+    res = simulate(sc, tightening=_tightening(sc, 1.0), solver_factory=Pursuit, progress=False)
+    assert np.max(np.abs(res.rho)) < 1e-9
+    assert np.max(np.abs(res.kappa[:-1])) < 1e-8
+    assert res.saturated_ticks == 0
+
+
+def test_rho_logged_and_reset_each_sample():
+    sc = _scenario(duration=6.0)
+    res = simulate(sc, tightening=_tightening(sc, 1.0), solver_factory=Pursuit, progress=False)
+    m = res.ticks_per_step
+    rho = np.linalg.norm(res.rho, axis=1)
+    assert res.states.shape == (sc.steps * m + 1, 4)
+    assert rho[0] == 0.0
+    assert np.max(rho) > 1e-4  # the current really perturbs the plant
+    # kappa at each sampling instant uses the reset nominal (rho = 0) ...
+    np.testing.assert_allclose(res.kappa[0:-1:m], 0.0, atol=1e-12)
+    # ... and inside an interval it is -sigma J^-1 rho computed from the logged rho
+    from tubekit.model.ancillary import jacobian_at
+    i = 5 * m + 7
+    want = -1.0 * np.linalg.solve(jacobian_at(res.states[i], res.desired[i]), res.rho[i])
+    np.testing.assert_allclose(res.kappa[i], want, rtol=1e-9, atol=1e-12)
+    # the logged nominal is the exact arc under the held v_hat from the state at the sampling instant
+    k0 = 3 * m
+    arc = nominal_arc(res.states[k0], res.v_hat[k0], np.arange(m + 1) * (sc.controller.dt / m))
+    np.testing.assert_allclose(res.nominal[k0 + 1:k0 + m], arc[1:m], atol=1e-12)
+    np.testing.assert_allclose(res.nominal[k0 + m], arc[m], atol=1e-12)  # left limit at the next sample
+
+
+def test_baseline_has_no_feedback():
+    sc = _scenario()
+    res = simulate(sc, tube=False, solver_factory=Pursuit, progress=False)
+    assert res.sigma == 0.0
+    np.testing.assert_array_equal(res.inputs[:-1], res.v_hat[:-1])
+    assert np.all(res.kappa[:-1] == 0.0)
+
+
+def test_tube_requires_tightening():
+    with pytest.raises(ConfigError, match="tightening"):
+        simulate(_scenario(), tube=True, solver_factory=Pursuit, progress=False)
+
+
+def test_fallback_path_never_passes_nan_and_is_counted():
+    sc = _scenario(duration=5.0)
+    nan_at, raise_at, flag_at = {3, 4, 20}, {10, 11, 12}, {30}
+    holder = {}
+
+    def factory(s, tg):
+        holder["p"] = Pursuit(s, tg, nan_at=nan_at, raise_at=raise_at, flag_at=flag_at)
+        return holder["p"]
+
+    res = simulate(sc, tightening=_tightening(sc, 1.0), solver_factory=factory, progress=False)
+    m = res.ticks_per_step
+    assert all(res.checks.values()), res.checks
+    assert np.all(np.isfinite(res.inputs[:-1])) and np.all(np.isfinite(res.states))
+    assert res.replaced_steps == len(nan_at | raise_at)
+    assert res.fallback_steps == len(nan_at | raise_at | flag_at)
+    assert [k for k in range(sc.steps) if res.replaced[k * m]] == sorted(nan_at | raise_at)
+    plans = holder["p"].plans
+    # replaced steps use the last good plan, shifted by the steps elapsed since it was computed
+    np.testing.assert_allclose(res.v_hat[3 * m], plans[2][1])
+    np.testing.assert_allclose(res.v_hat[4 * m], plans[2][2])
+    np.testing.assert_allclose(res.v_hat[12 * m], plans[9][3])
+    # a flagged but finite fallback result is applied as given
+    np.testing.assert_allclose(res.v_hat[30 * m], plans[30][0])
+    assert res.statuses.count("exception") == len(raise_at)
+
+
+def test_fallback_with_exhausted_plan_stops_the_vehicle():
+    sc = _scenario(duration=2.0)
+    res = simulate(sc, tube=False, progress=False,
+                   solver_factory=lambda s, tg: Pursuit(s, tg, raise_at=set(range(20))))
+    assert res.replaced_steps == sc.steps
+    np.testing.assert_array_equal(res.inputs[:-1], 0.0)
+    assert np.all(np.isfinite(res.states))
+
+
+class AtTheBounds(Pursuit):
+    """v_hat on a corner of V, sign flipping every step: any kappa pointing outward must be clipped."""
+
+    def solve(self, t, state, obstacles):
+        res = super().solve(t, state, obstacles)
+        sign = 1.0 if self.k % 2 == 0 else -1.0
+        return dataclasses.replace(res, inputs=np.tile(sign * self.sc.limits.vector, (len(res.inputs), 1)))
+
+
+def test_saturation_only_when_needed_and_counted():
+    sc = _scenario(duration=5.0)
+    res = simulate(sc, tightening=_tightening(sc, 5.0), progress=False, solver_factory=AtTheBounds)
+    lim = sc.limits.vector
+    raw = res.v_hat[:-1] + res.kappa[:-1]
+    outside = np.any(np.abs(raw) > lim, axis=1)
+    assert 0 < outside.sum() < len(outside)
+    assert res.saturated_ticks == int(outside.sum())
+    np.testing.assert_array_equal(res.saturated[:-1], outside)
+    np.testing.assert_allclose(res.inputs[:-1], np.clip(raw, -lim, lim))
+    assert res.saturated_steps == len({int(res.step[i]) for i in np.flatnonzero(outside)})
+    # where v_hat + kappa is inside V it is applied unchanged
+    np.testing.assert_array_equal(res.inputs[:-1][~outside], raw[~outside])
+    assert res.checks["inputs_within_limits"]
+
+
+def test_csv_round_trip(tmp_path):
+    sc = _scenario(duration=2.0)
+    res = simulate(sc, tightening=_tightening(sc, 1.0), solver_factory=Pursuit, progress=False)
+    path = res.write_csv(tmp_path / "trajectory.csv")
+    cols = read_trajectory_csv(path)
+    assert tuple(cols) == CSV_COLUMNS
+    for key in ("t", "x", "y", "z", "psi", "u", "w", "r", "x_d", "y_d", "z_d"):
+        np.testing.assert_allclose(cols[key], res.columns()[key], rtol=1e-11, atol=1e-12, equal_nan=True)
+    assert np.isnan(cols["u"][-1]) and cols["t"][-1] == pytest.approx(2.0)
+
+
+def test_real_fhocp_short_closed_loop():
+    pytest.importorskip("tubekit.fhocp")
+    sc = _scenario(duration=3.0)
+    base = simulate(sc, tube=False, progress=False)
+    tube = simulate(sc, tightening=_tightening(sc, 0.5), progress=False)
+    for res in (base, tube):
+        assert all(res.checks.values()), res.checks
+        assert res.steps == 30
+        # the vehicle closes on the target: e_d after 3 s is below its initial 0.5 m
+        assert res.errors[-1, 0] < res.errors[0, 0]
+
+
+def test_real_fhocp_with_injected_fallbacks():
+    fhocp = pytest.importorskip("tubekit.fhocp")
+    sc = _scenario(duration=3.0)
+    flagged, broken = {5, 6}, {12}
+
+    class Flaky:
+        def __init__(self, s, tg):
+            self.inner, self.k, self.last = fhocp.FHOCP(s, tg), -1, None
+
+        def solve(self, t, state, obstacles):
+            self.k += 1
+            res = self.inner.solve(t, state, obstacles)
+            if self.k in flagged:  # what the FHOCP returns when it fails: the shifted plan, flagged
+                shifted = np.vstack([self.last.inputs[1:], self.last.inputs[-1:]])
+                return dataclasses.replace(res, inputs=shifted, status="fallback", fallback=True)
+            if self.k in broken:
+                return dataclasses.replace(res, inputs=np.full_like(res.inputs, np.nan), fallback=True)
+            self.last = res
+            return res
+
+    res = simulate(sc, tightening=_tightening(sc, 0.5), solver_factory=Flaky, progress=False)
+    m = res.ticks_per_step
+    assert all(res.checks.values()), res.checks
+    assert res.fallback_steps == 3 and res.replaced_steps == 1
+    assert res.statuses.count("fallback") == 2
+    assert np.all(np.isfinite(res.v_hat[12 * m:13 * m]))
+
+
+# ---- named steps -----------------------------------------------------------------------
+
+def test_saturate_clips_only_outside_the_box():
+    lim = (0.4, 0.3, 0.5)
+    assert saturate((0.1, -0.3, 0.5), lim) == ((0.1, -0.3, 0.5), False)
+    v, clipped = saturate((0.5, -0.35, 0.2), lim)
+    assert clipped and v == (0.4, -0.3, 0.2)
+
+
+def test_plan_memory_shifts_the_last_good_plan_then_stops():
+    sc = _scenario(duration=1.0)
+    good = Pursuit(sc, None).solve(0.0, np.asarray(sc.initial_state, dtype=float), ())
+    memory = PlanMemory()
+    np.testing.assert_array_equal(memory.replacement(), 0.0)  # nothing to shift yet
+    assert memory.remember(good) is False and memory.age == 0
+    flagged = dataclasses.replace(good, fallback=True)
+    assert memory.remember(flagged) is True and memory.age == 1  # a flagged plan is not remembered
+    np.testing.assert_array_equal(memory.replacement(), good.inputs[2])
+    for _ in range(len(good.inputs)):
+        last = memory.replacement()
+    np.testing.assert_array_equal(last, 0.0)
+
+
+def test_dynamic_plant_run_logs_body_velocities_and_thrusts(tmp_path):
+    from tubekit.loop.result import DYNAMIC_COLUMNS
+    from tubekit.model.vehicles import PlantSettings
+    sc = _scenario(duration=2.0).with_changes(plant=PlantSettings("dynamic"))
+    res = simulate(sc, tightening=_tightening(sc, 1.0), solver_factory=Pursuit, progress=False)
+    assert res.body.shape == (len(res.t), 4) and res.thrust.shape == (len(res.t), 3)
+    cols = read_trajectory_csv(res.write_csv(tmp_path / "trajectory.csv"))
+    assert tuple(cols) == CSV_COLUMNS + DYNAMIC_COLUMNS
+    np.testing.assert_allclose(cols["v_b"], res.body[:, 1], rtol=1e-11, atol=1e-13)
+    assert np.all(np.abs(res.thrust) <= np.array(sc.plant.params.thrust_limits) + 1e-9)
+    # the logged omega is what moved the vehicle beyond f(x) v: current + loop error + hull sway
+    assert np.all(np.isfinite(res.omega[:-1])) and np.max(np.abs(res.body[:, 1])) > 0.0
+    kin = simulate(sc, tightening=_tightening(sc, 1.0), solver_factory=Pursuit, progress=False, plant="kinematic")
+    assert kin.body is None and np.max(np.abs(kin.states - res.states)) > 1e-4
+
+
+def test_kinematic_plant_is_the_default_and_unchanged():
+    from tubekit.model.vehicles import PlantSettings
+    sc = _scenario(duration=1.0)
+    a = simulate(sc, tightening=_tightening(sc, 1.0), solver_factory=Pursuit, progress=False)
+    b = simulate(sc.with_changes(plant=PlantSettings("kinematic")), tightening=_tightening(sc, 1.0),
+                 solver_factory=Pursuit, progress=False, plant="kinematic")
+    np.testing.assert_array_equal(a.states, b.states)
+    np.testing.assert_array_equal(a.omega, b.omega)
+    assert a.body is None and tuple(a.columns()) == CSV_COLUMNS

@@ -1,0 +1,132 @@
+"""Tests of tubekit.loop.plan_check: exact acceptance of a plan along its arcs (built by hand).
+
+Geometry of the hand-built cases: a stationary target at p_d = (0, 3, 0); the vehicle at (-2, 3, 0)
+heading +x (toward the target, e_o = 0); the plan is u = 0.4 m/s for 8 arcs of 0.1 s, so the nodes are at
+x = -2 + 0.04 j on the line y = 3. An obstacle centred 0.5 m beside the midpoint of arc 3 with
+radius + vehicle radius = 0.5002 m is missed at the nodes (distance sqrt(0.5^2 + 0.02^2) = 0.50040 m)
+but hit half-way (0.5 m).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from hypothesis import given
+from hypothesis import strategies as st
+
+from tubekit.loop.plan_check import PlanCheck, check_plan, plan_arcs
+from tubekit.scenario import Obstacle
+from tubekit.tightening import Tightening
+
+X0 = np.array([-2.0, 3.0, 0.0, 0.0])
+PLAN = np.tile([0.4, 0.0, 0.0], (8, 1))
+GRAZE = Obstacle((-2.0 + 0.14, 3.5, 0.0), 0.3002)
+
+
+def _tight(**changes) -> Tightening:
+    base = dict(v_max=np.array([0.4, 0.3, 0.5]), e_d_min=0.5, e_o_max=0.5, e_z_max=1.0, e_d_max=3.0,
+                obstacle_margin=0.0, rho_tilde=0.0, sigma=1.0, margins=np.zeros((8, 4)), rates=np.zeros(4),
+                tube=np.zeros(3), region=np.array([0.5, 3.0, 1.0, 0.5]), certified=True)
+    base.update(changes)
+    return Tightening(**base)
+
+
+def test_grazing_between_nodes_is_rejected(stationary):
+    nodes = X0[:2] + np.outer(np.arange(9) * 0.04, [1.0, 0.0])
+    clear_at_nodes = np.linalg.norm(nodes - GRAZE.center[:2], axis=1) - GRAZE.radius - stationary.vehicle_radius
+    assert np.all(clear_at_nodes > 1e-4)        # the nodes are clear ...
+    res = check_plan(stationary, _tight(), 0.0, X0, PLAN, [GRAZE], sign=-1)
+    assert isinstance(res, PlanCheck)
+    assert not res.ok and res.where == "obstacle 0"   # ... the arc is not
+    assert res.slack == pytest.approx(0.5 - 0.5002, abs=1e-9)
+
+
+def test_input_outside_v_bar_is_rejected(stationary):
+    plan = PLAN.copy()
+    plan[5, 2] = -0.51
+    res = check_plan(stationary, _tight(), 0.0, X0, plan, [], sign=-1)
+    assert not res.ok and res.where == "input outside V_bar" and res.slack == pytest.approx(-0.01)
+    res = check_plan(stationary, _tight(v_max=np.array([0.39, 0.3, 0.5])), 0.0, X0, PLAN, [], sign=-1)
+    assert not res.ok and res.where == "input outside V_bar"
+
+
+def test_a_plan_far_from_everything_is_accepted(stationary):
+    far = Obstacle((-6.0, -6.0, 0.0), 0.4)
+    res = check_plan(stationary, _tight(), 0.0, X0, PLAN, [far], sign=-1)
+    # the tightest constraint: |e_o| = 0 against 0.5, e_d = 1.68 against 3 - 1.68 = 1.32 and 1.68 - 0.5 = 1.18
+    assert res.ok and res.slack == pytest.approx(0.5)
+    assert res.where == "|e_o|"
+
+
+@pytest.mark.parametrize("plan, why", [
+    (PLAN[:7], "fewer rows than arcs"),
+    (np.full((8, 3), np.nan), "not finite"),
+    (PLAN.ravel(), "one dimension"),
+])
+def test_malformed_plans_are_rejected(stationary, plan, why):
+    res = check_plan(stationary, _tight(), 0.0, X0, plan, [], sign=-1)
+    assert not res.ok and res.where == "plan shape or values" and res.slack == -math.inf, why
+
+
+def test_a_plan_with_two_columns_is_rejected(stationary):
+    res = check_plan(stationary, _tight(), 0.0, X0, PLAN[:, :2], [], sign=-1)
+    assert not res.ok and res.where == "plan shape or values"
+
+
+@pytest.mark.parametrize("changes, where", [
+    (dict(margins=np.column_stack([np.full(8, 1.2), np.zeros((8, 3))]), region=np.array([0.5, 5.0, 1.0, 0.5])),
+     "e_d >= epsilon"),
+    (dict(margins=np.column_stack([np.zeros((8, 2)), np.full(8, 0.6), np.zeros(8)])), "|e_o|"),
+    (dict(region=np.array([0.5, 1.9, 1.0, 0.5])), "e_d <= e_d_max"),
+])
+def test_margins_tighten_the_error_constraints(stationary, changes, where):
+    res = check_plan(stationary, _tight(**changes), 0.0, X0, PLAN, [], sign=-1)
+    assert not res.ok and res.where == where
+
+
+def test_rates_pad_the_samples(stationary):
+    """An obstacle missed by 0.01 m everywhere is rejected once ||p'|| * spacing / 2 exceeds 0.01 m."""
+    side = Obstacle((-1.84, 3.0 + 0.2 + 0.3 + 0.01, 0.0), 0.3)
+    assert check_plan(stationary, _tight(), 0.0, X0, PLAN, [side], sign=-1).ok
+    pad = np.array([0.0, 0.0, 0.0, 0.5 / (0.5 * 0.01)])   # spacing 0.01 s -> pad 0.5 * 0.01 * rate = 0.5 m
+    res = check_plan(stationary, _tight(rates=pad), 0.0, X0, PLAN, [side], sign=-1)
+    assert not res.ok and res.where == "obstacle 0"
+
+
+def test_the_hemisphere_is_checked(stationary):
+    away = X0.copy()
+    away[3] = math.pi                               # heading -x: away from the target
+    back = np.tile([-0.1, 0.0, 0.0], (8, 1))        # reversing toward it keeps e_d in R
+    res = check_plan(stationary, _tight(), 0.0, away, back, [], sign=-1)
+    assert not res.ok and res.where == "hemisphere"
+    assert check_plan(stationary, _tight(), 0.0, away, back, [], sign=1).ok
+
+
+def test_the_workspace_is_checked(stationary):
+    small = stationary.with_changes(workspace=((-2.1, 2.5, -1.0), (1.0, 3.5, 1.0)))
+    res = check_plan(small, _tight(), 0.0, X0, PLAN, [], sign=-1)
+    assert not res.ok and res.where == "workspace"
+    assert res.slack == pytest.approx((-2.0 - -2.1) - 0.2, abs=1e-9)    # x - x_lo - vehicle radius at x0
+
+
+@given(u=st.floats(-0.4, 0.4), r=st.floats(-0.5, 0.5), w=st.floats(-0.3, 0.3), psi0=st.floats(-3.0, 3.0))
+def test_plan_arcs_are_the_exact_unicycle(u, r, w, psi0):
+    """Property: the sampled arcs follow x = x0 + u (sin(psi0 + r t) - sin psi0) / r,
+    y = y0 - u (cos(psi0 + r t) - cos psi0) / r (straight line when r = 0), z = z0 + w t, and chain."""
+    x0 = np.array([1.0, -2.0, 0.5, psi0])
+    inputs = np.tile([u, w, r], (3, 1))
+    arcs = plan_arcs(x0, inputs, 0.1, 4)
+    assert arcs.shape == (3, 5, 4)
+    t = (np.arange(3)[:, None] * 0.1 + np.linspace(0, 0.1, 5)[None, :])
+    psi = psi0 + r * t
+    if abs(r) > 1e-6:
+        x = 1.0 + u * (np.sin(psi) - math.sin(psi0)) / r
+        y = -2.0 - u * (np.cos(psi) - math.cos(psi0)) / r
+    else:
+        x, y = 1.0 + u * t * np.cos(psi0), -2.0 + u * t * np.sin(psi0)
+    np.testing.assert_allclose(arcs[..., 0], x, atol=1e-9)
+    np.testing.assert_allclose(arcs[..., 1], y, atol=1e-9)
+    np.testing.assert_allclose(arcs[..., 2], 0.5 + w * t, atol=1e-12)
+    np.testing.assert_allclose(arcs[..., 3], psi, atol=1e-12)

@@ -1,0 +1,151 @@
+"""The 4-DOF dynamic plant (issue 13): energy, terminal speed, sway sign, fast-loop limit, sway bound."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from tubekit import paper_scenario
+from tubekit.plant.factory import make_plant
+from tubekit.plant.dynamic import DynamicPlant, body_acceleration, body_forces, kinetic_energy
+from tubekit.exceptions import ConfigError
+from tubekit.model.kinematics import SwayModel
+from tubekit.plant.kinematic import Plant
+from tubekit.scenario import Disturbance
+from tubekit.model.vehicles import REMUS100, PlantSettings
+from verify.design import disturbance_bounds, hull_sway_bound
+
+CALM = Disturbance(amplitude=(0.0, 0.0, 0.0), sway=SwayModel(gain=0.0, amplitude=0.0, bound=0.0))
+
+
+def _open_loop(nu0, tau, h: float, steps: int, p=REMUS100) -> np.ndarray:
+    """RK4 of M ν̇ = τ − n(ν) with τ = (X, Z, N) held; returns ν at every step (steps + 1, 4)."""
+    def f(nu):
+        return np.array(body_acceleration(p, tuple(nu), tau))
+    out = [np.asarray(nu0, dtype=float)]
+    nu = out[0]
+    for _ in range(steps):
+        k1 = f(nu)
+        k2 = f(nu + 0.5 * h * k1)
+        k3 = f(nu + 0.5 * h * k2)
+        k4 = f(nu + h * k3)
+        nu = nu + h / 6.0 * (k1 + 2 * k2 + 2 * k3 + k4)
+        out.append(nu)
+    return np.array(out)
+
+
+def test_coriolis_is_skew_symmetric_so_only_damping_changes_energy():
+    p = REMUS100.with_overrides({name: 0.0 for name in ("X_uu", "Y_vv", "Y_rr", "Z_ww", "N_vv", "N_rr", "Y_uv",
+                                                        "Y_ur_lift", "Z_uw", "N_uv_lift", "N_ur_lift")})
+    rng = np.random.default_rng(1)
+    for _ in range(50):
+        nu = rng.uniform(-1, 1, 4)
+        assert abs(float(np.dot(nu, body_forces(p, nu)))) < 1e-12  # νᵀ C(ν) ν = 0
+
+
+@pytest.mark.parametrize("nu0", [(0.5, 0.1, 0.2, 0.3), (0.3, -0.2, -0.1, -0.5), (1.0, 0.0, 0.0, 0.4)])
+def test_no_thrust_no_current_kinetic_energy_does_not_increase(nu0):
+    traj = _open_loop(nu0, (0.0, 0.0, 0.0), 0.01, 3000)
+    energy = np.array([kinetic_energy(REMUS100, nu) for nu in traj])
+    assert np.all(traj[:, 0] >= 0.0)  # forward motion: the lift terms dissipate (docs/plant.md)
+    assert np.all(np.diff(energy) <= 1e-12 * energy[0])
+    assert energy[-1] < 0.5 * energy[0]
+
+
+@pytest.mark.parametrize("thrust", [0.5, 2.0])
+def test_constant_surge_thrust_reaches_the_speed_where_drag_balances_it(thrust):
+    traj = _open_loop((0.0, 0.0, 0.0, 0.0), (thrust, 0.0, 0.0), 0.05, 8000)
+    terminal = math.sqrt(thrust / -REMUS100.X_uu)  # X = -X_u|u| u |u| (X_u = 0)
+    assert traj[-1, 0] == pytest.approx(terminal, rel=1e-6)
+    assert np.all(np.abs(traj[:, 1:]) < 1e-12)
+
+
+@pytest.mark.parametrize("moment", [1.0, -1.0])
+def test_steady_turn_sway_has_the_sign_the_hull_coefficients_predict(moment):
+    traj = _open_loop((0.5, 0.0, 0.0, 0.0), (1.0, 0.0, moment), 0.02, 10000)
+    u, v, _, r = traj[-1]
+    assert np.max(np.abs(traj[-1] - traj[-100])) < 1e-6  # steady
+    m11 = REMUS100.mass_entries[0]
+    predicted = math.copysign(1.0, (REMUS100.Y_ur_lift - m11) * u * r)  # the centripetal + fin-lift force
+    assert math.copysign(1.0, v) == predicted and abs(v) > 1e-3
+
+
+def _scenario(**vehicle):
+    return paper_scenario().with_changes(disturbance=CALM, plant=PlantSettings("dynamic", overrides=vehicle))
+
+
+def _commands(n: int) -> list[tuple[float, float, float]]:
+    t = np.arange(n) * 0.01
+    return [(0.25 + 0.1 * math.sin(0.5 * ti), 0.1 * math.cos(0.3 * ti), 0.3 * math.sin(0.4 * ti)) for ti in t]
+
+
+def _run(plant, commands, substeps: int) -> np.ndarray:
+    x, out = (0.0, 0.0, 0.0, 0.0), []
+    for i, v in enumerate(commands):
+        x = plant.step_tuple(0.01 * i, x, v, 0.01 / substeps, substeps)
+        out.append(x)
+    return np.array(out)
+
+
+def test_fast_low_level_loop_tends_to_the_kinematic_plant():
+    commands = _commands(500)
+    kinematic = _run(Plant(CALM), commands, 2)
+    stiff_hull = {"Y_v": -1.0e5, "X_max": 1e5, "Z_max": 1e5, "N_max": 1e5}  # no sway: the kinematic eq. 11
+    gaps = []
+    for bandwidth, lag in ((5.0, 0.1), (50.0, 0.01), (500.0, 0.001)):
+        plant = DynamicPlant(_scenario(loop_bandwidth=bandwidth, thruster_time_constant=lag, **stiff_hull))
+        gaps.append(float(np.max(np.abs(_run(plant, commands, 40) - kinematic))))
+    assert gaps[0] > gaps[1] > gaps[2]
+    assert gaps[2] < 1e-3
+
+
+def test_velocity_loop_removes_steady_error():
+    plant = DynamicPlant(_scenario())
+    _run(plant, [(0.3, 0.1, 0.2)] * 1000, 2)
+    body, thrust = plant.history()
+    np.testing.assert_allclose(body[-1, [0, 2, 3]], [0.3, 0.1, 0.2], atol=1e-4)
+    assert np.all(np.abs(thrust) <= np.array(REMUS100.thrust_limits) + 1e-12)
+
+
+def test_hull_sway_stays_within_its_iss_bound_under_aggressive_commands():
+    sc = _scenario()
+    rng = np.random.default_rng(3)
+    commands = [tuple(rng.uniform(-1, 1, 3) * sc.limits.vector) for _ in range(60) for _ in range(50)]
+    plant = DynamicPlant(sc)
+    _run(plant, commands, 2)
+    body, _ = plant.history()
+    lim = sc.limits
+    gamma = float(hull_sway_bound(REMUS100, float(np.max(np.abs(body[:, 0]))), float(np.max(np.abs(body[:, 3])))))
+    assert np.max(np.abs(body[:, 1])) <= gamma
+    bounds = disturbance_bounds(sc)
+    assert bounds.gamma >= float(hull_sway_bound(REMUS100, lim.u_max, lim.r_max))
+    assert bounds.omega_xy > bounds.gamma and bounds.declared_sway == bounds.gamma
+
+
+def test_omega_series_is_current_plus_loop_error_and_sway():
+    sc = paper_scenario().with_changes(plant=PlantSettings("dynamic"))
+    plant = DynamicPlant(sc)
+    commands = _commands(30)
+    states = np.vstack([[0.0, 0.0, 0.0, 0.0], _run(plant, commands, 2)])
+    inputs = np.vstack([commands, [np.nan] * 3])
+    t = np.arange(31) * 0.01
+    omega = plant.omega_series(t, states, inputs)
+    body, _ = plant.history()
+    i = 17
+    c = Plant(sc.disturbance).current(t[i])
+    psi = states[i, 3]
+    want = c + np.array([(body[i, 0] - inputs[i, 0]) * math.cos(psi) - body[i, 1] * math.sin(psi),
+                         (body[i, 0] - inputs[i, 0]) * math.sin(psi) + body[i, 1] * math.cos(psi),
+                         body[i, 2] - inputs[i, 1]])
+    np.testing.assert_allclose(omega[i], want, atol=1e-14)
+    assert np.all(np.isnan(omega[-1]))
+
+
+def test_make_plant_kinds():
+    sc = paper_scenario()
+    assert isinstance(make_plant(sc), Plant)
+    assert isinstance(make_plant(sc, kind="dynamic"), DynamicPlant)
+    with pytest.raises(ConfigError, match="plant"):
+        make_plant(sc, kind="hovercraft")

@@ -1,0 +1,105 @@
+"""tubekit falsify: the one-period and closed-loop falsifiers, exit codes, JSON schema, bad input."""
+
+from __future__ import annotations
+
+import json
+from dataclasses import replace
+
+import numpy as np
+import pytest
+
+import verify
+from tubekit.app.cli import main
+from tubekit.exceptions import ConfigError
+from tubekit.scenario import load_scenario, paper_scenario
+from verify.falsify.one_period import falsify, falsify_closed_loop, search_space
+
+CERTIFIABLE = str(verify.SCENARIOS_DIR / "certifiable.toml")
+PAPER_CURRENTS = verify.SCENARIOS_DIR / "paper_currents.toml"
+STATE_KEYS = {"e_x", "e_y", "e_z", "psi"}
+
+
+@pytest.fixture(scope="module")
+def currents():
+    scenario = load_scenario(PAPER_CURRENTS)
+    return scenario, verify.certify(scenario)
+
+
+def test_search_space_from_certificate(currents):
+    scenario, cert = currents
+    space = search_space(scenario, certificate=cert)
+    assert space.sigma == cert.design.sigma and space.tube == tuple(cert.tube["rho"])
+    assert space.theta == cert.tube["theta"] and space.certified
+    assert space.ticks * space.tick == pytest.approx(scenario.controller.dt)
+    assert all(lo < hi for lo, hi in space.start)
+
+
+def test_one_period_certified_finds_nothing(currents):
+    scenario, cert = currents
+    res = falsify(scenario, certificate=cert, budget=60, local_iterations=150)
+    assert not res.found and res.stage == "none"
+    assert 0.3 < res.worst_value <= 1.0  # tightness: the search reaches the tube
+
+
+def test_one_period_shrunk_tube_is_found(currents):
+    scenario, cert = currents
+    space = search_space(scenario, certificate=cert)
+    small = replace(space, tube=tuple(x / 2 for x in space.tube))
+    res = falsify(scenario, space=small, budget=60, local_iterations=150)
+    assert res.found and res.value > 1.0
+    data = res.to_dict()
+    assert set(data["counterexample"]["real"]) == STATE_KEYS and data["counterexample"]["ratio"] > 1
+
+
+def test_closed_loop_certified_finds_nothing(currents):
+    """Tightness figure on paper_currents: largest observed deviation / certified radius."""
+    scenario, cert = currents
+    res = falsify_closed_loop(scenario, budget=5, seed=0, duration=2.0, certificate=cert)
+    assert res.check() and not res.found
+    assert 0.3 < res.ratio <= 1.0
+    assert res.simulations == 5 and res.worst.promises
+    data = json.loads(json.dumps(res.to_dict()))
+    assert data["found"] is False and data["mode"] == "closed-loop"
+
+
+def test_closed_loop_shrunk_tube_is_found(currents):
+    scenario, cert = currents
+    tight = cert.tightening
+    small = replace(tight, tube=np.asarray(tight.tube) / 2)
+    res = falsify_closed_loop(scenario, budget=2, seed=0, duration=2.0, certificate=cert, tightening=small)
+    assert res.found and not res.check() and res.ratio > 1.0
+    assert "COUNTEREXAMPLE" in res.summary()
+
+
+def test_closed_loop_cli_exit_0(tmp_path):
+    out = tmp_path / "cl.json"
+    assert main(["falsify", str(PAPER_CURRENTS), "--closed-loop", "--budget", "2", "--duration", "1",
+                 "--json", str(out)]) == 0
+    data = json.loads(out.read_text())
+    assert data["found"] is False and data["simulations"] == 2
+
+
+def test_certified_design_exit_0(tmp_path):
+    out = tmp_path / "none.json"
+    assert main(["falsify", CERTIFIABLE, "--law", "corrected", "--budget", "40", "--json", str(out)]) == 0
+    data = json.loads(out.read_text())
+    assert data["found"] is False and "counterexample" not in data
+
+
+@pytest.mark.parametrize("argv, field", [
+    (["falsify", "--budget", "0"], "budget"),
+    (["falsify", CERTIFIABLE, "--sigma", "-1"], "--sigma"),
+    (["falsify", CERTIFIABLE, "--closed-loop", "--duration", "0"], "--duration"),
+    (["falsify", "no/such/file.toml"], "CONFIG"),
+])
+def test_bad_input_exit_2(argv, field, capsys):
+    assert main(argv) == 2
+    err = capsys.readouterr().err
+    assert field in err and "Traceback" not in err
+
+
+def test_budget_validation_in_python():
+    with pytest.raises(ConfigError, match="budget"):
+        falsify(paper_scenario(), "paper", budget=-5)
+    with pytest.raises(ConfigError, match="budget"):
+        falsify_closed_loop(paper_scenario(), budget=0)

@@ -1,0 +1,474 @@
+"""The closed loop: plant + sensing + FHOCP + ancillary feedback (issue 5, items 1-3).
+
+Timeline (dt = FHOCP period, h = 1 / ancillary_rate_hz, m = dt / h ticks):
+
+* at every sampling instant t_k = k dt the position is sensed
+  (:class:`tubekit.loop.sensing.ObstacleMap`), the FHOCP is solved from the measured
+  state (nominal reset, ê(t_k) = e(t_k), paper eq. diff_mpc) and its first input
+  v̂ is held over [t_k, t_k + dt);
+* the nominal state x̂ is propagated from x(t_k) with v̂ and the nominal
+  kinematics (eq. 3), in closed form (exact unicycle arcs, :func:`nominal_arc`);
+* at every tick t_i = i h the ancillary law gives κ(e, ê) (zero-order hold over
+  [t_i, t_i + h)), the applied input is v = v̂ + κ; only when v leaves V is it
+  clipped to V (saturation, counted per tick and per sampling period);
+* the plant ẋ = f(x) v + ω(t, x, v) (eq. 11, :class:`tubekit.plant.kinematic.Plant`), or the
+  4-DOF vehicle whose velocity loop tracks v (``[plant] kind = "dynamic"``,
+  :class:`tubekit.plant.dynamic.DynamicPlant`), is integrated with classical RK4 at a
+  fixed step h / plant_substeps (5 ms by default: 100 Hz ticks, 2 substeps).
+
+:func:`simulate` is a pipeline of named steps: :func:`validate_inputs` →
+:func:`build_solver` → per sampling period (:meth:`_ClosedLoop.run_period`):
+sense → solve (:meth:`_ClosedLoop.solve`, :class:`PlanMemory`) → nominal arc →
+ticks (:meth:`_ClosedLoop.run_ticks`: ancillary law, :func:`saturate`, plant) →
+log (:class:`_Log`).
+
+Fallbacks: a FHOCP result flagged ``fallback`` is used (its first input) and
+counted; a result whose first input is not finite, or a :class:`SolverError`,
+is replaced by the previous successful plan shifted by the steps elapsed (zero
+input once that plan is exhausted) and counted as ``replaced``. A non-finite κ
+(J singular) is replaced by zero and counted. Nothing non-finite reaches the
+plant.
+
+Logging: one row per tick plus a final row at t = duration (inputs NaN there).
+The nominal x̂ logged at a sampling instant is the left limit x̂(t_k⁻), before the
+reset, so ‖ρ‖ = ‖e - ê‖ shows the largest deviation of every interval; the κ
+applied at that tick uses the reset nominal (ρ = 0).
+"""
+
+from __future__ import annotations
+
+import enum
+import math
+import sys
+import time
+import warnings
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from tubekit.model.ancillary import AncillaryLaw, get_law
+from tubekit.exceptions import ConfigError, SolverError
+from tubekit.loop.plan_check import check_plan
+from tubekit.plant.base import OmegaOverride, PlantModel
+from tubekit.plant.factory import make_plant
+from tubekit.plant.kinematic import nominal_arc
+from tubekit.scenario import HEMISPHERE_SIGN, Obstacle, Scenario
+from tubekit.loop.sensing import ObstacleMap
+from tubekit.loop.result import SimulationResult
+from tubekit.tightening import Tightening
+
+if TYPE_CHECKING:  # the solver package (cvxpy) is loaded only when a solver is built
+    from tubekit.fhocp.result import FhocpResult, FhocpSolver, SolverFactory
+
+__all__ = [
+    "simulate",
+    "PlanMemory",
+    "validate_inputs",
+    "build_solver",
+    "saturate",
+]
+
+
+_ZERO_INPUT = np.zeros(3)
+_ZERO_INPUT.setflags(write=False)
+
+
+# ---- setup ------------------------------------------------------------------------------
+
+def validate_inputs(scenario: Scenario, tightening: Tightening | None, law: str | AncillaryLaw | None,
+                    sigma: float | None, tube: bool,
+                    plant_substeps: int) -> tuple[Tightening, AncillaryLaw, float]:
+    """Check the arguments of :func:`simulate`; return (tightening, ancillary law, σ in 1/s).
+
+    Raises
+    ------
+    ConfigError
+        Bad ``plant_substeps``, a duration shorter than one period, a tube run
+        without tightening, or a σ that is not finite and >= 0.
+    """
+    ctrl = scenario.controller
+    if not isinstance(plant_substeps, int) or plant_substeps < 1:
+        raise ConfigError("plant_substeps", "an integer >= 1", plant_substeps)
+    if scenario.steps < 1:
+        raise ConfigError("duration", f"at least one FHOCP period (dt = {ctrl.dt:g} s)", scenario.duration)
+    if tightening is None:
+        if tube:
+            raise ConfigError("tightening", "a Tightening (e.g. verify.certify(...).tightening) for the tube run",
+                              None)
+        tightening = Tightening.untightened(scenario)
+    law_obj = law if isinstance(law, AncillaryLaw) else get_law(law if law is not None else ctrl.law)
+    if not tube:
+        return tightening, law_obj, 0.0
+    sig = float(tightening.sigma if sigma is None else sigma)
+    if not math.isfinite(sig) or sig < 0:
+        raise ConfigError("sigma", "a finite number >= 0", sig)
+    return tightening, law_obj, sig
+
+
+def build_solver(scenario: Scenario, tightening: Tightening, solver_factory: SolverFactory | None,
+                 mode: str | None) -> FhocpSolver:
+    """``solver_factory(scenario, tightening)``, or :class:`tubekit.fhocp.FHOCP` in ``mode``."""
+    if solver_factory is not None:
+        return solver_factory(scenario, tightening)
+    from tubekit.fhocp import FHOCP  # imported lazily: the solver is optional for tests with fakes
+    return FHOCP(scenario, tightening, mode=mode)
+
+
+def _silence_fallback_warnings() -> None:
+    try:
+        from tubekit.fhocp import FallbackWarning
+    except ImportError:  # pragma: no cover - a stand-in solver without the real module
+        return
+    warnings.simplefilter("ignore", FallbackWarning)
+
+
+def _progress(total: int, enabled: bool, label: str) -> Any:
+    if not enabled or not sys.stderr.isatty():
+        return None
+    try:
+        from tqdm import tqdm
+    except ImportError:  # pragma: no cover
+        return None
+    return tqdm(total=total, desc=label, unit="step", leave=False, dynamic_ncols=True)
+
+
+@dataclass(frozen=True)
+class _Clock:
+    """The time grid: ``steps`` periods of ``ticks`` ticks of ``h`` s, ``substeps`` RK4 steps per tick."""
+
+    steps: int
+    ticks: int
+    h: float
+    substeps: int
+    t: np.ndarray  # (K + 1,) tick times (s), K = steps * ticks
+    tau: np.ndarray  # (ticks + 1,) times within a period (s)
+
+    @classmethod
+    def of(cls, scenario: Scenario, substeps: int) -> _Clock:
+        dt = scenario.controller.dt
+        m = int(round(scenario.controller.ancillary_rate_hz * dt))
+        h = dt / m
+        k_total = scenario.steps * m
+        return cls(steps=scenario.steps, ticks=m, h=h, substeps=substeps,
+                   t=np.round(np.arange(k_total + 1) * h, 9), tau=np.arange(m + 1) * h)
+
+    @property
+    def plant_step(self) -> float:
+        """RK4 step (s)."""
+        return self.h / self.substeps
+
+
+# ---- the "never pass NaN on" rule -----------------------------------------------------
+
+@dataclass
+class PlanMemory:
+    """The last good plan and its age, to replace a FHOCP result that cannot be applied.
+
+    Attributes
+    ----------
+    plan : array (N, 3) or None
+        Inputs of the last non-fallback, finite plan (m/s, m/s, rad/s).
+    age : int
+        Sampling periods elapsed since ``plan`` was computed.
+    """
+
+    plan: np.ndarray | None = None
+    age: int = 0
+
+    def remember(self, result: FhocpResult, accepted: bool = False) -> bool:
+        """Keep the plan of a usable result when it is a good one; return its ``fallback`` flag.
+
+        ``accepted`` (it passed :func:`tubekit.loop.plan_check.check_plan`) makes any finite plan a good one.
+        """
+        is_fallback = bool(result.fallback)
+        plan = np.asarray(result.inputs, dtype=float)
+        if (accepted or not is_fallback) and plan.ndim == 2 and np.all(np.isfinite(plan)):
+            self.plan, self.age = plan, 0
+        else:
+            self.age += 1
+        return is_fallback
+
+    def replacement(self) -> np.ndarray:
+        """v̂ (3,) replacing an unusable result: the last good plan shifted by its age, else zero."""
+        self.age += 1
+        if self.plan is not None and self.age < len(self.plan):
+            return self.plan[self.age].copy()
+        return _ZERO_INPUT.copy()
+
+
+def saturate(v: tuple[float, float, float],
+             limits: tuple[float, float, float]) -> tuple[tuple[float, float, float], bool]:
+    """Clip ``v`` to the box |v_i| <= limits_i (m/s, m/s, rad/s); return (v, whether it was clipped)."""
+    if abs(v[0]) <= limits[0] and abs(v[1]) <= limits[1] and abs(v[2]) <= limits[2]:
+        return v, False
+    return tuple(min(max(vi, -li), li) for vi, li in zip(v, limits)), True
+
+
+def _status_text(status: Any) -> str:
+    """A result status (a str-valued enum member or a str) as plain text."""
+    return str(status.value) if isinstance(status, enum.Enum) else str(status)
+
+
+# ---- the log ----------------------------------------------------------------------------
+
+@dataclass
+class _Log:
+    """Preallocated per-tick (K + 1 rows) and per-period arrays; see :class:`SimulationResult`."""
+
+    states: np.ndarray
+    nominal: np.ndarray
+    v_hat: np.ndarray
+    kappa: np.ndarray
+    inputs: np.ndarray
+    saturated: np.ndarray
+    fallback: np.ndarray
+    replaced: np.ndarray
+    n_detected: np.ndarray
+    solve_ms: np.ndarray
+    step_ms: np.ndarray
+    wall: np.ndarray
+    iterations: np.ndarray
+    max_violation: np.ndarray
+    rejected: np.ndarray
+    plan_age: np.ndarray
+    plan_slack: np.ndarray
+    statuses: list[str] = field(default_factory=list)
+    kappa_failures: int = 0
+
+    @classmethod
+    def allocate(cls, clock: _Clock) -> _Log:
+        rows, steps = len(clock.t), clock.steps
+        return cls(states=np.empty((rows, 4)), nominal=np.empty((rows, 4)), v_hat=np.full((rows, 3), np.nan),
+                   kappa=np.full((rows, 3), np.nan), inputs=np.full((rows, 3), np.nan),
+                   saturated=np.zeros(rows, dtype=bool), fallback=np.zeros(rows, dtype=bool),
+                   replaced=np.zeros(rows, dtype=bool), n_detected=np.zeros(rows, dtype=int),
+                   solve_ms=np.full(rows, np.nan), step_ms=np.full(rows, np.nan), wall=np.zeros(rows),
+                   iterations=np.zeros(steps), max_violation=np.full(steps, np.nan),
+                   rejected=np.zeros(steps, dtype=bool), plan_age=np.zeros(steps, dtype=int),
+                   plan_slack=np.full(steps, np.nan))
+
+    def record_solve(self, k: int, i0: int, result: FhocpResult | None, elapsed_s: float) -> None:
+        """Record the solver's answer at period ``k`` (first tick ``i0``); ``None`` when it raised."""
+        if result is None:
+            self.statuses.append("exception")
+            self.solve_ms[i0] = 1e3 * elapsed_s
+            return
+        self.statuses.append(_status_text(result.status))
+        self.iterations[k] = float(result.iterations)
+        self.max_violation[k] = float(result.max_violation)
+        self.solve_ms[i0] = 1e3 * float(result.solve_time_s)
+
+
+@dataclass
+class _Period:
+    """What one sampling period applies: the held v̂, its flags and the nominal arc (ticks + 1, 4)."""
+
+    v_hat: np.ndarray
+    fallback: bool
+    replaced: bool
+    arc: np.ndarray
+
+
+# ---- the loop ---------------------------------------------------------------------------
+
+class _ClosedLoop:
+    """One run's fixed context (scenario, sets, clock, solver, law, plant, map) and its log."""
+
+    def __init__(self, scenario: Scenario, tightening: Tightening, clock: _Clock, solver: FhocpSolver,
+                 law: AncillaryLaw, sigma: float, plant: PlantModel, obstacle_map: ObstacleMap) -> None:
+        self.scenario, self.tightening, self.clock, self.solver = scenario, tightening, clock, solver
+        self.law, self.sigma, self.plant, self.map = law, sigma, plant, obstacle_map
+        self.desired = np.asarray(scenario.trajectory.position(clock.t), dtype=float)
+        self.limits = tuple(float(c) for c in scenario.limits.vector)
+        self.memory = PlanMemory()
+        self.log = _Log.allocate(clock)
+        self.sign = HEMISPHERE_SIGN[scenario.region.heading]
+
+    def sense(self, xk: np.ndarray) -> tuple[Obstacle, ...]:
+        """Obstacles known after sensing at the position of ``xk``."""
+        return self.map.update(xk[:3])
+
+    def solve(self, k: int, tk: float, xk: np.ndarray,
+              known: tuple[Obstacle, ...]) -> tuple[np.ndarray, bool, bool]:
+        """Solve the FHOCP at ``tk`` and decide v̂; never pass NaN on. Returns (v̂, fallback, replaced)."""
+        c0 = time.perf_counter()
+        result: FhocpResult | None = None
+        try:
+            result = self.solver.solve(tk, xk.copy(), known)
+            first = np.asarray(result.first_input, dtype=float).reshape(3)
+            usable = bool(np.all(np.isfinite(first)))
+        except SolverError:
+            first, usable = _ZERO_INPUT, False
+        self.log.record_solve(k, k * self.clock.ticks, result, time.perf_counter() - c0)
+        accepted = usable and self.accept(k, tk, xk, result, known)
+        if accepted:
+            flagged = self.memory.remember(result, accepted=self.tightening.horizon_arcs > 0)
+            self.log.plan_age[k] = self.memory.age
+            return first, flagged, False
+        v_hat = self.memory.replacement()
+        self.log.plan_age[k] = self.memory.age
+        return v_hat, True, True
+
+    def accept(self, k: int, tk: float, xk: np.ndarray, result: FhocpResult, known: tuple[Obstacle, ...]) -> bool:
+        """Exact arc check of the plan against the certificate's margins (always True without margins)."""
+        if self.tightening.horizon_arcs == 0:
+            return True
+        check = check_plan(self.scenario, self.tightening, tk, xk, result.inputs, known, self.sign)
+        self.log.plan_slack[k] = check.slack
+        self.log.rejected[k] = not check.ok
+        return check.ok
+
+    def ancillary(self, i: int, xs: np.ndarray, x_hat: np.ndarray) -> np.ndarray:
+        """κ (3,) at tick ``i``; zero (and counted) when the law fails."""
+        try:
+            return self.law(xs, x_hat, self.desired[i], self.sigma)
+        except (ConfigError, FloatingPointError, np.linalg.LinAlgError):
+            self.log.kappa_failures += 1
+            return _ZERO_INPUT
+
+    def run_ticks(self, k: int, x: tuple, period: _Period) -> tuple[tuple, float]:
+        """Ticks of period ``k``: ancillary law, saturation, plant. Returns (state, ancillary time in s)."""
+        clock, log = self.clock, self.log
+        i0, h = k * clock.ticks, clock.plant_step
+        vh = tuple(float(c) for c in period.v_hat)
+        law_s = 0.0
+        for j in range(clock.ticks):
+            i = i0 + j
+            xs = np.asarray(x)
+            log.states[i] = xs
+            if self.sigma > 0.0:
+                a0 = time.perf_counter()
+                kap = self.ancillary(i, xs, period.arc[j])
+                law_s += time.perf_counter() - a0
+                log.kappa[i] = kap
+                v = (vh[0] + float(kap[0]), vh[1] + float(kap[1]), vh[2] + float(kap[2]))
+            else:
+                log.kappa[i] = 0.0
+                v = vh
+            v, log.saturated[i] = saturate(v, self.limits)
+            log.inputs[i] = v
+            x = self.plant.step_tuple(float(clock.t[i]), x, v, h, clock.substeps)
+        return x, law_s
+
+    def log_period(self, k: int, xk: np.ndarray, period: _Period, nominal_before: np.ndarray) -> None:
+        """Per-tick copies of the period's v̂, flags, map size and nominal (left limit at the sample)."""
+        m, log = self.clock.ticks, self.log
+        i0 = k * m
+        log.fallback[i0:i0 + m] = period.fallback
+        log.replaced[i0:i0 + m] = period.replaced
+        log.n_detected[i0:i0 + m] = self.map.count
+        log.nominal[i0] = nominal_before if k > 0 else xk
+        log.nominal[i0 + 1:i0 + m] = period.arc[1:m]
+        log.v_hat[i0:i0 + m] = period.v_hat
+
+    def run_period(self, k: int, x: tuple, nominal_before: np.ndarray,
+                   wall0: float) -> tuple[tuple, np.ndarray]:
+        """Sense → solve → nominal arc → ticks → log for period ``k``.
+
+        Returns (state at the next sample, nominal x̂ at its left limit there).
+        """
+        i0, m = k * self.clock.ticks, self.clock.ticks
+        xk = np.asarray(x)
+        c0 = time.perf_counter()
+        known = self.sense(xk)
+        v_hat, flagged, replaced = self.solve(k, float(self.clock.t[i0]), xk, known)
+        period = _Period(v_hat, flagged, replaced, nominal_arc(xk, v_hat, self.clock.tau))
+        control_s = time.perf_counter() - c0
+        self.log_period(k, xk, period, nominal_before)
+        x, law_s = self.run_ticks(k, x, period)
+        self.log.step_ms[i0] = 1e3 * (control_s + law_s)
+        self.log.wall[i0:i0 + m] = time.perf_counter() - wall0
+        return x, period.arc[m]
+
+    def omega_log(self) -> np.ndarray:
+        """ω = ẋ − f(x) v (m/s) at the start of every tick (NaN where the input is NaN)."""
+        return self.plant.omega_series(self.clock.t, self.log.states, self.log.inputs)
+
+
+def simulate(scenario: Scenario, *, tightening: Tightening | None = None,
+             law: str | AncillaryLaw | None = None, sigma: float | None = None, tube: bool = True,
+             progress: bool = True, solver_factory: SolverFactory | None = None,
+             mode: str | None = None, plant_substeps: int = 2, remember_obstacles: bool = True,
+             label: str | None = None, disturbance: OmegaOverride | None = None,
+             plant: str | None = None) -> SimulationResult:
+    """Run the closed loop on ``scenario`` for ``scenario.duration`` seconds.
+
+    Parameters
+    ----------
+    scenario : Scenario
+        What to simulate.
+    tightening : Tightening, optional
+        Sets of the FHOCP. Required when ``tube``; the baseline defaults to
+        :meth:`Tightening.untightened`.
+    law : str or AncillaryLaw, optional
+        Ancillary law; default ``scenario.controller.law``.
+    sigma : float, optional
+        Ancillary gain (1/s); default ``tightening.sigma``. Ignored (0) when not ``tube``.
+    tube : bool
+        ``False`` runs the baseline: nominal MPC alone, κ = 0.
+    progress : bool
+        Show a tqdm bar (only on a TTY).
+    solver_factory : callable, optional
+        ``factory(scenario, tightening)`` returning a :class:`FhocpSolver`;
+        default :class:`tubekit.fhocp.FHOCP`.
+    mode : str, optional
+        FHOCP mode for the default factory; default ``scenario.controller.fhocp_mode``.
+    plant_substeps : int
+        RK4 steps per ancillary tick (plant step = 1 / (rate * substeps) s).
+    remember_obstacles : bool
+        Keep obstacles in the map once detected (see :mod:`tubekit.loop.sensing`).
+    label : str, optional
+        Progress-bar label.
+    disturbance : callable, optional
+        ``disturbance(t) -> omega`` (3,) replacing the scenario's current + sway
+        (e.g. a :class:`verify.falsify.strategies.DisturbanceSignal` in property tests);
+        on the dynamic plant it replaces the current (the sway is the hull's).
+    plant : str, optional
+        ``"kinematic"`` or ``"dynamic"``; default ``scenario.plant.kind``.
+
+    Returns
+    -------
+    SimulationResult
+    """
+    wall0 = time.perf_counter()
+    tightening, law_obj, sig = validate_inputs(scenario, tightening, law, sigma, tube, plant_substeps)
+    solver = build_solver(scenario, tightening, solver_factory, mode)
+    clock = _Clock.of(scenario, plant_substeps)
+    loop = _ClosedLoop(scenario, tightening, clock, solver, law_obj, sig, make_plant(scenario, disturbance, plant),
+                       ObstacleMap(scenario.obstacles, scenario.sensing_range, remember=remember_obstacles))
+    x = tuple(float(c) for c in scenario.initial_state)
+    nominal_end = np.asarray(x)
+    bar = _progress(clock.steps, progress, label or ("tube" if tube else "baseline"))
+    with warnings.catch_warnings():
+        _silence_fallback_warnings()  # fallbacks are counted; one warning each would flood the terminal
+        try:
+            for k in range(clock.steps):
+                x, nominal_end = loop.run_period(k, x, nominal_end, wall0)
+                if bar is not None:
+                    bar.update(1)
+        finally:
+            if bar is not None:
+                bar.close()
+    loop.log.states[-1] = np.asarray(x)
+    loop.log.nominal[-1] = nominal_end
+    return _result(loop, tube, wall0, disturbance is not None)
+
+
+def _result(loop: _ClosedLoop, tube: bool, wall0: float, overridden: bool) -> SimulationResult:
+    """Pack the log of a finished run."""
+    log, clock = loop.log, loop.clock
+    omega = loop.omega_log()
+    wall_s = time.perf_counter() - wall0
+    log.wall[-1] = wall_s
+    step_idx = np.minimum(np.arange(len(clock.t)) // clock.ticks, clock.steps)
+    body, thrust = loop.plant.history()
+    return SimulationResult(
+        scenario=loop.scenario, tube=tube, law=loop.law.name if tube else "none", sigma=loop.sigma,
+        tightening=loop.tightening, plant_step_s=clock.plant_step, ticks_per_step=clock.ticks,
+        t=clock.t, step=step_idx, states=log.states, desired=loop.desired, nominal=log.nominal, v_hat=log.v_hat,
+        kappa=log.kappa, inputs=log.inputs, omega=omega, saturated=log.saturated, fallback=log.fallback,
+        replaced=log.replaced, n_detected=log.n_detected, solve_ms=log.solve_ms, step_ms=log.step_ms,
+        wall=log.wall, statuses=log.statuses, iterations=log.iterations, max_violation=log.max_violation,
+        kappa_failures=log.kappa_failures, wall_s=wall_s, rejected=log.rejected, plan_age=log.plan_age,
+        plan_slack=log.plan_slack, omega_overridden=overridden, body=body, thrust=thrust)

@@ -1,0 +1,104 @@
+"""Exact acceptance of a FHOCP plan along its arcs (the step the sampled-data theorem relies on).
+
+The FHOCP enforces its constraints at the nodes, linearised and softened. The
+certificate does not rely on that: a plan is *accepted* only when
+:func:`check_plan` verifies, along every arc j of the exact nominal trajectory
+(the unicycle arcs of :func:`tubekit.plant.kinematic.nominal_arc`, the same the loop
+follows), that
+
+* v̂_j is in V̄;
+* ε + M_d[j] <= e_d <= e_d_max - M_d[j], |e_z| <= e_z_max - M_z[j],
+  |e_o| <= e_o_max - M_o[j], and the heading stays in the certified hemisphere;
+* the vehicle ball inflated by M_pos[j] is clear of every known obstacle and
+  inside the workspace;
+
+at ``samples_per_arc + 1`` points per arc, each constraint tightened further by
+rate · spacing / 2 with the certificate's bound on its rate along an arc
+(:attr:`Tightening.rates`), so the check covers the whole arc, not only its
+samples. A plan that fails is replaced by the previous accepted plan, replayed.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Sequence
+
+import numpy as np
+
+from tubekit.model.errors import error_coordinates, heading_cosine
+from tubekit.plant.kinematic import nominal_arc
+from tubekit.scenario import Obstacle, Scenario
+from tubekit.tightening import Tightening
+
+__all__ = ["PlanCheck", "check_plan", "plan_arcs"]
+
+#: Points per arc of the check (plus the arc's end).
+SAMPLES_PER_ARC = 10
+
+
+@dataclass(frozen=True)
+class PlanCheck:
+    """Outcome of :func:`check_plan`: ``ok``, the smallest slack (error units or m) and where it is."""
+
+    ok: bool
+    slack: float
+    where: str
+
+
+def plan_arcs(x0: np.ndarray, inputs: np.ndarray, dt: float, samples: int) -> np.ndarray:
+    """States (N, samples + 1, 4) along the exact nominal arcs of ``inputs`` (N, 3) from ``x0``."""
+    tau = np.linspace(0.0, dt, samples + 1)
+    out = np.empty((len(inputs), samples + 1, 4))
+    x = np.asarray(x0, dtype=float)
+    for j, v in enumerate(inputs):
+        out[j] = nominal_arc(x, v, tau)
+        x = out[j, -1]
+    return out
+
+
+def _error_slacks(tight: Tightening, e: np.ndarray, cos_rel: np.ndarray, margins: np.ndarray,
+                  pad: np.ndarray, sign: int) -> dict[str, np.ndarray]:
+    """Per-sample slack (>= 0 is fine) of each error constraint; ``margins``, ``pad`` are (N, 1) columns."""
+    eps, ed_max, ez_max, eo_max = tight.region
+    md, mz, mo = (margins[:, k:k + 1] + pad[k] for k in range(3))
+    return {"e_d >= epsilon": e[..., 0] - eps - md, "e_d <= e_d_max": ed_max - md - e[..., 0],
+            "|e_z|": ez_max - mz - np.abs(e[..., 1]), "|e_o|": eo_max - mo - np.abs(e[..., 2]),
+            "hemisphere": sign * cos_rel if sign else np.abs(cos_rel)}
+
+
+def _position_slacks(scenario: Scenario, pos: np.ndarray, margin: np.ndarray,
+                     obstacles: Sequence[Obstacle]) -> dict[str, np.ndarray]:
+    r = scenario.vehicle_radius + margin
+    out: dict[str, np.ndarray] = {}
+    for i, o in enumerate(obstacles):
+        out[f"obstacle {i}"] = np.linalg.norm(pos - np.asarray(o.center), axis=-1) - o.radius - r
+    if scenario.workspace is not None:
+        lo, hi = (np.asarray(b) for b in scenario.workspace)
+        out["workspace"] = np.minimum((pos - lo).min(axis=-1), (hi - pos).min(axis=-1)) - r
+    return out
+
+
+def check_plan(scenario: Scenario, tight: Tightening, t0: float, x0: np.ndarray, inputs: np.ndarray,
+               obstacles: Sequence[Obstacle], sign: int, samples: int = SAMPLES_PER_ARC) -> PlanCheck:
+    """Verify a plan (module doc). ``sign`` is the certified hemisphere (-1 toward, +1 away, 0 both)."""
+    inputs = np.asarray(inputs, dtype=float)
+    n = tight.horizon_arcs
+    if inputs.ndim != 2 or inputs.shape[1] != 3 or inputs.shape[0] < n or not np.all(np.isfinite(inputs)):
+        return PlanCheck(False, -math.inf, "plan shape or values")
+    inputs = inputs[:n]
+    over = np.max(np.abs(inputs) - np.asarray(tight.v_max)[None, :])
+    if over > 1e-9:
+        return PlanCheck(False, -float(over), "input outside V_bar")
+    dt = scenario.controller.dt
+    arcs = plan_arcs(x0, inputs, dt, samples)
+    times = t0 + dt * (np.arange(n)[:, None] + np.linspace(0.0, 1.0, samples + 1)[None, :])
+    desired = np.asarray(scenario.trajectory.position(times.reshape(-1)), dtype=float).reshape(n, samples + 1, 3)
+    e = error_coordinates(arcs, desired)
+    cos_rel = heading_cosine(arcs, desired)
+    pad = 0.5 * (dt / samples) * np.asarray(tight.rates, dtype=float)
+    m = np.asarray(tight.margins, dtype=float)
+    slacks = _error_slacks(tight, e, cos_rel, m, pad, sign)
+    slacks.update(_position_slacks(scenario, arcs[..., :3], m[:, 3:4] + pad[3], obstacles))
+    worst_name, worst = min(((k, float(np.min(v))) for k, v in slacks.items()), key=lambda kv: kv[1])
+    return PlanCheck(ok=worst >= 0.0 and math.isfinite(worst), slack=worst, where=worst_name)

@@ -1,0 +1,197 @@
+"""Underactuated AUV kinematics, eqs. (2) and (11) of the paper.
+
+State ``x = [x, y, z, psi]`` (m, m, m, rad), input ``v = [u, w, r]`` (surge m/s,
+heave m/s, yaw rate rad/s), disturbance ``omega = [omega_1, omega_2, omega_3]``
+(m/s, inertial frame) = current ``delta`` + sway term ``g(x, v_sway)``.
+The disturbance is evaluated (and the plant integrated) in :mod:`tubekit.plant.kinematic`.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from tubekit.validation import nonnegative, positive
+
+__all__ = [
+    "InputLimits",
+    "SwayModel",
+    "nominal_kinematics",
+    "kinematics",
+    "sinc",
+    "dsinc",
+    "SINC_SERIES_THRESHOLD",
+    "unicycle_step",
+]
+
+
+@dataclass(frozen=True)
+class InputLimits:
+    """Box input set V = {|u| <= u_max, |w| <= w_max, |r| <= r_max}.
+
+    Parameters
+    ----------
+    u_max, w_max : float
+        Surge and heave speed limits (m/s).
+    r_max : float
+        Yaw-rate limit (rad/s).
+    """
+
+    u_max: float
+    w_max: float
+    r_max: float
+
+    def __post_init__(self) -> None:
+        for name in ("u_max", "w_max", "r_max"):
+            object.__setattr__(self, name, positive(f"limits.{name}", getattr(self, name)))
+
+    @property
+    def vector(self) -> np.ndarray:
+        """The limits as ``[u_max, w_max, r_max]``."""
+        return np.array([self.u_max, self.w_max, self.r_max])
+
+    @property
+    def norm(self) -> float:
+        """The paper's scalar bound V-bar = sqrt(u_max^2 + w_max^2 + r_max^2) (eq. Vbar)."""
+        return float(np.linalg.norm(self.vector))
+
+    def contains(self, v: np.ndarray, tol: float = 1e-9) -> bool:
+        """True when every component of ``v`` is within its limit (plus ``tol``)."""
+        return bool(np.all(np.abs(np.asarray(v)) <= self.vector + tol))
+
+
+@dataclass(frozen=True)
+class SwayModel:
+    """How the unactuated sway velocity v_s is generated (the paper leaves it open).
+
+    ``v_s = gain * u * r + amplitude * sin(2 pi t / period)`` (no clip).
+    ``gain * u * r`` is the steady-turn side-slip of a slender hull (sway
+    proportional to centripetal acceleration); the sinusoid models wave-induced
+    sway. Over V the model gives |v_s| <= gain u_max r_max + amplitude: that is
+    gamma-bar (the paper's v-bar), derived by the verifier. ``bound`` is the bound
+    the user *declares*; the certificate fails (condition ``sway_bound``) when it
+    is below what the model produces, and every run checks the sway it applied.
+    Evaluated by :meth:`tubekit.plant.kinematic.Plant.sway_velocity`.
+
+    Parameters
+    ----------
+    gain : float
+        Side-slip coefficient (s); v_s contribution gain*u*r (m/s).
+    amplitude : float
+        Wave-induced sway amplitude (m/s).
+    period : float
+        Wave period (s).
+    bound : float
+        Declared bound on |v_s| (m/s); must cover gain u_max r_max + amplitude.
+        Set gain = amplitude = 0 for no sway.
+    """
+
+    gain: float = 0.1
+    amplitude: float = 0.0
+    period: float = 10.0
+    bound: float = 0.02
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "gain", nonnegative("sway.gain", self.gain))
+        object.__setattr__(self, "amplitude", nonnegative("sway.amplitude", self.amplitude))
+        object.__setattr__(self, "period", positive("sway.period", self.period))
+        object.__setattr__(self, "bound", nonnegative("sway.bound", self.bound))
+
+
+def nominal_kinematics(x: np.ndarray, v: np.ndarray) -> np.ndarray:
+    """Nominal kinematics f(x) v of eq. (3); vectorised over leading axes.
+
+    Parameters
+    ----------
+    x : array (..., 4)
+        State [x, y, z, psi].
+    v : array (..., 3)
+        Input [u, w, r].
+
+    Returns
+    -------
+    array (..., 4)
+        [x_dot, y_dot, z_dot, psi_dot].
+    """
+    x = np.asarray(x, dtype=float)
+    v = np.asarray(v, dtype=float)
+    psi = x[..., 3]
+    u, w, r = v[..., 0], v[..., 1], v[..., 2]
+    return np.stack([u * np.cos(psi), u * np.sin(psi), w, r + 0.0 * psi], axis=-1)
+
+
+def kinematics(x: np.ndarray, v: np.ndarray, omega: np.ndarray) -> np.ndarray:
+    """Perturbed kinematics f(x) v + [omega, 0] of eq. (11); vectorised.
+
+    ``omega`` (..., 3) is the total inertial disturbance (current + sway term).
+    """
+    omega = np.asarray(omega, dtype=float)
+    dx = nominal_kinematics(x, v)
+    return dx + np.concatenate([omega, np.zeros(omega.shape[:-1] + (1,))], axis=-1)
+
+
+def sinc(a: np.ndarray) -> np.ndarray:
+    """S(a) = sin(a)/a with S(0) = 1 (unnormalised sinc), vectorised.
+
+    sin(a)/a has no cancellation, so the quotient is accurate to round-off for every a != 0.
+    """
+    a = np.asarray(a, dtype=float)
+    safe = np.where(a == 0.0, 1e-300, a)  # sin(1e-300)/1e-300 == 1.0
+    return np.sin(safe) / safe
+
+
+#: below this |a| = |r| dt / 2 the derivative of sin(a)/a uses its Taylor series (error < 1e-19)
+SINC_SERIES_THRESHOLD = 0.1
+
+
+def _dsinc_series(a: np.ndarray, a2: np.ndarray) -> np.ndarray:
+    """d/da sin(a)/a by its Taylor series to a^9 (error < 1e-19 for |a| < 0.1)."""
+    return a * (-1.0 / 3.0 + a2 * (1.0 / 30.0 + a2 * (-1.0 / 840.0 + a2 * (1.0 / 45360.0
+                + a2 * (-1.0 / 3991680.0)))))
+
+
+def dsinc(a: np.ndarray) -> np.ndarray:
+    """S'(a) = (a cos a - sin a)/a^2 with S'(0) = 0, vectorised.
+
+    The quotient cancels for small a, so |a| < :data:`SINC_SERIES_THRESHOLD` uses the
+    Taylor series (error < 1e-19 there).
+    """
+    a = np.asarray(a, dtype=float)
+    a2 = a * a
+    series = _dsinc_series(a, a2)
+    if a.size == 0 or a2.max() < SINC_SERIES_THRESHOLD ** 2:
+        return series
+    small = a2 < SINC_SERIES_THRESHOLD ** 2
+    safe = np.where(small, 1.0, a)
+    return np.where(small, series, (safe * np.cos(safe) - np.sin(safe)) / (safe * safe))
+
+
+def unicycle_step(s: np.ndarray, v: np.ndarray, dt: float | np.ndarray) -> np.ndarray:
+    """Exact solution of the nominal kinematics (eq. 3) after ``dt`` under a constant input; vectorised.
+
+    x(dt) = x + dt u S(r dt / 2) [cos, sin](psi + r dt / 2), z + dt w, psi + dt r (S = :func:`sinc`):
+    exact for every r, with no division by r.
+
+    Parameters
+    ----------
+    s : array (..., 4)
+        State [x, y, z, psi] (m, m, m, rad).
+    v : array (..., 3)
+        Input [u, w, r] (m/s, m/s, rad/s), held for ``dt``.
+    dt : float or array (...)
+        Elapsed time (s), broadcast against the leading axes.
+
+    Returns
+    -------
+    array (..., 4)
+    """
+    s = np.asarray(s, dtype=float)
+    v = np.asarray(v, dtype=float)
+    dt = np.asarray(dt, dtype=float)
+    u, w, r = v[..., 0], v[..., 1], v[..., 2]
+    a = 0.5 * dt * r
+    th = s[..., 3] + a
+    k = dt * u * sinc(a)
+    return np.stack(np.broadcast_arrays(s[..., 0] + k * np.cos(th), s[..., 1] + k * np.sin(th),
+                                        s[..., 2] + dt * w, s[..., 3] + dt * r), axis=-1)

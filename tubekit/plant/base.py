@@ -1,0 +1,44 @@
+"""What the closed loop needs from a plant: :class:`PlantModel`.
+
+A plant integrates the simulated vehicle over one ancillary tick with the applied command held,
+reports the current it applies and, afterwards, the total disturbance ω = ẋ − f(x) v it saw. The
+kinematic plant of eq. (11) and the 4-DOF dynamic vehicle both satisfy it; the loop never asks which
+one it has.
+"""
+
+from __future__ import annotations
+
+from typing import Any, Callable, Protocol, Sequence
+
+import numpy as np
+
+
+__all__ = ["PlantModel", "OmegaOverride"]
+
+#: ``override(t) -> omega`` (3,), m/s: a disturbance replacing the scenario's current + sway.
+OmegaOverride = Callable[[float], Any]
+
+
+class PlantModel(Protocol):
+    """The simulated vehicle as the closed loop drives it (state [x, y, z, ψ] in m and rad)."""
+
+    def step_tuple(self, t: float, x: Sequence[float], v: Sequence[float], h: float,
+                   n: int) -> tuple[float, float, float, float]:
+        """``n`` RK4 steps of ``h`` (s) from ``x`` at ``t`` (s) with the command ``v`` (m/s, m/s, rad/s) held."""
+        ...
+
+    def step(self, t: float, x: np.ndarray, v: np.ndarray, h: float, n: int) -> np.ndarray:
+        """:meth:`step_tuple` on arrays."""
+        ...
+
+    def current_at(self, t: float) -> tuple[float, float, float]:
+        """The current (m/s) at time ``t`` (s)."""
+        ...
+
+    def omega_series(self, t: np.ndarray, states: np.ndarray, inputs: np.ndarray) -> np.ndarray:
+        """ω = ẋ − f(x) v (K + 1, 3), m/s, at the logged ticks."""
+        ...
+
+    def history(self) -> tuple[np.ndarray | None, np.ndarray | None]:
+        """Body velocities and thrusts at every tick (``None, None`` for a plant without a body)."""
+        ...

@@ -1,0 +1,172 @@
+"""The dynamic plant: a 4-DOF (surge, sway, heave, yaw) vehicle with thrusters and a velocity loop.
+
+Fossen (2011), body velocities ν = (u, v, w, r) relative to the water (m/s, rad/s):
+
+    M ν̇ + C(ν) ν + D(ν) ν = τ = (X, 0, Z, N),
+
+* M = M_RB + M_A (rigid body + added mass, :class:`tubekit.model.vehicles.VehicleParams`);
+* C(ν) = C_RB + C_A, skew-symmetric, with the added-mass (Munk) terms:
+  C(ν)ν = (−(m22 v + m24 r) r, m11 u r, 0, (m22 v + m24 r) u − m11 u v);
+* D(ν)ν: linear + quadratic cross-flow drag and body/fin lift (Prestero 2001);
+* neutral buoyancy (W = B, no restoring force in heave); no roll or pitch.
+
+Kinematics: ṗ_xy = R(ψ)(u, v) + δ_xy(t), ż = w + δ_z(t), ψ̇ = r, with the
+scenario's current δ (:class:`tubekit.plant.kinematic.Plant`); the current's acceleration
+is neglected in the relative-velocity dynamics (documented in ``docs/plant.md``).
+
+Thrust: τ̇ = (sat(τ_cmd) − τ) / T_thr (first-order thrusters, saturation at
+X_max, Z_max, N_max). The low-level velocity loop turns the kinematic command
+v = v̂ + κ = (u_c, w_c, r_c) into τ_cmd: model feedforward n(ν) = C(ν)ν + D(ν)ν
+(feedback linearisation, the sway row eliminated from the yaw row) plus PI on
+e = (u_c − u, w_c − w, r_c − r) with k_p = ω_b, k_i = ω_b²/4 and conditional
+integration while saturated. Positions, ν, τ and the integrators are integrated
+together by classical RK4 at the closed loop's fixed step.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Sequence
+
+import numpy as np
+
+from tubekit.plant.base import OmegaOverride
+from tubekit.plant.kinematic import Plant, rk4_tuple
+from tubekit.scenario import Scenario
+from tubekit.model.vehicles import VehicleParams
+
+__all__ = ["DynamicPlant", "body_forces", "body_acceleration", "kinetic_energy"]
+
+Floats4 = tuple[float, float, float, float]
+
+
+def body_forces(p: VehicleParams, nu: Sequence[float]) -> Floats4:
+    """n(ν) = C(ν)ν + D(ν)ν (N, N, N, N m) at body velocities ``nu`` = (u, v, w, r)."""
+    u, v, w, r = nu
+    m11, m22, _, _, m24, _ = p.mass_entries
+    sway_momentum = m22 * v + m24 * r
+    d1 = -(p.X_u + p.X_uu * abs(u)) * u
+    d2 = -(p.Y_v + p.Y_vv * abs(v)) * v - p.Y_rr * r * abs(r) - p.Y_uv * u * v - p.Y_ur_lift * u * r
+    d3 = -(p.Z_w + p.Z_ww * abs(w)) * w - p.Z_uw * u * w
+    d4 = -(p.N_r + p.N_rr * abs(r)) * r - p.N_vv * v * abs(v) - p.N_uv_lift * u * v - p.N_ur_lift * u * r
+    return (-sway_momentum * r + d1, m11 * u * r + d2, d3, sway_momentum * u - m11 * u * v + d4)
+
+
+def body_acceleration(p: VehicleParams, nu: Sequence[float], tau: Sequence[float]) -> Floats4:
+    """ν̇ = M⁻¹(τ − n(ν)) for thrust ``tau`` = (X, Z, N) (N, N, N m); returns (u̇, v̇, ẇ, ṙ)."""
+    m11, m22, m33, m44, m24, m42 = p.mass_entries
+    n1, n2, n3, n4 = body_forces(p, nu)
+    b2, b4 = -n2, tau[2] - n4
+    det = m22 * m44 - m24 * m42
+    return ((tau[0] - n1) / m11, (m44 * b2 - m24 * b4) / det, (tau[1] - n3) / m33, (m22 * b4 - m42 * b2) / det)
+
+
+def kinetic_energy(p: VehicleParams, nu: Sequence[float]) -> float:
+    """½ νᵀ M ν (J)."""
+    u, v, w, r = nu
+    m11, m22, m33, m44, m24, m42 = p.mass_entries
+    return 0.5 * (m11 * u * u + m22 * v * v + m33 * w * w + m44 * r * r + (m24 + m42) * v * r)
+
+
+class DynamicPlant:
+    """The 4-DOF vehicle, its thrusters and its velocity loop, driven by the kinematic command v.
+
+    Same interface as :class:`tubekit.plant.kinematic.Plant` for the closed loop
+    (:meth:`step_tuple` on the pose [x, y, z, ψ]); the body velocities, thrusts
+    and integrators are internal state, initialised on the first step to the
+    trimmed start ν = (u_c, 0, w_c, r_c), τ = sat(n(ν)) (the vehicle already
+    moving at the first command, as the kinematic plant assumes). Each call of
+    :meth:`step_tuple` (one tick) logs ν and τ at its start (:meth:`history`).
+
+    Parameters
+    ----------
+    scenario : Scenario
+        Supplies the current (``disturbance``) and the vehicle (``plant``).
+    override : callable, optional
+        ``override(t) -> current`` (3,) m/s replacing the scenario's current.
+    params : VehicleParams, optional
+        Vehicle (default ``scenario.plant.params``).
+    """
+
+    def __init__(self, scenario: Scenario, override: OmegaOverride | None = None,
+                 params: VehicleParams | None = None) -> None:
+        self.params = params if params is not None else scenario.plant.params
+        self.override = override
+        self._current_model = Plant(scenario.disturbance)
+        p = self.params
+        self._mass = p.mass_entries
+        self._limits = p.thrust_limits
+        self._kp, self._ki = p.loop_bandwidth, 0.25 * p.loop_bandwidth ** 2
+        self._tau_inv = 1.0 / p.thruster_time_constant
+        self.state: tuple[float, ...] | None = None  # (u, v, w, r, X, Z, N, I_u, I_w, I_r)
+        self._log: list[tuple[float, ...]] = []
+
+    # ---- the model ---------------------------------------------------------------------
+    def current_at(self, t: float) -> tuple[float, float, float]:
+        """The water's velocity δ(t) (m/s): the override or the scenario's current."""
+        if self.override is not None:
+            o = self.override(t)
+            return float(o[0]), float(o[1]), float(o[2])
+        return self._current_model.current_at(t)
+
+    def thrust_command(self, nu: Sequence[float], command: Sequence[float],
+                       integral: Sequence[float]) -> tuple[tuple[float, float, float], tuple[bool, bool, bool]]:
+        """τ_cmd (saturated) and which channels saturate: feedforward n(ν) + M (k_p e + k_i ∫e)."""
+        m11, m22, m33, m44, m24, m42 = self._mass
+        n1, n2, n3, n4 = body_forces(self.params, nu)
+        e = (command[0] - nu[0], command[1] - nu[2], command[2] - nu[3])
+        a = [self._kp * ei + self._ki * ii for ei, ii in zip(e, integral)]
+        raw = (n1 + m11 * a[0], n3 + m33 * a[1], n4 - m42 * n2 / m22 + (m44 - m42 * m24 / m22) * a[2])
+        sat = tuple(min(max(c, -lim), lim) for c, lim in zip(raw, self._limits))
+        return sat, tuple(s != c for s, c in zip(sat, raw))
+
+    def _rhs(self, t: float, y: Sequence[float], command: Sequence[float]) -> tuple[float, ...]:
+        """d/dt of (x, y, z, ψ, u, v, w, r, X, Z, N, I_u, I_w, I_r)."""
+        psi, nu, tau, integral = y[3], y[4:8], y[8:11], y[11:14]
+        c1, c2, c3 = self.current_at(t)
+        cp, sp = math.cos(psi), math.sin(psi)
+        u, v, w, r = nu
+        acc = body_acceleration(self.params, nu, tau)
+        cmd, saturated = self.thrust_command(nu, command, integral)
+        err = (command[0] - u, command[1] - w, command[2] - r)
+        # conditional integration: hold the integral while its channel saturates in the error's direction
+        integ = tuple(0.0 if s and c * e > 0.0 else e for s, c, e in zip(saturated, cmd, err))
+        return (u * cp - v * sp + c1, u * sp + v * cp + c2, w + c3, r, *acc,
+                *((ci - ti) * self._tau_inv for ci, ti in zip(cmd, tau)), *integ)
+
+    def _start(self, command: Sequence[float]) -> tuple[float, ...]:
+        nu = (float(command[0]), 0.0, float(command[1]), float(command[2]))
+        tau, _ = self.thrust_command(nu, command, (0.0, 0.0, 0.0))
+        return (*nu, *tau, 0.0, 0.0, 0.0)
+
+    # ---- the closed loop's interface ----------------------------------------------------
+    def step_tuple(self, t: float, x: Sequence[float], v: Sequence[float], h: float, n: int) -> Floats4:
+        """Pose after ``n`` RK4 steps of ``h`` (s) from pose ``x`` at ``t`` (s), command ``v`` held."""
+        if self.state is None:
+            self.state = self._start(v)
+        self._log.append(self.state[:7])
+        y = rk4_tuple(self._rhs, t, (*x, *self.state), v, h, n)
+        self.state = y[4:]
+        return y[0], y[1], y[2], y[3]
+
+    def step(self, t: float, x: np.ndarray, v: np.ndarray, h: float, n: int) -> np.ndarray:
+        """:meth:`step_tuple` on arrays."""
+        return np.array(self.step_tuple(float(t), tuple(map(float, x)), tuple(map(float, v)), float(h), n))
+
+    def history(self) -> tuple[np.ndarray, np.ndarray]:
+        """Body velocities (K + 1, 4) and thrusts (K + 1, 3) at the start of every tick, plus the final state."""
+        rows = [*self._log, self.state[:7]] if self.state is not None else []
+        data = np.asarray(rows, dtype=float).reshape(-1, 7)
+        return data[:, :4], data[:, 4:7]
+
+    def omega_series(self, t: np.ndarray, states: np.ndarray, inputs: np.ndarray) -> np.ndarray:
+        """ω = ẋ − f(x) v at every tick (K + 1, 3), m/s: δ + R(ψ)(u_b − u_c, v_b), δ_z + w_b − w_c."""
+        body, _ = self.history()
+        out = np.full((len(t), 3), np.nan)
+        for i, ti in enumerate(t):
+            if i < len(body) and np.isfinite(inputs[i, 0]) and np.isfinite(inputs[i, 2]):
+                c1, c2, c3 = self.current_at(float(ti))
+                du, vb = body[i, 0] - inputs[i, 0], body[i, 1]
+                cp, sp = math.cos(states[i, 3]), math.sin(states[i, 3])
+                out[i] = (c1 + du * cp - vb * sp, c2 + du * sp + vb * cp, c3 + body[i, 2] - inputs[i, 1])
+        return out

@@ -1,0 +1,361 @@
+"""The closed-loop falsifier: disturbance *sequences* against the loop that runs (issue 11).
+
+The certificate promises, for the sampled-data loop of :mod:`tubekit.loop.closed_loop`
+(reset every δt, κ held at the ancillary rate, plans accepted by
+:mod:`tubekit.loop.plan_check`), that max_j |e_j - ê_j| / tube_j <= 1 and that e stays in
+R and v in V, as long as ‖ω_xy‖ <= ω̄_xy and |ω_z| <= ω̄_z. This module attacks
+that claim with :func:`tubekit.loop.closed_loop.simulate` itself (``disturbance=``
+override) and measures every run with :func:`tubekit.loop.promises.check_promises`:
+
+* **starts** on the boundary of Ē: the initial error on a face of R shrunk by the
+  first arc margin, in the certified hemisphere (:func:`start_state`);
+* **greedy**: at every tick ω maximises d/dt of the tube Lyapunov function in the
+  box norm, i.e. the growth of |ρ_j| on the axis with the largest |ρ_j| / tube_j
+  (or on one fixed axis), read from the loop's own state (:class:`_StateTap`);
+* **evolution**: piecewise-constant sequences (one ω per FHOCP period, and the
+  start) optimised by a seeded (1 + λ) evolution strategy.
+
+The budget counts simulations, never seconds; the search is deterministic for a seed.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field, replace
+from typing import Any, Callable
+
+import numpy as np
+
+from tubekit.model.ancillary import AncillaryLaw, get_law
+from tubekit.loop.closed_loop import simulate
+from tubekit.model.errors import error_coordinates, numeric
+from tubekit.exceptions import ConfigError
+from tubekit.loop.promises import Promise, check_promises
+from tubekit.scenario import HEMISPHERE_SIGN, Scenario
+from tubekit.tightening import Tightening
+
+from verify.falsify.strategies import state_from_error
+
+__all__ = ["LoopRun", "ClosedLoopResult", "falsify_closed_loop", "start_state", "greedy_disturbance",
+           "piecewise_disturbance", "PREMISE_NAMES", "GREEDY_AXES"]
+
+#: Promises that are premises of the theorem (a run breaking one claims nothing).
+PREMISE_NAMES = ("disturbance", "recursive_feasibility")
+#: Greedy variants: the axis with the largest |ρ_j| / tube_j, or one fixed axis (0: e_d, 1: e_z, 2: e_o).
+GREEDY_AXES: tuple[int | None, ...] = (None, 0, 1, 2)
+#: Offspring per generation of the evolution strategy, and its mutation step (unit cube).
+_LAMBDA, _STEP = 4, 0.2
+#: Unit numbers of a start state: face, three coordinates, bearing.
+_START_DIM = 5
+
+
+@dataclass(frozen=True)
+class LoopRun:
+    """One simulated run: what was applied and what :func:`check_promises` measured.
+
+    ``ratio`` is max_j |e_j - ê_j| / tube_j over the run (1 = the certified tube);
+    ``broken`` names the non-premise promises broken (``sway`` is NaN under an
+    override and skipped); ``vacuous`` is True when a premise failed.
+    """
+
+    strategy: str
+    initial_state: tuple[float, float, float, float]
+    ratio: float
+    broken: tuple[str, ...]
+    vacuous: bool
+    promises: tuple[Promise, ...]
+    sequence: tuple[tuple[float, float, float], ...] | None = None
+    axis_ratios: tuple[float, float, float] = (math.nan, math.nan, math.nan)
+
+    @property
+    def counterexample(self) -> bool:
+        """The run breaks the certificate (ratio > 1 or a promise broken, premises holding)."""
+        return not self.vacuous and (self.ratio > 1.0 or bool(self.broken))
+
+    def fitness(self) -> float:
+        """What the search maximises: the ratio, plus 10 for a broken promise."""
+        return (self.ratio if math.isfinite(self.ratio) else 1e6) + (10.0 if self.broken else 0.0) - \
+            (100.0 if self.vacuous else 0.0)
+
+    def to_dict(self) -> dict:
+        """JSON form."""
+        return {"strategy": self.strategy, "initial_state": list(self.initial_state), "ratio": self.ratio,
+                "axis_ratios": list(self.axis_ratios),
+                "broken": list(self.broken), "vacuous": self.vacuous,
+                "promises": [p.to_dict() for p in self.promises],
+                "sequence": None if self.sequence is None else [list(w) for w in self.sequence]}
+
+
+@dataclass(frozen=True)
+class ClosedLoopResult:
+    """Outcome of :func:`falsify_closed_loop`: the worst run and the tightness figure."""
+
+    scenario: str
+    law: str
+    certified: bool
+    tube: tuple[float, float, float]
+    omega_bar: tuple[float, float]
+    duration: float
+    seed: int
+    simulations: int
+    vacuous_runs: int
+    worst: LoopRun
+    runs: tuple[LoopRun, ...] = field(repr=False, default=())
+
+    @property
+    def ratio(self) -> float:
+        """Largest deviation/radius ratio observed over the runs whose premises held."""
+        return self.worst.ratio
+
+    @property
+    def axis_ratios(self) -> tuple[float, float, float]:
+        """Largest |rho_j| / tube_j per axis over the runs whose premises held (tightness per axis)."""
+        valid = [r.axis_ratios for r in self.runs if not r.vacuous] or [self.worst.axis_ratios]
+        return tuple(float(np.nanmax([a[j] for a in valid])) for j in range(3))
+
+    @property
+    def found(self) -> bool:
+        """A counterexample was found."""
+        return any(r.counterexample for r in self.runs)
+
+    def check(self) -> bool:
+        """True when the certificate survived: no run with ratio > 1 or a broken promise."""
+        return not self.found
+
+    def summary(self) -> str:
+        """Readable text."""
+        w = self.worst
+        head = (f"closed loop, law '{self.law}', {self.simulations} simulations of {self.duration:g} s, "
+                f"seed {self.seed}, ||omega_xy|| <= {self.omega_bar[0]:.4g}, |omega_z| <= {self.omega_bar[1]:.4g}")
+        lines = [("COUNTEREXAMPLE found" if self.found else "no counterexample") + f" ({head})",
+                 f"  largest deviation/radius ratio = {w.ratio:.6f} (tube = {np.round(self.tube, 6).tolist()}), "
+                 f"by {w.strategy} from {np.round(w.initial_state, 4).tolist()}",
+                 "  per axis (e_d, e_z, e_o), largest over all runs: "
+                 + ", ".join(f"{x:.4f}" for x in self.axis_ratios)]
+        if w.broken:
+            lines.append("  broken: " + ", ".join(f"{p.name} {p.observed:.4g} vs {p.bound:.4g}"
+                                                   for p in w.promises if p.name in w.broken))
+        if self.vacuous_runs:
+            lines.append(f"  {self.vacuous_runs} run(s) broke a premise (disturbance or recursive feasibility) "
+                         "and claim nothing")
+        if not self.certified:
+            lines.append("  the scenario is not certified: these figures claim nothing")
+        return "\n".join(lines)
+
+    def to_dict(self) -> dict:
+        """JSON form (``found``, ``ratio``, ``worst`` with its sequence and promises)."""
+        return {"mode": "closed-loop", "found": self.found, "ratio": self.ratio, "scenario": self.scenario,
+                "law": self.law, "certified": self.certified, "tube": list(self.tube),
+                "omega_bar": list(self.omega_bar), "duration": self.duration, "seed": self.seed,
+                "simulations": self.simulations, "vacuous_runs": self.vacuous_runs,
+                "axis_ratios": list(self.axis_ratios), "worst": self.worst.to_dict()}
+
+
+# --------------------------------------------------------------------------- starts and disturbances
+def start_state(scenario: Scenario, tightening: Tightening, unit: np.ndarray) -> tuple[float, ...]:
+    """Initial state whose error lies on a face of Ē as the FHOCP enforces it (unit in [0,1]^5).
+
+    Ē = R shrunk by the largest arc margin plus the inter-node allowance (the Tightening's
+    node bounds e_d_min..e_d_max, |e_z| <= e_z_max, |e_o| <= e_o_max); a face of R shrunk by the
+    first margin only is outside what an accepted plan may start from, so runs from there break the
+    recursive-feasibility premise and claim nothing.
+
+    ``unit[0]`` picks the face (e_d low/high, e_z low/high, e_o low/high), ``unit[1:4]`` the
+    coordinates, ``unit[4]`` the bearing; the heading is in the certified hemisphere.
+    """
+    u = np.clip(np.asarray(unit, dtype=float), 0.0, 1.0)
+    t = tightening
+    box = np.array([[t.e_d_min, t.e_d_max], [-t.e_z_max, t.e_z_max], [-t.e_o_max, t.e_o_max]], dtype=float)
+    e = box[:, 0] + (box[:, 1] - box[:, 0]) * u[1:4]
+    face = min(int(u[0] * 6), 5)
+    e[face // 2] = box[face // 2, face % 2]
+    sign = HEMISPHERE_SIGN[scenario.region.heading] or (-1 if u[4] < 0.5 else 1)
+    rel = state_from_error(e[0], e[1], e[2], 2 * math.pi * u[4], sign)
+    target = np.asarray(scenario.trajectory.position(np.array([0.0]))[0], dtype=float)
+    return tuple(float(x) for x in (rel + np.append(target, 0.0)))
+
+
+def _omega_from_unit(omega_xy: float, omega_z: float, u: np.ndarray) -> tuple[float, float, float]:
+    """ω with ‖ω_xy‖ <= ω̄_xy, |ω_z| <= ω̄_z from u in [0,1]^3 (u[1] > 0.5: on the circle)."""
+    a = 2 * math.pi * float(u[0])
+    mag = omega_xy * min(1.0, 2.0 * float(u[1]))
+    return mag * math.cos(a), mag * math.sin(a), omega_z * (2.0 * float(u[2]) - 1.0)
+
+
+def piecewise_disturbance(omega_xy: float, omega_z: float, dt: float, units: np.ndarray) -> Callable:
+    """``disturbance(t)``: one ω per FHOCP period (``units`` (periods, 3) in [0,1])."""
+    table = [_omega_from_unit(omega_xy, omega_z, u) for u in np.clip(units, 0.0, 1.0)]
+
+    def omega(t: float) -> tuple[float, float, float]:
+        return table[min(int(t / dt + 1e-9), len(table) - 1)]
+    omega.table = table  # type: ignore[attr-defined]
+    return omega
+
+
+@dataclass(frozen=True)
+class _StateTap(AncillaryLaw):
+    """The named law, unchanged, that also records (state, nominal, p_d) at every tick it is called."""
+
+    tap: list = field(default_factory=list, compare=False)
+
+    def __call__(self, state: np.ndarray, state_hat: np.ndarray, p_d: np.ndarray, sigma: float) -> np.ndarray:
+        self.tap[:] = [np.asarray(state, dtype=float), np.asarray(state_hat, dtype=float), np.asarray(p_d)]
+        return super().__call__(state, state_hat, p_d, sigma)
+
+
+def greedy_disturbance(tap: list, tube: np.ndarray, omega_xy: float, omega_z: float,
+                       axis: int | None = None) -> Callable:
+    """``disturbance(t)`` maximising d/dt |ρ_j| / tube_j at the state last read by the law (``tap``).
+
+    ė is affine in ω (ė = J v + ζ + ξ(ω)), so ∂ė_j/∂ω = g_j and the best ω is ω̄ along s_j g_j,
+    s_j = sign(ρ_j). ``axis`` None: j = argmax |ρ_j| / tube_j (right after the reset, ρ = 0: the
+    axis with the fastest normalised growth).
+    """
+    e_dot = numeric().e_dot
+    tube = np.asarray(tube, dtype=float)
+
+    def omega(t: float) -> tuple[float, float, float]:
+        if not tap:
+            return 0.0, 0.0, 0.0
+        x, x_hat, p_d = tap
+        rel = x[:2] - p_d[:2]
+        zero = np.asarray(e_dot(rel[0], rel[1], x[3], 0, 0, 0, 0, 0, 0, 0, 0, 0), dtype=float).ravel()
+        g = np.column_stack([np.asarray(e_dot(rel[0], rel[1], x[3], 0, 0, 0, *np.eye(3)[k], 0, 0, 0),
+                                        dtype=float).ravel() - zero for k in range(3)])
+        ratio = np.abs(error_coordinates(x, p_d) - error_coordinates(x_hat, p_d)) / tube
+        rho = error_coordinates(x, p_d) - error_coordinates(x_hat, p_d)
+        if axis is not None:
+            j = axis
+        elif ratio.max() > 1e-9:
+            j = int(np.argmax(ratio))
+        else:
+            j = int(np.argmax((omega_xy * np.hypot(g[:, 0], g[:, 1]) + omega_z * np.abs(g[:, 2])) / tube))
+        s = 1.0 if rho[j] >= 0 else -1.0
+        gx, gy, gz = s * g[j]
+        n = math.hypot(gx, gy)
+        wx, wy = (omega_xy * gx / n, omega_xy * gy / n) if n > 0 else (0.0, 0.0)
+        return wx, wy, omega_z * (1.0 if gz >= 0 else -1.0)
+    return omega
+
+
+# --------------------------------------------------------------------------- one run
+@dataclass(frozen=True)
+class _Attack:
+    """Fixed context of a search: the short scenario, the certificate's Tightening and bounds."""
+
+    scenario: Scenario
+    tightening: Tightening
+    law: AncillaryLaw
+    omega_xy: float
+    omega_z: float
+
+    def run(self, strategy: str, start: tuple[float, ...], disturbance: Callable, tap: list | None = None,
+            sequence: tuple | None = None) -> LoopRun:
+        """Simulate from ``start`` under ``disturbance`` and measure the promises."""
+        law = self.law if tap is None else _StateTap(self.law.name, self.law.gain_of_jacobian,
+                                                      self.law.description, self.law.symbolic_gain,
+                                                      self.law.closed_form, tap=tap)
+        sc = replace(self.scenario, initial_state=start)
+        result = simulate(sc, tightening=self.tightening, law=law, progress=False, disturbance=disturbance)
+        promises = tuple(check_promises(result))
+        by_name = {p.name: p for p in promises}
+        broken = tuple(p.name for p in promises if p.name not in PREMISE_NAMES and math.isfinite(p.observed)
+                       and not p.ok)
+        vacuous = any(not by_name[n].ok for n in PREMISE_NAMES if n in by_name)
+        axes = np.nanmax(np.abs(np.asarray(result.rho)) / np.asarray(self.tightening.tube), axis=0)
+        return LoopRun(strategy, tuple(float(x) for x in start), float(by_name["tube"].observed), broken, vacuous,
+                       promises, sequence, tuple(float(a) for a in axes))
+
+
+def _setup(scenario: Scenario, law: str | None, duration: float, certificate: Any,
+           tightening: Tightening | None) -> tuple[_Attack, Any]:
+    from verify.certificate import certify
+
+    name = scenario.controller.law if law is None else law
+    law_obj = get_law(name)
+    if not (isinstance(duration, (int, float)) and math.isfinite(duration) and duration > 0):
+        raise ConfigError("duration", "a number of seconds > 0", duration)
+    cert = certificate if certificate is not None else certify(scenario, name)
+    tight = tightening if tightening is not None else cert.best_effort_tightening()
+    if not np.all(np.asarray(tight.tube) > 0):
+        raise ConfigError("tube", "a certificate with a finite one-period tube", list(tight.tube),
+                          "the design has no tube to attack")
+    short = replace(scenario, duration=float(max(duration, scenario.controller.dt)))
+    wxy, wz = float(tight.disturbance[0]), float(tight.disturbance[1])
+    return _Attack(short, tight, law_obj, wxy, wz), cert
+
+
+def falsify_closed_loop(scenario: Scenario, law: str | None = None, *, budget: int = 20, seed: int = 0,
+                        duration: float = 3.0, certificate: Any = None,
+                        tightening: Tightening | None = None) -> ClosedLoopResult:
+    """Search disturbance sequences and boundary starts for a run that breaks the certificate.
+
+    Parameters
+    ----------
+    scenario : Scenario
+        The design to attack (its duration is replaced by ``duration``).
+    law : str, optional
+        Ancillary law (default: the scenario's).
+    budget : int
+        Simulations (>= 1): a quarter greedy (the four :data:`GREEDY_AXES` variants from
+        boundary starts), the rest a (1 + 4) evolution strategy on piecewise-constant sequences.
+    seed : int
+        Seed; the search is deterministic for a seed.
+    duration : float
+        Seconds simulated per run (2-5 s keeps a budget of 20 under a minute).
+    certificate : Certificate, optional
+        Reuse a certificate instead of computing one.
+    tightening : Tightening, optional
+        Attack these sets instead of the certificate's (e.g. a deliberately shrunk tube).
+    """
+    if not isinstance(budget, int) or isinstance(budget, bool) or budget < 1:
+        raise ConfigError("budget", "an integer >= 1 (simulations)", budget)
+    attack, cert = _setup(scenario, law, duration, certificate, tightening)
+    rng = np.random.default_rng(seed)
+    runs: list[LoopRun] = []
+    n_greedy = max(1, budget // 4)
+    for k in range(n_greedy):
+        tap: list = []
+        axis = GREEDY_AXES[k % len(GREEDY_AXES)]
+        start = attack.scenario.initial_state if k == 0 else start_state(scenario, attack.tightening,
+                                                                         rng.uniform(0, 1, _START_DIM))
+        omega = greedy_disturbance(tap, attack.tightening.tube, attack.omega_xy, attack.omega_z, axis)
+        runs.append(attack.run(f"greedy:{'max' if axis is None else ('e_d', 'e_z', 'e_o')[axis]}",
+                               tuple(start), omega, tap=tap))
+    runs.extend(_evolve(attack, scenario, rng, budget - n_greedy))
+    valid = [r for r in runs if not r.vacuous] or runs
+    worst = max(valid, key=LoopRun.fitness)
+    return ClosedLoopResult(scenario=scenario.name, law=attack.law.name, certified=bool(cert.certified),
+                            tube=tuple(float(x) for x in attack.tightening.tube),
+                            omega_bar=(attack.omega_xy, attack.omega_z), duration=float(attack.scenario.duration),
+                            seed=seed, simulations=len(runs), vacuous_runs=sum(r.vacuous for r in runs),
+                            worst=worst, runs=tuple(runs))
+
+
+def _evolve(attack: _Attack, scenario: Scenario, rng: np.random.Generator, budget: int) -> list[LoopRun]:
+    """(1 + λ) evolution strategy over (start, one ω per period) in the unit cube; ``budget`` simulations."""
+    periods = attack.scenario.steps
+    dt = attack.scenario.controller.dt
+
+    def evaluate(genome: np.ndarray) -> LoopRun:
+        start = start_state(scenario, attack.tightening, genome[:_START_DIM])
+        units = genome[_START_DIM:].reshape(periods, 3)
+        omega = piecewise_disturbance(attack.omega_xy, attack.omega_z, dt, units)
+        return attack.run("evolution", start, omega, sequence=tuple(omega.table))
+
+    runs: list[LoopRun] = []
+    if budget < 1:
+        return runs
+    parent = rng.uniform(0, 1, _START_DIM + 3 * periods)
+    parent[_START_DIM + 1::3] = 1.0  # start with every ω on the circle ‖ω_xy‖ = ω̄_xy
+    best = evaluate(parent)
+    runs.append(best)
+    while len(runs) < budget:
+        children = [np.clip(parent + rng.normal(0, _STEP, parent.size), 0, 1)
+                    for _ in range(min(_LAMBDA, budget - len(runs)))]
+        for child in children:
+            run = evaluate(child)
+            runs.append(run)
+            if run.fitness() >= best.fitness():
+                parent, best = child, run
+    return runs

@@ -5,11 +5,12 @@ Usage::
     python benchmarks/closed_loop.py [--duration S] [--json FILE] [--profile]
 
 The tightening comes from :func:`verify.certify` on the paper's scenario; certification is done before the
-clock starts and is excluded. The run is :func:`tubekit.simulate` (tube, real-time FHOCP, the scenario's
-law) timed as a whole: ``realtime_factor`` = simulated seconds / wall seconds. The breakdown replays the
-recorded run's ticks through each part on its own (the law, the plant's ``step_tuple``, saturation) and
-takes the FHOCP time from the run's own log, so the parts are measured without timer overhead inside the
-loop; ``other`` is the remainder (logging, sensing, nominal arc, plan check, Python glue).
+clock starts and is excluded. The run is :func:`tubekit.loop.closed_loop.run_closed_loop` (tube, real-time
+FHOCP, the scenario's law) timed as a whole: ``realtime_factor`` = simulated seconds / wall seconds. The
+breakdown replays the recorded run's ticks through each part on its own (the law, the plant's
+``step_tuple``, saturation) and takes the FHOCP time from the run's own log, so the parts are measured
+without timer overhead inside the loop; ``other`` is the remainder (logging, sensing, nominal arc, plan
+check, Python glue).
 """
 
 from __future__ import annotations
@@ -26,7 +27,7 @@ import numpy as np
 import verify
 from tubekit import paper_scenario
 from tubekit.model.ancillary import get_law
-from tubekit.loop.closed_loop import saturate, simulate
+from tubekit.loop.closed_loop import run_closed_loop, saturate
 from tubekit.plant.kinematic import Plant
 
 __all__ = ["measure", "main"]
@@ -84,7 +85,7 @@ def measure(duration: float | None = None, profile: bool = False) -> dict:
     w0 = time.perf_counter()
     if profiler is not None:
         profiler.enable()
-    res = simulate(scenario, tightening=tightening, tube=True, progress=False)
+    res = run_closed_loop(scenario, tightening, tube=True, progress=False)
     if profiler is not None:
         profiler.disable()
     wall_s = time.perf_counter() - w0

@@ -56,7 +56,7 @@ from pathlib import Path
 import numpy as np
 
 from tubekit import Tightening, paper_scenario
-from tubekit.fhocp import FHOCP, IpoptFHOCP
+from tubekit.fhocp import FHOCP, IpoptFHOCP, ScpOptions
 from tubekit.model.kinematics import kinematics
 from tubekit.plant.kinematic import Plant
 from tubekit.scenario import Obstacle, Scenario
@@ -131,11 +131,11 @@ def _versions() -> dict:
 def make_methods(scenario: Scenario, tightening: Tightening, slots: int | None = None,
                  with_casadi: bool = True) -> dict[str, tuple[object, bool]]:
     """{name: (solver, converged?)}: ours and the CasADi peers, all with the same obstacle slots."""
-    rt = FHOCP(scenario, tightening, mode="realtime", max_obstacles=slots)
+    rt = FHOCP(scenario, tightening, mode="realtime", options=ScpOptions(max_obstacles=slots))
     slots = rt.max_obstacles
     methods: dict[str, tuple[object, bool]] = {
         "scp_realtime": (rt, False),
-        "scp_converged": (FHOCP(scenario, tightening, mode="converged", max_obstacles=slots), True)}
+        "scp_converged": (FHOCP(scenario, tightening, mode="converged", options=ScpOptions(max_obstacles=slots)), True)}
     if with_casadi:
         methods["ipopt"] = (IpoptFHOCP(scenario, tightening, max_obstacles=slots, warm_start_duals=True,
                                        ipopt_options=IPOPT_TUNING), True)
@@ -216,8 +216,9 @@ def run(duration: float, with_ipopt: bool = True, profile: bool = False, toleran
     sim_s = time.perf_counter() - t0
     methods = make_methods(sc, tg, with_casadi=with_ipopt)
     if tolerance is not None:
-        methods["scp_converged"] = (FHOCP(sc, tg, mode="converged", tolerance=tolerance,
-                                          max_obstacles=methods["scp_realtime"][0].max_obstacles), True)
+        slots = methods["scp_realtime"][0].max_obstacles
+        methods["scp_converged"] = (FHOCP(sc, tg, mode="converged",
+                                          options=ScpOptions(tolerance=tolerance, max_obstacles=slots)), True)
     prof = cProfile.Profile() if profile else None
     gc.disable()
     try:

@@ -65,7 +65,7 @@ def _fake_certify(scenario, law=None):
 
     class Fake:
         certified = False
-        failures = [{"condition": "fake"}]
+        failures = [SimpleNamespace(condition="fake")]
         disturbance = SimpleNamespace(gamma=0.02)  # read by the dynamic-plant part of reproduce
 
         def to_dict(self):
@@ -75,7 +75,8 @@ def _fake_certify(scenario, law=None):
             return "fake certificate"
 
         def best_effort_tightening(self, min_input_fraction=0.5):
-            return dc_replace(Tightening.untightened(scenario), sigma=0.5, rho_tilde=0.03)
+            return dc_replace(Tightening.untightened(scenario), sigma=0.5, rho_tilde=0.03,
+                              disturbance=(0.0, 0.0, 0.02))
     return Fake()
 
 
@@ -90,3 +91,67 @@ def test_diagnostics_are_logged_on_stderr_results_on_stdout(flag, shown, tmp_pat
     captured = capsys.readouterr()
     assert ("certifying" in captured.err) is shown and "certifying" not in captured.out
     assert "wrote" in captured.out and "min_clearance" in captured.out  # results stay on stdout
+
+
+# ---- exit codes by error type: one row of tubekit.app.exit_codes.error_table each ---------------------------
+
+def _raise(exc):
+    def run(args):
+        raise exc
+    return run
+
+
+def _error_rows():
+    from verify.certificate import NotCertifiedError
+
+    from tubekit.exceptions import ConfigError, NotAvailableError, ShapeError, SolverError, TubekitError
+
+    return [
+        (ConfigError("--out", "a directory", "x.txt"), 2, "error: --out: expected a directory"),
+        (ShapeError("initial_state", "(4,)", (3,)), 2, "error: initial_state: expected shape (4,)"),
+        (NotCertifiedError("scenario 'x' is not certified"), 3, "not certified: scenario 'x' is not certified"),
+        (SolverError("IPOPT failed"), 1, "solver failed: IPOPT failed"),
+        (NotAvailableError("cyipopt is not installed"), 1, "not available: cyipopt is not installed. Try: pip install"),
+        (ImportError("No module named 'dask'"), 1, "not available: No module named 'dask'. Try: pip install"),
+        (TubekitError("a state nobody expected"), 1, "internal error: TubekitError: a state nobody expected"),
+        (FileNotFoundError(2, "No such file or directory", "cfg.toml"), 2, "error: cfg.toml: No such file"),
+        (KeyboardInterrupt(), 130, "interrupted"),
+    ]
+
+
+@pytest.mark.parametrize("row", range(9))
+def test_each_error_type_has_its_exit_code_and_one_line(row, monkeypatch, capsys):
+    import tubekit.app.cli as cli
+
+    exc, code, message = _error_rows()[row]
+    monkeypatch.setitem(cli.SUBCOMMANDS, "failing", Subcommand("raises", lambda parser: None, _raise(exc)))
+    assert main(["failing"]) == code
+    err = capsys.readouterr().err
+    assert len(err.strip().splitlines()) == 1 and "Traceback" not in err
+    assert err.startswith(f"tubekit failing: {message}")
+
+
+def test_an_error_outside_the_table_is_not_hidden(monkeypatch):
+    import tubekit.app.cli as cli
+
+    monkeypatch.setitem(cli.SUBCOMMANDS, "buggy", Subcommand("a bug", lambda parser: None,
+                                                             _raise(ZeroDivisionError("a bug"))))
+    with pytest.raises(ZeroDivisionError, match="a bug"):
+        main(["buggy"])
+
+
+def test_a_multi_line_error_is_reported_on_one_line(monkeypatch, capsys):
+    import tubekit.app.cli as cli
+    from tubekit.exceptions import SolverError
+
+    monkeypatch.setitem(cli.SUBCOMMANDS, "noisy", Subcommand("x", lambda parser: None,
+                                                             _raise(SolverError("first\nsecond\nthird"))))
+    assert main(["noisy"]) == 1
+    assert capsys.readouterr().err == "tubekit noisy: solver failed: first\n"
+
+
+def test_bad_input_exits_2_in_a_subprocess(tmp_path):
+    out = subprocess.run([sys.executable, "-m", "tubekit.app.cli", "simulate", str(tmp_path / "none.toml")],
+                         capture_output=True, text=True)
+    assert out.returncode == 2 and len(out.stderr.strip().splitlines()) == 1
+    assert out.stderr.startswith("tubekit simulate: error: CONFIG")

@@ -8,7 +8,7 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from tubekit.loop.closed_loop import simulate
+from tubekit.loop.closed_loop import run_closed_loop
 from tubekit.loop.metrics import rho_period_peaks
 from tubekit.app.plots import (FIGURE_FILES, clearance_figure, errors_figure, inputs_figure, period_envelope, plot_all,
                                top_view, view_3d)
@@ -21,7 +21,7 @@ def short_run():
     sc = replace(paper_scenario(), duration=2.0)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        run = simulate(sc, tightening=Tightening.untightened(sc), tube=False, progress=False)
+        run = run_closed_loop(sc, tightening=Tightening.untightened(sc), tube=False, progress=False)
     return sc, run.columns()
 
 
@@ -117,3 +117,22 @@ def test_animation_gif(tmp_path, short_run):
     assert paths[0].name == ANIMATION_GIF
     with Image.open(paths[0]) as gif:
         assert gif.n_frames == 8
+
+
+def test_plot_run_is_the_figure_of_a_run():
+    """The app draws a run (the core's SimulationResult has no plot method)."""
+    from tubekit.app.plots import plot_run
+    from tubekit.exceptions import ConfigError
+
+    sc = replace(paper_scenario(), duration=1.0)
+    tight = replace(Tightening.untightened(sc), sigma=0.5, obstacle_margin=0.05)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        run = run_closed_loop(sc, tightening=tight, tube=True, progress=False)
+    fig = plot_run(run)
+    lines = [ln for ax in fig.axes for ln in ax.get_lines() if ln.get_label() == "tube"]
+    assert lines and np.allclose(lines[0].get_xdata(), run.states[:, 0])
+    labels = [t.get_text() for ax in fig.axes if ax.get_legend() for t in ax.get_legend().get_texts()]
+    assert any("position tube" in text for text in labels)  # a tube run shows its tube
+    with pytest.raises(ConfigError, match="run: expected a tubekit.SimulationResult"):
+        plot_run(run.columns())

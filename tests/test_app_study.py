@@ -30,7 +30,7 @@ class FakeCertificate:
 
     def __init__(self, scenario, certified):
         self.scenario, self.certified = scenario, certified
-        self.failures = [] if certified else [{"condition": "fake"}]
+        self.failures = [] if certified else [SimpleNamespace(condition="fake")]
         self.disturbance = SimpleNamespace(gamma=0.02)  # what the dynamic part of reproduce reads
 
     def to_dict(self):
@@ -40,9 +40,10 @@ class FakeCertificate:
         return "fake certificate for tests"
 
     def best_effort_tightening(self, min_input_fraction=0.5):
-        base = Tightening.untightened(self.scenario)
+        base = Tightening.untightened(self.scenario)  # the verdict and gamma travel in the tightening
         return dataclasses.replace(base, sigma=0.5, rho_tilde=0.03, e_d_min=self.scenario.epsilon + 0.03,
-                                   obstacle_margin=0.02, v_max=base.v_max * 0.9)
+                                   obstacle_margin=0.02, v_max=base.v_max * 0.9, certified=self.certified,
+                                   disturbance=(0.0, 0.0, self.disturbance.gamma))
 
 
 def _fake_certify(certified=False):
@@ -254,6 +255,30 @@ def test_reproduce_writes_every_file_and_key(certified, tmp_path, monkeypatch):
     dyn_csv = np.genfromtxt(out / "dynamic_trajectory.csv", delimiter=",", names=True)
     assert {"u_b", "v_b", "w_b", "r_b", "X", "Z", "N"} <= set(dyn_csv.dtype.names)
     assert dyn["sway_max"] == pytest.approx(float(np.nanmax(np.abs(dyn_csv["v_b"]))), rel=1e-9)
+
+
+@pytest.mark.parametrize("certified", [False, True])
+def test_metrics_json_is_the_runs_metrics_key_for_key(certified, tmp_path, monkeypatch):
+    """One convention: metrics.json's run part is SimulationResult.metrics, key for key and value for value."""
+    pytest.importorskip("tubekit.fhocp")
+    from tubekit.app.study import STUDY_KEYS, StudyResult, run_study
+    from tubekit.scenario import paper_scenario
+
+    monkeypatch.setattr(verify, "certify", _fake_certify(certified), raising=False)
+    out = tmp_path / "m"
+    result = run_study(paper_scenario().with_changes(duration=2.0), out, progress=False, with_acceptance=True,
+                       dynamic=True, echo=lambda line: None)
+    stored = json.loads((out / "metrics.json").read_text())
+    assert isinstance(result, StudyResult) and result.to_dict() == stored
+    assert {k: v for k, v in stored.items() if k not in STUDY_KEYS} == result.tube.run.metrics
+    assert stored["baseline"] == result.baseline.run.metrics
+    dynamic_only = ("failures", "vehicle", "tracking_bound")
+    assert {k: v for k, v in stored["dynamic"].items() if k not in dynamic_only} == result.dynamic.run.metrics
+    assert stored["sway_bound"] == 0.02 and stored["max_rho_ratio"] is None and "promises" in stored
+    # the fake certified certificate's zero tube is broken by any disturbed run: check() fails only then
+    assert result.check() is (not certified) and result.certified is certified
+    summary = result.summary()
+    assert "min_clearance" in summary and "acceptance:" in summary and "dynamic plant" in summary
 
 
 def test_quick_and_law_options(tmp_path, monkeypatch):

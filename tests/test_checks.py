@@ -5,7 +5,8 @@ from __future__ import annotations
 import pytest
 
 from tubekit.checks import (LOG_BYTES_PER_TICK, MAX_HORIZON_STEPS, MEMORY_BUDGET_BYTES, RUNS_PER_STUDY,
-                            check_horizon_and_limits, check_log_size, check_run_inputs, check_start, log_bytes)
+                            check_horizon_and_limits, check_log_size, check_run_inputs, check_start, horizon_reach,
+                            log_bytes, require_one_period, workspace_fits, workspace_rule)
 from tubekit.exceptions import ConfigError
 from tubekit.scenario import paper_scenario, scenario_from_dict
 
@@ -79,3 +80,36 @@ def test_check_run_inputs_rejects_a_bad_duration_argument():
     assert _field(paper_scenario(), float("nan")) == "duration"
     assert _field(paper_scenario(), -1.0) == "duration"
     assert _field(paper_scenario(), 1e9) == "duration"
+
+
+@pytest.mark.parametrize("duration, dt", [(0.04, 0.1), (0.0, 0.1), (-1.0, 0.1), (0.9, 2.0)])
+def test_require_one_period_refuses_a_run_without_a_period(duration, dt):
+    with pytest.raises(ConfigError, match=rf"^--duration: expected at least one FHOCP period \({dt:g} s\)"):
+        require_one_period("--duration", duration, dt)
+
+
+@pytest.mark.parametrize("duration, dt", [(0.1, 0.1), (0.06, 0.1), (100.0, 0.1), (1.2, 2.0)])
+def test_require_one_period_accepts_a_run_of_one_period_or_more(duration, dt):
+    require_one_period("duration", duration, dt)  # the loop runs round(duration / dt) >= 1 periods
+
+
+def test_workspace_rule_is_strict_on_both_horizontal_axes():
+    box = ((-2.0, -3.0, -1.0), (2.0, 3.0, 1.0))        # x extent 4 m, y extent 6 m; z is not read
+    assert horizon_reach(0.5, 0.1, 8) == pytest.approx(0.4)
+    assert workspace_fits(box, 0.5, 1.4)                 # 4 - 1 = 3 > 2.8
+    assert not workspace_fits(box, 0.5, 1.5)             # 3 > 3 fails: strict
+    assert not workspace_fits(box, 1.0, 1.0)             # x: 4 - 2 = 2 > 2 fails
+    assert workspace_fits(((-5.0, -5.0, 0.0), (5.0, 5.0, 0.1)), 1.0, 3.9)
+    assert workspace_rule(0.2, 0.3) == "x and y extents > 2 (vehicle_radius + u_max N dt) = 1 m"
+
+
+def test_fhocp_and_pre_run_check_share_the_workspace_rule():
+    """The FHOCP's check (tightened speed and clearance) is the same rule as the pre-run check's."""
+    from tubekit.fhocp import FHOCP
+    from tubekit.tightening import Tightening
+    narrow = paper_scenario().with_changes(workspace=((-0.5, -5.0, -1.0), (0.5, 5.0, 1.0)))  # 1 - 0.4 < 0.64
+    with pytest.raises(ConfigError, match=r"^workspace: expected .*x and y extents > 2"):
+        check_run_inputs(narrow)
+    with pytest.raises(ConfigError, match=r"^scenario\.workspace: expected x and y extents > 2 \(vehicle_radius \+ "
+                                          r"obstacle_margin \+ u_max T\)"):
+        FHOCP(narrow, Tightening.untightened(narrow))

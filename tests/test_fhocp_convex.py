@@ -6,7 +6,7 @@ import cvxpy as cp
 import numpy as np
 import pytest
 
-from tubekit.fhocp import FHOCP
+from tubekit.fhocp import FHOCP, ScpOptions
 
 from .fhocp_cases import OBSTACLES, SC, STATES, tightening
 
@@ -56,7 +56,7 @@ def test_resolve_does_not_recanonicalise(monkeypatch):
 
 
 def test_cvxpy_path_reuses_its_compiled_map(monkeypatch):
-    solver = FHOCP(SC, tightening(), mode="realtime", fast_path=False)
+    solver = FHOCP(SC, tightening(), mode="realtime", options=ScpOptions(fast_path=False))
     t, s = STATES[1]
     solver.solve(t, np.array(s), OBSTACLES)
     prog = solver.problem._cache.param_prog
@@ -78,7 +78,7 @@ def test_cvxpy_path_reuses_its_compiled_map(monkeypatch):
 @pytest.mark.parametrize("mode", ["realtime", "converged"])
 def test_fast_path_equals_problem_solve_path(mode):
     fast = FHOCP(SC, tightening(), mode=mode)
-    slow = FHOCP(SC, tightening(), mode=mode, fast_path=False)
+    slow = FHOCP(SC, tightening(), mode=mode, options=ScpOptions(fast_path=False))
     assert fast.compiled is not None and slow.compiled is None
     for t, s in STATES[:4]:
         a = fast.solve(t, np.array(s), OBSTACLES)
@@ -103,7 +103,7 @@ def test_subproblem_objective_equals_cvxpy_value(rt):
 
 @pytest.mark.parametrize("terminal", ["soft", "hard", "off"])
 def test_terminal_modes_build_and_solve(terminal):
-    solver = FHOCP(SC, tightening(), terminal=terminal)
+    solver = FHOCP(SC, tightening(), options=ScpOptions(terminal=terminal))
     assert solver.problem.is_dcp(dpp=True)
     t, s = STATES[1]
     res = solver.solve(t, np.array(s), OBSTACLES)

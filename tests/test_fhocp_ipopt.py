@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from tubekit import NotAvailableError
-from tubekit.fhocp import FHOCP
+from tubekit.fhocp import FHOCP, ScpOptions
 
 from .fhocp_cases import SC, tightening
 from .fhocp_cases import RUN_STATES as STATES
@@ -54,7 +54,7 @@ def test_ipopt_warm_start_and_terminal_modes():
     from tubekit.fhocp.ipopt import IpoptFHOCP
     for terminal in ("hard", "off"):
         peer = IpoptFHOCP(SC, tightening(), terminal=terminal)
-        scp = FHOCP(SC, tightening(), mode="converged", terminal=terminal)
+        scp = FHOCP(SC, tightening(), mode="converged", options=ScpOptions(terminal=terminal))
         t, s = STATES[1]
         a = scp.solve(t, np.array(s), SC.obstacles)
         b = peer.solve(t, np.array(s), SC.obstacles)
@@ -74,7 +74,7 @@ def test_missing_casadi_raises_not_available(monkeypatch):
 
     monkeypatch.setattr(builtins, "__import__", fake_import)
     from tubekit.fhocp.ipopt import IpoptFHOCP
-    with pytest.raises(NotAvailableError, match="pip install"):
+    with pytest.raises(NotAvailableError, match=r"pip install -e \"\.\[bench\]\""):
         IpoptFHOCP(SC, tightening())
 
 

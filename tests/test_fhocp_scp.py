@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from tubekit import ConfigError, Obstacle, ShapeError
-from tubekit.fhocp import FHOCP, FallbackWarning, FhocpResult
+from tubekit.fhocp import FHOCP, FallbackWarning, FhocpResult, ScpOptions
 from tubekit.fhocp.nlp import rollout, select_obstacles
 
 from .fhocp_cases import OBSTACLES, SC, STATES, tightening
@@ -108,7 +108,7 @@ def test_realtime_warm_step_is_one_convex_solve(rt):
 # ------------------------------------------------------------------ fallback
 def _hard_terminal_solver() -> FHOCP:
     """Hard terminal set F = {||e_N||_P <= 2}: reachable near the target, not from 2.8 m away."""
-    return FHOCP(SC, tightening(), mode="realtime", terminal="hard")
+    return FHOCP(SC, tightening(), mode="realtime", options=ScpOptions(terminal="hard"))
 
 
 def test_forced_infeasible_subproblem_returns_shifted_previous_plan():
@@ -190,13 +190,13 @@ def test_validation_errors():
     with pytest.raises(ConfigError, match="mode"):
         FHOCP(SC, tg, mode="fast")
     with pytest.raises(ConfigError, match="terminal"):
-        FHOCP(SC, tg, terminal="sometimes")
+        FHOCP(SC, tg, options=ScpOptions(terminal="sometimes"))
     with pytest.raises(ConfigError, match="max_obstacles"):
-        FHOCP(SC, tg, max_obstacles=-1)
+        FHOCP(SC, tg, options=ScpOptions(max_obstacles=-1))
     with pytest.raises(ConfigError, match="max_iterations"):
-        FHOCP(SC, tg, max_iterations=0)
+        FHOCP(SC, tg, options=ScpOptions(max_iterations=0))
     with pytest.raises(ConfigError, match="tolerance"):
-        FHOCP(SC, tg, tolerance=-1.0)
+        FHOCP(SC, tg, options=ScpOptions(tolerance=-1.0))
     with pytest.raises(ConfigError, match="tightening"):
         FHOCP(SC, object())
     with pytest.raises(ConfigError, match="workspace"):
@@ -222,16 +222,16 @@ def test_obstacle_selection_and_slots():
     assert np.allclose(kept[0, :3], (1.0, 0.0, 0.0))     # nearest first; the far one is out of range
     kept, dropped = select_obstacles(s, obs, sensing_range=1.5, max_count=1)
     assert dropped == 1 and kept.shape == (1, 4)
-    solver = FHOCP(SC, tightening(), max_obstacles=1)
+    solver = FHOCP(SC, tightening(), options=ScpOptions(max_obstacles=1))
     with pytest.warns(RuntimeWarning, match="max_obstacles=1"):
         solver.select_obstacles(s, obs)
-    none = FHOCP(SC, tightening(), max_obstacles=0)
+    none = FHOCP(SC, tightening(), options=ScpOptions(max_obstacles=0))
     res = none.solve(2.0, np.array(STATES[0][1]), ())
     assert not res.fallback
 
 
 def test_cold_start_cap_reports_iteration_limit():
-    solver = FHOCP(SC, tightening(), mode="converged", cold_start_iterations=1)
+    solver = FHOCP(SC, tightening(), mode="converged", options=ScpOptions(cold_start_iterations=1))
     t, s = STATES[2]
     with warnings.catch_warnings():
         warnings.simplefilter("error")

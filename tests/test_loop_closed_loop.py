@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from tubekit import ConfigError, SolverError, Tightening, paper_scenario
-from tubekit.loop.closed_loop import PlanMemory, saturate, simulate
+from tubekit.loop.closed_loop import PlanMemory, run_closed_loop, saturate
 from tubekit.loop.result import CSV_COLUMNS
 from tubekit.plant.kinematic import nominal_arc
 from tubekit.fhocp import FhocpResult
@@ -65,7 +65,7 @@ def _tightening(sc, sigma):
 
 def test_no_disturbance_means_no_deviation_from_nominal():
     sc = _scenario(amplitude=(0.0, 0.0, 0.0), sway=SwayModel(gain=0.0, amplitude=0.0, bound=0.0))
-    res = simulate(sc, tightening=_tightening(sc, 1.0), solver_factory=Pursuit, progress=False)
+    res = run_closed_loop(sc, tightening=_tightening(sc, 1.0), solver_factory=Pursuit, progress=False)
     assert np.max(np.abs(res.rho)) < 1e-9
     assert np.max(np.abs(res.kappa[:-1])) < 1e-8
     assert res.saturated_ticks == 0
@@ -73,7 +73,7 @@ def test_no_disturbance_means_no_deviation_from_nominal():
 
 def test_rho_logged_and_reset_each_sample():
     sc = _scenario(duration=6.0)
-    res = simulate(sc, tightening=_tightening(sc, 1.0), solver_factory=Pursuit, progress=False)
+    res = run_closed_loop(sc, tightening=_tightening(sc, 1.0), solver_factory=Pursuit, progress=False)
     m = res.ticks_per_step
     rho = np.linalg.norm(res.rho, axis=1)
     assert res.states.shape == (sc.steps * m + 1, 4)
@@ -95,7 +95,7 @@ def test_rho_logged_and_reset_each_sample():
 
 def test_baseline_has_no_feedback():
     sc = _scenario()
-    res = simulate(sc, tube=False, solver_factory=Pursuit, progress=False)
+    res = run_closed_loop(sc, tube=False, solver_factory=Pursuit, progress=False)
     assert res.sigma == 0.0
     np.testing.assert_array_equal(res.inputs[:-1], res.v_hat[:-1])
     assert np.all(res.kappa[:-1] == 0.0)
@@ -103,7 +103,7 @@ def test_baseline_has_no_feedback():
 
 def test_tube_requires_tightening():
     with pytest.raises(ConfigError, match="tightening"):
-        simulate(_scenario(), tube=True, solver_factory=Pursuit, progress=False)
+        run_closed_loop(_scenario(), tube=True, solver_factory=Pursuit, progress=False)
 
 
 def test_fallback_path_never_passes_nan_and_is_counted():
@@ -115,7 +115,7 @@ def test_fallback_path_never_passes_nan_and_is_counted():
         holder["p"] = Pursuit(s, tg, nan_at=nan_at, raise_at=raise_at, flag_at=flag_at)
         return holder["p"]
 
-    res = simulate(sc, tightening=_tightening(sc, 1.0), solver_factory=factory, progress=False)
+    res = run_closed_loop(sc, tightening=_tightening(sc, 1.0), solver_factory=factory, progress=False)
     m = res.ticks_per_step
     assert all(res.checks.values()), res.checks
     assert np.all(np.isfinite(res.inputs[:-1])) and np.all(np.isfinite(res.states))
@@ -134,8 +134,8 @@ def test_fallback_path_never_passes_nan_and_is_counted():
 
 def test_fallback_with_exhausted_plan_stops_the_vehicle():
     sc = _scenario(duration=2.0)
-    res = simulate(sc, tube=False, progress=False,
-                   solver_factory=lambda s, tg: Pursuit(s, tg, raise_at=set(range(20))))
+    res = run_closed_loop(sc, tube=False, progress=False,
+                          solver_factory=lambda s, tg: Pursuit(s, tg, raise_at=set(range(20))))
     assert res.replaced_steps == sc.steps
     np.testing.assert_array_equal(res.inputs[:-1], 0.0)
     assert np.all(np.isfinite(res.states))
@@ -152,7 +152,7 @@ class AtTheBounds(Pursuit):
 
 def test_saturation_only_when_needed_and_counted():
     sc = _scenario(duration=5.0)
-    res = simulate(sc, tightening=_tightening(sc, 5.0), progress=False, solver_factory=AtTheBounds)
+    res = run_closed_loop(sc, tightening=_tightening(sc, 5.0), progress=False, solver_factory=AtTheBounds)
     lim = sc.limits.vector
     raw = res.v_hat[:-1] + res.kappa[:-1]
     outside = np.any(np.abs(raw) > lim, axis=1)
@@ -168,7 +168,7 @@ def test_saturation_only_when_needed_and_counted():
 
 def test_csv_round_trip(tmp_path):
     sc = _scenario(duration=2.0)
-    res = simulate(sc, tightening=_tightening(sc, 1.0), solver_factory=Pursuit, progress=False)
+    res = run_closed_loop(sc, tightening=_tightening(sc, 1.0), solver_factory=Pursuit, progress=False)
     path = res.write_csv(tmp_path / "trajectory.csv")
     cols = read_trajectory_csv(path)
     assert tuple(cols) == CSV_COLUMNS
@@ -180,8 +180,8 @@ def test_csv_round_trip(tmp_path):
 def test_real_fhocp_short_closed_loop():
     pytest.importorskip("tubekit.fhocp")
     sc = _scenario(duration=3.0)
-    base = simulate(sc, tube=False, progress=False)
-    tube = simulate(sc, tightening=_tightening(sc, 0.5), progress=False)
+    base = run_closed_loop(sc, tube=False, progress=False)
+    tube = run_closed_loop(sc, tightening=_tightening(sc, 0.5), progress=False)
     for res in (base, tube):
         assert all(res.checks.values()), res.checks
         assert res.steps == 30
@@ -209,7 +209,7 @@ def test_real_fhocp_with_injected_fallbacks():
             self.last = res
             return res
 
-    res = simulate(sc, tightening=_tightening(sc, 0.5), solver_factory=Flaky, progress=False)
+    res = run_closed_loop(sc, tightening=_tightening(sc, 0.5), solver_factory=Flaky, progress=False)
     m = res.ticks_per_step
     assert all(res.checks.values()), res.checks
     assert res.fallback_steps == 3 and res.replaced_steps == 1
@@ -244,7 +244,7 @@ def test_dynamic_plant_run_logs_body_velocities_and_thrusts(tmp_path):
     from tubekit.loop.result import DYNAMIC_COLUMNS
     from tubekit.model.vehicles import PlantSettings
     sc = _scenario(duration=2.0).with_changes(plant=PlantSettings("dynamic"))
-    res = simulate(sc, tightening=_tightening(sc, 1.0), solver_factory=Pursuit, progress=False)
+    res = run_closed_loop(sc, tightening=_tightening(sc, 1.0), solver_factory=Pursuit, progress=False)
     assert res.body.shape == (len(res.t), 4) and res.thrust.shape == (len(res.t), 3)
     cols = read_trajectory_csv(res.write_csv(tmp_path / "trajectory.csv"))
     assert tuple(cols) == CSV_COLUMNS + DYNAMIC_COLUMNS
@@ -252,16 +252,73 @@ def test_dynamic_plant_run_logs_body_velocities_and_thrusts(tmp_path):
     assert np.all(np.abs(res.thrust) <= np.array(sc.plant.params.thrust_limits) + 1e-9)
     # the logged omega is what moved the vehicle beyond f(x) v: current + loop error + hull sway
     assert np.all(np.isfinite(res.omega[:-1])) and np.max(np.abs(res.body[:, 1])) > 0.0
-    kin = simulate(sc, tightening=_tightening(sc, 1.0), solver_factory=Pursuit, progress=False, plant="kinematic")
+    kin_sc = sc.with_changes(**{"plant.kind": "kinematic"})
+    kin = run_closed_loop(kin_sc, tightening=_tightening(sc, 1.0), solver_factory=Pursuit, progress=False)
     assert kin.body is None and np.max(np.abs(kin.states - res.states)) > 1e-4
 
 
 def test_kinematic_plant_is_the_default_and_unchanged():
     from tubekit.model.vehicles import PlantSettings
     sc = _scenario(duration=1.0)
-    a = simulate(sc, tightening=_tightening(sc, 1.0), solver_factory=Pursuit, progress=False)
-    b = simulate(sc.with_changes(plant=PlantSettings("kinematic")), tightening=_tightening(sc, 1.0),
-                 solver_factory=Pursuit, progress=False, plant="kinematic")
+    a = run_closed_loop(sc, tightening=_tightening(sc, 1.0), solver_factory=Pursuit, progress=False)
+    b = run_closed_loop(sc.with_changes(plant=PlantSettings("kinematic")), tightening=_tightening(sc, 1.0),
+                        solver_factory=Pursuit, progress=False)
     np.testing.assert_array_equal(a.states, b.states)
     np.testing.assert_array_equal(a.omega, b.omega)
     assert a.body is None and tuple(a.columns()) == CSV_COLUMNS
+
+
+# ---- what runs is the scenario's ------------------------------------------------------
+
+def test_signature_has_no_scenario_overrides():
+    import inspect
+    params = inspect.signature(run_closed_loop).parameters
+    assert list(params) == ["scenario", "tightening", "tube", "progress", "label", "solver_factory", "disturbance",
+                            "plant_substeps", "remember_obstacles"]
+    assert params["tube"].kind is inspect.Parameter.KEYWORD_ONLY
+    sc = _scenario(duration=0.5)
+    for override in ({"law": "paper"}, {"sigma": 1.0}, {"mode": "converged"}, {"plant": "dynamic"}):
+        with pytest.raises(TypeError, match="unexpected keyword"):
+            run_closed_loop(sc, _tightening(sc, 1.0), solver_factory=Pursuit, progress=False, **override)
+
+
+def test_law_from_the_scenario_and_sigma_from_the_tightening():
+    sc = _scenario(duration=1.0)
+    paper = sc.with_changes(**{"controller.law": "paper"})
+    a = run_closed_loop(paper, _tightening(sc, 2.5), solver_factory=Pursuit, progress=False)
+    b = run_closed_loop(sc, _tightening(sc, 2.5), solver_factory=Pursuit, progress=False)
+    c = run_closed_loop(sc, _tightening(sc, 0.5), solver_factory=Pursuit, progress=False)
+    assert (a.law, a.sigma, b.law, c.sigma) == ("paper", 2.5, "corrected", 0.5)
+    assert np.max(np.abs(a.kappa[:-1] - b.kappa[:-1])) > 0.0   # another law, another feedback
+    assert np.max(np.abs(b.kappa[:-1] - c.kappa[:-1])) > 0.0   # another gain, another feedback
+
+
+def test_default_solver_is_the_scenarios_backend(monkeypatch):
+    from tubekit.fhocp import registry
+    monkeypatch.setattr(registry, "_BACKENDS", dict(registry._BACKENDS))
+    built = []
+
+    def pursuit_backend(s, tg):
+        built.append(Pursuit(s, tg))
+        return built[-1]
+
+    registry.register_backend("pursuit", pursuit_backend)
+    sc = _scenario(duration=1.0).with_changes(**{"controller.fhocp_backend": "pursuit"})
+    res = run_closed_loop(sc, _tightening(sc, 1.0), progress=False)
+    assert len(built) == 1 and built[0].k == sc.steps - 1 and res.fallback_steps == 0
+    with pytest.raises(ConfigError, match="controller.fhocp_backend"):
+        run_closed_loop(sc.with_changes(**{"controller.fhocp_backend": "nope"}), _tightening(sc, 1.0),
+                        progress=False)
+
+
+@pytest.mark.parametrize("kwargs, match", [
+    ({"duration": 0.04}, r"duration: expected at least one FHOCP period \(0\.1 s\)"),
+    ({"plant_substeps": 0}, "plant_substeps"),
+    ({"plant_substeps": True}, "plant_substeps"),
+])
+def test_bad_run_inputs(kwargs, match):
+    sc = _scenario(duration=kwargs.pop("duration", 1.0))
+    with pytest.raises(ConfigError, match=match):
+        run_closed_loop(sc, _tightening(sc, 1.0), solver_factory=Pursuit, progress=False, **kwargs)
+    with pytest.raises(ConfigError, match="scenario"):
+        run_closed_loop(sc.to_dict(), _tightening(sc, 1.0), solver_factory=Pursuit, progress=False)

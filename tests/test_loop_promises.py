@@ -159,3 +159,12 @@ def test_dynamic_runs_check_hull_sway_and_the_velocity_loop(stationary):
     p = _promise(replace(run, body=off, thrust=thrust), "sway")
     assert not p.ok and p.observed == pytest.approx(0.03)
     assert "velocity_loop" not in {p.name for p in check_promises(run)}  # kinematic: no such promise
+
+
+def test_a_run_without_a_certificate_is_refused(stationary):
+    """The baseline (no tube) is promised nothing: no infinite tube ratio comes back, a ConfigError does."""
+    from tubekit.exceptions import ConfigError
+
+    baseline = replace(_run(stationary), tube=False, sigma=0.0, tightening=Tightening.untightened(stationary))
+    with pytest.raises(ConfigError, match="run: expected a tube run .* without a certificate"):
+        check_promises(baseline)

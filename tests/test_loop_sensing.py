@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from tubekit import ConfigError, Obstacle, paper_scenario
-from tubekit.loop.closed_loop import simulate
+from tubekit.loop.closed_loop import run_closed_loop
 from tubekit.loop.sensing import ObstacleMap, detected_obstacles, surface_distance
 
 OBS = Obstacle((3.0, 0.0, 0.0), 0.4)
@@ -81,7 +81,7 @@ def test_closed_loop_hands_fhocp_only_sensed_obstacles():
         holder["solver"] = _Recorder(s, tg)
         return holder["solver"]
 
-    res = simulate(sc, tube=False, solver_factory=factory, progress=False)
+    res = run_closed_loop(sc, tube=False, solver_factory=factory, progress=False)
     calls = holder["solver"].calls
     assert len(calls) == sc.steps
     seen_before: set = set()

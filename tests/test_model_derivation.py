@@ -70,23 +70,6 @@ def test_closed_form_polar():
     assert np.allclose(J[:, 1, 1], 1.0)
 
 
-def test_numeric_is_vectorised():
-    n = numeric()
-    x = np.linspace(0.1, 1, 7)
-    assert n.J(x, x, x).shape == (7, 3, 3)
-    assert n.zeta(x, x, x, 1.0, 0.0, 0.0).shape == (7, 3)
-    assert n.xi(x[:, None], x[None, :], 0.0, 0.1, 0.1, 0.1).shape == (7, 7, 3)
-    assert n.J(1.0, 2.0, 0.3).shape == (3, 3)
-
-
-def test_error_coordinates_definition():
-    state = np.array([1.0, 1.0, 2.0, np.pi / 2])
-    e = error_coordinates(state, np.zeros(3))
-    assert e[0] == pytest.approx(np.sqrt(2))
-    assert e[1] == pytest.approx(2.0)
-    assert e[2] == pytest.approx(1 / np.sqrt(2))  # (e_x sin psi - e_y cos psi)/e_d
-
-
 def test_generated_module_equals_the_derivation():
     """The shipped closed-form code is the derivation: same source hash, same text (same sympy), same values."""
     import tubekit.model._generated_dynamics as gen

@@ -118,6 +118,12 @@ BAD = [
     ({"controller": {"gain": 1.0}}, r"controller\.gain"),
     ({"region": {"e_o_max": 1.0}}, r"region\.e_o_max"),
     ({"region": {"heading": "sideways"}}, r"region\.heading"),
+    ({"controller": {"fhocp_mode": "fast"}}, r"controller\.fhocp_mode: expected one of \('realtime', 'converged'\)"),
+    ({"controller": {"terminal_mode": "SOFT"}},
+     r"controller\.terminal_mode: expected one of \('soft', 'hard', 'off'\)"),
+    ({"region": {"heading": "TOWARD"}}, r"region\.heading: expected one of \('toward', 'away', 'both'\)"),
+    ({"controller": {"fhocp_backend": ""}}, r"controller\.fhocp_backend"),
+    ({"controller": {"fhocp_backend": 3}}, r"controller\.fhocp_backend"),
     ({"region": {"e_d_max": 0.05}}, r"region\.e_d_max"),
     ({"workspace": [[0.0, 0.0, 0.0], [-1.0, 1.0, 1.0]]}, r"workspace"),
     ({"workspace": [[0.0, 0.0, 0.0]]}, r"workspace"),
@@ -160,3 +166,53 @@ def test_file_errors_name_config(tmp_path):
     bad.write_text("duration = = 3\n")
     with pytest.raises(ConfigError, match="CONFIG.*valid TOML"):
         load_scenario(bad)
+
+
+# ---- enums, backend name, dotted changes ------------------------------------------------------
+
+def test_modes_and_heading_are_enums_equal_to_their_toml_strings(tmp_path):
+    import json
+
+    from tubekit.scenario import FhocpMode, Heading, TerminalMode
+    sc = scenario_from_dict({"controller": {"fhocp_mode": "converged", "terminal_mode": "hard"},
+                             "region": {"heading": "both"}})
+    assert sc.controller.fhocp_mode is FhocpMode.CONVERGED and sc.controller.fhocp_mode == "converged"
+    assert sc.controller.terminal_mode is TerminalMode.HARD and sc.region.heading is Heading.BOTH
+    d = sc.to_dict()
+    assert type(d["controller"]["fhocp_mode"]) is str and type(d["region"]["heading"]) is str
+    assert json.loads(json.dumps(d))["controller"]["terminal_mode"] == "hard"
+    path = tmp_path / "s.toml"
+    path.write_text(_to_toml(d))
+    assert load_scenario(path) == sc
+
+
+def test_backend_name_is_left_out_by_default_and_round_trips_otherwise(tmp_path):
+    assert "fhocp_backend" not in paper_scenario().to_dict()["controller"]
+    sc = scenario_from_dict({"controller": {"fhocp_backend": "ipopt"}})
+    assert sc.controller.fhocp_backend == "ipopt" and sc.to_dict()["controller"]["fhocp_backend"] == "ipopt"
+    path = tmp_path / "s.toml"
+    path.write_text(_to_toml(sc.to_dict()))
+    assert load_scenario(path) == sc
+
+
+def test_with_changes_accepts_dotted_nested_fields():
+    sc = paper_scenario()
+    changed = sc.with_changes(duration=20.0, **{"limits.u_max": 0.3, "controller.fhocp_mode": "converged",
+                                                "disturbance.sway.gain": 0.2})
+    assert changed.duration == 20.0 and changed.limits.u_max == 0.3 and changed.limits.w_max == sc.limits.w_max
+    assert changed.controller.fhocp_mode == "converged" and changed.controller.dt == sc.controller.dt
+    assert changed.disturbance.sway.gain == 0.2 and changed.disturbance.period == sc.disturbance.period
+    assert sc.limits.u_max == 0.4  # the original is untouched
+
+
+@pytest.mark.parametrize("changes, match", [
+    ({"limits.v_max": 1.0}, r"^limits\.v_max: expected a field of InputLimits"),
+    ({"speed": 1.0}, r"^speed: expected a field of Scenario"),
+    ({"duration.seconds": 1.0}, r"^duration\.seconds: expected no dotted part"),
+    ({"limits.u_max": -0.3}, r"^limits\.u_max: expected a number > 0"),
+    ({"controller.fhocp_mode": "fast"}, r"^controller\.fhocp_mode: expected one of \('realtime', 'converged'\)"),
+    ({"region.heading": "up"}, r"^region\.heading: expected one of"),
+])
+def test_with_changes_errors_name_the_field(changes, match):
+    with pytest.raises(ConfigError, match=match):
+        paper_scenario().with_changes(**changes)

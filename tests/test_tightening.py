@@ -2,11 +2,15 @@
 
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
+import pytest
 
 import verify
+from tubekit.exceptions import ConfigError
 from tubekit.scenario import load_scenario, paper_scenario
-from tubekit.tightening import MARGIN_COLUMNS, Tightening
+from tubekit.tightening import MARGIN_COLUMNS, DisturbanceBound, RegionBounds, Tightening
 
 
 def test_untightened_is_the_scenario():
@@ -17,8 +21,10 @@ def test_untightened_is_the_scenario():
     assert t.e_o_max == sc.region.e_o_max and t.e_z_max == sc.region.e_z_max
     assert t.obstacle_margin == 0 and t.rho_tilde == 0 and t.sigma == 0
     assert t.horizon_arcs == 0 and not t.certified
-    np.testing.assert_array_equal(t.region, [sc.epsilon, sc.region.e_d_max, sc.region.e_z_max, sc.region.e_o_max])
-    assert np.all(t.tube == 0) and np.all(t.disturbance == 0) and t.margins.shape == (0, 4)
+    assert t.region == RegionBounds(epsilon=sc.epsilon, e_d_max=sc.region.e_d_max, e_z_max=sc.region.e_z_max,
+                                    e_o_max=sc.region.e_o_max)
+    assert np.all(t.tube == 0) and t.disturbance == DisturbanceBound(0.0, 0.0, 0.0) and t.margins.shape == (0, 4)
+    assert t.law is None and t.design_key is None and t.design_fields is None   # the baseline is not checked
 
 
 def test_untightened_does_not_share_the_limits_array():
@@ -51,3 +57,28 @@ def test_certified_tightening_is_the_pontryagin_difference():
     assert np.all(t.v_max > 0) and np.all(t.v_max < sc.limits.vector)
     assert t.rho_tilde == float(np.linalg.norm(t.tube)) > 0
     assert t.e_d_min > sc.epsilon and t.e_d_max < sc.region.e_d_max and t.e_o_max < sc.region.e_o_max
+
+
+def _plain(**changes) -> Tightening:
+    return Tightening(v_max=np.ones(3), e_d_min=0.5, e_o_max=0.4, e_z_max=0.9, e_d_max=2.9, obstacle_margin=0.1,
+                      rho_tilde=0.0, sigma=1.0, **changes)
+
+
+def test_region_and_disturbance_are_named_and_accept_numbers_in_order():
+    t = _plain(region=np.array([0.5, 3.0, 1.0, 0.4]), disturbance=(0.04, 0.02, 0.01))
+    assert (t.region.epsilon, t.region.e_d_max, t.region.e_z_max, t.region.e_o_max) == (0.5, 3.0, 1.0, 0.4)
+    assert (t.disturbance.omega_xy, t.disturbance.omega_z, t.disturbance.sway) == (0.04, 0.02, 0.01)
+    again = dataclasses.replace(t, sigma=2.0)
+    assert again.region == t.region and again.disturbance == t.disturbance
+
+
+@pytest.mark.parametrize("changes, field", [
+    (dict(region=[0.5, 3.0, 1.0]), "tightening.region"),
+    (dict(region=[0.5, 3.0, 1.0, float("nan")]), "tightening.region"),
+    (dict(region="abcd"), "tightening.region"),
+    (dict(disturbance=[0.1, 0.2]), "tightening.disturbance"),
+    (dict(disturbance=[0.1, float("inf"), 0.0]), "tightening.disturbance"),
+])
+def test_bad_region_or_disturbance_is_refused(changes, field):
+    with pytest.raises(ConfigError, match=field):
+        _plain(**changes)

@@ -2,12 +2,14 @@
 
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
 import pytest
 
 from tubekit.exceptions import ConfigError, ShapeError
-from tubekit.validation import (as_vector, finite, interval, nonnegative, nonnegative_triple, positive,
-                                positive_triple)
+from tubekit.validation import (StrChoice, as_vector, choice, duration_seconds, finite, interval, nonnegative,
+                                nonnegative_triple, positive, positive_triple, replace_fields)
 
 
 @pytest.mark.parametrize("fn, value, match", [
@@ -74,3 +76,68 @@ def test_triple_errors(fn, value, match):
 def test_triple_ok():
     assert positive_triple("t", [1, 2, 3]) == (1.0, 2.0, 3.0)
     assert nonnegative_triple("t", np.zeros(3)) == (0.0, 0.0, 0.0)
+
+
+# ---- str-valued enums, durations, dotted replacement ---------------------------------------------
+
+class _Colour(StrChoice):
+    RED = "red"
+    DARK_BLUE = "dark blue"
+
+
+def test_str_choice_members_behave_as_their_strings():
+    import json
+    assert _Colour.RED == "red" and {"red": 1}[_Colour.RED] == 1
+    assert str(_Colour.DARK_BLUE) == f"{_Colour.DARK_BLUE}" == "dark blue" and f"{_Colour.RED:>5}" == "  red"
+    assert json.dumps({"c": _Colour.RED}) == '{"c": "red"}'
+    assert _Colour.values() == ("red", "dark blue")
+
+
+def test_choice_maps_explicitly_and_lists_the_allowed_values():
+    assert choice("colour", _Colour, "dark blue") is _Colour.DARK_BLUE
+    assert choice("colour", _Colour, _Colour.RED) is _Colour.RED
+    for bad in ("DARK_BLUE", "Red", 1, None):
+        with pytest.raises(ConfigError, match=r"^colour: expected one of \('red', 'dark blue'\)"):
+            choice("colour", _Colour, bad)
+
+
+@pytest.mark.parametrize("value", [0, -1.0, float("nan"), float("inf"), True, "5", None])
+def test_duration_seconds_errors(value):
+    with pytest.raises(ConfigError, match=r"^--duration: expected a number of seconds > 0"):
+        duration_seconds("--duration", value)
+
+
+def test_duration_seconds_ok():
+    assert duration_seconds("duration", 3) == 3.0 and isinstance(duration_seconds("duration", np.int64(2)), float)
+
+
+@dataclasses.dataclass(frozen=True)
+class _Inner:
+    a: float = 1.0
+
+    def __post_init__(self):
+        positive("inner.a", self.a)
+
+
+@dataclasses.dataclass(frozen=True)
+class _Outer:
+    inner: _Inner = dataclasses.field(default_factory=_Inner)
+    n: int = 0
+
+
+def test_replace_fields_reaches_nested_fields_and_validates_them():
+    out = replace_fields(_Outer(), {"inner.a": 2.0, "n": 3})
+    assert out == _Outer(_Inner(2.0), 3)
+    with pytest.raises(ConfigError, match="inner.a: expected a number > 0"):
+        replace_fields(_Outer(), {"inner.a": -1.0})
+
+
+@pytest.mark.parametrize("changes, match", [
+    ({"m": 1}, r"^m: expected a field of _Outer, one of \['inner', 'n'\]"),
+    ({"inner.b": 1}, r"^inner\.b: expected a field of _Inner"),
+    ({"n.x": 1}, r"^n\.x: expected no dotted part \(n is a int\)"),
+    ({"inner": _Inner(), "inner.a": 2.0}, r"^inner: expected the whole field or dotted parts of it, not both"),
+])
+def test_replace_fields_errors_name_the_field(changes, match):
+    with pytest.raises(ConfigError, match=match):
+        replace_fields(_Outer(), changes)

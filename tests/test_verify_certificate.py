@@ -20,7 +20,7 @@ import pytest
 import verify
 from tubekit.model.ancillary import LAWS
 from tubekit.app.cli import main as cli_main
-from tubekit.loop.closed_loop import simulate
+from tubekit.loop.closed_loop import run_closed_loop
 from tubekit.exceptions import ConfigError
 from tubekit.loop.promises import check_promises
 from tubekit.scenario import ControllerSettings, load_scenario, paper_scenario
@@ -49,8 +49,8 @@ def paper_cert() -> Certificate:
 
 
 def _failure(cert: Certificate, name: str) -> dict:
-    found = [f for f in cert.failures if f["condition"] == name]
-    assert found, f"{name} not among {[f['condition'] for f in cert.failures]}"
+    found = [f for f in cert.failures if f.condition == name]
+    assert found, f"{name} not among {[f.condition for f in cert.failures]}"
     return found[0]
 
 
@@ -76,7 +76,7 @@ def test_shipped_scenarios_certify_on_the_command_line(path, capsys):
 
 def test_shipped_scenarios_certify(pc_cert, ok_cert):
     for c in (pc_cert, ok_cert):
-        assert c.certified and c.is_certified and c.failures == [] and c.not_evaluated == []
+        assert c.certified and c.is_certified and c.failures == () and c.not_evaluated == ()
         assert all(cond.ok is True for cond in c.conditions)
         # the honest sway bound: gain u_max r_max = 0.1 * 0.4 * 0.5
         assert c.disturbance.gamma == pytest.approx(0.02) and c.disturbance.declared_sway >= 0.02
@@ -87,15 +87,16 @@ def test_paper_scenario_is_not_certified_with_named_inequalities(paper_cert):
     the cross current turns the line of sight at 0.12 / 0.1 = 1.2 rad/s > r_max = 0.5."""
     c = paper_cert
     assert not c.certified
-    names = {f["condition"] for f in c.failures}
+    names = {f.condition for f in c.failures}
     assert {"keep_up[u]", "yaw_budget"} <= names
     ku = _failure(c, "keep_up[u]")
-    assert ku["lhs"] <= 0.4 and ku["rhs"] == pytest.approx(3 * math.pi / 25 + 0.12, rel=1e-9)
+    assert ku.lhs <= 0.4 and ku.rhs == pytest.approx(3 * math.pi / 25 + 0.12, rel=1e-9)
     yb = _failure(c, "yaw_budget")
-    assert yb["lhs"] <= 0.5 and yb["rhs"] == pytest.approx(1.2, rel=1e-9)
+    assert yb.lhs <= 0.5 and yb.rhs == pytest.approx(1.2, rel=1e-9)
     for f in c.failures:
+        assert f.ok is False and f.lhs is not None and f.rhs is not None
+    for f in c.to_dict()["failures"]:
         assert set(f) == {"condition", "inequality", "lhs", "rhs", "detail"}
-        assert f["lhs"] is not None and f["rhs"] is not None
     with pytest.raises(NotCertifiedError, match="not certified.*keep_up"):
         c.tightening
 
@@ -114,24 +115,24 @@ def test_the_tube_condition_has_both_numbers(pc_cert):
 
 
 def test_the_chosen_sigma_has_the_largest_slack(pc_cert, ok_cert):
-    tried = pc_cert.sigma["tried"]
-    assert [t["sigma"] for t in tried] == [0.0] + [100.0 / 2 ** k for k in range(5, -1, -1)]
-    best = max((t for t in tried if t["certified"]), key=lambda t: (t["score"], t["sigma"]))
-    assert pc_cert.sigma["value"] == best["sigma"] == 0.0   # under the reset, no feedback leaves the most room
-    assert pc_cert.sigma["source"] == "largest slack among the certified ones tried"
+    tried = pc_cert.sigma.tried
+    assert [t.sigma for t in tried] == [0.0] + [100.0 / 2 ** k for k in range(5, -1, -1)]
+    best = max((t for t in tried if t.certified), key=lambda t: (t.score, t.sigma))
+    assert pc_cert.sigma.value == best.sigma == 0.0   # under the reset, no feedback leaves the most room
+    assert pc_cert.sigma.source == "largest slack among the certified ones tried"
     # certifiable.toml fixes its gain: sigma = 100 is what it certifies
-    assert ok_cert.sigma["value"] == 100.0 and ok_cert.sigma["source"] == "controller.sigma"
+    assert ok_cert.sigma.value == 100.0 and ok_cert.sigma.source == "controller.sigma"
 
 
 def test_certificate_views(pc_cert):
     c = pc_cert
-    rho = np.asarray(c.tube["rho"])
+    rho = np.asarray(c.tube.rho)
     assert c.rho_tilde == pytest.approx(float(np.linalg.norm(rho)))
     np.testing.assert_allclose(c.v_bar, np.array([0.4, 0.3, 0.5]) - c.kappa_bar, rtol=1e-12)
     m = c.margins
-    assert c.e_bar["e_d"] == pytest.approx((0.5 + m["e_d"][-1], 3.0 - m["e_d"][-1]))
-    assert c.e_bar["e_o"] == pytest.approx((-0.5 + m["e_o"][-1], 0.5 - m["e_o"][-1]))
-    assert "restarts at 0" in c.tube["form"]
+    assert c.e_bar.e_d == pytest.approx((0.5 + m.e_d[-1], 3.0 - m.e_d[-1]))
+    assert c.e_bar.e_o == pytest.approx((-0.5 + m.e_o[-1], 0.5 - m.e_o[-1]))
+    assert "restarts at 0" in c.to_dict()["tube"]["form"]
 
 
 # --------------------------------------------------------------------------- JSON
@@ -174,14 +175,14 @@ def test_an_undersized_sway_bound_fails(ok_cert):
     c = certify(sc.with_changes(disturbance=low))
     assert not c.certified
     f = _failure(c, "sway_bound")
-    assert f["lhs"] == 0.005 and f["rhs"] == pytest.approx(0.02)
+    assert f.lhs == 0.005 and f.rhs == pytest.approx(0.02)
 
 
 def test_deadbeat_overshoot_at_50_hz_is_not_certified():
     """Issue 11 item 2: sigma = 100 held at 50 Hz (sigma h = 2) must not certify."""
     sc = _stationary(verify.certifiable_scenario())
     c = certify(sc.with_changes(controller=replace(sc.controller, sigma=100.0, ancillary_rate_hz=50.0)))
-    assert not c.certified and c.sigma["value"] == 100.0 and c.sigma["source"] == "controller.sigma"
+    assert not c.certified and c.sigma.value == 100.0 and c.sigma.source == "controller.sigma"
 
 
 def _adversarial_run(sc, duration=5.0):
@@ -191,7 +192,7 @@ def _adversarial_run(sc, duration=5.0):
     if not c0.certified:
         return c0, None
     pd = np.asarray(sc.trajectory.position(0.0))
-    ed, eo = c0.e_bar["e_d"][0] * (1 + 1e-9), c0.e_bar["e_o"][1] * (1 - 1e-9)
+    ed, eo = c0.e_bar.e_d[0] * (1 + 1e-9), c0.e_bar.e_o[1] * (1 - 1e-9)
     # bearing theta = pi (vehicle west of the target): sin(psi - theta) = e_o, cos(psi - theta) < 0
     x0 = (pd[0] - ed, pd[1], pd[2], -math.asin(eo))
     sc = sc.with_changes(initial_state=x0, duration=duration)
@@ -200,7 +201,7 @@ def _adversarial_run(sc, duration=5.0):
         return cert, None
     wxy, wz = cert.disturbance.omega_xy * (1 - 1e-9), cert.disturbance.omega_z * (1 - 1e-9)
     # d e_o / dt = sqrt(1 - e_o^2) omega . n_t / e_d with n_t = (-sin theta, cos theta) = (0, -1)
-    run = simulate(sc, tightening=cert.tightening, progress=False, disturbance=lambda t: np.array([0.0, -wxy, wz]))
+    run = run_closed_loop(sc, cert.tightening, progress=False, disturbance=lambda t: np.array([0.0, -wxy, wz]))
     return cert, run
 
 
@@ -225,7 +226,7 @@ def test_stationary_target_construction(rate_hz):
 def test_fixed_sigma_is_used(ok_cert):
     sc = verify.certifiable_scenario()
     c = certify(sc.with_changes(controller=replace(sc.controller, sigma=12.5)))
-    assert c.sigma["value"] == 12.5 and c.sigma["source"] == "controller.sigma" and len(c.sigma["tried"]) == 1
+    assert c.sigma.value == 12.5 and c.sigma.source == "controller.sigma" and len(c.sigma.tried) == 1
     free = sc.with_changes(controller=replace(sc.controller, sigma=None))
     assert sigma_candidates(free) == ((0.0, 3.125, 6.25, 12.5, 25.0, 50.0, 100.0),
                                       "largest slack among the certified ones tried")
@@ -243,7 +244,7 @@ def test_the_paper_law_cannot_hold_the_tube_toward_the_target():
     the largest certified sigma is then the open loop (sigma = 0) or nothing."""
     c = certify(load_scenario(PAPER_CURRENTS), "paper")
     assert c.law == "paper"
-    certified = [t["sigma"] for t in c.sigma["tried"] if t["certified"]]
+    certified = [t.sigma for t in c.sigma.tried if t.certified]
     assert all(s <= 3.125 for s in certified)
 
 
@@ -343,7 +344,7 @@ VARIANTS = ["centre", "radius 4.5", "obstacles", "period 6 s", "speed 0.25 m/s",
 @pytest.mark.parametrize("kind", VARIANTS)
 def test_paper_currents_variants_certify(kind):
     cert = certify(_variant(kind))
-    assert cert.certified, [f["condition"] for f in cert.failures]
+    assert cert.certified, [f.condition for f in cert.failures]
     # the paper's current, as modelled: omega_bar_xy = 0.1 current + 0.02 sway, omega_bar_z = 0.1
     assert cert.disturbance.omega_xy == pytest.approx(0.12) and cert.disturbance.omega_z == pytest.approx(0.1)
 
@@ -353,6 +354,87 @@ def test_beyond_the_physical_limits_paper_currents_does_not_certify():
     from dataclasses import replace as dc_replace
     sc = _paper_currents()
     fast = sc.with_changes(trajectory=dc_replace(sc.trajectory, rate=0.285 / 3.0))
-    assert "keep_up[u]" in {f["condition"] for f in certify(fast).failures}
+    assert "keep_up[u]" in {f.condition for f in certify(fast).failures}
     close = sc.with_changes(epsilon=0.2, region=dc_replace(sc.region, e_d_max=3.0))
-    assert "yaw_budget" in {f["condition"] for f in certify(close).failures}
+    assert "yaw_budget" in {f.condition for f in certify(close).failures}
+
+
+# --------------------------------------------------------------------------- typed round trip
+def _no_tube() -> Certificate:
+    sc = paper_scenario()
+    return certify(sc.with_changes(disturbance=type(sc.disturbance)(amplitude=(2.0, 2.0, 2.0))))
+
+
+@pytest.mark.parametrize("fixture", ["pc_cert", "paper_cert", "no_tube"])
+def test_from_dict_of_to_dict_is_the_certificate(fixture, request):
+    """Certified, uncertified and tube-less certificates come back exactly, through strict JSON text."""
+    c = _no_tube() if fixture == "no_tube" else request.getfixturevalue(fixture)
+    d = json.loads(json.dumps(c.to_dict(), allow_nan=False))
+    again = Certificate.from_dict(d)
+    assert again == c
+    assert again.to_dict() == d
+    assert isinstance(again.sigma, verify.certificate.SigmaChoice) and again.sigma.tried == c.tried
+    assert again.tube == c.tube and again.margins == c.margins and again.e_bar == c.e_bar
+    assert again.design_key == c.design_key == d["design_key"]
+
+
+def test_typed_views(pc_cert, paper_cert):
+    from verify.parts import EBar, SigmaTrial
+    from verify.sampled import HorizonMargins, PeriodTube
+    assert isinstance(pc_cert.tube, PeriodTube) and isinstance(pc_cert.margins, HorizonMargins)
+    assert isinstance(pc_cert.e_bar, EBar) and all(isinstance(t, SigmaTrial) for t in pc_cert.tried)
+    assert all(f.ok is False for f in paper_cert.failures) and paper_cert.failures
+    d = pc_cert.to_dict()
+    assert d["e_bar"]["e_d"] == [0.5 + pc_cert.margins.e_d[-1], 3.0 - pc_cert.margins.e_d[-1]]
+    assert d["limits"] == [0.4, 0.3, 0.5] and d["theorem_version"] == pc_cert.design_fields["theorem_version"]
+
+
+def _without(d: dict, *path: str) -> dict:
+    out = json.loads(json.dumps(d))
+    node = out
+    for k in path[:-1]:
+        node = node[k]
+    del node[path[-1]]
+    return out
+
+
+def _with(d: dict, value, *path: str) -> dict:
+    out = json.loads(json.dumps(d))
+    node = out
+    for k in path[:-1]:
+        node = node[k]
+    node[path[-1]] = value
+    return out
+
+
+FROM_DICT_ERRORS = [
+    (lambda d: _without(d, "tube"), "certificate.tube: expected present"),
+    (lambda d: _without(d, "sigma", "tried"), "certificate.sigma.tried"),
+    (lambda d: _with(d, "fast", "tube", "rho"), "certificate.tube.rho"),
+    (lambda d: _with(d, [0.1, "x", 0.2], "tube", "kappa"), r"certificate.tube.kappa\[1\]"),
+    (lambda d: _with(d, [[1, 2, 3], [3], [1, 2, 3]], "gains", "k_abs"), r"certificate.gains.k_abs\[1\]"),
+    (lambda d: _with(d, 8.5, "horizon", "steps"), "certificate.horizon.steps"),
+    (lambda d: _with(d, [0.6, 0.5], "region", "e_d"), "certificate.region.e_d"),
+    (lambda d: _with(d, None, "law"), "certificate.law"),
+    (lambda d: _with(d, "yes", "conditions", 0, "ok"), r"certificate.conditions\[0\].ok"),
+    (lambda d: _with(d, [0.1], "margins", "e_z"), "certificate.margins"),
+    (lambda d: [1, 2], "certificate"),
+]
+
+
+@pytest.mark.parametrize("change, match", FROM_DICT_ERRORS)
+def test_from_dict_names_the_bad_key(pc_cert, change, match):
+    with pytest.raises(ConfigError, match=match):
+        Certificate.from_dict(change(pc_cert.to_dict()))
+
+
+def test_the_json_carries_its_key_checksum_and_the_papers_route(pc_cert):
+    import hashlib
+    d = pc_cert.to_dict()
+    body = {k: v for k, v in d.items() if k not in ("checksum", "elapsed_s")}
+    text = json.dumps(body, sort_keys=True, separators=(",", ":"), ensure_ascii=False)
+    assert d["checksum"] == hashlib.sha256(text.encode()).hexdigest()
+    assert d["design_key"] == pc_cert.tightening.design_key and d["design_fields"]["law"] == "corrected"
+    assert d["paper_route"] == pc_cert.paper_route.to_dict()
+    text = pc_cert.summary()
+    assert all(line in text for line in pc_cert.paper_route.summary_lines())

@@ -28,8 +28,8 @@ def currents():
 def test_search_space_from_certificate(currents):
     scenario, cert = currents
     space = search_space(scenario, certificate=cert)
-    assert space.sigma == cert.design.sigma and space.tube == tuple(cert.tube["rho"])
-    assert space.theta == cert.tube["theta"] and space.certified
+    assert space.sigma == cert.design.sigma and space.tube == tuple(cert.tube.rho)
+    assert space.theta == cert.tube.theta and space.certified
     assert space.ticks * space.tick == pytest.approx(scenario.controller.dt)
     assert all(lo < hi for lo, hi in space.start)
 

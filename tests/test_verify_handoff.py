@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 
 from tubekit.scenario import paper_scenario
-from tubekit.tightening import Tightening
+from tubekit.tightening import DisturbanceBound, RegionBounds, Tightening
 from verify import NotCertifiedError, certify
 
 P = 3.0 * math.pi / 50     # horizontal target speed of paper_currents (m/s)
@@ -24,23 +24,25 @@ def test_certified_tightening_is_the_certificate(pc_cert):
     t = c.tightening
     assert isinstance(t, Tightening) and t.certified
     np.testing.assert_allclose(t.v_max, np.array([0.4, 0.3, 0.5]) - c.kappa_bar, rtol=1e-12)
-    np.testing.assert_array_equal(t.tube, np.asarray(c.tube["rho"]))
-    assert t.rho_tilde == pytest.approx(math.sqrt(sum(r * r for r in c.tube["rho"])))
-    assert t.sigma == c.sigma["value"] and t.horizon_arcs == 8
+    np.testing.assert_array_equal(t.tube, np.asarray(c.tube.rho))
+    assert t.rho_tilde == pytest.approx(math.sqrt(sum(r * r for r in c.tube.rho)))
+    assert t.sigma == c.sigma.value and t.horizon_arcs == 8
     m = c.margins
-    np.testing.assert_array_equal(t.margins, np.column_stack([m["e_d"], m["e_z"], m["e_o"], m["position"]]))
+    np.testing.assert_array_equal(t.margins, np.column_stack([m.e_d, m.e_z, m.e_o, m.position]))
     np.testing.assert_allclose(t.rates, [0.4 + P, 0.3, 0.5 + (0.4 + P) / 0.5, 0.5], rtol=1e-12)
-    np.testing.assert_array_equal(t.region, [0.5, 3.0, 1.0, 0.5])
+    assert t.region == RegionBounds(epsilon=0.5, e_d_max=3.0, e_z_max=1.0, e_o_max=0.5)
     d = c.disturbance
-    np.testing.assert_array_equal(t.disturbance, [d.omega_xy, d.omega_z, d.gamma])
+    assert t.disturbance == DisturbanceBound(omega_xy=d.omega_xy, omega_z=d.omega_z, sway=d.gamma)
+    assert t.law == c.law == "corrected" and t.design_key == c.design_key and len(t.design_key) == 64
+    assert t.design_fields == c.design_fields and t.design_fields["law"] == "corrected"
 
 
 def test_node_constraints_are_the_last_margin_plus_the_allowance(pc_cert):
     t = pc_cert.tightening
     m = pc_cert.margins
     half = 0.05     # dt / 2 (s)
-    worst = [m["e_d"][-1] + half * (0.4 + P), m["e_z"][-1] + half * 0.3,
-             m["e_o"][-1] + half * (0.5 + (0.4 + P) / 0.5), m["position"][-1] + half * 0.5]
+    worst = [m.e_d[-1] + half * (0.4 + P), m.e_z[-1] + half * 0.3,
+             m.e_o[-1] + half * (0.5 + (0.4 + P) / 0.5), m.position[-1] + half * 0.5]
     assert t.e_d_min == pytest.approx(0.5 + min(worst[0], 0.75 * 1.25))
     assert t.e_d_max == pytest.approx(3.0 - min(worst[0], 0.75 * 1.25))
     assert t.e_z_max == pytest.approx(1.0 - min(worst[1], 0.75 * 1.0))
@@ -60,7 +62,7 @@ def test_best_effort_tightening(paper_cert, fraction):
     t = paper_cert.best_effort_tightening(min_input_fraction=fraction)
     v = np.array([0.4, 0.3, 0.5])
     need = np.array([min(3 * math.pi / 25 + 0.12, 0.4), min(0.1, 0.3), 0.0])
-    assert not t.certified
+    assert not t.certified and t.design_key == paper_cert.design_key and t.law == paper_cert.law
     assert np.all(t.v_max <= v + 1e-15) and np.all(t.v_max >= np.maximum(fraction * v, need) - 1e-15)
     assert t.v_max[0] == pytest.approx(0.4)    # the keep-up need (0.497 m/s) is above u_max
     reg = paper_scenario().region
@@ -77,3 +79,59 @@ def test_best_effort_without_a_tube():
     assert not c.design.tube.certified
     t = c.best_effort_tightening()
     assert t.horizon_arcs == 0 and np.all(t.tube == 0) and t.rho_tilde == 0.0 and not t.certified
+
+
+# --------------------------------------------------------------------------- misuse, refused before anything runs
+class _MustNotSolve:
+    """A solver factory that fails the test if the loop gets as far as building a solver."""
+
+    def __init__(self, *args, **kwargs) -> None:
+        raise AssertionError("the loop started: the certificate should have been refused first")
+
+
+def _pc():
+    from tubekit.scenario import load_scenario
+    import verify
+    return load_scenario(verify.SCENARIOS_DIR / "paper_currents.toml")
+
+
+def _misuses(pc_cert):
+    from dataclasses import replace
+    sc = _pc()
+    paper_law = replace(sc, controller=replace(sc.controller, law="paper"))
+    third = certify(replace(sc, disturbance=replace(sc.disturbance, amplitude=tuple(a / 3 for a in
+                                                                                     sc.disturbance.amplitude))))
+    assert third.certified
+    return [(paper_law, pc_cert, r"design_key\.law: expected the certificate's value 'corrected'.*'paper'"),
+            (sc, third, r"design_key\.disturbance\.amplitude: expected the certificate's value \[0\.0333")]
+
+
+def test_a_certificate_of_another_design_is_refused_by_simulate(pc_cert):
+    import tubekit
+    from tubekit.exceptions import ConfigError
+    from tubekit.loop.closed_loop import run_closed_loop
+    for scenario, cert, match in _misuses(pc_cert):
+        with pytest.raises(ConfigError, match=match):
+            tubekit.simulate(scenario, cert, duration=0.2, progress=False)
+        with pytest.raises(ConfigError, match=match):
+            run_closed_loop(scenario, tightening=cert.tightening, progress=False, solver_factory=_MustNotSolve)
+
+
+def test_the_matching_certificate_runs(pc_cert):
+    """Control: the same call with the scenario the certificate was issued for gets past the check."""
+    from tubekit.loop.closed_loop import run_closed_loop
+    with pytest.raises(AssertionError, match="the loop started"):
+        run_closed_loop(_pc(), tightening=pc_cert.tightening, progress=False, solver_factory=_MustNotSolve)
+
+
+def test_a_certificate_over_another_region_is_bound_to_it(pc_cert):
+    """certify(region=R') records R' (region_override): a run of the scenario's own region refuses it."""
+    from tubekit.design_key import require_matching
+    from tubekit.exceptions import ConfigError
+    from verify import Region
+    sc = _pc()
+    narrow = certify(sc, region=Region.from_scenario(sc, e_o=(-0.3, 0.3)))
+    assert narrow.design_fields["region_override"] == {"e_o": [-0.3, 0.3]}
+    assert "region_override" not in pc_cert.design_fields
+    with pytest.raises(ConfigError, match=r"design_key\.region_override: .*\[-0\.3, 0\.3\].*'absent'"):
+        require_matching(sc, narrow.tightening)

@@ -23,6 +23,7 @@ import sympy as sp
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from tubekit.exceptions import ConfigError
 from tubekit.model.ancillary import LAWS
 from tubekit.model.errors import numeric
 from tubekit.scenario import load_scenario, paper_scenario
@@ -308,3 +309,20 @@ def test_an_exhausted_budget_is_reported_not_hidden():
     assert not b["L1"].converged
     assert b["L1"].gap > 1e-6
     assert b["L1"].bound >= b["L1"].sampled
+
+
+def test_names_selects_a_subset_with_the_same_values():
+    full = bounds("certifiable", "corrected")
+    part = compute_bounds(REGIONS["certifiable"], "corrected", gap=GAP, max_boxes=20000, names=("J_lower", "xi_bar"))
+    assert set(part.items) == {"J_lower", "xi_bar"}
+    assert part["xi_bar"].bound == full["xi_bar"].bound and part["J_lower"].bound == full["J_lower"].bound == 1.0
+
+
+@pytest.mark.parametrize("names, match", [
+    (("L1", "L3"), r"names: expected a non-empty tuple of names in .*received 'L3'"),
+    ((), r"names: expected a non-empty tuple"),
+    ("L1", r"names: expected a non-empty tuple"),
+])
+def test_names_refuses_unknown(names, match):
+    with pytest.raises(ConfigError, match=match):
+        compute_bounds(REGIONS["paper"], "paper", names=names)

@@ -16,9 +16,10 @@ def test_certified_text(pc_cert):
     for c in pc_cert.conditions:
         assert f"{c.condition}: {c.inequality}" in text
     assert "Premises" in text and "Assumptions" in text and "Elapsed:" in text
-    rho = pc_cert.tube["rho"]
+    rho = pc_cert.tube.rho
     assert f"|rho| <= [{rho[0]:.4g}, {rho[1]:.4g}, {rho[2]:.4g}]" in text
     assert "sigma = 0 1/s" in text and "0*" in text and "3.125*" in text
+    assert f"Design key: {pc_cert.design_key}" in text and len(pc_cert.design_key) == 64
 
 
 def test_uncertified_text_names_every_failure(paper_cert):
@@ -27,9 +28,9 @@ def test_uncertified_text_names_every_failure(paper_cert):
     assert f"NOT CERTIFIED ({n} failed conditions)" in text.splitlines()[0]
     assert text.count("[FAIL]") == n
     for f in paper_cert.failures:
-        line = next(ln for ln in text.splitlines() if f"] {f['condition']}:" in ln)
-        assert line.startswith("  [FAIL]") and f"{f['lhs']:.6g} vs {f['rhs']:.6g}" in line
-        assert f["detail"] in line
+        line = next(ln for ln in text.splitlines() if f"] {f.condition}:" in ln)
+        assert line.startswith("  [FAIL]") and f"{f.lhs:.6g} vs {f.rhs:.6g}" in line
+        assert f.detail in line
 
 
 def test_text_without_a_tube():

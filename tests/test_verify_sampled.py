@@ -105,10 +105,10 @@ def simulate_period(sc, cert, x0, t0, v_hat, mode, angle=(0.0,), zsign=1.0, subs
     """One period of the loop; returns (max_j |e_j - e_hat_j| / tube_j, max_i |kappa_i| / kappa_bar_i,
     whether e stayed in R, whether e_hat stayed in R shrunk by the tube)."""
     law = get_law(sc.controller.law)
-    sigma = cert.sigma["value"]
+    sigma = cert.sigma.value
     ticks = int(round(sc.controller.ancillary_rate_hz * sc.controller.dt))
     h = sc.controller.dt / ticks
-    tube = np.asarray(cert.tube["rho"])
+    tube = np.asarray(cert.tube.rho)
     kbar = np.asarray(cert.kappa_bar)
     wxy, wz = cert.disturbance.omega_xy, cert.disturbance.omega_z
     reg = cert.region
@@ -149,7 +149,7 @@ def period_cases(draw, name: str):
 
 
 def _state(sc, cert, case):
-    reg, tube = cert.region, np.asarray(cert.tube["rho"])
+    reg, tube = cert.region, np.asarray(cert.tube.rho)
     ed = reg.e_d[0] + tube[0] + case["fd"] * (reg.e_d[1] - reg.e_d[0] - 2 * tube[0])
     ez = case["fz"] * (reg.e_z[1] - tube[1])
     eo = case["fo"] * (reg.e_o[1] - tube[2])
@@ -308,9 +308,9 @@ def test_margins_are_the_tube_plus_the_candidate_drifts(sigma, wxy, arcs):
 def test_margins_of_the_shipped_certificate(certs):
     sc, cert = certs["paper_currents.toml"]
     m = cert.margins
-    assert set(m) == {"e_d", "e_z", "e_o", "position"}
-    assert all(len(v) == sc.controller.horizon_steps for v in m.values())
-    assert m["e_d"][0] == cert.tube["rho"][0] and m["e_o"][0] == cert.tube["rho"][2]
+    assert set(m.to_dict()) == {"e_d", "e_z", "e_o", "position"}
+    assert all(len(v) == sc.controller.horizon_steps for v in m.to_dict().values())
+    assert m.e_d[0] == cert.tube.rho[0] and m.e_o[0] == cert.tube.rho[2]
     assert isinstance(cert.design.tube, PeriodTube)
 
 

@@ -13,15 +13,16 @@ says what to do when it is not certified. With no certificate the nominal MPC al
 
 from __future__ import annotations
 
-import math
 from typing import Any
 
 from tubekit.checks import check_run_inputs
-from tubekit.loop.closed_loop import simulate as _simulate
+from tubekit.design_key import require_matching
+from tubekit.loop.closed_loop import run_closed_loop
 from tubekit.exceptions import ConfigError, TubekitError
 from tubekit.scenario import Scenario
 from tubekit.loop.result import SimulationResult
 from tubekit.tightening import Tightening
+from tubekit.validation import duration_seconds
 
 __all__ = ["simulate"]
 
@@ -61,16 +62,16 @@ def simulate(scenario: Scenario, certificate: Any = None, duration: float | None
     Returns
     -------
     SimulationResult
-        With ``metrics``, ``plot()`` and ``to_csv(path)``; :func:`tubekit.check_promises` measures it.
+        With ``metrics`` and ``to_csv(path)``; :func:`tubekit.check_promises` measures a tube run;
+        its figure is ``tubekit.app.plots.plot_run(run)``.
     """
     if not isinstance(scenario, Scenario):
         raise ConfigError("scenario", "a tubekit.Scenario", type(scenario).__name__)
     if duration is not None:
-        if isinstance(duration, bool) or not isinstance(duration, (int, float)) or not math.isfinite(duration) \
-                or duration <= 0:
-            raise ConfigError("duration", "a number of seconds > 0", duration)
-        scenario = scenario.with_changes(duration=float(duration))
+        scenario = scenario.with_changes(duration=duration_seconds("duration", duration))
     check_run_inputs(scenario)
     if certificate is None:
-        return _simulate(scenario, tube=False, progress=progress, label="baseline")
-    return _simulate(scenario, tightening=_tightening_of(certificate), tube=True, progress=progress, label="tube")
+        return run_closed_loop(scenario, tube=False, progress=progress, label="baseline")
+    tightening = _tightening_of(certificate)
+    require_matching(scenario, tightening)  # a certificate of another design is refused before anything runs
+    return run_closed_loop(scenario, tightening, tube=True, progress=progress, label="tube")

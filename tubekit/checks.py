@@ -13,19 +13,27 @@ the field to fix, before certification, simulation or any file is written:
   of the workspace (the FHOCP keeps one wall row per axis). When that fails
   the error names the field whose paper value would make it fit
   (``controller.horizon_steps``, then ``limits.u_max``), else ``workspace``.
+
+Rules used elsewhere too, written once here: :func:`require_one_period` (a run lasts at
+least one FHOCP period), :func:`horizon_reach`, :func:`workspace_fits` and
+:func:`workspace_rule` (one horizon's travel fits between the walls; the FHOCP checks
+the same rule with its tightened speed and clearance). "duration > 0" is
+:func:`tubekit.validation.duration_seconds`.
 """
 
 from __future__ import annotations
 
-import math
+from typing import Any
 
 import numpy as np
 
 from tubekit.model.errors import error_coordinates
 from tubekit.exceptions import ConfigError
 from tubekit.scenario import ControllerSettings, Scenario, paper_scenario
+from tubekit.validation import duration_seconds
 
 __all__ = ["check_run_inputs", "check_start", "check_log_size", "check_horizon_and_limits", "log_bytes",
+           "require_one_period", "horizon_reach", "workspace_fits", "workspace_rule",
            "MEMORY_BUDGET_BYTES", "LOG_BYTES_PER_TICK", "RUNS_PER_STUDY", "MAX_HORIZON_STEPS"]
 
 #: Memory a study may spend on its per-tick logs (bytes): 2 GiB.
@@ -94,16 +102,36 @@ def check_start(scenario: Scenario) -> None:
                           f"e_d(0) = {e_d0:.4g} m")
 
 
-def _reach(scenario: Scenario, u_max: float, horizon_steps: int) -> float:
-    """Farthest horizontal travel within one horizon (m)."""
-    return u_max * scenario.controller.dt * horizon_steps
+def require_one_period(field: str, duration: float, dt: float) -> None:
+    """Raise ``ConfigError(field, ...)`` unless ``duration`` (s) holds at least one FHOCP period ``dt`` (s).
+
+    The loop runs ``round(duration / dt)`` periods; a duration that rounds to none is refused.
+    """
+    if not round(duration / dt) >= 1:
+        raise ConfigError(field, f"at least one FHOCP period ({dt:g} s)", duration)
+
+
+def horizon_reach(speed: float, dt: float, horizon_steps: int) -> float:
+    """Farthest horizontal travel within one horizon, ``speed`` N δt (m)."""
+    return speed * dt * horizon_steps
+
+
+def workspace_fits(workspace: Any, clearance: float, reach: float) -> bool:
+    """Whether both horizontal extents of ``workspace`` [lower, upper] exceed 2 (clearance + reach) (m)."""
+    lower, upper = (np.asarray(side, dtype=float) for side in workspace)
+    width = upper[:2] - lower[:2] - 2 * clearance
+    return bool(np.all(width > 2 * reach))
+
+
+def workspace_rule(clearance: float, reach: float, terms: str = "vehicle_radius + u_max N dt") -> str:
+    """The text of :func:`workspace_fits`' rule, with its right-hand side 2 (clearance + reach) in m."""
+    return f"x and y extents > 2 ({terms}) = {2 * (clearance + reach):.4g} m"
 
 
 def _fits_workspace(scenario: Scenario, u_max: float, horizon_steps: int) -> bool:
     """Whether both horizontal workspace extents exceed 2 (r̄ + u_max N δt)."""
-    lower, upper = (np.asarray(side, dtype=float) for side in scenario.workspace)  # type: ignore[union-attr]
-    width = upper[:2] - lower[:2] - 2 * scenario.vehicle_radius
-    return bool(np.all(width > 2 * _reach(scenario, u_max, horizon_steps)))
+    reach = horizon_reach(u_max, scenario.controller.dt, horizon_steps)
+    return workspace_fits(scenario.workspace, scenario.vehicle_radius, reach)
 
 
 def check_horizon_and_limits(scenario: Scenario) -> None:
@@ -116,9 +144,8 @@ def check_horizon_and_limits(scenario: Scenario) -> None:
     u_max = scenario.limits.u_max
     if _fits_workspace(scenario, u_max, steps):
         return
-    need = 2 * (scenario.vehicle_radius + _reach(scenario, u_max, steps))
-    rule = (f"u_max N dt small enough that the workspace's x and y extents exceed 2 (vehicle_radius + "
-            f"u_max N dt) = {need:.4g} m")
+    reach = horizon_reach(u_max, scenario.controller.dt, steps)
+    rule = f"u_max N dt small enough for the workspace's {workspace_rule(scenario.vehicle_radius, reach)}"
     default_steps = ControllerSettings().horizon_steps
     if steps > default_steps and _fits_workspace(scenario, u_max, default_steps):
         raise ConfigError("controller.horizon_steps", f"a smaller horizon: {rule}", steps)
@@ -138,9 +165,7 @@ def check_run_inputs(scenario: Scenario, duration: float | None = None) -> None:
     duration : float, optional
         Simulated time (s) if it differs from ``scenario.duration``.
     """
-    seconds = scenario.duration if duration is None else duration
-    if not (isinstance(seconds, (int, float)) and math.isfinite(seconds) and seconds > 0):
-        raise ConfigError("duration", "a number of seconds > 0", seconds)
+    duration_seconds("duration", scenario.duration if duration is None else duration)
     check_log_size(scenario, duration)
     check_horizon_and_limits(scenario)
     check_start(scenario)

@@ -7,6 +7,10 @@ or built in Python. Values the paper leaves out are chosen here and documented:
 * initial pose 0.5 m behind the target, 0.2 m above it, heading along the path;
 * sway ``v_s = clip(0.1 u r, +-0.02 m/s)`` (:class:`tubekit.model.kinematics.SwayModel`);
 * FHOCP weights Q, R, P (diagonal) and the verification region.
+
+The FHOCP mode, the terminal mode and the heading hemisphere are str-valued enums
+(:class:`FhocpMode`, :class:`TerminalMode`, :class:`Heading`): a member equals its string,
+so TOML and JSON keep plain strings. The law stays a registered name (users register laws).
 """
 
 from __future__ import annotations
@@ -23,7 +27,7 @@ import numpy as np
 from tubekit.exceptions import ConfigError, ShapeError
 from tubekit.model.kinematics import InputLimits, SwayModel
 from tubekit.model.trajectory import Circle, Trajectory, trajectory_from_dict
-from tubekit.validation import as_vector, positive
+from tubekit.validation import StrChoice, as_vector, choice, positive, replace_fields
 from tubekit.model.vehicles import PlantSettings
 
 __all__ = [
@@ -39,12 +43,39 @@ __all__ = [
     "scenario_from_dict",
     "LAW_NAMES",
     "HEADINGS",
+    "FhocpMode",
+    "TerminalMode",
+    "Heading",
 ]
 
+
+class FhocpMode(StrChoice):
+    """FHOCP mode: one warm-started convex solve per step, or SCP to convergence."""
+
+    REALTIME = "realtime"
+    CONVERGED = "converged"
+
+
+class TerminalMode(StrChoice):
+    """Terminal set F: exact penalty, hard constraint, or none."""
+
+    SOFT = "soft"
+    HARD = "hard"
+    OFF = "off"
+
+
+class Heading(StrChoice):
+    """Heading hemisphere of the region: cos(psi - theta) < 0 ("toward"), > 0 ("away"), or either."""
+
+    TOWARD = "toward"
+    AWAY = "away"
+    BOTH = "both"
+
+
 LAW_NAMES = ("paper", "corrected")
-HEADINGS = ("toward", "away", "both")
+HEADINGS: tuple[str, ...] = Heading.values()
 #: Sign of cos(psi - theta) in each heading hemisphere (0: either).
-HEMISPHERE_SIGN: dict[str, int] = {"toward": -1, "away": 1, "both": 0}
+HEMISPHERE_SIGN: dict[str, int] = {Heading.TOWARD: -1, Heading.AWAY: 1, Heading.BOTH: 0}
 
 
 @dataclass(frozen=True)
@@ -127,11 +158,14 @@ class ControllerSettings:
         Rate of the ancillary feedback kappa (Hz); a multiple of 1/dt.
     terminal_level : float
         epsilon-bar of the terminal set F = {||e||_P <= epsilon-bar}.
-    fhocp_mode : str
+    fhocp_mode : FhocpMode
         ``"realtime"`` (one convex solve per step, warm-started) or ``"converged"``
         (sequential convex programming to convergence), see :mod:`tubekit.fhocp`.
-    terminal_mode : str
+    terminal_mode : TerminalMode
         Terminal set F: ``"soft"`` (exact penalty), ``"hard"`` or ``"off"``.
+    fhocp_backend : str
+        FHOCP solver: a name in :func:`tubekit.fhocp.registry.backends` (``"scp"``, ``"ipopt"``);
+        checked when the solver is built. Left out of :meth:`Scenario.to_dict` when ``"scp"``.
     """
 
     dt: float = 0.1
@@ -143,8 +177,9 @@ class ControllerSettings:
     sigma: float | None = None
     ancillary_rate_hz: float = 100.0
     terminal_level: float = 2.0
-    fhocp_mode: str = "realtime"
-    terminal_mode: str = "soft"
+    fhocp_mode: FhocpMode = FhocpMode.REALTIME
+    terminal_mode: TerminalMode = TerminalMode.SOFT
+    fhocp_backend: str = "scp"
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "dt", positive("controller.dt", self.dt))
@@ -168,10 +203,12 @@ class ControllerSettings:
             raise ConfigError("controller.ancillary_rate_hz", "a positive multiple of 1/dt",
                               self.ancillary_rate_hz)
         object.__setattr__(self, "terminal_level", positive("controller.terminal_level", self.terminal_level))
-        if self.fhocp_mode not in ("realtime", "converged"):
-            raise ConfigError("controller.fhocp_mode", "one of ('realtime', 'converged')", self.fhocp_mode)
-        if self.terminal_mode not in ("soft", "hard", "off"):
-            raise ConfigError("controller.terminal_mode", "one of ('soft', 'hard', 'off')", self.terminal_mode)
+        object.__setattr__(self, "fhocp_mode", choice("controller.fhocp_mode", FhocpMode, self.fhocp_mode))
+        object.__setattr__(self, "terminal_mode", choice("controller.terminal_mode", TerminalMode,
+                                                         self.terminal_mode))
+        if not isinstance(self.fhocp_backend, str) or not self.fhocp_backend:
+            raise ConfigError("controller.fhocp_backend", "a backend name (e.g. 'scp' or 'ipopt')",
+                              self.fhocp_backend)
 
     @property
     def horizon(self) -> float:
@@ -192,7 +229,7 @@ class RegionSettings:
     e_d_max: float = 3.0
     e_z_max: float = 1.0
     e_o_max: float = 0.9
-    heading: str = "toward"
+    heading: Heading = Heading.TOWARD
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "e_d_max", positive("region.e_d_max", self.e_d_max))
@@ -201,8 +238,7 @@ class RegionSettings:
         if eo >= 1.0:
             raise ConfigError("region.e_o_max", "a number in (0, 1) (|e_o| = 1 makes J singular)", eo)
         object.__setattr__(self, "e_o_max", eo)
-        if self.heading not in HEADINGS:
-            raise ConfigError("region.heading", f"one of {HEADINGS}", self.heading)
+        object.__setattr__(self, "heading", choice("region.heading", Heading, self.heading))
 
 
 @dataclass(frozen=True)
@@ -295,8 +331,17 @@ class Scenario:
         return int(round(self.duration / self.controller.dt))
 
     def with_changes(self, **changes: Any) -> "Scenario":
-        """A copy with top-level fields replaced (``dataclasses.replace``)."""
-        return replace(self, **changes)
+        """A copy with fields replaced; a dotted name reaches into a nested settings object.
+
+        ``sc.with_changes(duration=20.0, **{"limits.u_max": 0.3, "controller.fhocp_mode": "converged"})``.
+        Every changed object is rebuilt, so its validation runs again.
+
+        Raises
+        ------
+        ConfigError
+            An unknown field (named in full), or a value its owner rejects.
+        """
+        return replace_fields(self, changes)
 
     def to_dict(self) -> dict:
         """A JSON/TOML-friendly description (the inverse of :func:`scenario_from_dict`)."""
@@ -316,9 +361,10 @@ class Scenario:
                 "constant": list(self.disturbance.constant),
                 "sway": asdict(self.disturbance.sway),
             },
-            "controller": {k: (list(v) if isinstance(v, tuple) else v)
-                           for k, v in asdict(self.controller).items() if v is not None},
-            "region": asdict(self.region),
+            "controller": {k: (list(v) if isinstance(v, tuple) else str(v) if isinstance(v, str) else v)
+                           for k, v in asdict(self.controller).items()
+                           if v is not None and not (k == "fhocp_backend" and v == "scp")},
+            "region": {k: (str(v) if isinstance(v, str) else v) for k, v in asdict(self.region).items()},
         }
         if self.workspace is not None:
             d["workspace"] = [list(self.workspace[0]), list(self.workspace[1])]

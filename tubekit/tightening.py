@@ -11,25 +11,79 @@ Two layers of data:
 * the certificate's per-arc margins ``margins`` (N, 4) (columns e_d, e_z, e_o,
   position), its nominal-arc rate bounds ``rates`` (4,) and its one-period tube
   ``tube`` (3,) per axis, used by :mod:`tubekit.loop.plan_check` to accept a plan
-  exactly along its arcs and by the run's promise checks.
+  exactly along its arcs and by the run's promise checks;
+* the bounds it holds over, by name: :class:`RegionBounds` (R) and
+  :class:`DisturbanceBound` (ω̄_xy, ω̄_z, γ̄);
+* what it was certified for: ``law``, ``design_key`` and ``design_fields``
+  (:mod:`tubekit.design_key`; :func:`tubekit.design_key.require_matching` refuses a run
+  of another design). The untightened baseline carries no key.
 """
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 
+from tubekit.exceptions import ConfigError
 from tubekit.scenario import Scenario
 
-__all__ = ["Tightening", "MARGIN_COLUMNS"]
+__all__ = ["Tightening", "MARGIN_COLUMNS", "RegionBounds", "DisturbanceBound"]
 
 #: Columns of :attr:`Tightening.margins` and :attr:`Tightening.rates`.
 MARGIN_COLUMNS: tuple[str, ...] = ("e_d", "e_z", "e_o", "position")
 
 
-def _zeros(n: int, k: int = 4) -> np.ndarray:
-    return np.zeros((n, k)) if n else np.zeros(k)
+def _numbers(name: str, value: Any, n: int) -> list[float]:
+    """``n`` finite floats from a sequence (or a named record's ``as_tuple()``), else ConfigError."""
+    if hasattr(value, "as_tuple"):
+        value = value.as_tuple()
+    try:
+        out = [float(x) for x in np.asarray(value, dtype=float).reshape(-1)]
+    except (TypeError, ValueError):
+        raise ConfigError(name, f"{n} numbers", value) from None
+    if len(out) != n or not all(math.isfinite(x) for x in out):
+        raise ConfigError(name, f"{n} finite numbers", value)
+    return out
+
+
+@dataclass(frozen=True)
+class RegionBounds:
+    """R as the loop uses it: e_d in [epsilon, e_d_max] (m), |e_z| <= e_z_max (m), |e_o| <= e_o_max."""
+
+    epsilon: float = 0.0
+    e_d_max: float = 0.0
+    e_z_max: float = 0.0
+    e_o_max: float = 0.0
+
+    @classmethod
+    def of(cls, value: Any) -> "RegionBounds":
+        """A RegionBounds, or one from 4 numbers (epsilon, e_d_max, e_z_max, e_o_max)."""
+        return value if isinstance(value, cls) else cls(*_numbers("tightening.region", value, 4))
+
+    def as_tuple(self) -> tuple[float, float, float, float]:
+        """(epsilon, e_d_max, e_z_max, e_o_max)."""
+        return (self.epsilon, self.e_d_max, self.e_z_max, self.e_o_max)
+
+
+@dataclass(frozen=True)
+class DisturbanceBound:
+    """The certificate's ω̄_xy, ω̄_z and sway bound γ̄ (m/s); zeros for the baseline."""
+
+    omega_xy: float = 0.0
+    omega_z: float = 0.0
+    sway: float = 0.0
+
+    @classmethod
+    def of(cls, value: Any) -> "DisturbanceBound":
+        """A DisturbanceBound, or one from 3 numbers (omega_xy, omega_z, sway)."""
+        return value if isinstance(value, cls) else cls(*_numbers("tightening.disturbance", value, 3))
+
+    def as_tuple(self) -> tuple[float, float, float]:
+        """(omega_xy, omega_z, sway)."""
+        return (self.omega_xy, self.omega_z, self.sway)
 
 
 @dataclass(frozen=True)
@@ -59,12 +113,19 @@ class Tightening:
         Bounds on |ė_d|, |ė_z|, |ė_o|, ‖ṗ‖ along a nominal arc (spacing margin of the arc check).
     tube : array (3,)
         Certified one-period per-axis bounds on |e - ê| (m, m, -); zeros for the baseline.
-    region : array (4,)
-        R: e_d lower (epsilon), e_d upper, |e_z| bound, |e_o| bound.
-    disturbance : array (3,)
-        The certificate's ω̄_xy, ω̄_z and sway bound γ̄ (m/s); zeros for the baseline.
+    region : RegionBounds
+        R: ``epsilon``, ``e_d_max``, ``e_z_max``, ``e_o_max`` (4 numbers in that order are accepted).
+    disturbance : DisturbanceBound
+        The certificate's ``omega_xy``, ``omega_z`` and ``sway`` bound γ̄ (m/s); zeros for the baseline
+        (3 numbers in that order are accepted).
     certified : bool
         True only when it comes from a certified certificate.
+    law : str or None
+        The ancillary law it was certified for (None: the baseline).
+    design_key : str or None
+        SHA-256 of the design (:func:`tubekit.design_key.design_key`); None: not checked.
+    design_fields : dict or None
+        The fields the key hashes, to name the first one that differs.
     """
 
     v_max: np.ndarray
@@ -78,9 +139,16 @@ class Tightening:
     margins: np.ndarray = field(default_factory=lambda: np.zeros((0, 4)))
     rates: np.ndarray = field(default_factory=lambda: np.zeros(4))
     tube: np.ndarray = field(default_factory=lambda: np.zeros(3))
-    region: np.ndarray = field(default_factory=lambda: np.zeros(4))
-    disturbance: np.ndarray = field(default_factory=lambda: np.zeros(3))
+    region: RegionBounds = field(default_factory=RegionBounds)
+    disturbance: DisturbanceBound = field(default_factory=DisturbanceBound)
     certified: bool = False
+    law: str | None = None
+    design_key: str | None = None
+    design_fields: dict | None = None
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "region", RegionBounds.of(self.region))
+        object.__setattr__(self, "disturbance", DisturbanceBound.of(self.disturbance))
 
     @property
     def horizon_arcs(self) -> int:
@@ -93,4 +161,4 @@ class Tightening:
         reg = scenario.region
         return cls(v_max=scenario.limits.vector.copy(), e_d_min=scenario.epsilon, e_o_max=reg.e_o_max,
                    e_z_max=reg.e_z_max, e_d_max=reg.e_d_max, obstacle_margin=0.0, rho_tilde=0.0, sigma=0.0,
-                   region=np.array([scenario.epsilon, reg.e_d_max, reg.e_z_max, reg.e_o_max]))
+                   region=RegionBounds(scenario.epsilon, reg.e_d_max, reg.e_z_max, reg.e_o_max))

@@ -59,8 +59,8 @@ scenario = load_scenario(verify.SCENARIOS_DIR / "paper_currents.toml")
 scenario = scenario.with_changes(controller=replace(scenario.controller, sigma=3.125))
 cert = verify.certify(scenario)
 problem = cert.design.problem
-print(f"certified: {cert.certified}, sigma = {cert.sigma['value']:g} 1/s, "
-      f"one-period tube rho = {np.round(cert.tube['rho'], 4)} (e_d m, e_z m, e_o)")
+print(f"certified: {cert.certified}, sigma = {cert.sigma.value:g} 1/s, "
+      f"one-period tube rho = {np.round(cert.tube.rho, 4)} (e_d m, e_z m, e_o)")
 
 # %% [markdown]
 # ## Step 1: V̄ = V − κ̄
@@ -95,8 +95,8 @@ for j, (ax, unit, why) in enumerate((("u", "m/s", "target speed + omega_xy"), ("
 # %%
 tube = cert.design.tube
 margins = horizon_margins(problem, tube, scenario.controller.horizon_steps)
-assert margins.to_dict() == cert.margins
-M = np.column_stack([cert.margins[k] for k in MARGIN_COLUMNS])
+assert margins == cert.margins
+M = np.column_stack([getattr(cert.margins, k) for k in MARGIN_COLUMNS])
 print(f"Cartesian one-period tube: p_xy = {tube.p_xy:.4f} m, p_z = {tube.p_z:.4f} m, psi = {tube.psi:.4f} rad")
 print(f"{'arc j':>6} | " + " | ".join(f"{k:>8}" for k in MARGIN_COLUMNS) + " | e_d step = p_xy + u psi j delta")
 for j, row in enumerate(M):

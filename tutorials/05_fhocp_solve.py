@@ -39,8 +39,8 @@ import numpy as np
 from matplotlib.patches import Circle
 
 import verify
-from tubekit import NotAvailableError, error_coordinates, paper_scenario
-from tubekit.fhocp import FHOCP
+from tubekit import ConfigError, NotAvailableError, error_coordinates, paper_scenario
+from tubekit.fhocp import FHOCP, ScpOptions, backends, make_solver
 from tubekit.loop.sensing import detected_obstacles, surface_distance
 
 QUICK = os.environ.get("TUBEKIT_QUICK") == "1"
@@ -103,6 +103,24 @@ print(f"cost (stage + terminal) = {res.cost:.4f}, merit (cost + penalties) = {re
 print(f"build {1e3 * solver.build_time_s:.1f} ms (once)  vs  solve {1e3 * res.solve_time_s:.2f} ms "
       f"(Clarabel {1e3 * res.solver_time_s:.2f} ms, linearising {1e3 * res.setup_time_s:.2f} ms)")
 print(f"max violation of the NONLINEAR constraints on the returned plan: {res.max_violation:.2e}")
+
+# %% [markdown]
+# The solver's options are one frozen, validated value, `ScpOptions` (trust radius, tolerance,
+# iteration caps, penalties, terminal mode, obstacle slots, fast path, Clarabel settings); a bad
+# value is a `ConfigError` naming the field before anything is built. The closed loop builds its
+# solver by name from `scenario.controller.fhocp_backend` (`"scp"`, or the CasADi peer `"ipopt"`)
+# through `tubekit.fhocp.make_solver`.
+
+# %%
+tight_solver = FHOCP(scenario, tight, mode="converged", options=ScpOptions(tolerance=1e-7, max_iterations=60))
+tight_res = tight_solver.solve(t0, state, detected)
+print(f"tolerance 1e-7: {tight_res.iterations} subproblems, merit {tight_res.merit:.6f} (vs {res.merit:.6f})")
+try:
+    ScpOptions(trust_radius=-1.0)
+except ConfigError as exc:
+    print(f"ConfigError: {exc}")
+print(f"backends: {backends()}; the scenario's: {scenario.controller.fhocp_backend!r} -> "
+      f"{type(make_solver(scenario, tight)).__name__}")
 print("  per family:", {k: float(f"{v:.2e}") for k, v in res.violations.items()})
 res.check(1e-6)  # raises SolverError if the plan violates anything by more than 1e-6
 print("first input to apply [u, w, r] =", np.round(res.first_input, 4))
@@ -256,7 +274,7 @@ print(f"max relative gap before the obstacle becomes active: {np.max(np.abs(rel[
 #
 # ## The same NLP in IPOPT (optional)
 # `tubekit.fhocp_ipopt.IpoptFHOCP` transcribes the identical NLP in CasADi with the exact
-# nonlinear constraints. If CasADi is missing (`pip install "tubekit[bench]"`), we skip.
+# nonlinear constraints. If CasADi is missing (`pip install -e ".[bench]"`), we skip.
 
 # %%
 ipopt_plan = None

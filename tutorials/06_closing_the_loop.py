@@ -14,7 +14,9 @@
 # holds the first nominal input v̂; at 100 Hz the ancillary law adds κ = −σ J⁻¹(e − ê), and
 # the plant (eq. 11, with the paper's currents and a sway term) is integrated with RK4.
 #
-# We run two controllers under the same disturbance, with `tubekit.loop.closed_loop.simulate`:
+# We run two controllers under the same disturbance, with `tubekit.loop.closed_loop.run_closed_loop`
+# (what runs is the scenario's: its ancillary law, FHOCP backend and mode, plant kind; σ is the
+# tightening's; a variant is `scenario.with_changes(**{"controller.fhocp_mode": "converged"})`):
 #
 # * **tube**: the FHOCP on the tightened sets (V̄, e_d ≥ ε + ρ̃, obstacle margin) plus κ;
 # * **baseline**: the same FHOCP on the untightened sets (V, e_d ≥ ε, no margin), no κ.
@@ -39,7 +41,7 @@ from matplotlib.patches import Circle
 
 import verify
 from tubekit import Tightening, paper_scenario
-from tubekit.loop.closed_loop import simulate
+from tubekit.loop.closed_loop import run_closed_loop
 from tubekit.loop.promises import check_promises
 from tubekit.fhocp import FHOCP
 from tubekit.loop.metrics import clearance as vehicle_clearance
@@ -65,7 +67,7 @@ scenario = paper_scenario().with_changes(duration=DURATION)
 cert = verify.certify(scenario, "corrected")
 print(f"certified: {cert.certified}")
 for f in cert.failures:
-    print(f"  FAILED {f['condition']:<22} {f['lhs']:9.4g} vs {f['rhs']:.4g}")
+    print(f"  FAILED {f.condition:<22} {f.lhs:9.4g} vs {f.rhs:.4g}")
 tight = cert.best_effort_tightening()
 print(f"best-effort: sigma = {tight.sigma:g} 1/s, rho_tilde = {tight.rho_tilde:g} (assumed, not certified), "
       f"V-bar = {np.round(tight.v_max, 4)}, e_d_min = {tight.e_d_min:g} m, margin = {tight.obstacle_margin:.4f} m")
@@ -81,7 +83,7 @@ print(f"target speed {speed:.4f} m/s; nominal surge bound V-bar_u = {tight.v_max
 # ## Two closed-loop runs
 
 # %% [markdown]
-# `simulate` accepts a `solver_factory(scenario, tightening)`: any object with a
+# `run_closed_loop` accepts a `solver_factory(scenario, tightening)`: any object with a
 # `solve(t, state, obstacles)` method. We use it to wrap the default `FHOCP` and keep, per
 # constraint family, the largest violation of the nonlinear constraints its plans had
 # (`FhocpResult.violations`) — the closed loop itself only logs the overall maximum.
@@ -113,10 +115,10 @@ def recording_factory(name):
 
 
 t_run = time.perf_counter()
-tube = simulate(scenario, tightening=tight, tube=True, progress=False, solver_factory=recording_factory("tube"))
+tube = run_closed_loop(scenario, tight, tube=True, progress=False, solver_factory=recording_factory("tube"))
 print(tube.summary())
-base = simulate(scenario, tightening=Tightening.untightened(scenario), tube=False, progress=False,
-                solver_factory=recording_factory("baseline"))
+base = run_closed_loop(scenario, Tightening.untightened(scenario), tube=False, progress=False,
+                       solver_factory=recording_factory("baseline"))
 print(base.summary())
 print(f"both runs: {time.perf_counter() - t_run:.1f} s wall for {2 * scenario.steps} FHOCP steps")
 for name, sol in solvers.items():
@@ -306,8 +308,8 @@ easy_tight = easy_cert.tightening  # raises NotCertifiedError if the design were
 rho_tilde = easy_tight.rho_tilde
 print(f"certified: {easy_cert.certified}, sigma = {easy_tight.sigma:g} 1/s, rho_tilde = {rho_tilde:.5f}, "
       f"V-bar = {np.round(easy_tight.v_max, 4)}")
-easy_tube = simulate(easy, tightening=easy_tight, tube=True, progress=False)
-easy_base = simulate(easy, tightening=Tightening.untightened(easy), tube=False, progress=False)
+easy_tube = run_closed_loop(easy, easy_tight, tube=True, progress=False)
+easy_base = run_closed_loop(easy, Tightening.untightened(easy), tube=False, progress=False)
 me_tube = compute_metrics(easy_tube.columns(), easy, rho_bound=rho_tilde)
 me_base = compute_metrics(easy_base.columns(), easy)
 for name, m in (("tube", me_tube), ("baseline", me_base)):

@@ -143,7 +143,7 @@ print("wrote", FIGURES / "07_property_testing.png")
 
 # %% [markdown]
 # ## The whole loop: disturbance sequences
-# `falsify_closed_loop` runs `tubekit.loop.closed_loop.simulate` itself (FHOCP, plan check,
+# `falsify_closed_loop` runs `tubekit.loop.closed_loop.run_closed_loop` itself (FHOCP, plan check,
 # reset, ZOH) from starts on the faces of Ē, with a greedy ω that pushes the largest
 # |ρ_j| / tube_j at every tick and with piecewise-constant sequences tuned by a (1 + λ)
 # evolution strategy, and checks every promise of the run. The largest ratio it finds is the

@@ -63,10 +63,10 @@ def num(x, digits=4):
 currents = load_scenario(verify.SCENARIOS_DIR / "paper_currents.toml")
 cert = verify.certify(currents)
 print("verdict:", "CERTIFIED" if cert.certified else "not certified", f"(law {cert.law!r})")
-print("sigma:", cert.sigma["value"], "1/s, because:", cert.sigma["source"])
-print("tried:", ", ".join(f"{t['sigma']:g}{'*' if t['certified'] else ''}" for t in cert.sigma["tried"]),
+print("sigma:", cert.sigma.value, "1/s, because:", cert.sigma.source)
+print("tried:", ", ".join(f"{t.sigma:g}{'*' if t.certified else ''}" for t in cert.sigma.tried),
       " (* = certified)")
-print("one-period tube rho (e_d m, e_z m, e_o):", np.round(cert.tube["rho"], 5))
+print("one-period tube rho (e_d m, e_z m, e_o):", np.round(cert.tube.rho, 5))
 print("kappa_bar:", np.round(cert.kappa_bar, 4), " V_bar:", np.round(cert.v_bar, 4))
 print("\nevery condition, lhs vs rhs:")
 for c in cert.conditions:
@@ -94,9 +94,9 @@ sigma_values = (1.0, 3.125, 6.25, 12.5, 50.0, 100.0, 250.0)
 by_sigma = [(f"sigma = {s:g}", verify.certify(with_sigma(currents, s))) for s in sigma_values]
 print(f"{'':>14} | {'cert.':5} | {'rho_e_o':>8} | {'kappa_r':>8} | failed conditions (lhs vs rhs)")
 for name, c in by_sigma:
-    rho_o = num(c.tube["rho"][2]) if c.tube["certified"] else "-"
+    rho_o = num(c.tube.rho[2]) if c.tube.certified else "-"
     kap_r = num(c.kappa_bar[2]) if c.kappa_bar is not None else "-"
-    why = "; ".join(f"{f['condition']} {num(f['lhs'], 3)} vs {num(f['rhs'], 3)}" for f in c.failures) or "-"
+    why = "; ".join(f"{f.condition} {num(f.lhs, 3)} vs {num(f.rhs, 3)}" for f in c.failures) or "-"
     print(f"{name:>14} | {str(c.certified):5} | {rho_o:>8} | {kap_r:>8} | {why}")
 
 # %% [markdown]
@@ -170,12 +170,12 @@ print("diag-inverse, toward the target: G = J K =")
 sp.pprint(sp.Matrix(3, 3, G_entries))
 for name, c in law_certs.items():
     g = c.gains
-    print(f"\n{name:>12}: {'CERTIFIED' if c.certified else 'not certified'} at sigma = {c.sigma['value']:g}; "
+    print(f"\n{name:>12}: {'CERTIFIED' if c.certified else 'not certified'} at sigma = {c.sigma.value:g}; "
           f"G diagonal in [{', '.join(f'{lo:.3g}..{hi:.3g}' for lo, hi in zip(g.g_lo, g.g_hi))}], "
           f"sup|G_od| = {g.g_off[2][0]:.3g}, sup|K| rows = {np.round(np.sum(g.k_abs, axis=1), 3)}")
-    print(f"{'':>14}tube rho = {np.round(c.tube['rho'], 4)}, kappa_bar = {np.round(c.kappa_bar, 4)}")
+    print(f"{'':>14}tube rho = {np.round(c.tube.rho, 4)}, kappa_bar = {np.round(c.kappa_bar, 4)}")
     for f in c.failures:
-        print(f"{'':>14}FAIL {f['condition']}: {num(f['lhs'])} vs {num(f['rhs'])}")
+        print(f"{'':>14}FAIL {f.condition}: {num(f.lhs)} vs {num(f.rhs)}")
 
 # %% [markdown]
 # The three laws differ in G = J K, and the tube reads only entry bounds of K and G:

@@ -20,6 +20,8 @@ matplotlib. ``import verify`` loads no sympy either: the names below are importe
 from __future__ import annotations
 
 import importlib
+import sys
+import types
 from pathlib import Path
 from typing import Any
 
@@ -64,3 +66,19 @@ def __getattr__(name: str) -> Any:
 
 def __dir__() -> list[str]:
     return sorted(set(globals()) | set(_LAZY))
+
+
+class _Package(types.ModuleType):
+    """``verify`` itself: keeps ``verify.envelope`` / ``verify.recheck`` the functions, not their modules.
+
+    Importing a submodule binds it on the package under its own name; for the two public functions
+    named like their modules, the function is bound instead (the module stays in ``sys.modules``).
+    """
+
+    def __setattr__(self, name: str, value: Any) -> None:
+        if isinstance(value, types.ModuleType) and _LAZY.get(name) == value.__name__:
+            value = getattr(value, name)
+        super().__setattr__(name, value)
+
+
+sys.modules[__name__].__class__ = _Package

@@ -21,12 +21,15 @@ obstacle, and |e_j - ê_j| <= tube_j within every period, provided the two
 
 from __future__ import annotations
 
+import importlib.util
 import math
 import time
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 
+from tubekit.design_key import design_fields, design_key
 from tubekit.model.ancillary import AncillaryLaw, get_law, register_law
 from tubekit.exceptions import ConfigError, TubekitError
 from tubekit.jsonable import to_jsonable
@@ -35,10 +38,12 @@ from tubekit.tightening import Tightening
 
 from verify.design import Condition, Design, DisturbanceBounds, disturbance_bounds, evaluate_design
 from verify.gains import GainBounds, gain_bounds
+from verify.parts import EBar, SigmaChoice, SigmaTrial
 from verify.region import Region
+from verify.sampled import HorizonMargins, PeriodTube
 
 __all__ = ["Condition", "Certificate", "NotCertifiedError", "certify", "sigma_candidates", "choose_design",
-           "ASSUMPTIONS", "PREMISES", "THEOREM"]
+           "certificate_fields", "paper_route_of", "ASSUMPTIONS", "PREMISES", "THEOREM"]
 
 THEOREM = ("sampled-data tube under the nominal reset: one-period box tube (verify.sampled), per-arc margins of "
            "the replayed candidate (verify.sampled.horizon_margins), exact arc acceptance (tubekit.loop.plan_check)")
@@ -68,6 +73,9 @@ class NotCertifiedError(TubekitError):
 class Certificate:
     """Result of :func:`certify`. ``certified`` is True only if every condition of the chosen design holds.
 
+    Every part is typed; :meth:`to_dict` / :meth:`from_dict` are exact inverses
+    (``Certificate.from_dict(c.to_dict()) == c``, :mod:`verify.certificate_json`).
+
     Attributes
     ----------
     scenario_name, law : str
@@ -80,12 +88,23 @@ class Certificate:
         ω̄_xy, ω̄_z, γ̄ (m/s).
     design : Design
         The chosen σ with its tube, margins, V̄ and conditions.
-    tried : tuple of dict
+    tried : tuple of SigmaTrial
         Every σ evaluated: ``sigma``, ``certified``, ``score``, ``failed``.
     sigma_source : str
         Why this σ.
     elapsed_s : float
-        Wall time (s): reported, never part of a verdict.
+        Wall time (s, rounded to ms): reported, never part of a verdict or of the checksum.
+    horizon_steps, dt : int, float
+        N and δ (s).
+    limits : (3,) floats
+        V of the scenario (m/s, m/s, rad/s).
+    scenario_data : dict
+        The scenario as JSON (``Scenario.to_dict()``).
+    design_fields : dict
+        What the theorem read (:func:`tubekit.design_key.design_fields`, plus ``region_override``
+        when ``certify`` was given another region); :attr:`design_key` is their hash.
+    paper_route : object or None
+        The paper's Lemma-1 route (``verify.lemma1.route.PaperRoute``) when available: a report, not the verdict.
     """
 
     scenario_name: str
@@ -94,7 +113,7 @@ class Certificate:
     gains: GainBounds
     disturbance: DisturbanceBounds
     design: Design
-    tried: tuple[dict, ...]
+    tried: tuple[SigmaTrial, ...]
     sigma_source: str
     elapsed_s: float
     horizon_steps: int = 8
@@ -103,6 +122,8 @@ class Certificate:
     premises: tuple[str, ...] = PREMISES
     limits: tuple[float, float, float] = field(default=(0.4, 0.3, 0.5))
     scenario_data: dict = field(default_factory=dict)
+    design_fields: dict = field(default_factory=dict)
+    paper_route: Any = None
 
     # ------------------------------------------------------------------ status
     @property
@@ -121,26 +142,34 @@ class Certificate:
         return self.certified
 
     @property
-    def failures(self) -> list[dict]:
-        """One ``{condition, inequality, lhs, rhs, detail}`` per failed condition."""
-        return [{k: v for k, v in c.to_dict().items() if k != "ok"} for c in self.conditions if c.ok is False]
+    def failures(self) -> tuple[Condition, ...]:
+        """The failed conditions."""
+        return tuple(c for c in self.conditions if c.ok is False)
 
     @property
-    def not_evaluated(self) -> list[str]:
+    def not_evaluated(self) -> tuple[str, ...]:
         """Names of conditions that could not be evaluated."""
-        return [c.condition for c in self.conditions if c.ok is None]
+        return tuple(c.condition for c in self.conditions if c.ok is None)
 
     @property
-    def sigma(self) -> dict:
-        """``value`` (1/s), ``source``, ``tried`` (every σ evaluated)."""
-        return {"value": self.design.sigma, "source": self.sigma_source, "tried": list(self.tried)}
+    def theorem(self) -> str:
+        """The theorem this certificate states (:data:`THEOREM`)."""
+        return THEOREM
 
     @property
-    def tube(self) -> dict:
-        """The one-period tube: per-axis ``rho`` (m, m, -), ``theta``, Cartesian bounds, ``kappa``, form."""
-        d = self.design.tube.to_dict()
-        d["form"] = "box: |e_j - e_hat_j| <= rho_j within every FHOCP period (deviation restarts at 0)"
-        return d
+    def design_key(self) -> str:
+        """SHA-256 of :attr:`design_fields` (:func:`tubekit.design_key.design_key`)."""
+        return design_key(self.design_fields)
+
+    @property
+    def sigma(self) -> SigmaChoice:
+        """σ (1/s), why it was chosen, every σ tried."""
+        return SigmaChoice(value=self.design.sigma, source=self.sigma_source, tried=self.tried)
+
+    @property
+    def tube(self) -> PeriodTube:
+        """The one-period box tube (per-axis ``rho``, ``theta``, Cartesian bounds, ``kappa``)."""
+        return self.design.tube
 
     @property
     def rho_tilde(self) -> float | None:
@@ -159,35 +188,31 @@ class Certificate:
         return np.asarray(self.design.tube.kappa) if self.design.tube.certified else None
 
     @property
-    def margins(self) -> dict | None:
+    def margins(self) -> HorizonMargins | None:
         """Per-arc margins (e_d, e_z, e_o, position) or None."""
-        return None if self.design.margins is None else self.design.margins.to_dict()
+        return self.design.margins
 
     @property
-    def e_bar(self) -> dict | None:
+    def e_bar(self) -> EBar | None:
         """Ē on the last arc: R shrunk by the largest margin."""
         m, reg = self.design.margins, self.region
         if m is None:
             return None
-        return {"e_d": (reg.e_d[0] + m.e_d[-1], reg.e_d[1] - m.e_d[-1]),
-                "e_z": (reg.e_z[0] + m.e_z[-1], reg.e_z[1] - m.e_z[-1]),
-                "e_o": (reg.e_o[0] + m.e_o[-1], reg.e_o[1] - m.e_o[-1])}
+        return EBar(e_d=(reg.e_d[0] + m.e_d[-1], reg.e_d[1] - m.e_d[-1]),
+                    e_z=(reg.e_z[0] + m.e_z[-1], reg.e_z[1] - m.e_z[-1]),
+                    e_o=(reg.e_o[0] + m.e_o[-1], reg.e_o[1] - m.e_o[-1]))
 
     # ------------------------------------------------------------------ output
     def to_dict(self) -> dict:
-        """JSON-ready dict: verdict, theorem, inputs of the theorem, tube, margins, conditions."""
-        return to_jsonable({
-            "certified": self.certified, "scenario": self.scenario_name, "law": self.law, "theorem": THEOREM,
-            "region": self.region.to_dict(), "disturbance": self.disturbance.to_dict(),
-            "gains": self.gains.to_dict(), "sigma": self.sigma, "problem": self.design.problem.to_dict(),
-            "tube": self.tube, "margins": self.margins, "v_bar": self.v_bar, "kappa_bar": self.kappa_bar,
-            "e_bar": self.e_bar, "arc_rates": list(self.design.rates),
-            "horizon": {"steps": self.horizon_steps, "dt": self.dt},
-            "conditions": [c.to_dict() for c in self.conditions], "failures": self.failures,
-            "not_evaluated": self.not_evaluated, "assumptions": list(self.assumptions),
-            "premises": list(self.premises), "scenario_data": self.scenario_data,
-            "elapsed_s": round(self.elapsed_s, 3),
-        })
+        """JSON-ready dict: verdict, theorem, its inputs, tube, margins, conditions, design key, checksum."""
+        from verify.certificate_json import certificate_to_dict
+        return certificate_to_dict(self)
+
+    @classmethod
+    def from_dict(cls, d: dict) -> "Certificate":
+        """The certificate of a :meth:`to_dict` dict (ConfigError naming the key when one is missing or mistyped)."""
+        from verify.certificate_json import certificate_from_dict
+        return certificate_from_dict(cls, d)
 
     def summary(self) -> str:
         """Human-readable certificate."""
@@ -204,7 +229,7 @@ class Certificate:
         """
         from verify.handoff import tightening_of
         if not self.certified:
-            names = ", ".join(f["condition"] for f in self.failures) or ", ".join(self.not_evaluated)
+            names = ", ".join(f.condition for f in self.failures) or ", ".join(self.not_evaluated)
             raise NotCertifiedError(f"scenario '{self.scenario_name}' with law '{self.law}' is not certified "
                                     f"(failed: {names}); use best_effort_tightening() for a run without a "
                                     "guarantee")
@@ -308,11 +333,37 @@ def certify(scenario: Scenario, law: str | AncillaryLaw | None = None, *, region
     sigmas, source = sigma_candidates(scenario)
     designs = [evaluate_design(scenario, region, gains, s, dist) for s in sigmas]
     best = choose_design(designs)
-    tried = tuple({"sigma": d.sigma, "certified": d.certified, "score": d.score if math.isfinite(d.score) else None,
-                   "failed": [c.condition for c in d.failures]} for d in designs)
+    tried = tuple(SigmaTrial(sigma=d.sigma, certified=d.certified, score=d.score if math.isfinite(d.score) else None,
+                             failed=tuple(c.condition for c in d.failures)) for d in designs)
     ctrl = scenario.controller
     assumptions = ASSUMPTIONS + (_dynamic_assumptions(scenario, dist) if _is_dynamic(scenario) else ())
     return Certificate(scenario_name=scenario.name, law=law, region=region, gains=gains, disturbance=dist,
-                       design=best, tried=tried, sigma_source=source, elapsed_s=time.perf_counter() - t0,
-                       horizon_steps=ctrl.horizon_steps, dt=ctrl.dt, limits=tuple(scenario.limits.vector),
-                       scenario_data=scenario.to_dict(), assumptions=assumptions)
+                       design=best, tried=tried, sigma_source=source,
+                       elapsed_s=round(time.perf_counter() - t0, 3), horizon_steps=ctrl.horizon_steps, dt=ctrl.dt,
+                       limits=tuple(float(x) for x in scenario.limits.vector),
+                       scenario_data=to_jsonable(scenario.to_dict()), assumptions=assumptions,
+                       design_fields=certificate_fields(scenario, law, best.sigma, region),
+                       paper_route=paper_route_of(scenario, law, region))
+
+
+def certificate_fields(scenario: Scenario, law: str, sigma: float, region: Region) -> dict:
+    """:func:`tubekit.design_key.design_fields`, plus ``region_override`` (the entries of ``region`` that differ
+    from :meth:`Region.from_scenario`) when the certificate holds over another region than the scenario's."""
+    fields = design_fields(scenario, law, sigma)
+    default, used = Region.from_scenario(scenario).to_dict(), region.to_dict()
+    override = {k: v for k, v in used.items() if k != "bearing" and v != default[k]}
+    if override:
+        fields["region_override"] = to_jsonable(override)
+    return fields
+
+
+def paper_route_of(scenario: Scenario, law: str, region: Region | None = None) -> Any:
+    """The paper's Lemma-1 route over ``region`` (``verify.lemma1.route.paper_route``) when that module is
+    present, else None.
+
+    A report beside the verdict, never part of it (see ``docs/verify.md``).
+    """
+    if importlib.util.find_spec("verify.lemma1.route") is None:
+        return None
+    from verify.lemma1.route import paper_route
+    return paper_route(scenario, law, region=region)

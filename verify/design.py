@@ -31,6 +31,7 @@ from tubekit.model.vehicles import VehicleParams
 
 from verify.gains import GainBounds
 from verify.intervals import lower, upper
+from verify.parts import bound, flag, item, number, text
 from verify.region import Region
 from verify.sampled import HorizonMargins, PeriodTube, TubeProblem, horizon_margins, one_period_tube
 
@@ -49,12 +50,25 @@ class Condition:
     ok: bool | None
     detail: str = ""
 
+    def __post_init__(self) -> None:
+        # the JSON keeps finite numbers only: a non-finite side is "no number" here too (exact round trip)
+        for k in ("lhs", "rhs"):
+            v = getattr(self, k)
+            object.__setattr__(self, k, None if v is None or not math.isfinite(float(v)) else float(v))
+
     def to_dict(self) -> dict:
         """``{condition, inequality, lhs, rhs, ok, detail}`` (non-finite numbers as None)."""
         def num(x: float | None) -> float | None:
             return None if x is None or not math.isfinite(float(x)) else float(x)
         return {"condition": self.condition, "inequality": self.inequality, "lhs": num(self.lhs),
                 "rhs": num(self.rhs), "ok": self.ok, "detail": self.detail}
+
+    @classmethod
+    def from_dict(cls, d: dict, where: str = "certificate.conditions[]") -> "Condition":
+        """Inverse of :meth:`to_dict`."""
+        sides = {k: None if item(d, k, where) is None else number(d, k, where) for k in ("lhs", "rhs")}
+        return cls(condition=text(d, "condition", where), inequality=text(d, "inequality", where), **sides,
+                   ok=flag(d, "ok", where, allow_none=True), detail=text(d, "detail", where))
 
 
 @dataclass(frozen=True)
@@ -70,6 +84,13 @@ class DisturbanceBounds:
     def to_dict(self) -> dict:
         """JSON-ready copy."""
         return dict(self.__dict__)
+
+    @classmethod
+    def from_dict(cls, d: dict, where: str = "certificate.disturbance") -> "DisturbanceBounds":
+        """Inverse of :meth:`to_dict` (``null`` bounds read as +inf)."""
+        return cls(omega_xy=bound(d, "omega_xy", where), omega_z=bound(d, "omega_z", where),
+                   gamma=bound(d, "gamma", where), declared_sway=bound(d, "declared_sway", where),
+                   yaw_rate_error=bound(d, "yaw_rate_error", where))
 
 
 def hull_sway_bound(params: VehicleParams, u_bar: float, r_bar: float) -> arb:

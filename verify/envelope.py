@@ -244,7 +244,7 @@ def _frontier_at(scenario: Scenario, law: str, speed: float, eps: float, top: fl
     the first failure at the refuted a, and the sigma (1/s) of the certified design at the certified a."""
     def verdict(a: float) -> tuple[bool, str, float]:
         cert = certify(scenario_at(scenario, speed=speed, amplitude_xy=a, epsilon=eps), law)
-        return cert.certified, (cert.failures[0]["condition"] if cert.failures else ""), cert.design.sigma
+        return cert.certified, (cert.failures[0].condition if cert.failures else ""), cert.design.sigma
 
     ok, fail, sigma = verdict(0.0)
     if not ok:

@@ -13,6 +13,7 @@ taken exactly.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from functools import lru_cache
 
@@ -22,10 +23,11 @@ import sympy as sp
 from tubekit.model.ancillary import get_law
 from tubekit.exceptions import ConfigError
 
-from verify.intervals import Case, compile_arb, compile_numpy, maximise
+from verify.intervals import Case, compile_arb, compile_numpy, enclose, maximise, upper
+from verify.parts import flag, matrix, numbers
 from verify.region import Region
 
-__all__ = ["GainBounds", "gain_bounds", "gain_entries", "polar_jacobian"]
+__all__ = ["GainBounds", "GainProof", "gain_bounds", "gain_entries", "polar_jacobian", "prove_gain_bounds"]
 
 _ED, _EO = sp.symbols("e_d e_o", real=True)
 #: Relative gap the gain bounds aim for (they enter the tube linearly).
@@ -52,6 +54,13 @@ class GainBounds:
         """JSON-ready copy."""
         return {"k_abs": [list(r) for r in self.k_abs], "g_lo": list(self.g_lo), "g_hi": list(self.g_hi),
                 "g_off": [list(r) for r in self.g_off], "converged": self.converged}
+
+    @classmethod
+    def from_dict(cls, d: dict, where: str = "certificate.gains") -> "GainBounds":
+        """Inverse of :meth:`to_dict`."""
+        return cls(k_abs=matrix(d, "k_abs", where), g_lo=numbers(d, "g_lo", where, 3, none=None),
+                   g_hi=numbers(d, "g_hi", where, 3, none=None), g_off=matrix(d, "g_off", where),
+                   converged=bool(flag(d, "converged", where)))
 
 
 @lru_cache(maxsize=32)
@@ -108,3 +117,78 @@ def gain_bounds(law: str, region: Region, max_boxes: int = 4000) -> GainBounds:
             conv = conv and ok1
     return GainBounds(k_abs=tuple(map(tuple, k_abs)), g_lo=tuple(g_lo), g_hi=tuple(g_hi),
                       g_off=tuple(map(tuple, g_off)), converged=conv)
+
+
+# --------------------------------------------------------------------------- re-proof of stored bounds
+@dataclass(frozen=True)
+class GainProof:
+    """One stored gain bound re-proved: ``status`` 'proved', 'refuted' (``witness`` > ``stored``) or 'unresolved'."""
+
+    name: str
+    stored: float
+    status: str
+    witness: float
+    boxes: int
+
+
+@lru_cache(maxsize=256)
+def _compiled(expr: sp.Expr):
+    return compile_arb([expr], [_ED, _EO]), compile_numpy([expr], [_ED, _EO])
+
+
+def _prove_at_most(exprs: list[sp.Expr], region: Region, limit: float, max_boxes: int) -> tuple[str, float, int]:
+    """Prove sup expr <= ``limit`` over R for every expr: Arb on a bisection of the box (the split rule of
+    :func:`verify.intervals.maximise`, so a bound ``gain_bounds`` reached is re-proved within its budget)."""
+    lo0, hi0 = np.array([region.e_d[0], region.e_o[0]]), np.array([region.e_d[1], region.e_o[1]])
+    scale = np.where(hi0 > lo0, hi0 - lo0, 1.0)
+    grid = np.meshgrid(np.linspace(lo0[0], hi0[0], 33), np.linspace(lo0[1], hi0[1], 33))
+    worst, boxes = -math.inf, 0
+    for e in exprs:
+        if not e.free_symbols:
+            worst = max(worst, float(e))
+            continue
+        f_arb, f_np = _compiled(e)
+        vals = np.asarray(f_np(grid[0], grid[1]), dtype=float)
+        worst = max(worst, float(np.nanmax(vals)) if np.any(np.isfinite(vals)) else -math.inf)
+        stack = [(lo0.copy(), hi0.copy())]
+        while stack and worst <= limit:
+            lo, hi = stack.pop()
+            boxes += 1
+            ub = upper(f_arb(enclose(lo[0], hi[0]), enclose(lo[1], hi[1]))[0])
+            if ub <= limit:
+                continue
+            if boxes >= max_boxes:
+                return "unresolved", worst, boxes
+            k = int(np.argmax((hi - lo) / scale))
+            m = 0.5 * (lo[k] + hi[k])
+            h1, l2 = hi.copy(), lo.copy()
+            h1[k], l2[k] = m, m
+            centre = 0.5 * (lo + hi)
+            worst = max(worst, float(np.asarray(f_np(centre[0], centre[1]), dtype=float).reshape(-1)[0]))
+            stack += [(l2, hi), (lo, h1)]
+    if worst > limit:
+        return "refuted", worst, boxes
+    return "proved", worst, boxes
+
+
+def prove_gain_bounds(law: str, region: Region, gains: GainBounds, max_boxes: int = 1500) -> list[GainProof]:
+    """Re-prove every stored entry bound of ``gains`` for ``law`` over ``region`` in Arb.
+
+    Each bound b is proved as sup f <= b (for ``g_lo``: sup(-G_jj) <= -b) by bisection with Arb
+    enclosures; a sampled value above b refutes it. ``max_boxes`` is the budget per entry (boxes).
+    """
+    per = [gain_entries(law, s) for s in region.hemisphere_signs]
+    out: list[GainProof] = []
+    for j in range(3):
+        for l in range(3):
+            idx = 3 * j + l
+            items = [(f"gains.k_abs[{j}][{l}]", [sp.Abs(K[idx]) for K, _ in per], gains.k_abs[j][l], 1.0)]
+            if j == l:
+                items += [(f"gains.g_hi[{j}]", [G[idx] for _, G in per], gains.g_hi[j], 1.0),
+                          (f"gains.g_lo[{j}]", [-G[idx] for _, G in per], -gains.g_lo[j], -1.0)]
+            else:
+                items.append((f"gains.g_off[{j}][{l}]", [sp.Abs(G[idx]) for _, G in per], gains.g_off[j][l], 1.0))
+            for name, exprs, limit, sign in items:
+                status, worst, boxes = _prove_at_most(exprs, region, float(limit), max_boxes)
+                out.append(GainProof(name, sign * float(limit), status, sign * worst, boxes))
+    return out

@@ -9,13 +9,16 @@ Best effort (not certified): the same construction from the best design found,
 each input limit kept at >= max(``min_input_fraction`` · V_i, the keep-up need)
 and each node constraint keeping >= a quarter of R's half-width; flagged
 ``certified=False`` — it carries no guarantee.
+
+Both carry what they were certified for: the law, the certificate's design key and its fields
+(:mod:`tubekit.design_key`), so a run of another design refuses them before it starts.
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-from tubekit.tightening import Tightening
+from tubekit.tightening import DisturbanceBound, RegionBounds, Tightening
 
 __all__ = ["tightening_of", "MIN_KEPT_FRACTION"]
 
@@ -72,8 +75,9 @@ def tightening_of(cert, min_input_fraction: float = 0.5) -> Tightening:
     tube = np.asarray(d.tube.rho, dtype=float) if d.tube.certified else np.zeros(3)
     return Tightening(v_max=_input_limits(cert, min_input_fraction), rho_tilde=float(np.linalg.norm(tube)),
                       sigma=float(d.sigma), margins=margins, rates=rates, tube=tube,
-                      region=np.array([reg.e_d[0], reg.e_d[1], min(-reg.e_z[0], reg.e_z[1]),
-                                       min(-reg.e_o[0], reg.e_o[1])]),
-                      disturbance=np.array([cert.disturbance.omega_xy, cert.disturbance.omega_z,
-                                            cert.disturbance.gamma]),
-                      certified=bool(cert.certified), **nodes)
+                      region=RegionBounds(epsilon=reg.e_d[0], e_d_max=reg.e_d[1], e_z_max=min(-reg.e_z[0], reg.e_z[1]),
+                                          e_o_max=min(-reg.e_o[0], reg.e_o[1])),
+                      disturbance=DisturbanceBound(omega_xy=cert.disturbance.omega_xy,
+                                                   omega_z=cert.disturbance.omega_z, sway=cert.disturbance.gamma),
+                      certified=bool(cert.certified), law=cert.law, design_key=cert.design_key,
+                      design_fields=dict(cert.design_fields), **nodes)

@@ -137,6 +137,21 @@ class Region:
         d["bearing"] = "any angle in [0, 2 pi)"
         return d
 
+    @classmethod
+    def from_dict(cls, d: dict, where: str = "certificate.region") -> "Region":
+        """Inverse of :meth:`to_dict` (``bearing`` is a description and is not read)."""
+        from verify.parts import number, numbers, text
+        try:
+            return cls(e_d=numbers(d, "e_d", where, 2, none=None), e_z=numbers(d, "e_z", where, 2, none=None),
+                       e_o=numbers(d, "e_o", where, 2, none=None), heading=text(d, "heading", where),
+                       pd_dot_max=numbers(d, "pd_dot_max", where, 3, none=None),
+                       pd_dot_xy_max=number(d, "pd_dot_xy_max", where), omega_bar=number(d, "omega_bar", where),
+                       v_max=numbers(d, "v_max", where, 3, none=None))
+        except ConfigError as exc:
+            if exc.field.startswith("region."):
+                raise ConfigError(f"{where}{exc.field[len('region'):]}", exc.expected, exc.received) from None
+            raise
+
     def describe(self) -> str:
         """Multi-line printable description of the set."""
         hem = {"toward": "toward (cos(psi - theta) < 0: the vehicle points at the target)",

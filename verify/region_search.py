@@ -135,6 +135,6 @@ def search_region(scenario: Scenario, law: str | None = None, *, e_o_max=E_O_MAX
                 continue
             region = dataclasses.replace(scenario.region, e_o_max=eo, e_d_max=ed)
             cert = certify(scenario.with_changes(region=region), law)
-            first = cert.failures[0]["condition"] if cert.failures else ""
+            first = cert.failures[0].condition if cert.failures else ""
             tried.append(RegionTrial(eo, ed, cert.certified, first))
     return RegionSearchResult(scenario_name=scenario.name, law=law, epsilon=scenario.epsilon, tried=tuple(tried))

@@ -23,7 +23,7 @@ def _tube_lines(cert) -> list[str]:
     d = cert.design
     t = d.tube
     out = [f"sigma = {_f(d.sigma)} 1/s ({cert.sigma_source}); tried: "
-           + ", ".join(f"{_f(x['sigma'])}{'*' if x['certified'] else ''}" for x in cert.tried)
+           + ", ".join(f"{_f(x.sigma)}{'*' if x.certified else ''}" for x in cert.tried)
            + "  (* = certified)"]
     if not t.certified:
         out.append(f"One-period tube: none ({t.reason})")
@@ -65,5 +65,8 @@ def certificate_text(cert) -> str:
     lines.extend(f"  - {p}" for p in cert.premises)
     lines.append("Assumptions (outside the model):")
     lines.extend(f"  - {a}" for a in cert.assumptions)
+    if cert.paper_route is not None:  # a report beside the verdict (verify.lemma1.route), never the verdict
+        lines.extend(cert.paper_route.summary_lines())
+    lines.append(f"Design key: {cert.design_key} (theorem {cert.design_fields.get('theorem_version', 'n/a')})")
     lines.append(f"Elapsed: {cert.elapsed_s:.2f} s")
     return "\n".join(lines)

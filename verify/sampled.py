@@ -34,7 +34,10 @@ from functools import lru_cache
 
 from flint import arb
 
+from tubekit.exceptions import ConfigError
+
 from verify.intervals import upper
+from verify.parts import bound, flag, integer, matrix, number, numbers, text
 
 __all__ = ["TubeProblem", "PeriodTube", "tube_map", "one_period_tube", "horizon_margins", "HorizonMargins"]
 
@@ -82,6 +85,16 @@ class TubeProblem:
         return {k: (list(map(list, v)) if isinstance(v, tuple) and v and isinstance(v[0], tuple)
                     else list(v) if isinstance(v, tuple) else v) for k, v in asdict(self).items()}
 
+    @classmethod
+    def from_dict(cls, d: dict, where: str = "certificate.problem") -> "TubeProblem":
+        """Inverse of :meth:`to_dict` (ConfigError naming the key on a missing or mistyped entry)."""
+        scalars = ("eps", "e_o_max", "u_max", "w_max", "r_max", "omega_xy", "omega_z", "pd_xy", "pd_z", "sigma",
+                   "tick", "yaw_rate_error")
+        kw = {k: number(d, k, where) for k in scalars}
+        return cls(**kw, ticks=integer(d, "ticks", where), k_abs=matrix(d, "k_abs", where),
+                   g_lo=numbers(d, "g_lo", where, 3, none=None), g_hi=numbers(d, "g_hi", where, 3, none=None),
+                   g_off=matrix(d, "g_off", where))
+
 
 @dataclass(frozen=True)
 class PeriodTube:
@@ -123,6 +136,14 @@ class PeriodTube:
         d = asdict(self)
         d["rho"], d["kappa"] = list(self.rho), list(self.kappa)
         return d
+
+    @classmethod
+    def from_dict(cls, d: dict, where: str = "certificate.tube") -> "PeriodTube":
+        """Inverse of :meth:`to_dict`; ``null`` bounds read as +inf (no finite bound). Extra keys are ignored."""
+        return cls(rho=numbers(d, "rho", where, 3), theta=bound(d, "theta", where), p_xy=bound(d, "p_xy", where),
+                   p_z=bound(d, "p_z", where), psi=bound(d, "psi", where), kappa=numbers(d, "kappa", where, 3),
+                   certified=bool(flag(d, "certified", where)), iterations=integer(d, "iterations", where),
+                   reason=text(d, "reason", where), contraction=bound(d, "contraction", where))
 
 
 # --------------------------------------------------------------------------- the map F
@@ -310,6 +331,15 @@ class HorizonMargins:
     def to_dict(self) -> dict:
         """JSON-ready copy."""
         return {k: list(v) for k, v in asdict(self).items()}
+
+    @classmethod
+    def from_dict(cls, d: dict, where: str = "certificate.margins") -> "HorizonMargins":
+        """Inverse of :meth:`to_dict`: four lists of one length (``null`` read as +inf)."""
+        cols = {k: numbers(d, k, where) for k in ("e_d", "e_z", "e_o", "position")}
+        if len({len(v) for v in cols.values()}) != 1:
+            raise ConfigError(where, "four lists of one length (one entry per arc)",
+                              {k: len(v) for k, v in cols.items()})
+        return cls(**cols)
 
 
 def horizon_margins(p: TubeProblem, tube: PeriodTube, arcs: int) -> HorizonMargins:

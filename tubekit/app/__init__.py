@@ -1,9 +1,15 @@
 """The application layer: the only code that parses arguments, plots, writes result files or imports verify.
 
-* :mod:`tubekit.app.cli` — the ``tubekit`` console script (one parser, every subcommand);
+* :mod:`tubekit.app.cli` — the ``tubekit`` console script (one parser, every subcommand), with the
+  subcommands in :mod:`tubekit.app.commands_study` and :mod:`tubekit.app.commands_verify`, the exit
+  codes by error type in :mod:`tubekit.app.exit_codes` and the output-path / ``--json`` policy in
+  :mod:`tubekit.app.output`;
+* :mod:`tubekit.app.certified` — certify (or take a given certificate): the tightening a run uses;
 * :mod:`tubekit.app.study` — the closed-loop study of ``reproduce`` / ``simulate``
-  (certify → tube run + baseline → metrics → files);
-* :mod:`tubekit.app.plots` — every figure (a run's, an envelope's);
+  (certify → tube run + baseline with :func:`tubekit.loop.pipeline.certified_run` → files; a
+  :class:`~tubekit.app.study.StudyResult`), :mod:`tubekit.app.dynamic_study` its dynamic-plant part,
+  :mod:`tubekit.app.campaign` many runs on dask;
+* :mod:`tubekit.app.plots` — every figure (a run's: :func:`~tubekit.app.plots.plot_run`; an envelope's);
 * :mod:`tubekit.app.animate` — the animated top view (``--animate``).
 
 Nothing here is imported by ``import tubekit``; import the submodule you need.

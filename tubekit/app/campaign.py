@@ -6,7 +6,8 @@ certify once per distinct certificate input (:func:`verify.certify`, on the clie
 → submit the unfinished runs (``retries``) → store each finished run as ``DIR/runs/run_KKKKKK.json``
 the moment it completes → assemble ``DIR/runs.parquet`` atomically → ``summary.json`` → figures.
 
-Worker side (:func:`simulate_task`): the run's scenario under the shipped tightening, plus
+Worker side (:func:`simulate_task`): the run's scenario under the shipped tightening (each simulation is
+:func:`tubekit.loop.pipeline.certified_run`; the verdict travels in ``Tightening.certified``), plus
 ``falsify.sequences`` runs where the current is replaced by a random piecewise-constant disturbance
 within the certificate's bounds (:func:`verify.falsify.closed_loop.piecewise_disturbance`, one ω per FHOCP
 period, drawn from the run's seed); the row keeps the worst figure of each metric over those runs.
@@ -18,7 +19,6 @@ from __future__ import annotations
 import contextlib
 import json
 import logging
-import math
 import os
 import sys
 import time
@@ -33,10 +33,10 @@ from tubekit.jsonable import write_json
 from tubekit.scenario import Scenario
 from tubekit.tightening import Tightening
 from tubekit.app.campaign_spec import CampaignSpec, RunPlan, certificate_key, spec_from_stored
-from tubekit.app.study import check_output_dir
+from tubekit.app.output import check_output_dir
 
-__all__ = ["RunTask", "Certified", "simulate_task", "certify_plans", "open_client", "run_campaign",
-           "read_rows", "replay_run", "replay_into", "summarise", "summary_line", "write_figures", "METRIC_COLUMNS", "FIGURES"]
+__all__ = ["RunTask", "simulate_task", "certify_plans", "open_client", "run_campaign", "read_rows", "replay_run",
+           "replay_into", "ReplayResult", "summarise", "summary_line", "write_figures", "METRIC_COLUMNS", "FIGURES"]
 
 LOGGER = logging.getLogger("tubekit.campaign")
 #: Per-run metric columns of ``runs.parquet`` (after run, seed and the sampled values).
@@ -46,25 +46,16 @@ METRIC_COLUMNS = ("certified", "max_rho_ratio", "min_clearance", "min_e_d", "tra
 FIGURES = ("ecdf.png", "worst_runs.png")
 #: Retries of a run whose worker raised or died (dask ``retries``).
 RETRIES = 3
-_PREMISES = ("disturbance", "recursive_feasibility")
-
-
-@dataclass(frozen=True)
-class Certified:
-    """The certificate shipped for one distinct certificate input: its tightening and verdict."""
-
-    tightening: Tightening
-    certified: bool
 
 
 @dataclass(frozen=True)
 class RunTask:
-    """Everything a worker needs for one run (pickled to the worker)."""
+    """Everything a worker needs for one run (pickled to the worker); ``tightening.certified`` is the verdict."""
 
     run: int
     seed: int
     scenario: Scenario
-    certificate: Certified
+    tightening: Tightening
     sequences: int
 
 
@@ -76,34 +67,28 @@ def _disturbances(task: RunTask) -> list[Callable | None]:
         return [None]
     from verify.falsify.closed_loop import piecewise_disturbance
 
-    omega_xy, omega_z = (float(x) for x in task.certificate.tightening.disturbance[:2])
+    bound = task.tightening.disturbance
+    omega_xy, omega_z = bound.omega_xy, bound.omega_z
     rng = np.random.default_rng([task.seed, 1])
     dt = task.scenario.controller.dt
     return [None] + [piecewise_disturbance(omega_xy, omega_z, dt, rng.random((task.scenario.steps, 3)))
                      for _ in range(task.sequences)]
 
 
-def _simulate_all(task: RunTask) -> list[tuple[Any, list]]:
-    """Each simulation of the run with its promises: [(SimulationResult, [Promise])]."""
-    from tubekit.loop.closed_loop import simulate
-    from tubekit.loop.promises import check_promises
+def _simulate_all(task: RunTask) -> list[Any]:
+    """Each simulation of the run: a :class:`tubekit.loop.pipeline.CertifiedRun` per disturbance."""
+    from tubekit.loop.pipeline import certified_run
 
-    out = []
-    for disturbance in _disturbances(task):
-        run = simulate(task.scenario, tightening=task.certificate.tightening, tube=True, progress=False,
-                       label="tube", disturbance=disturbance)
-        out.append((run, check_promises(run)))
-    return out
+    return [certified_run(task.scenario, task.tightening, label="tube", disturbance=disturbance)
+            for disturbance in _disturbances(task)]
 
 
-def _figures_of(run: Any, promises: list) -> dict[str, Any]:
-    by_name = {p.name: p for p in promises}
-    broken = [p.name for p in promises if p.name not in _PREMISES and math.isfinite(p.observed) and not p.ok]
-    metrics = run.metrics
-    return {"max_rho_ratio": float(by_name["tube"].observed), "min_clearance": float(metrics["min_clearance"]),
+def _figures_of(sim: Any) -> dict[str, Any]:
+    metrics = sim.metrics
+    return {"max_rho_ratio": sim.ratio, "min_clearance": float(metrics["min_clearance"]),
             "min_e_d": float(metrics["min_e_d"]), "tracking_rmse": float(metrics["tracking_rmse"]),
-            "saturated_steps": int(metrics["saturated_steps"]), "broken": broken,
-            "premises_held": all(by_name[n].ok for n in _PREMISES if n in by_name)}
+            "saturated_steps": int(metrics["saturated_steps"]), "broken": list(sim.broken),
+            "premises_held": sim.premises_held}
 
 
 def simulate_task(task: RunTask) -> dict[str, Any]:
@@ -112,18 +97,18 @@ def simulate_task(task: RunTask) -> dict[str, Any]:
     try:
         sims = _simulate_all(task)
     except TubekitError as exc:  # a run that cannot be simulated is recorded, not retried
-        return {"run": task.run, "seed": task.seed, "certified": task.certificate.certified,
+        return {"run": task.run, "seed": task.seed, "certified": bool(task.tightening.certified),
                 "max_rho_ratio": None, "min_clearance": None, "min_e_d": None, "tracking_rmse": None,
                 "saturated_steps": None, "violated": False, "premises_held": False, "broken": "",
                 "worst_sequence": -1, "error": str(exc).splitlines()[0], "wall_s": time.perf_counter() - started}
     return _row_of(task, sims, started)
 
 
-def _row_of(task: RunTask, sims: list[tuple[Any, list]], started: float) -> dict[str, Any]:
+def _row_of(task: RunTask, sims: list[Any], started: float) -> dict[str, Any]:
     """The row of a run: the worst figure of each metric over its simulations."""
-    figures = [_figures_of(run, promises) for run, promises in sims]
+    figures = [_figures_of(sim) for sim in sims]
     worst = int(np.argmax([f["max_rho_ratio"] for f in figures]))
-    return {"run": task.run, "seed": task.seed, "certified": task.certificate.certified,
+    return {"run": task.run, "seed": task.seed, "certified": bool(task.tightening.certified),
             "max_rho_ratio": figures[worst]["max_rho_ratio"],
             "min_clearance": min(f["min_clearance"] for f in figures),
             "min_e_d": min(f["min_e_d"] for f in figures),
@@ -137,16 +122,16 @@ def _row_of(task: RunTask, sims: list[tuple[Any, list]], started: float) -> dict
 
 # ---- certificates and the cluster (client side) ---------------------------------------------------------
 
-def certify_plans(plans: list[RunPlan]) -> dict[str, Certified]:
-    """One :func:`verify.certify` per distinct certificate input of ``plans`` (keyed by :func:`certificate_key`)."""
-    import verify
+def certify_plans(plans: list[RunPlan]) -> dict[str, Tightening]:
+    """One certification per distinct certificate input of ``plans`` (keyed by :func:`certificate_key`):
+    its best-effort tightening, ``certified`` set when the certificate certified it."""
+    from tubekit.app.certified import certify_design
 
-    certs: dict[str, Certified] = {}
+    certs: dict[str, Tightening] = {}
     for plan in plans:
         key = certificate_key(plan.scenario)
         if key not in certs:
-            cert = verify.certify(plan.scenario, law=plan.scenario.controller.law)
-            certs[key] = Certified(cert.best_effort_tightening(), bool(cert.certified))
+            certs[key] = certify_design(plan.scenario).tightening
     return certs
 
 
@@ -255,17 +240,17 @@ def _worst(rows: list[dict], count: int = 10) -> list[dict]:
     return [{**{k: r[k] for k in keep}, "values": {k: r[k] for k in values}} for r in ranked[:count]]
 
 
-def summarise(rows: list[dict], spec: CampaignSpec, certs: dict[str, Certified], facts: dict) -> dict[str, Any]:
+def summarise(rows: list[dict], spec: CampaignSpec, certs: dict[str, Tightening], facts: dict) -> dict[str, Any]:
     """``summary.json``: the largest max_rho_ratio beside the certified radius (1 in the tube's box norm), counts."""
     certified = [r for r in rows if r["certified"]]
-    tubes = np.array([c.tightening.tube for c in certs.values() if c.certified], dtype=float).reshape(-1, 3)
+    tubes = np.array([t.tube for t in certs.values() if t.certified], dtype=float).reshape(-1, 3)
     largest = _worst(rows, 1)
     largest_cert = _worst(certified, 1)
     return {
         "runs": len(rows), "planned_runs": spec.runs, "seed": spec.seed, "duration_s": spec.duration,
         "scenario": spec.scenario_source, "falsify_sequences": spec.falsify_sequences,
         "certified_runs": len(certified), "distinct_certificates": len(certs),
-        "certified_certificates": int(sum(c.certified for c in certs.values())),
+        "certified_certificates": int(sum(bool(t.certified) for t in certs.values())),
         "certificate_radius": 1.0,
         "certificate_tube_box": {"min": tubes.min(axis=0).tolist() if tubes.size else None,
                                  "max": tubes.max(axis=0).tolist() if tubes.size else None},
@@ -409,28 +394,60 @@ def replay_run(campaign_dir: str | Path, run: int) -> tuple[dict, dict | None, A
     sims = _simulate_all(task)
     row = _row_of(task, sims, started)
     row = {"run": run, "seed": plan.seed, **_flat_values(plan.values), **{k: row[k] for k in METRIC_COLUMNS}}
-    worst = sims[row["worst_sequence"]][0]
+    worst = sims[row["worst_sequence"]].run
     path = _run_file(folder, run)
     previous = json.loads(path.read_text(encoding="utf-8")) if path.exists() else None
     return row, previous, worst
 
 
-def replay_into(campaign_dir: str | Path, run: int, out: str | Path | None, echo: Callable = print) -> dict:
-    """``tubekit simulate --from-campaign DIR --run K``: replay, write ``trajectory.csv`` and ``replay.json``.
+@dataclass(frozen=True)
+class ReplayResult:
+    """A campaign run replayed: the replayed row, the stored one (None if never stored), where it was written."""
 
-    Returns ``{"identical": replayed row == stored row (wall_s aside), "broken": certified and violated}``.
-    """
-    from tubekit.jsonable import dumps
+    row: dict[str, Any]
+    stored: dict[str, Any] | None
+    out: Path
 
+    @property
+    def identical(self) -> bool:
+        """The replayed row equals the stored one (``wall_s`` aside)."""
+        from tubekit.jsonable import dumps
+
+        return self.stored is not None and dumps({**self.stored, "wall_s": 0}) == dumps({**self.row, "wall_s": 0})
+
+    @property
+    def broken(self) -> bool:
+        """The run is certified and broke a promise (its premises aside)."""
+        return bool(self.row["certified"] and self.row["violated"])
+
+    def check(self) -> bool:
+        """True when the replay is identical to the campaign's row and no certified promise broke."""
+        return self.identical and not self.broken
+
+    def summary(self) -> str:
+        """Each figure replayed beside the campaign's, then the verdict line."""
+        stored = self.stored or {}
+        lines = [f"{key:16s} replayed {self.row[key]!s:24s} campaign {stored.get(key)!s}"
+                 for key in ("max_rho_ratio", "min_clearance", "min_e_d", "tracking_rmse", "saturated_steps",
+                             "violated")]
+        lines.append(f"run {self.row['run']} (seed {self.row['seed']}): "
+                     f"{'identical to' if self.identical else 'DIFFERS from'} the campaign's row; wrote {self.out}")
+        return "\n".join(lines)
+
+    def to_dict(self) -> dict[str, Any]:
+        """``replay.json``."""
+        return {"replayed": self.row, "stored": self.stored, "identical": self.identical}
+
+
+def replay_into(campaign_dir: str | Path, run: int, out: str | Path | None,
+                echo: Callable = print) -> ReplayResult:
+    """``tubekit simulate --from-campaign DIR --run K``: replay, write ``trajectory.csv`` and ``replay.json``."""
     target = Path(out) if out else Path(campaign_dir) / f"replay_{run:06d}"
     check_output_dir(target)
-    row, stored, result = replay_run(campaign_dir, run)
+    row, stored, worst = replay_run(campaign_dir, run)
     target.mkdir(parents=True, exist_ok=True)
-    result.write_csv(target / "trajectory.csv")
-    same = stored is not None and dumps({**stored, "wall_s": 0}) == dumps({**row, "wall_s": 0})
-    write_json(target / "replay.json", {"replayed": row, "stored": stored, "identical": same})
-    for key in ("max_rho_ratio", "min_clearance", "min_e_d", "tracking_rmse", "saturated_steps", "violated"):
-        echo(f"{key:16s} replayed {row[key]!s:24s} campaign {None if stored is None else stored[key]!s}")
-    echo(f"run {run} (seed {row['seed']}): {'identical to' if same else 'DIFFERS from'} the campaign's row; "
-         f"wrote {target}")
-    return {"identical": same, "broken": bool(row["certified"] and row["violated"])}
+    worst.write_csv(target / "trajectory.csv")
+    result = ReplayResult(row, stored, target)
+    write_json(target / "replay.json", result.to_dict())
+    echo(result.summary())
+    return result

@@ -34,6 +34,7 @@ from typing import Any
 
 import numpy as np
 
+from tubekit.checks import require_one_period
 from tubekit.exceptions import ConfigError, TubekitError
 from tubekit.scenario import Scenario, load_scenario, paper_scenario, read_toml, scenario_from_dict
 
@@ -237,8 +238,7 @@ def spec_from_dict(data: Any, spec_dir: Path | None = None) -> CampaignSpec:
     runs = _integer("runs", data["runs"], 1, MAX_RUNS)
     seed = _integer("seed", data["seed"], 0)
     duration = _number("duration", data.get("duration", scenario.duration))
-    if duration < scenario.controller.dt:
-        raise ConfigError("duration", f"seconds >= one FHOCP period ({scenario.controller.dt:g} s)", duration)
+    require_one_period("duration", duration, scenario.controller.dt)
     base = scenario.to_dict()
     sample = data.get("sample", {})
     if not isinstance(sample, dict):

@@ -3,7 +3,8 @@
 :func:`run_dynamic` certifies the scenario with ``[plant] kind = "dynamic"`` (the velocity
 loop's tracking bound and the hull's sway bound enter ω; usually not certified, and then the
 best-effort sets are used and flagged), runs the tube controller on the dynamic plant under
-the same current, measures every promise, and writes ``dynamic_trajectory.csv``,
+the same current with :func:`tubekit.loop.pipeline.certified_run` (metrics and promises in the
+one convention), and writes ``dynamic_trajectory.csv``,
 ``dynamic_certificate.txt`` and ``dynamic_vs_kinematic.png``.
 """
 
@@ -17,14 +18,11 @@ import numpy as np
 from matplotlib.figure import Figure
 from matplotlib.patches import Circle as CirclePatch
 
-import verify
-
-from tubekit.loop.closed_loop import simulate
-from tubekit.loop.result import SimulationResult
 from tubekit.jsonable import write_text
-from tubekit.loop.metrics import compute_metrics
-from tubekit.loop.promises import check_promises
+from tubekit.loop.pipeline import CertifiedRun, certified_run
+from tubekit.loop.result import SimulationResult
 from tubekit.scenario import Scenario
+from tubekit.app.certified import certify_design
 
 __all__ = ["run_dynamic", "comparison_figure", "DYNAMIC_FILES"]
 
@@ -74,22 +72,21 @@ def comparison_figure(scenario: Scenario, kinematic: SimulationResult, dynamic: 
     return fig
 
 
-def run_dynamic(scenario: Scenario, staging: Path, kinematic: SimulationResult, progress: bool) -> dict[str, Any]:
-    """Certify and run the dynamic plant; write its files into ``staging``; return its metrics."""
+def run_dynamic(scenario: Scenario, staging: Path, kinematic: SimulationResult,
+                progress: bool) -> tuple[CertifiedRun, dict[str, Any]]:
+    """Certify and run the dynamic plant; write its files into ``staging``; return the run and its metrics.
+
+    The metrics are the run's (``run.metrics``) plus ``failures`` (the certificate's failed
+    conditions), ``vehicle`` and ``tracking_bound``.
+    """
     scd = _dynamic_scenario(scenario)
-    cert = verify.certify(scd, law=scd.controller.law)
-    write_text(staging / "dynamic_certificate.txt", cert.summary() + "\n")
-    tight = cert.best_effort_tightening()
-    run = simulate(scd, tightening=tight, tube=True, progress=progress, label="dynamic", plant="dynamic")
-    run.write_csv(staging / "dynamic_trajectory.csv")
-    gamma = float(cert.disturbance.gamma)
-    metrics = compute_metrics(run.columns(), scd, rho_bound=tight.rho_tilde if cert.certified else None,
-                              sway_bound=gamma, extra={"tube": True, "law": run.law, "sigma": run.sigma})
-    promises = check_promises(run)
-    metrics.update(certified=bool(cert.certified), failures=[f["condition"] for f in cert.failures],
-                   promises=[p.to_dict() for p in promises], promises_kept=all(p.ok for p in promises),
-                   vehicle=scd.plant.vehicle, tracking_bound=list(scd.plant.tracking_bound))
-    if run.velocity_error is not None:
-        metrics["velocity_error_max"] = [float(x) for x in np.nanmax(np.abs(run.velocity_error), axis=0)]
-    comparison_figure(scd, kinematic, run, gamma).savefig(staging / "dynamic_vs_kinematic.png", dpi=100)
-    return metrics
+    design = certify_design(scd)
+    write_text(staging / "dynamic_certificate.txt", design.certificate.summary() + "\n")
+    dyn = certified_run(scd, design.tightening, progress=progress, label="dynamic")
+    dyn.run.write_csv(staging / "dynamic_trajectory.csv")
+    metrics = dyn.to_dict()
+    metrics.update(failures=[f.condition for f in design.certificate.failures], vehicle=scd.plant.vehicle,
+                   tracking_bound=list(scd.plant.tracking_bound))
+    gamma = float(design.tightening.disturbance.sway)
+    comparison_figure(scd, kinematic, dyn.run, gamma).savefig(staging / "dynamic_vs_kinematic.png", dpi=100)
+    return dyn, metrics

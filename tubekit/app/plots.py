@@ -18,6 +18,7 @@ from matplotlib.ticker import MaxNLocator
 
 from tubekit.exceptions import ConfigError
 from tubekit.loop.metrics import clearance, rho_period_peaks
+from tubekit.loop.result import SimulationResult
 from tubekit.scenario import Scenario
 from tubekit.tightening import Tightening
 
@@ -26,6 +27,7 @@ if TYPE_CHECKING:  # verify is imported for its type only; plotting needs no cer
 
 __all__ = [
     "Run",
+    "plot_run",
     "top_view",
     "draw_scene_xy",
     "fit_canvas",
@@ -177,6 +179,14 @@ def top_view(scenario: Scenario, runs: Sequence[Run], *, tightening: Tightening 
     fit_canvas(fig, ax)
     ax.legend(**_LEGEND_OUTSIDE)
     return fig
+
+
+def plot_run(run: SimulationResult) -> Figure:
+    """The figure of one run: its top view (:func:`top_view`), with the position tube of a tube run."""
+    if not isinstance(run, SimulationResult):
+        raise ConfigError("run", "a tubekit.SimulationResult", type(run).__name__)
+    label = "tube" if run.tube else "baseline"
+    return top_view(run.scenario, [(label, run.columns())], tightening=run.tightening if run.tube else None)
 
 
 def errors_figure(scenario: Scenario, runs: Sequence[Run]) -> Figure:

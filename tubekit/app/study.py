@@ -7,29 +7,27 @@ MPC alone: no κ, no tightening) under the same disturbance, then write into
 the output directory:
 
 * ``trajectory.csv`` / ``baseline_trajectory.csv`` (columns: see
-  :data:`tubekit.loop.closed_loop.CSV_COLUMNS`),
+  :data:`tubekit.loop.result.CSV_COLUMNS`),
 * ``metrics.json`` (tube metrics at the top level, ``baseline`` nested,
   ``acceptance`` for ``reproduce``),
 * ``certificate.json`` and ``certificate.txt``, ``scenario.json``,
 * the figures of :data:`tubekit.app.plots.FIGURE_FILES` (and, with
   ``animate=True``, the animation of :func:`tubekit.app.animate.animate_top_view`).
 
-:func:`run_study` is the pipeline; each step is a function of its own. Every
-input is checked first (:func:`tubekit.checks.check_run_inputs` and the output
-path), then everything is written into a temporary directory next to ``out``
-that replaces ``out`` in one rename at the end (:class:`StagedOutput`): a failed
-or interrupted run leaves the previous results untouched. Diagnostics go to the
-``logging`` logger of this module; the results (comparison table, promises,
-acceptance, ``wrote ...``) are printed on stdout.
+:func:`run_study` is the pipeline: certify (:func:`tubekit.app.certified.certify_design`), then
+each run is :func:`tubekit.loop.pipeline.certified_run` (simulate → metrics → promises), so the
+top level of ``metrics.json`` is the tube run's ``SimulationResult.metrics`` key for key, plus the
+study's own keys (:data:`STUDY_KEYS`). It returns a typed :class:`StudyResult`. Every input is
+checked first (:func:`tubekit.checks.check_run_inputs` and the output path), then everything is
+written into a temporary directory next to ``out`` that replaces ``out`` in one rename at the end
+(:class:`tubekit.app.output.StagedOutput`): a failed or interrupted run leaves the previous results
+untouched. Diagnostics go to the ``logging`` logger of this module; the results (comparison table,
+promises, acceptance, ``wrote ...``) are printed on stdout.
 """
 
 from __future__ import annotations
 
 import logging
-import math
-import os
-import shutil
-import tempfile
 import time
 from dataclasses import dataclass, replace
 from pathlib import Path
@@ -37,29 +35,26 @@ from typing import Any, Callable
 
 import numpy as np
 
-import verify
-
-from tubekit.checks import check_run_inputs
-from tubekit.loop.closed_loop import simulate
-from tubekit.loop.result import SimulationResult
-from tubekit.exceptions import ConfigError
+from tubekit.checks import check_run_inputs, require_one_period
 from tubekit.jsonable import write_json, write_text
-from tubekit.loop.metrics import compute_metrics
-from tubekit.loop.promises import check_promises
+from tubekit.loop.pipeline import CertifiedRun, certified_run
 from tubekit.scenario import Scenario
 from tubekit.tightening import Tightening
+from tubekit.validation import duration_seconds
 from tubekit.app import QUICK_S
+from tubekit.app.certified import CertifiedDesign, certify_design
+from tubekit.app.output import StagedOutput, check_output_dir
 from tubekit.app.plots import plot_all
 
 __all__ = [
     "run_study",
+    "StudyResult",
     "apply_overrides",
     "acceptance",
     "output_dir_name",
     "QUICK_DURATION_S",
     "OUTPUT_FILES",
-    "StagedOutput",
-    "check_output_dir",
+    "STUDY_KEYS",
 ]
 
 LOGGER = logging.getLogger(__name__)
@@ -69,6 +64,9 @@ QUICK_DURATION_S = QUICK_S  # re-exported; the parser reads it from tubekit.app 
 #: Files (besides figures) every study writes.
 OUTPUT_FILES: tuple[str, ...] = ("trajectory.csv", "baseline_trajectory.csv", "metrics.json", "certificate.json",
                                  "certificate.txt", "scenario.json")
+#: Keys of ``metrics.json`` that are the study's, not the tube run's (every other key is ``run.metrics``'s).
+STUDY_KEYS: tuple[str, ...] = ("baseline", "e_d_peaks", "certify_s", "closed_loop", "dynamic", "total_wall_s",
+                               "acceptance")
 
 Echo = Callable[[str], None]
 
@@ -91,11 +89,9 @@ def apply_overrides(scenario: Scenario, *, duration: float | None = None, quick:
     """
     duration = QUICK_DURATION_S if quick else duration
     if duration is not None:
-        if not (isinstance(duration, (int, float)) and math.isfinite(duration) and duration > 0):
-            raise ConfigError("--duration", "a number of seconds > 0", duration)
-        scenario = scenario.with_changes(duration=float(duration))
-        if scenario.steps < 1:
-            raise ConfigError("--duration", f"at least one FHOCP period ({scenario.controller.dt:g} s)", duration)
+        duration = duration_seconds("--duration", duration)
+        require_one_period("--duration", duration, scenario.controller.dt)
+        scenario = scenario.with_changes(duration=duration)
     if law:
         scenario = scenario.with_changes(controller=replace(scenario.controller, law=law))
     return scenario
@@ -144,53 +140,31 @@ def acceptance(metrics: dict[str, Any], total_wall_s: float) -> dict[str, Any]:
     }
 
 
-@dataclass(frozen=True)
-class CertifiedDesign:
-    """What the runs need from the certificate: the tightening, whether it is certified, and the time (s)."""
-
-    tightening: Tightening
-    certified: bool
-    certify_s: float
-
-
 def certify_and_write(scenario: Scenario, out: Path) -> CertifiedDesign:
-    """Certify with :func:`verify.certify`; write ``certificate.json`` and ``certificate.txt``."""
-    LOGGER.info("certifying %r (law %s) ...", scenario.name, scenario.controller.law)
-    started = time.perf_counter()
-    cert = verify.certify(scenario, law=scenario.controller.law)
-    certify_s = time.perf_counter() - started
-    certified = bool(cert.certified)
-    write_json(out / "certificate.json", cert.to_dict())
-    write_text(out / "certificate.txt", str(cert.summary()) + "\n")
-    tightening: Tightening = cert.best_effort_tightening()
-    LOGGER.info("  %s in %.1f s; sigma = %.4g, rho_tilde = %.4g",
-                "certified" if certified else "NOT certified (best-effort tightening used)", certify_s,
-                tightening.sigma, tightening.rho_tilde)
-    return CertifiedDesign(tightening, certified, certify_s)
+    """Certify (:func:`tubekit.app.certified.certify_design`); write ``certificate.json`` and ``certificate.txt``."""
+    design = certify_design(scenario)
+    write_json(out / "certificate.json", design.certificate.to_dict())
+    write_text(out / "certificate.txt", str(design.certificate.summary()) + "\n")
+    return design
 
 
 def run_tube_and_baseline(scenario: Scenario, tightening: Tightening,
-                          progress: bool) -> tuple[SimulationResult, SimulationResult]:
+                          progress: bool) -> tuple[CertifiedRun, CertifiedRun]:
     """The tube controller with ``tightening``, then the baseline (untightened, no κ) under the same disturbance."""
     LOGGER.info("tube run (%g s simulated) ...", scenario.duration)
-    tube = simulate(scenario, tightening=tightening, tube=True, progress=progress, label="tube")
-    LOGGER.info("  %s", tube.summary())
+    tube = certified_run(scenario, tightening, tube=True, progress=progress, label="tube")
+    LOGGER.info("  %s", tube.run.summary())
     LOGGER.info("baseline run (nominal MPC alone) ...")
-    base = simulate(scenario, tightening=Tightening.untightened(scenario), tube=False, progress=progress,
-                    label="baseline")
-    LOGGER.info("  %s", base.summary())
+    base = certified_run(scenario, Tightening.untightened(scenario), tube=False, progress=progress,
+                         label="baseline")
+    LOGGER.info("  %s", base.run.summary())
     return tube, base
 
 
-def _run_facts(run: SimulationResult) -> dict[str, Any]:
-    return {"tube": run.tube, "law": run.law if run.tube else None, "sigma": run.sigma,
-            "kappa_failures": run.kappa_failures, "checks": run.checks}
-
-
-def closed_loop_notes(scenario: Scenario, tube: SimulationResult) -> dict[str, str]:
+def closed_loop_notes(scenario: Scenario, tube: CertifiedRun) -> dict[str, str]:
     """How the closed loop was simulated, in words (``metrics.json["closed_loop"]``)."""
     return {
-        "plant": f"eq. (11), classical RK4, fixed step {tube.plant_step_s * 1e3:g} ms, input held over each tick",
+        "plant": f"eq. (11), classical RK4, fixed step {tube.run.plant_step_s * 1e3:g} ms, input held over each tick",
         "ancillary": f"kappa at {scenario.controller.ancillary_rate_hz:g} Hz, zero-order hold",
         "fhocp": f"every {scenario.controller.dt:g} s, nominal reset to the measured state, first input held",
         "sensing": "obstacle known once its surface is within sensing_range of the vehicle centre; remembered",
@@ -198,26 +172,18 @@ def closed_loop_notes(scenario: Scenario, tube: SimulationResult) -> dict[str, s
     }
 
 
-def write_runs(out: Path, scenario: Scenario, design: CertifiedDesign, tube: SimulationResult,
-               base: SimulationResult) -> dict[str, Any]:
-    """Write both CSVs and the figures; return the metrics of both runs (baseline nested)."""
-    tube.write_csv(out / "trajectory.csv")
-    base.write_csv(out / "baseline_trajectory.csv")
-    tube_cols, base_cols = tube.columns(), base.columns()
-    rho_tilde = float(design.tightening.rho_tilde)
-    metrics = compute_metrics(tube_cols, scenario, rho_bound=rho_tilde if design.certified else None,
-                              extra=_run_facts(tube))
-    metrics["baseline"] = compute_metrics(base_cols, scenario, rho_bound=None, extra=_run_facts(base))
+def write_runs(out: Path, scenario: Scenario, design: CertifiedDesign, tube: CertifiedRun,
+               base: CertifiedRun) -> dict[str, Any]:
+    """Write both CSVs and the figures; return ``metrics.json`` so far: the tube run's metrics, baseline nested."""
+    tube.run.write_csv(out / "trajectory.csv")
+    base.run.write_csv(out / "baseline_trajectory.csv")
+    tube_cols, base_cols = tube.run.columns(), base.run.columns()
+    tight = design.tightening
+    plot_all(out, scenario, [("tube", tube_cols), ("baseline", base_cols)], rho_tilde=float(tight.rho_tilde),
+             certified=design.certified, tightening=tight)
+    metrics = tube.to_dict()
+    metrics["baseline"] = base.to_dict()
     metrics["e_d_peaks"] = e_d_peaks(tube_cols["e_d"], tube_cols["t"])
-    plot_all(out, scenario, [("tube", tube_cols), ("baseline", base_cols)], rho_tilde=rho_tilde,
-             certified=design.certified, tightening=design.tightening)
-    metrics["certified"] = design.certified
-    metrics["rho_tilde_used"] = rho_tilde
-    promises = check_promises(tube)
-    metrics["promises"] = [p.to_dict() for p in promises]
-    metrics["promises_kept"] = all(p.ok for p in promises)
-    metrics["max_rho_ratio"] = promises[0].observed if promises[0].name == "tube" else None
-    metrics["tube_box"] = [float(x) for x in design.tightening.tube]
     metrics["certify_s"] = design.certify_s
     metrics["closed_loop"] = closed_loop_notes(scenario, tube)
     return metrics
@@ -242,140 +208,131 @@ def comparison_table(tube: dict[str, Any], base: dict[str, Any]) -> str:
     return "\n".join(lines)
 
 
-def log_promises(metrics: dict[str, Any], log: Echo = print) -> None:
+def promise_lines(metrics: dict[str, Any]) -> list[str]:
     """Each promise of the certificate with its numbers; says plainly when a certified one is broken."""
     certified = metrics["certified"]
-    head = ("promises of the certificate (certified):" if certified
-            else "figures a certificate would promise (NOT certified: nothing is claimed):")
-    log(head)
+    lines = ["promises of the certificate (certified):" if certified
+             else "figures a certificate would promise (NOT certified: nothing is claimed):"]
     for p in metrics["promises"]:
         mark = "ok  " if p["ok"] else ("BROKEN" if certified else "no  ")
-        log(f"  [{mark}] {p['name']}: {_fmt(p['observed'])} vs {_fmt(p['bound'])}  ({p['detail']})")
+        lines.append(f"  [{mark}] {p['name']}: {_fmt(p['observed'])} vs {_fmt(p['bound'])}  ({p['detail']})")
     if certified and not metrics["promises_kept"]:
-        log("CERTIFIED PROMISE BROKEN: the run violates what the certificate guarantees (exit 4)")
+        lines.append("CERTIFIED PROMISE BROKEN: the run violates what the certificate guarantees (exit 4)")
+    return lines
 
 
-def log_acceptance(metrics: dict[str, Any], log: Echo = print) -> None:
+def acceptance_lines(metrics: dict[str, Any]) -> list[str]:
     """The acceptance verdicts, then every e_d < ε interval and every collision."""
-    log("acceptance: " + ", ".join(f"{k}={v}" for k, v in metrics["acceptance"].items() if k != "notes"))
+    lines = ["acceptance: " + ", ".join(f"{k}={v}" for k, v in metrics["acceptance"].items() if k != "notes")]
     for iv in metrics["e_d_below_epsilon"]:
-        log(f"  e_d < epsilon from t={iv['t_start']:.2f} s to {iv['t_end']:.2f} s, "
-            f"min {iv['min']:.4f} m at t={iv['t_min']:.2f} s (by {iv['depth']:.4f} m)")
+        lines.append(f"  e_d < epsilon from t={iv['t_start']:.2f} s to {iv['t_end']:.2f} s, "
+                     f"min {iv['min']:.4f} m at t={iv['t_min']:.2f} s (by {iv['depth']:.4f} m)")
     for iv in metrics["collisions"]:
-        log(f"  collision from t={iv['t_start']:.2f} s to {iv['t_end']:.2f} s, "
-            f"penetration {iv['depth']:.4f} m at t={iv['t_min']:.2f} s")
+        lines.append(f"  collision from t={iv['t_start']:.2f} s to {iv['t_end']:.2f} s, "
+                     f"penetration {iv['depth']:.4f} m at t={iv['t_min']:.2f} s")
+    return lines
 
 
-class StagedOutput:
-    """An output directory written atomically: a temporary directory next to it, then one rename.
+def _dynamic_lines(dyn: dict[str, Any]) -> list[str]:
+    head = (f"dynamic plant ({dyn['vehicle']}): {'certified' if dyn['certified'] else 'NOT certified'}"
+            + (f" (failed: {', '.join(dyn['failures'])})" if dyn["failures"] else "")
+            + f"; min clearance {_fmt(dyn['min_clearance'])} m, min e_d {_fmt(dyn['min_e_d'])} m, "
+              f"sway max {_fmt(dyn.get('sway_max'))} vs {_fmt(dyn.get('sway_bound'))} m/s, velocity-loop error max "
+              f"{dyn.get('velocity_error_max')}")
+    return [head, *promise_lines(dyn)]
 
-    Use as a context manager; :attr:`path` is the staging directory to write into.
-    On a clean exit it replaces ``target`` (the previous contents are removed only
-    after the new ones are in place); on any exception, ``KeyboardInterrupt``
-    included, the staging directory is removed and ``target`` is untouched.
+
+@dataclass(frozen=True)
+class StudyResult:
+    """What :func:`run_study` did: the runs (typed), ``metrics.json`` and where it was written.
+
+    Attributes
+    ----------
+    out : Path
+        The results directory.
+    tube, baseline : CertifiedRun
+        The tube controller's run and the baseline's.
+    metrics : dict
+        What ``metrics.json`` holds (the tube run's metrics plus :data:`STUDY_KEYS`).
+    dynamic : CertifiedRun, optional
+        The tube run on the dynamic plant (``reproduce``).
     """
 
-    def __init__(self, target: Path) -> None:
-        self.target = Path(target)
-        self.path = self.target
+    out: Path
+    tube: CertifiedRun
+    baseline: CertifiedRun
+    metrics: dict[str, Any]
+    dynamic: CertifiedRun | None = None
 
-    def __enter__(self) -> "StagedOutput":
-        parent = self.target.parent
-        try:
-            parent.mkdir(parents=True, exist_ok=True)
-            self.path = Path(tempfile.mkdtemp(prefix=f".{self.target.name}.tmp-", dir=parent))
-            umask = os.umask(0)
-            os.umask(umask)
-            self.path.chmod(0o777 & ~umask)
-        except OSError as exc:
-            raise ConfigError("--out", "a directory that can be created and written", str(self.target),
-                              exc.strerror or str(exc)) from None
-        return self
+    @property
+    def certified(self) -> bool:
+        """The scenario's certificate certified it."""
+        return self.tube.certified
 
-    def __exit__(self, kind: type | None, error: BaseException | None, trace: Any) -> None:
-        if kind is not None:
-            shutil.rmtree(self.path, ignore_errors=True)
-            return
-        self._commit()
+    def check(self) -> bool:
+        """False when a certified run (tube, or dynamic) broke a promise of its certificate (exit 4)."""
+        return self.tube.check() and (self.dynamic is None or self.dynamic.check())
 
-    def _commit(self) -> None:
-        """Swap the staging directory in; the old ``target`` goes only after the new one is in place."""
-        old = None
-        try:
-            if self.target.exists():
-                old = self.target.with_name(f".{self.target.name}.old-{os.getpid()}-{time.time_ns()}")
-                os.replace(self.target, old)
-            os.replace(self.path, self.target)
-        except OSError as exc:
-            if old is not None and not self.target.exists():
-                os.replace(old, self.target)
-            shutil.rmtree(self.path, ignore_errors=True)
-            raise ConfigError("--out", "a directory that can be replaced", str(self.target),
-                              exc.strerror or str(exc)) from None
-        if old is not None:
-            shutil.rmtree(old, ignore_errors=True)
+    def summary(self) -> str:
+        """The comparison table, the promises, the dynamic-plant line and the acceptance, one item a line."""
+        lines = [comparison_table(self.metrics, self.metrics["baseline"]), *promise_lines(self.metrics)]
+        if "dynamic" in self.metrics:
+            lines += _dynamic_lines(self.metrics["dynamic"])
+        if "acceptance" in self.metrics:
+            lines += acceptance_lines(self.metrics)
+        return "\n".join(lines)
 
-
-def check_output_dir(out: Path) -> None:
-    """Raise ``ConfigError('--out', ...)`` unless ``out`` can become a results directory; creates nothing.
-
-    ``out`` must be a directory or not exist; its nearest existing ancestor must be a
-    writable directory (the staging directory is created next to ``out``).
-    """
-    out = Path(out)
-    if out.exists() and not out.is_dir():
-        raise ConfigError("--out", "a directory (or a path that does not exist yet)", str(out),
-                          "It names an existing file.")
-    ancestor = out.parent
-    while not ancestor.exists():
-        ancestor = ancestor.parent
-    if not ancestor.is_dir():
-        raise ConfigError("--out", "a path under a directory", str(out), f"{ancestor} is a file.")
-    if not os.access(ancestor, os.W_OK | os.X_OK):
-        raise ConfigError("--out", "a path in a writable directory", str(out), f"{ancestor} is not writable.")
-    if out.exists() and not os.access(out, os.W_OK | os.X_OK):
-        raise ConfigError("--out", "a writable directory", str(out), "permission denied")
+    def to_dict(self) -> dict[str, Any]:
+        """``metrics.json``."""
+        return dict(self.metrics)
 
 
 def _write_study(scenario: Scenario, out: Path, staging: Path, progress: bool, with_acceptance: bool,
-                 animate: bool, started: float, dynamic: bool = False) -> dict[str, Any]:
-    """Certify, run, and write every file of the study into ``staging``; returns the metrics."""
+                 animate: bool, started: float, dynamic: bool = False) -> StudyResult:
+    """Certify, run, and write every file of the study into ``staging``."""
     write_json(staging / "scenario.json", scenario.to_dict())
     design = certify_and_write(scenario, staging)
     tube, base = run_tube_and_baseline(scenario, design.tightening, progress)
     metrics = write_runs(staging, scenario, design, tube, base)
+    dyn_run = None
     if dynamic:
         from tubekit.app.dynamic_study import run_dynamic
 
         LOGGER.info("tube run on the dynamic plant (%s) ...", scenario.plant.vehicle)
-        metrics["dynamic"] = run_dynamic(scenario, staging, tube, progress)
+        dyn_run, metrics["dynamic"] = run_dynamic(scenario, staging, tube.run, progress)
     if animate:
         from tubekit.app.animate import animate_top_view
 
-        for path in animate_top_view(staging, scenario, [("tube", tube.columns()), ("baseline", base.columns())]):
+        runs = [("tube", tube.run.columns()), ("baseline", base.run.columns())]
+        for path in animate_top_view(staging, scenario, runs):
             LOGGER.info("animation written: %s", out / path.name)
     total = time.perf_counter() - started
     metrics["total_wall_s"] = total
     if with_acceptance:
         metrics["acceptance"] = acceptance(metrics, total)
     write_json(staging / "metrics.json", metrics)
-    return metrics
+    return StudyResult(out=out, tube=tube, baseline=base, metrics=metrics, dynamic=dyn_run)
 
 
 def run_study(scenario: Scenario, out: Path, *, progress: bool = True, with_acceptance: bool = False,
-              animate: bool = False, dynamic: bool = False, echo: Echo = print) -> dict[str, Any]:
-    """Check every input, certify, run tube + baseline, write every output into ``out``; returns the metrics.
+              animate: bool = False, dynamic: bool = False, echo: Echo = print) -> StudyResult:
+    """Check every input, certify, run tube + baseline, write every output into ``out``.
 
     Parameters
     ----------
     out : Path
-        Results directory; replaced atomically at the end (see :class:`StagedOutput`).
+        Results directory; replaced atomically at the end (see :class:`tubekit.app.output.StagedOutput`).
     animate : bool
         Also write the top-view animation (GIF; MP4 where ffmpeg exists).
     dynamic : bool
         Also run the tube controller on the 4-DOF dynamic plant (:mod:`tubekit.app.dynamic_study`).
     echo : callable
-        Receives the result lines (comparison table, promises, acceptance, ``wrote ...``).
+        Receives the result lines (:meth:`StudyResult.summary`, then ``wrote ...``).
+
+    Returns
+    -------
+    StudyResult
+        The runs and ``metrics.json``; ``check()`` is False when a certified promise broke.
 
     Raises
     ------
@@ -384,24 +341,12 @@ def run_study(scenario: Scenario, out: Path, *, progress: bool = True, with_acce
         ``out`` (field ``--out``); nothing is written.
     """
     started = time.perf_counter()
-    if scenario.steps < 1:
-        raise ConfigError("duration", f"at least one FHOCP period ({scenario.controller.dt:g} s)", scenario.duration)
+    require_one_period("duration", scenario.duration, scenario.controller.dt)
     check_run_inputs(scenario)
     out = Path(out)
     check_output_dir(out)
     with StagedOutput(out) as staged:
-        metrics = _write_study(scenario, out, staged.path, progress, with_acceptance, animate, started, dynamic)
-    echo(comparison_table(metrics, metrics["baseline"]))
-    log_promises(metrics, echo)
-    if "dynamic" in metrics:
-        dyn = metrics["dynamic"]
-        echo(f"dynamic plant ({dyn['vehicle']}): {'certified' if dyn['certified'] else 'NOT certified'}"
-             + (f" (failed: {', '.join(dyn['failures'])})" if dyn["failures"] else "")
-             + f"; min clearance {_fmt(dyn['min_clearance'])} m, min e_d {_fmt(dyn['min_e_d'])} m, "
-               f"sway max {_fmt(dyn.get('sway_max'))} vs {_fmt(dyn.get('sway_bound'))} m/s, velocity-loop error max "
-               f"{dyn.get('velocity_error_max')}")
-        log_promises(dyn, echo)
-    if with_acceptance:
-        log_acceptance(metrics, echo)
+        result = _write_study(scenario, out, staged.path, progress, with_acceptance, animate, started, dynamic)
+    echo(result.summary())
     echo(f"wrote {out} in {time.perf_counter() - started:.1f} s")
-    return metrics
+    return result

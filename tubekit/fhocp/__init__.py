@@ -8,8 +8,10 @@ Modules, from the contract outwards:
   exact step, rollout, linearisations, obstacle selection, evaluation;
 * :mod:`~tubekit.fhocp.convex` — the DPP cvxpy subproblem of one SCP iteration;
 * :mod:`~tubekit.fhocp.fastpath` — the compiled parameter-to-data map + persistent Clarabel;
+* :mod:`~tubekit.fhocp.options` — :class:`ScpOptions`, the SCP solver's validated options;
 * :mod:`~tubekit.fhocp.scp` — :class:`FHOCP`: SCP loop, trust region, fallback;
-* :mod:`~tubekit.fhocp.ipopt` — :class:`IpoptFHOCP`, the CasADi + IPOPT peer (optional).
+* :mod:`~tubekit.fhocp.ipopt` — :class:`IpoptFHOCP`, the CasADi + IPOPT peer (optional);
+* :mod:`~tubekit.fhocp.registry` — the backends by name (``"scp"``, ``"ipopt"``): :func:`make_solver`.
 """
 
 from __future__ import annotations
@@ -19,8 +21,11 @@ from tubekit.fhocp.fastpath import CompiledConeProgram
 from tubekit.fhocp.ipopt import IpoptFHOCP
 from tubekit.fhocp.nlp import FhocpNlp, NlpEvaluation
 from tubekit.fhocp.result import RESULT_STATUSES, FallbackWarning, FhocpResult, Status, shifted_plan
+from tubekit.fhocp.options import ScpOptions
+from tubekit.fhocp.registry import backends, get_backend, make_solver, register_backend
 from tubekit.fhocp.scp import FHOCP, MODES, obstacle_slots
 
-__all__ = ["FHOCP", "FhocpResult", "FallbackWarning", "MODES", "obstacle_slots", "DEFAULT_CLARABEL_SETTINGS",
-           "Status", "RESULT_STATUSES", "shifted_plan", "IpoptFHOCP", "FhocpNlp", "NlpEvaluation",
-           "ConvexSubproblem", "CompiledConeProgram"]
+__all__ = ["FHOCP", "ScpOptions", "FhocpResult", "FallbackWarning", "MODES", "obstacle_slots",
+           "DEFAULT_CLARABEL_SETTINGS", "Status", "RESULT_STATUSES", "shifted_plan", "IpoptFHOCP", "FhocpNlp",
+           "NlpEvaluation", "ConvexSubproblem", "CompiledConeProgram", "backends", "get_backend", "make_solver",
+           "register_backend"]

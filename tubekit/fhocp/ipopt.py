@@ -73,7 +73,7 @@ def import_casadi() -> Any:
         import casadi  # noqa: PLC0415
     except ImportError as exc:  # pragma: no cover - depends on the environment
         raise NotAvailableError(
-            "the IPOPT peer needs CasADi, an optional dependency: pip install \"tubekit[bench]\" "
+            "the IPOPT peer needs CasADi, an optional dependency: pip install -e \".[bench]\" "
             "(or pip install casadi)") from exc
     return casadi
 

@@ -53,16 +53,17 @@ from typing import Sequence
 import numpy as np
 
 from tubekit.exceptions import ConfigError, ShapeError
+from tubekit.model.errors import error_coordinates
 from tubekit.model.kinematics import dsinc, sinc, unicycle_step
-from tubekit.scenario import Obstacle, Scenario
+from tubekit.scenario import Obstacle, Scenario, TerminalMode
 from tubekit.tightening import Tightening
-from tubekit.validation import as_vector, positive
+from tubekit.validation import as_vector, choice, positive
 
 __all__ = ["TERMINAL_MODES", "discrete_step", "rollout",
            "step_linearisation", "STEP_LINEARISATION_ROWS", "eo_linearisation", "obstacle_array",
            "select_obstacles", "FhocpNlp", "NlpEvaluation"]
 
-TERMINAL_MODES: tuple[str, ...] = ("soft", "hard", "off")
+TERMINAL_MODES: tuple[str, ...] = TerminalMode.values()
 _ED_FLOOR = 1e-9  # guards e_o = (...)/e_d against e_d = 0 (m)
 
 
@@ -286,7 +287,7 @@ class FhocpNlp:
     e_o_max: float
     clearance: float
     workspace: np.ndarray | None
-    terminal: str = "soft"
+    terminal: TerminalMode = TerminalMode.SOFT
     terminal_level: float = 2.0
     penalty: float = 1e3
     terminal_penalty: float = 50.0
@@ -307,8 +308,7 @@ class FhocpNlp:
             raise ConfigError("e_d_max", f"a number > e_d_min = {self.e_d_min}", self.e_d_max)
         if self.clearance < 0 or not math.isfinite(self.clearance):
             raise ConfigError("clearance", "a finite number >= 0", self.clearance)
-        if self.terminal not in TERMINAL_MODES:
-            raise ConfigError("terminal", f"one of {TERMINAL_MODES}", self.terminal)
+        object.__setattr__(self, "terminal", choice("terminal", TerminalMode, self.terminal))
         if self.workspace is not None:
             ws = np.asarray(self.workspace, dtype=float)
             if ws.shape != (2, 3):
@@ -322,7 +322,7 @@ class FhocpNlp:
         object.__setattr__(self, "_dt_r", self.dt * self.r)
 
     @classmethod
-    def from_scenario(cls, scenario: Scenario, tightening: Tightening, *, terminal: str = "soft",
+    def from_scenario(cls, scenario: Scenario, tightening: Tightening, *, terminal: TerminalMode | str = "soft",
                       penalty: float = 1e3, terminal_penalty: float | None = None) -> "FhocpNlp":
         """The NLP of ``scenario`` (weights, horizon, workspace) with the sets of ``tightening``."""
         if not isinstance(scenario, Scenario):
@@ -353,12 +353,7 @@ class FhocpNlp:
 
     def errors(self, states: np.ndarray, ref: np.ndarray) -> np.ndarray:
         """[e_d, e_z, e_o] (K, 3) of ``states`` (K, 4) w.r.t. ``ref`` (K, 3), e_d floored at 1e-9."""
-        ex = states[:, 0] - ref[:, 0]
-        ey = states[:, 1] - ref[:, 1]
-        ed = np.maximum(np.hypot(ex, ey), _ED_FLOOR)
-        psi = states[:, 3]
-        eo = (ex * np.sin(psi) - ey * np.cos(psi)) / ed
-        return np.stack([ed, states[:, 2] - ref[:, 2], eo], axis=-1)
+        return error_coordinates(states, ref, _ED_FLOOR)
 
     def cost(self, states: np.ndarray, inputs: np.ndarray, ref: np.ndarray) -> float:
         """Stage + terminal cost (no penalties)."""
@@ -381,13 +376,7 @@ class FhocpNlp:
         states = np.asarray(states, dtype=float)
         inputs = np.asarray(inputs, dtype=float)
         n = self.n
-        d = states[:, :3] - ref
-        e = np.empty((n + 1, 3))
-        ed2 = d[:, 0] * d[:, 0] + d[:, 1] * d[:, 1]
-        np.sqrt(np.maximum(ed2, _ED_FLOOR * _ED_FLOOR), out=e[:, 0])
-        e[:, 1] = d[:, 2]
-        psi = states[:, 3]
-        e[:, 2] = (d[:, 0] * np.sin(psi) - d[:, 1] * np.cos(psi)) / e[:, 0]
+        e = error_coordinates(states, ref, _ED_FLOOR)
         e2 = e * e
         cost = float(np.einsum("kc,ck->", e2, self._w) + np.einsum("kc,kc,c->", inputs, inputs, self._dt_r))
         # per-step violations, rows: e_d_min, obstacle, e_o, box (k = 1..N)

@@ -35,18 +35,20 @@ from typing import Sequence
 import cvxpy as cp
 import numpy as np
 
+from tubekit.checks import horizon_reach, workspace_fits, workspace_rule
 from tubekit.exceptions import ConfigError
-from tubekit.scenario import Obstacle, Scenario
+from tubekit.scenario import FhocpMode, Obstacle, Scenario
 from tubekit.tightening import Tightening
-from tubekit.validation import as_vector, finite, positive
+from tubekit.validation import as_vector, choice, finite
 from tubekit.fhocp.convex import ConvexSubproblem
 from tubekit.fhocp.fastpath import CompiledConeProgram
-from tubekit.fhocp.nlp import TERMINAL_MODES, FhocpNlp, NlpEvaluation, rollout, select_obstacles
+from tubekit.fhocp.nlp import FhocpNlp, NlpEvaluation, rollout, select_obstacles
+from tubekit.fhocp.options import ScpOptions
 from tubekit.fhocp.result import FallbackWarning, FhocpResult, Status, shift_steps, shifted_plan
 
 __all__ = ["FHOCP", "MODES", "TAIL_GRID", "obstacle_slots", "search_tail"]
 
-MODES: tuple[str, ...] = ("realtime", "converged")
+MODES: tuple[str, ...] = FhocpMode.values()
 #: grid points per input component [u, w, r] of the fallback's tail search over V-bar
 TAIL_GRID: tuple[int, int, int] = (7, 5, 7)
 
@@ -65,13 +67,6 @@ def obstacle_slots(scenario: Scenario) -> int:
     r = np.array([o.radius for o in obs]) + scenario.sensing_range
     meet = np.linalg.norm(c[:, None] - c[None], axis=-1) <= r[:, None] + r[None]
     return int(max(1, meet.sum(axis=1).max()))
-
-
-def _count(name: str, value: object, minimum: int, expected: str) -> int:
-    """``value`` if it is an int >= ``minimum`` (bool rejected), else :class:`ConfigError` (``expected``)."""
-    if not isinstance(value, int) or isinstance(value, bool) or value < minimum:
-        raise ConfigError(name, expected, value)
-    return value
 
 
 def search_tail(nlp: FhocpNlp, s0: np.ndarray, v: np.ndarray, kept: int, ref: np.ndarray,
@@ -129,37 +124,13 @@ class FHOCP:
         vehicle radius, sensing range, workspace.
     tightening : Tightening
         Tightened sets (V-bar, e_d_min, e_o_max, e_z_max, e_d_max, obstacle margin).
-    mode : {"realtime", "converged"}, optional
+    mode : FhocpMode or {"realtime", "converged"}, optional
         One convex solve per warm-started step, or SCP to convergence; default
         ``scenario.controller.fhocp_mode``.
-    max_obstacles : int, optional
-        Obstacle slots in the compiled problem (the nearest detected obstacles are kept,
-        with a warning when some do not fit). Default: :func:`obstacle_slots` of the
-        scenario (1 for the paper's).
-    terminal : {"soft", "hard", "off"}
-        Terminal-set handling (see :mod:`tubekit.fhocp.convex`); default ``scenario.controller.terminal_mode``.
-    penalty : float
-        Exact-penalty weight mu on the state-constraint slacks.
-    terminal_penalty : float, optional
-        mu_T for the soft terminal set (default ``penalty / 20``: safety slacks outrank F).
-    max_iterations : int, optional
-        Converged-mode cap (default 30).
-    cold_start_iterations : int
-        Cap for a solve without a previous plan (any mode).
-    tolerance : float
-        Converged mode stops when the predicted merit decrease, or the decrease of
-        an accepted step, is below ``tolerance * max(1, |merit|)``, or the input
-        step below ``tolerance * V-bar`` (default 1e-5).
-    trust_radius : float, optional
-        Input trust region as a fraction of V-bar per component (default 0.5;
-        in converged mode the initial radius, adapted by the ratio test).
-    extrapolate : bool
-        Converged mode: stretch accurately predicted steps by a merit line search.
-    fast_path : bool
-        Re-solve through the compiled map + persistent Clarabel (default);
-        False uses ``problem.solve(solver=cp.CLARABEL)`` (same problem, slower).
-    clarabel_settings : dict, optional
-        Overrides of :data:`tubekit.fhocp.convex.DEFAULT_CLARABEL_SETTINGS` / Clarabel's settings.
+    options : ScpOptions, optional
+        Solver options (:class:`tubekit.fhocp.options.ScpOptions`); default ``ScpOptions()``.
+        Its ``terminal`` defaults to ``scenario.controller.terminal_mode``, its
+        ``max_obstacles`` to :func:`obstacle_slots` of the scenario.
 
     Attributes
     ----------
@@ -171,41 +142,36 @@ class FHOCP:
         Construction time: cvxpy build + compilation (s).
     """
 
-    def __init__(self, scenario: Scenario, tightening: Tightening, mode: str | None = None, *,
-                 max_obstacles: int | None = None, terminal: str | None = None, penalty: float = 1e3,
-                 terminal_penalty: float | None = None, max_iterations: int | None = None,
-                 cold_start_iterations: int = 30, tolerance: float = 1e-5,
-                 trust_radius: float | None = None, extrapolate: bool = True, fast_path: bool = True,
-                 clarabel_settings: dict | None = None) -> None:
+    def __init__(self, scenario: Scenario, tightening: Tightening, mode: FhocpMode | str | None = None, *,
+                 options: ScpOptions | None = None) -> None:
         t0 = time.perf_counter()
-        mode = scenario.controller.fhocp_mode if mode is None else mode
-        terminal = scenario.controller.terminal_mode if terminal is None else terminal
-        if mode not in MODES:
-            raise ConfigError("mode", f"one of {MODES}", mode)
-        if terminal not in TERMINAL_MODES:
-            raise ConfigError("terminal", f"one of {TERMINAL_MODES}", terminal)
-        self.max_obstacles = _count("max_obstacles", obstacle_slots(scenario) if max_obstacles is None
-                                    else max_obstacles, 0, "an integer >= 0 or None")
-        self.max_iterations = _count("max_iterations", 30 if max_iterations is None else max_iterations, 1,
-                                     "an integer >= 1")
-        self.cold_start_iterations = _count("cold_start_iterations", cold_start_iterations, 1, "an integer >= 1")
+        if not isinstance(scenario, Scenario):
+            raise ConfigError("scenario", "a tubekit.Scenario", type(scenario).__name__)
+        opts = ScpOptions() if options is None else options
+        if not isinstance(opts, ScpOptions):
+            raise ConfigError("options", "a tubekit.fhocp.ScpOptions", type(opts).__name__)
+        self.mode = choice("mode", FhocpMode, scenario.controller.fhocp_mode if mode is None else mode)
+        terminal = scenario.controller.terminal_mode if opts.terminal is None else opts.terminal
+        self.options = opts
+        self.max_obstacles = obstacle_slots(scenario) if opts.max_obstacles is None else opts.max_obstacles
+        self.max_iterations = opts.max_iterations
+        self.cold_start_iterations = opts.cold_start_iterations
         self.scenario = scenario
         self.tightening = tightening
-        self.nlp = FhocpNlp.from_scenario(scenario, tightening, terminal=terminal, penalty=penalty,
-                                          terminal_penalty=terminal_penalty)
+        self.nlp = FhocpNlp.from_scenario(scenario, tightening, terminal=terminal, penalty=opts.penalty,
+                                          terminal_penalty=opts.terminal_penalty)
         self._check_workspace()
-        self.mode = mode
-        self.tolerance = positive("tolerance", tolerance)
-        self.trust_radius = positive("trust_radius", 0.5 if trust_radius is None else trust_radius)
-        self.extrapolate = bool(extrapolate)
+        self.tolerance = opts.tolerance
+        self.trust_radius = opts.trust_radius
+        self.extrapolate = opts.extrapolate
         self._plan_t: float | None = None
         self._plan_inputs: np.ndarray | None = None
         self._dropped_warned = False
-        self.fast_path = bool(fast_path)
+        self.fast_path = opts.fast_path
         s0 = np.asarray(scenario.initial_state, dtype=float)
         self.subproblem = ConvexSubproblem(self.nlp, self.max_obstacles, s0,
                                            self.nlp.reference(scenario.trajectory, 0.0), self.trust_radius,
-                                           fast_path=self.fast_path, clarabel_settings=clarabel_settings)
+                                           fast_path=self.fast_path, clarabel_settings=opts.clarabel_overrides())
         self.build_time_s = time.perf_counter() - t0
 
     def _check_workspace(self) -> None:
@@ -213,12 +179,10 @@ class FHOCP:
         nlp = self.nlp
         if nlp.workspace is None:
             return
-        reach = float(nlp.v_max[0]) * nlp.dt * nlp.n  # farthest horizontal travel (m)
-        width = nlp.workspace[1, :2] - nlp.workspace[0, :2] - 2 * nlp.clearance
-        if np.any(width <= 2 * reach):
-            raise ConfigError("scenario.workspace",
-                              f"x and y extents > 2 (vehicle_radius + obstacle_margin + u_max T) = "
-                              f"{2 * (nlp.clearance + reach):.4g} m", self.scenario.workspace,
+        reach = horizon_reach(float(nlp.v_max[0]), nlp.dt, nlp.n)  # farthest horizontal travel (m)
+        if not workspace_fits(nlp.workspace, nlp.clearance, reach):
+            raise ConfigError("scenario.workspace", workspace_rule(nlp.clearance, reach, "vehicle_radius + "
+                              "obstacle_margin + u_max T"), self.scenario.workspace,
                               "the FHOCP keeps one wall row per axis (the nearer wall)")
 
     # ------------------------------------------------------- the subproblem
@@ -307,7 +271,7 @@ class FHOCP:
         ref = nlp.reference(self.scenario.trajectory, t)
         guess, warm = self.warm_start_inputs(t)
         guess = np.clip(guess, -nlp.v_max, nlp.v_max)
-        realtime = warm and self.mode == "realtime"
+        realtime = warm and self.mode is FhocpMode.REALTIME
         cap = 1 if realtime else (self.max_iterations if warm else self.cold_start_iterations)
         s = rollout(s0, guess, nlp.dt)
         it = _Iterate(v=guess, s=s, ev=None if realtime else nlp.evaluate(s, guess, ref, obs),

@@ -16,11 +16,17 @@ Timeline (dt = FHOCP period, h = 1 / ancillary_rate_hz, m = dt / h ticks):
   :class:`tubekit.plant.dynamic.DynamicPlant`), is integrated with classical RK4 at a
   fixed step h / plant_substeps (5 ms by default: 100 Hz ticks, 2 substeps).
 
-:func:`simulate` is a pipeline of named steps: :func:`validate_inputs` →
+:func:`run_closed_loop` is a pipeline of named steps: :func:`validate_inputs` →
 :func:`build_solver` → per sampling period (:meth:`_ClosedLoop.run_period`):
 sense → solve (:meth:`_ClosedLoop.solve`, :class:`PlanMemory`) → nominal arc →
 ticks (:meth:`_ClosedLoop.run_ticks`: ancillary law, :func:`saturate`, plant) →
 log (:class:`_Log`).
+
+What runs is the scenario's: the ancillary law ``controller.law`` (a registered name), the
+FHOCP backend ``controller.fhocp_backend`` in mode ``controller.fhocp_mode``
+(:func:`tubekit.fhocp.registry.make_solver`), the plant ``plant.kind``; σ is the
+tightening's. A variant is a changed scenario (``scenario.with_changes(...)``) or tightening
+(``dataclasses.replace(tightening, sigma=...)``).
 
 Fallbacks: a FHOCP result flagged ``fallback`` is used (its first input) and
 counted; a result whose first input is not finite, or a :class:`SolverError`,
@@ -47,6 +53,8 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from tubekit.design_key import require_matching
+from tubekit.checks import require_one_period
 from tubekit.model.ancillary import AncillaryLaw, get_law
 from tubekit.exceptions import ConfigError, SolverError
 from tubekit.loop.plan_check import check_plan
@@ -55,14 +63,14 @@ from tubekit.plant.factory import make_plant
 from tubekit.plant.kinematic import nominal_arc
 from tubekit.scenario import HEMISPHERE_SIGN, Obstacle, Scenario
 from tubekit.loop.sensing import ObstacleMap
-from tubekit.loop.result import SimulationResult
+from tubekit.loop.result import LogArrays, SimulationResult, allocate_log
 from tubekit.tightening import Tightening
 
 if TYPE_CHECKING:  # the solver package (cvxpy) is loaded only when a solver is built
     from tubekit.fhocp.result import FhocpResult, FhocpSolver, SolverFactory
 
 __all__ = [
-    "simulate",
+    "run_closed_loop",
     "PlanMemory",
     "validate_inputs",
     "build_solver",
@@ -76,43 +84,47 @@ _ZERO_INPUT.setflags(write=False)
 
 # ---- setup ------------------------------------------------------------------------------
 
-def validate_inputs(scenario: Scenario, tightening: Tightening | None, law: str | AncillaryLaw | None,
-                    sigma: float | None, tube: bool,
+def validate_inputs(scenario: Scenario, tightening: Tightening | None, tube: bool,
                     plant_substeps: int) -> tuple[Tightening, AncillaryLaw, float]:
-    """Check the arguments of :func:`simulate`; return (tightening, ancillary law, σ in 1/s).
+    """Check the arguments of :func:`run_closed_loop`; return (tightening, the scenario's law, σ in 1/s).
 
     Raises
     ------
     ConfigError
         Bad ``plant_substeps``, a duration shorter than one period, a tube run
-        without tightening, or a σ that is not finite and >= 0.
+        without tightening, a tightening of another design, or a σ that is not finite and >= 0.
     """
-    ctrl = scenario.controller
-    if not isinstance(plant_substeps, int) or plant_substeps < 1:
+    if not isinstance(scenario, Scenario):
+        raise ConfigError("scenario", "a tubekit.Scenario", type(scenario).__name__)
+    if not isinstance(plant_substeps, int) or isinstance(plant_substeps, bool) or plant_substeps < 1:
         raise ConfigError("plant_substeps", "an integer >= 1", plant_substeps)
-    if scenario.steps < 1:
-        raise ConfigError("duration", f"at least one FHOCP period (dt = {ctrl.dt:g} s)", scenario.duration)
+    require_one_period("duration", scenario.duration, scenario.controller.dt)
     if tightening is None:
         if tube:
             raise ConfigError("tightening", "a Tightening (e.g. verify.certify(...).tightening) for the tube run",
                               None)
         tightening = Tightening.untightened(scenario)
-    law_obj = law if isinstance(law, AncillaryLaw) else get_law(law if law is not None else ctrl.law)
+    law_obj = get_law(scenario.controller.law)
     if not tube:
         return tightening, law_obj, 0.0
-    sig = float(tightening.sigma if sigma is None else sigma)
+    require_matching(scenario, tightening)
+    sig = float(tightening.sigma)
     if not math.isfinite(sig) or sig < 0:
         raise ConfigError("sigma", "a finite number >= 0", sig)
     return tightening, law_obj, sig
 
 
-def build_solver(scenario: Scenario, tightening: Tightening, solver_factory: SolverFactory | None,
-                 mode: str | None) -> FhocpSolver:
-    """``solver_factory(scenario, tightening)``, or :class:`tubekit.fhocp.FHOCP` in ``mode``."""
+def build_solver(scenario: Scenario, tightening: Tightening, solver_factory: SolverFactory | None) -> FhocpSolver:
+    """``solver_factory(scenario, tightening)``, or the scenario's backend from the registry.
+
+    The default is :func:`tubekit.fhocp.registry.make_solver`: backend
+    ``scenario.controller.fhocp_backend`` (``"scp"``: :class:`tubekit.fhocp.FHOCP` in
+    ``scenario.controller.fhocp_mode``).
+    """
     if solver_factory is not None:
         return solver_factory(scenario, tightening)
-    from tubekit.fhocp import FHOCP  # imported lazily: the solver is optional for tests with fakes
-    return FHOCP(scenario, tightening, mode=mode)
+    from tubekit.fhocp.registry import make_solver  # imported lazily: cvxpy loads only when a solver is built
+    return make_solver(scenario, tightening)
 
 
 def _silence_fallback_warnings() -> None:
@@ -213,40 +225,15 @@ def _status_text(status: Any) -> str:
 # ---- the log ----------------------------------------------------------------------------
 
 @dataclass
-class _Log:
-    """Preallocated per-tick (K + 1 rows) and per-period arrays; see :class:`SimulationResult`."""
+class _Log(LogArrays):
+    """Preallocated per-tick (K + 1 rows) and per-period arrays: the fields of :data:`LOG_FIELDS`."""
 
-    states: np.ndarray
-    nominal: np.ndarray
-    v_hat: np.ndarray
-    kappa: np.ndarray
-    inputs: np.ndarray
-    saturated: np.ndarray
-    fallback: np.ndarray
-    replaced: np.ndarray
-    n_detected: np.ndarray
-    solve_ms: np.ndarray
-    step_ms: np.ndarray
-    wall: np.ndarray
-    iterations: np.ndarray
-    max_violation: np.ndarray
-    rejected: np.ndarray
-    plan_age: np.ndarray
-    plan_slack: np.ndarray
     statuses: list[str] = field(default_factory=list)
     kappa_failures: int = 0
 
     @classmethod
     def allocate(cls, clock: _Clock) -> _Log:
-        rows, steps = len(clock.t), clock.steps
-        return cls(states=np.empty((rows, 4)), nominal=np.empty((rows, 4)), v_hat=np.full((rows, 3), np.nan),
-                   kappa=np.full((rows, 3), np.nan), inputs=np.full((rows, 3), np.nan),
-                   saturated=np.zeros(rows, dtype=bool), fallback=np.zeros(rows, dtype=bool),
-                   replaced=np.zeros(rows, dtype=bool), n_detected=np.zeros(rows, dtype=int),
-                   solve_ms=np.full(rows, np.nan), step_ms=np.full(rows, np.nan), wall=np.zeros(rows),
-                   iterations=np.zeros(steps), max_violation=np.full(steps, np.nan),
-                   rejected=np.zeros(steps, dtype=bool), plan_age=np.zeros(steps, dtype=int),
-                   plan_slack=np.full(steps, np.nan))
+        return cls(**allocate_log(len(clock.t), clock.steps))
 
     def record_solve(self, k: int, i0: int, result: FhocpResult | None, elapsed_s: float) -> None:
         """Record the solver's answer at period ``k`` (first tick ``i0``); ``None`` when it raised."""
@@ -386,56 +373,50 @@ class _ClosedLoop:
         return self.plant.omega_series(self.clock.t, self.log.states, self.log.inputs)
 
 
-def simulate(scenario: Scenario, *, tightening: Tightening | None = None,
-             law: str | AncillaryLaw | None = None, sigma: float | None = None, tube: bool = True,
-             progress: bool = True, solver_factory: SolverFactory | None = None,
-             mode: str | None = None, plant_substeps: int = 2, remember_obstacles: bool = True,
-             label: str | None = None, disturbance: OmegaOverride | None = None,
-             plant: str | None = None) -> SimulationResult:
+def run_closed_loop(scenario: Scenario, tightening: Tightening | None = None, *, tube: bool = True,
+                    progress: bool = True, label: str | None = None, solver_factory: SolverFactory | None = None,
+                    disturbance: OmegaOverride | None = None, plant_substeps: int = 2,
+                    remember_obstacles: bool = True) -> SimulationResult:
     """Run the closed loop on ``scenario`` for ``scenario.duration`` seconds.
+
+    The ancillary law is ``scenario.controller.law``, the FHOCP the scenario's backend
+    in ``scenario.controller.fhocp_mode``, the plant ``scenario.plant.kind``, σ is
+    ``tightening.sigma`` (module doc). The short public API is :func:`tubekit.simulate`.
 
     Parameters
     ----------
     scenario : Scenario
         What to simulate.
     tightening : Tightening, optional
-        Sets of the FHOCP. Required when ``tube``; the baseline defaults to
-        :meth:`Tightening.untightened`.
-    law : str or AncillaryLaw, optional
-        Ancillary law; default ``scenario.controller.law``.
-    sigma : float, optional
-        Ancillary gain (1/s); default ``tightening.sigma``. Ignored (0) when not ``tube``.
+        Sets of the FHOCP and the gain σ (1/s). Required when ``tube``; the baseline
+        defaults to :meth:`Tightening.untightened`.
     tube : bool
         ``False`` runs the baseline: nominal MPC alone, κ = 0.
     progress : bool
         Show a tqdm bar (only on a TTY).
-    solver_factory : callable, optional
-        ``factory(scenario, tightening)`` returning a :class:`FhocpSolver`;
-        default :class:`tubekit.fhocp.FHOCP`.
-    mode : str, optional
-        FHOCP mode for the default factory; default ``scenario.controller.fhocp_mode``.
-    plant_substeps : int
-        RK4 steps per ancillary tick (plant step = 1 / (rate * substeps) s).
-    remember_obstacles : bool
-        Keep obstacles in the map once detected (see :mod:`tubekit.loop.sensing`).
     label : str, optional
         Progress-bar label.
+    solver_factory : callable, optional
+        ``factory(scenario, tightening)`` returning a :class:`FhocpSolver`; default the
+        scenario's backend (:func:`tubekit.fhocp.registry.make_solver`).
     disturbance : callable, optional
         ``disturbance(t) -> omega`` (3,) replacing the scenario's current + sway
         (e.g. a :class:`verify.falsify.strategies.DisturbanceSignal` in property tests);
         on the dynamic plant it replaces the current (the sway is the hull's).
-    plant : str, optional
-        ``"kinematic"`` or ``"dynamic"``; default ``scenario.plant.kind``.
+    plant_substeps : int
+        RK4 steps per ancillary tick (plant step = 1 / (rate * substeps) s).
+    remember_obstacles : bool
+        Keep obstacles in the map once detected (see :mod:`tubekit.loop.sensing`).
 
     Returns
     -------
     SimulationResult
     """
     wall0 = time.perf_counter()
-    tightening, law_obj, sig = validate_inputs(scenario, tightening, law, sigma, tube, plant_substeps)
-    solver = build_solver(scenario, tightening, solver_factory, mode)
+    tightening, law_obj, sig = validate_inputs(scenario, tightening, tube, plant_substeps)
+    solver = build_solver(scenario, tightening, solver_factory)
     clock = _Clock.of(scenario, plant_substeps)
-    loop = _ClosedLoop(scenario, tightening, clock, solver, law_obj, sig, make_plant(scenario, disturbance, plant),
+    loop = _ClosedLoop(scenario, tightening, clock, solver, law_obj, sig, make_plant(scenario, disturbance),
                        ObstacleMap(scenario.obstacles, scenario.sensing_range, remember=remember_obstacles))
     x = tuple(float(c) for c in scenario.initial_state)
     nominal_end = np.asarray(x)

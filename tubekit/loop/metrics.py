@@ -21,6 +21,8 @@ centre), so each can be recomputed from the two files. Definitions (units m, s):
 * ``sway_max``: max over samples of |sway| (m/s): the hull's v_b on the dynamic plant (column
   ``v_b``), else the component of ω − δ(t) normal to the heading (the sway model's v_s);
   ``sway_bound``: the certificate's γ̄ (null when none was given).
+* ``velocity_error_max``: max over samples of |u_b − u|, |w_b − w|, |r_b − r| (the dynamic plant's
+  velocity loop, from the columns ``u_b``, ``w_b``, ``r_b``); null on the kinematic plant.
 * ``fhocp_max_violation``: largest nonlinear-constraint violation of the
   nominal plans the FHOCP returned (its ``max_violation``; 0 when every plan
   is feasible for the tightened problem).
@@ -28,6 +30,13 @@ centre), so each can be recomputed from the two files. Definitions (units m, s):
   propagation + ancillary law; the plant simulation excluded); ``solve_ms_*``:
   the FHOCP's own solve time; ``wall_s``: elapsed time of the whole run
   (solver construction included), the last value of the ``wall_s`` column.
+
+The one convention for a run's metrics is :func:`run_metrics` (what
+:attr:`SimulationResult.metrics <tubekit.loop.result.SimulationResult.metrics>` and the
+run's part of ``metrics.json`` hold): :func:`compute_metrics` with ``rho_bound`` = ρ̃ of a
+certified tightening (else null) and ``sway_bound`` = the tightening's γ̄ on a tube run (null
+for the baseline), plus the run's facts (tube, law, σ, κ failures, checks), ``certified``,
+``rho_tilde_used``, ``tube_box`` and the promises (:data:`RUN_KEYS`).
 """
 
 from __future__ import annotations
@@ -39,9 +48,12 @@ from typing import Any, Mapping, Sequence
 
 import numpy as np
 
+from tubekit.jsonable import json_number
+from tubekit.loop.promises import Promise, RunLog, check_promises
 from tubekit.plant.kinematic import Plant
 from tubekit.scenario import Obstacle, Scenario
 from tubekit.model.trajectory import Circle
+from tubekit.model.errors import error_coordinates
 
 __all__ = [
     "rho_period_peaks",
@@ -54,8 +66,11 @@ __all__ = [
     "percentile_ms",
     "sway_series",
     "compute_metrics",
+    "run_metrics",
+    "promise_figures",
     "read_trajectory_csv",
     "METRIC_KEYS",
+    "RUN_KEYS",
 ]
 
 #: Keys every metrics dictionary has (the issue's list plus a few more).
@@ -64,6 +79,9 @@ METRIC_KEYS: tuple[str, ...] = (
     "epsilon", "max_input_ratio", "saturated_steps", "encirclements", "tracking_rmse", "max_rho",
     "rho_bound", "step_ms_median", "step_ms_p95", "wall_s", "sway_max", "sway_bound",
 )
+#: Keys :func:`run_metrics` adds to :func:`compute_metrics` (every run has them; the baseline's promises are empty).
+RUN_KEYS: tuple[str, ...] = ("tube", "law", "sigma", "kappa_failures", "checks", "certified", "rho_tilde_used",
+                             "tube_box", "promises", "promises_kept", "max_rho_ratio")
 
 
 def clearance(positions: np.ndarray, obstacles: Sequence[Obstacle | Mapping[str, Any]],
@@ -208,6 +226,14 @@ def _sway_metrics(columns: Mapping[str, np.ndarray], scenario: Scenario,
             "sway_bound": None if sway_bound is None else float(sway_bound)}
 
 
+def _velocity_error_max(c: Mapping[str, np.ndarray]) -> list[float | None] | None:
+    """max |u_b - u|, |w_b - w|, |r_b - r| (m/s, m/s, rad/s) over the samples; None without body columns."""
+    if not all(k in c for k in ("u_b", "w_b", "r_b")):
+        return None
+    err = np.column_stack([c["u_b"] - c["u"], c["w_b"] - c["w"], c["r_b"] - c["r"]])
+    return [_nanmax_or_none(np.abs(err[:, j])) for j in range(3)]
+
+
 def compute_metrics(columns: Mapping[str, np.ndarray], scenario: Scenario, *,
                     rho_bound: float | None = None, sway_bound: float | None = None,
                     extra: Mapping[str, Any] | None = None) -> dict[str, Any]:
@@ -235,7 +261,7 @@ def compute_metrics(columns: Mapping[str, np.ndarray], scenario: Scenario, *,
 
     clr = clearance(pos, scenario.obstacles, scenario.vehicle_radius)
     i_clr = int(np.argmin(clr))
-    e_d = np.hypot(pos[:, 0] - des[:, 0], pos[:, 1] - des[:, 1])
+    e_d = error_coordinates(np.column_stack([pos, np.zeros(len(pos))]), des)[:, 0]  # e_d does not read psi
     i_ed = int(np.argmin(e_d))
     ratio = input_ratio(inputs[applied], lim)
     sat = c["saturated"] > 0.5
@@ -284,8 +310,44 @@ def compute_metrics(columns: Mapping[str, np.ndarray], scenario: Scenario, *,
         "wall_s": float(np.nanmax(c["wall_s"])),
     }
     m.update(_sway_metrics(c, scenario, sway_bound))
+    m["velocity_error_max"] = _velocity_error_max(c)
     if extra:
         m.update(extra)
+    return m
+
+
+def promise_figures(promises: Sequence[Promise]) -> dict[str, Any]:
+    """``promises`` (JSON-ready), ``promises_kept`` and ``max_rho_ratio`` (null when infinite) of a tube run.
+
+    The baseline (no promises) has ``promises`` empty and the other two null.
+    """
+    if not promises:
+        return {"promises": [], "promises_kept": None, "max_rho_ratio": None}
+    tube = [p for p in promises if p.name == "tube"]
+    return {"promises": [p.to_dict() for p in promises], "promises_kept": all(p.ok for p in promises),
+            "max_rho_ratio": json_number(tube[0].observed) if tube else None}
+
+
+def run_metrics(run: RunLog, promises: Sequence[Promise] | None = None) -> dict[str, Any]:
+    """The metrics of one run in the one convention (module doc); ``promises`` default: measured here.
+
+    Parameters
+    ----------
+    run : SimulationResult
+        The run (anything with its ``columns()``, ``facts``, ``scenario``, ``tightening`` and ``tube``).
+    promises : sequence of Promise, optional
+        :func:`tubekit.loop.promises.check_promises` of ``run`` when already measured (ignored for the baseline).
+    """
+    tight = run.tightening
+    certified = bool(tight.certified)
+    if not run.tube:
+        promises = ()
+    elif promises is None:
+        promises = check_promises(run)
+    m = compute_metrics(run.columns(), run.scenario, rho_bound=float(tight.rho_tilde) if certified else None,
+                        sway_bound=float(tight.disturbance.sway) if run.tube else None, extra=run.facts)
+    m.update(certified=certified, rho_tilde_used=float(tight.rho_tilde),
+             tube_box=[float(x) for x in np.asarray(tight.tube, dtype=float)], **promise_figures(promises))
     return m
 
 

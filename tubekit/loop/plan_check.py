@@ -60,7 +60,8 @@ def plan_arcs(x0: np.ndarray, inputs: np.ndarray, dt: float, samples: int) -> np
 def _error_slacks(tight: Tightening, e: np.ndarray, cos_rel: np.ndarray, margins: np.ndarray,
                   pad: np.ndarray, sign: int) -> dict[str, np.ndarray]:
     """Per-sample slack (>= 0 is fine) of each error constraint; ``margins``, ``pad`` are (N, 1) columns."""
-    eps, ed_max, ez_max, eo_max = tight.region
+    reg = tight.region
+    eps, ed_max, ez_max, eo_max = reg.epsilon, reg.e_d_max, reg.e_z_max, reg.e_o_max
     md, mz, mo = (margins[:, k:k + 1] + pad[k] for k in range(3))
     return {"e_d >= epsilon": e[..., 0] - eps - md, "e_d <= e_d_max": ed_max - md - e[..., 0],
             "|e_z|": ez_max - mz - np.abs(e[..., 1]), "|e_o|": eo_max - mo - np.abs(e[..., 2]),

@@ -23,15 +23,53 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import Protocol
 
 import numpy as np
 
+from tubekit.exceptions import ConfigError
 from tubekit.model.errors import heading_cosine
 from tubekit.plant.kinematic import Plant
-from tubekit.scenario import HEMISPHERE_SIGN
-from tubekit.loop.result import SimulationResult
+from tubekit.scenario import HEMISPHERE_SIGN, Scenario
+from tubekit.tightening import Tightening
 
-__all__ = ["Promise", "check_promises"]
+__all__ = ["Promise", "check_promises", "RunLog", "PREMISES"]
+
+#: Promises that are premises of the theorem: a run breaking one claims nothing.
+PREMISES: tuple[str, ...] = ("disturbance", "recursive_feasibility")
+
+
+class RunLog(Protocol):
+    """What the promises and the run's metrics read of a run (``tubekit.loop.result.SimulationResult`` has it all)."""
+
+    scenario: Scenario
+    tube: bool
+    tightening: Tightening
+    t: np.ndarray
+    states: np.ndarray
+    desired: np.ndarray
+    inputs: np.ndarray
+    omega: np.ndarray
+    saturated: np.ndarray
+    replaced: np.ndarray
+    rejected: np.ndarray
+    plan_age: np.ndarray
+    omega_overridden: bool
+    body: np.ndarray | None
+
+    @property
+    def errors(self) -> np.ndarray: ...
+
+    @property
+    def rho(self) -> np.ndarray: ...
+
+    @property
+    def velocity_error(self) -> np.ndarray | None: ...
+
+    @property
+    def facts(self) -> dict: ...
+
+    def columns(self) -> dict[str, np.ndarray]: ...
 
 
 @dataclass(frozen=True)
@@ -60,7 +98,7 @@ def _at_least(name: str, observed: float, bound: float, detail: str) -> Promise:
     return Promise(name, float(observed), float(bound), bool(observed >= bound), detail)
 
 
-def _tube(run: SimulationResult) -> Promise:
+def _tube(run: RunLog) -> Promise:
     tube = np.asarray(run.tightening.tube, dtype=float)
     rho = np.abs(run.rho)
     ratio = np.max(rho / np.where(tube > 0, tube, np.inf), axis=1) if np.all(tube > 0) else np.full(len(rho), np.inf)
@@ -68,8 +106,9 @@ def _tube(run: SimulationResult) -> Promise:
     return _at_most("tube", worst, 1.0, f"max_j |e_j - e_hat_j| / tube_j, tube = {np.round(tube, 6).tolist()}")
 
 
-def _region(run: SimulationResult) -> list[Promise]:
-    eps, ed_max, ez_max, eo_max = (float(x) for x in run.tightening.region)
+def _region(run: RunLog) -> list[Promise]:
+    reg = run.tightening.region
+    eps, ed_max, ez_max, eo_max = reg.epsilon, reg.e_d_max, reg.e_z_max, reg.e_o_max
     e = run.errors
     slack = np.min(np.column_stack([e[:, 0] - eps, ed_max - e[:, 0], ez_max - np.abs(e[:, 1]),
                                     eo_max - np.abs(e[:, 2])]))
@@ -81,7 +120,7 @@ def _region(run: SimulationResult) -> list[Promise]:
             _at_least("epsilon", float(np.min(e[:, 0])), eps, "min e_d (m) >= epsilon")]
 
 
-def _inputs(run: SimulationResult) -> Promise:
+def _inputs(run: RunLog) -> Promise:
     applied = run.inputs[:-1]
     lim = run.scenario.limits.vector
     over = float(np.max(np.abs(applied) / lim)) if len(applied) else 0.0
@@ -90,11 +129,11 @@ def _inputs(run: SimulationResult) -> Promise:
                    f"max |v_i| / V_i; clipped ticks = {sat} (the certificate promises none)")
 
 
-def _geometry(run: SimulationResult) -> list[Promise]:
+def _geometry(run: RunLog) -> list[Promise]:
     sc = run.scenario
     pos = run.states[:, :3]
     dist = run.tightening.disturbance
-    speed = float(np.hypot(sc.limits.u_max, sc.limits.w_max) + np.hypot(dist[0], dist[1]))
+    speed = float(np.hypot(sc.limits.u_max, sc.limits.w_max) + np.hypot(dist.omega_xy, dist.omega_z))
     half_tick = 0.5 * (run.t[1] - run.t[0]) if len(run.t) > 1 else 0.0
     pad = speed * half_tick
     clear = min((float(np.min(np.linalg.norm(pos - np.asarray(o.center), axis=1))) - o.radius - sc.vehicle_radius
@@ -108,8 +147,9 @@ def _geometry(run: SimulationResult) -> list[Promise]:
     return out
 
 
-def _disturbance(run: SimulationResult) -> list[Promise]:
-    wxy, wz, gamma = (float(x) for x in run.tightening.disturbance)
+def _disturbance(run: RunLog) -> list[Promise]:
+    bound = run.tightening.disturbance
+    wxy, wz, gamma = bound.omega_xy, bound.omega_z, bound.sway
     om = run.omega[:-1]
     tol = 1e-12
     if run.body is not None:
@@ -130,7 +170,7 @@ def _disturbance(run: SimulationResult) -> list[Promise]:
                      "premise: max over the run of ||omega_xy|| - omega_bar_xy and |omega_z| - omega_bar_z")]
 
 
-def _velocity_loop(run: SimulationResult) -> list[Promise]:
+def _velocity_loop(run: RunLog) -> list[Promise]:
     """The velocity loop's error against its assumed bound (dynamic plant only)."""
     err = run.velocity_error
     if err is None:
@@ -144,7 +184,7 @@ def _velocity_loop(run: SimulationResult) -> list[Promise]:
                      f"plant.tracking_bound = {bound.tolist()} (observed = largest ratio)")]
 
 
-def _feasibility(run: SimulationResult) -> Promise:
+def _feasibility(run: RunLog) -> Promise:
     n = run.tightening.horizon_arcs
     age = np.asarray(run.plan_age, dtype=int)
     first_ok = len(age) > 0 and age[0] == 0 and not bool(run.replaced[0])
@@ -155,7 +195,17 @@ def _feasibility(run: SimulationResult) -> Promise:
                    f"accepted at t = 0: {first_ok}")
 
 
-def check_promises(run: SimulationResult) -> list[Promise]:
-    """Every promise of the module doc measured on ``run`` (a tube run with a certificate's Tightening)."""
+def check_promises(run: RunLog) -> list[Promise]:
+    """Every promise of the module doc measured on ``run`` (a tube run with a certificate's Tightening).
+
+    Raises
+    ------
+    ConfigError
+        ``run`` is a run without a certificate (the baseline: no tube, nothing promised).
+    """
+    if not run.tube:
+        raise ConfigError("run", "a tube run with a certificate's Tightening (tubekit.simulate(scenario, "
+                          "certificate))", "a run without a certificate (the baseline)",
+                          "the baseline is promised nothing")
     return [_tube(run), *_region(run), _inputs(run), *_geometry(run), *_disturbance(run), *_velocity_loop(run),
             _feasibility(run)]

@@ -1,9 +1,12 @@
-"""The record of a closed-loop run (:func:`tubekit.loop.closed_loop.simulate`) and its CSV form."""
+"""The record of a closed-loop run (:func:`tubekit.loop.closed_loop.run_closed_loop`) and its CSV form."""
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, make_dataclass
+from dataclasses import field as dc_field
+from functools import partial
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -13,17 +16,96 @@ from tubekit.tightening import Tightening
 
 __all__ = [
     "SimulationResult",
+    "LogField",
+    "LOG_FIELDS",
+    "LogArrays",
+    "allocate_log",
     "CSV_COLUMNS",
     "DYNAMIC_COLUMNS",
 ]
 
-#: Column order of ``trajectory.csv`` (see :meth:`SimulationResult.columns`).
-CSV_COLUMNS: tuple[str, ...] = (
-    "t", "step", "x", "y", "z", "psi", "u", "w", "r", "x_d", "y_d", "z_d",
-    "e_d", "e_z", "e_o", "x_hat", "y_hat", "z_hat", "psi_hat", "rho_d", "rho_z", "rho_o", "rho_norm",
-    "u_hat", "w_hat", "r_hat", "kappa_u", "kappa_w", "kappa_r", "omega_1", "omega_2", "omega_3",
-    "saturated", "fallback", "replaced", "n_detected", "solve_ms", "step_ms", "plan_violation", "wall_s",
+
+@dataclass(frozen=True)
+class LogField:
+    """One array of the closed-loop log: name, rows, width, dtype, initial fill, CSV columns, meaning.
+
+    ``per`` is ``"tick"`` (K + 1 rows: every ancillary tick plus the final state) or
+    ``"period"`` (one row per FHOCP sampling period); ``width`` 0 means one value per row.
+    ``csv`` names its columns in ``trajectory.csv`` (empty: not written); a per-period
+    field is written on the first tick of each period, NaN elsewhere.
+    """
+
+    name: str
+    per: str
+    width: int
+    dtype: type
+    fill: Any
+    csv: tuple[str, ...]
+    doc: str
+
+    def allocate(self, ticks: int, periods: int) -> np.ndarray:
+        """A new array for a run of ``ticks`` log rows (K + 1) and ``periods`` sampling periods."""
+        rows = ticks if self.per == "tick" else periods
+        return np.full((rows, self.width) if self.width else (rows,), self.fill, dtype=self.dtype)
+
+
+#: The one list of the closed loop's logged arrays: the loop's buffer, :class:`SimulationResult`
+#: (through :class:`LogArrays`) and the columns of ``trajectory.csv`` all derive from it.
+LOG_FIELDS: tuple[LogField, ...] = (
+    LogField("states", "tick", 4, float, np.nan, ("x", "y", "z", "psi"), "real state x, y, z (m), psi (rad)"),
+    LogField("nominal", "tick", 4, float, np.nan, ("x_hat", "y_hat", "z_hat", "psi_hat"),
+             "nominal state (left limit at each sample)"),
+    LogField("v_hat", "tick", 3, float, np.nan, ("u_hat", "w_hat", "r_hat"), "nominal input held (m/s, m/s, rad/s)"),
+    LogField("kappa", "tick", 3, float, np.nan, ("kappa_u", "kappa_w", "kappa_r"), "ancillary feedback kappa"),
+    LogField("inputs", "tick", 3, float, np.nan, ("u", "w", "r"), "applied input v (after any clipping)"),
+    LogField("saturated", "tick", 0, bool, False, ("saturated",), "v left V and was clipped"),
+    LogField("fallback", "tick", 0, bool, False, ("fallback",), "the period's FHOCP result was a fallback"),
+    LogField("replaced", "tick", 0, bool, False, ("replaced",), "the period's FHOCP input was replaced"),
+    LogField("n_detected", "tick", 0, int, 0, ("n_detected",), "obstacles known to the map"),
+    LogField("solve_ms", "tick", 0, float, np.nan, ("solve_ms",), "FHOCP solve time (ms), first tick of a period"),
+    LogField("step_ms", "tick", 0, float, np.nan, ("step_ms",), "controller time per period (ms), first tick"),
+    LogField("wall", "tick", 0, float, 0.0, ("wall_s",), "elapsed wall time of the run (s)"),
+    LogField("iterations", "period", 0, float, 0.0, (), "solver iterations"),
+    LogField("max_violation", "period", 0, float, np.nan, ("plan_violation",),
+             "largest constraint violation of the returned plan"),
+    LogField("rejected", "period", 0, bool, False, (), "the plan failed the arc check"),
+    LogField("plan_age", "period", 0, int, 0, (), "periods since the plan in use was computed"),
+    LogField("plan_slack", "period", 0, float, np.nan, (), "smallest slack of the arc check"),
 )
+
+_BY_NAME = {f.name: f for f in LOG_FIELDS}
+
+
+def allocate_log(ticks: int, periods: int) -> dict[str, np.ndarray]:
+    """Fresh arrays of every :data:`LOG_FIELDS` entry for ``ticks`` log rows and ``periods`` periods."""
+    return {f.name: f.allocate(ticks, periods) for f in LOG_FIELDS}
+
+
+#: The logged arrays as dataclass fields (keyword-only; per-period ones default to empty), built from
+#: :data:`LOG_FIELDS`; :class:`SimulationResult` (and the loop's buffer) derive from it.
+LogArrays = make_dataclass(
+    "LogArrays",
+    [(f.name, np.ndarray, dc_field(default_factory=partial(f.allocate, 0, 0))) if f.per == "period"
+     else (f.name, np.ndarray) for f in LOG_FIELDS],
+    kw_only=True)
+LogArrays.__module__ = __name__
+LogArrays.__doc__ = "The closed loop's logged arrays:\n\n" + "\n".join(
+    f"* ``{f.name}`` ({f.per}{f', {f.width} columns' if f.width else ''}): {f.doc}" for f in LOG_FIELDS)
+
+#: Columns computed from the log (not stored in it), by the attribute of :class:`SimulationResult` they come from.
+_DERIVED: dict[str, tuple[str, ...]] = {
+    "t": ("t",), "step": ("step",), "desired": ("x_d", "y_d", "z_d"), "errors": ("e_d", "e_z", "e_o"),
+    "rho": ("rho_d", "rho_z", "rho_o"), "rho_norm": ("rho_norm",), "omega": ("omega_1", "omega_2", "omega_3"),
+}
+#: Where each group of ``trajectory.csv`` columns comes from, in column order.
+_CSV_ORDER: tuple[str, ...] = ("t", "step", "states", "inputs", "desired", "errors", "nominal", "rho", "rho_norm",
+                               "v_hat", "kappa", "omega", "saturated", "fallback", "replaced", "n_detected",
+                               "solve_ms", "step_ms", "max_violation", "wall")
+_CSV_SOURCES: tuple[tuple[str, tuple[str, ...]], ...] = tuple(
+    (src, _DERIVED[src] if src in _DERIVED else _BY_NAME[src].csv) for src in _CSV_ORDER)
+
+#: Column order of ``trajectory.csv`` (see :meth:`SimulationResult.columns`).
+CSV_COLUMNS: tuple[str, ...] = tuple(name for _, names in _CSV_SOURCES for name in names)
 
 #: Columns appended to ``trajectory.csv`` by a dynamic-plant run (absent for the kinematic plant):
 #: body velocities reached (m/s, m/s, m/s, rad/s) and thrusts (N, N, N m) at the start of each tick.
@@ -31,8 +113,8 @@ DYNAMIC_COLUMNS: tuple[str, ...] = ("u_b", "v_b", "w_b", "r_b", "X", "Z", "N")
 
 
 @dataclass
-class SimulationResult:
-    """A closed-loop run: per-tick log, per-step solver data, counts, timings and checks.
+class SimulationResult(LogArrays):
+    """A closed-loop run: per-tick log (:data:`LOG_FIELDS`), per-step solver data, counts, timings and checks.
 
     Per-tick arrays have K + 1 rows (K = steps * ticks per step; the last row is
     the final state at t = duration with NaN inputs). Units: m, rad, s, m/s, rad/s.
@@ -48,28 +130,11 @@ class SimulationResult:
     ticks_per_step: int
     t: np.ndarray
     step: np.ndarray
-    states: np.ndarray
     desired: np.ndarray
-    nominal: np.ndarray
-    v_hat: np.ndarray
-    kappa: np.ndarray
-    inputs: np.ndarray
     omega: np.ndarray
-    saturated: np.ndarray
-    fallback: np.ndarray
-    replaced: np.ndarray
-    n_detected: np.ndarray
-    solve_ms: np.ndarray
-    step_ms: np.ndarray
-    wall: np.ndarray
-    statuses: list[str] = field(default_factory=list)
-    iterations: np.ndarray = field(default_factory=lambda: np.zeros(0))
-    max_violation: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    statuses: list[str] = dc_field(default_factory=list)
     kappa_failures: int = 0
     wall_s: float = 0.0
-    rejected: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=bool))
-    plan_age: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=int))
-    plan_slack: np.ndarray = field(default_factory=lambda: np.zeros(0))
     omega_overridden: bool = False
     body: np.ndarray | None = None
     thrust: np.ndarray | None = None
@@ -135,46 +200,39 @@ class SimulationResult:
             "inputs_within_limits": bool(np.all(np.abs(applied) <= lim + 1e-12)),
         }
 
+    @property
+    def facts(self) -> dict[str, Any]:
+        """What the run was: tube or baseline, its law (None for the baseline), σ (1/s), κ failures, checks."""
+        return {"tube": self.tube, "law": self.law if self.tube else None, "sigma": self.sigma,
+                "kappa_failures": self.kappa_failures, "checks": self.checks}
+
+    def _csv_source(self, source: str, derived: dict[str, np.ndarray]) -> np.ndarray:
+        """The array behind one group of CSV columns (per-period fields on the first tick of each period)."""
+        if source in derived:
+            return derived[source]
+        values = np.asarray(getattr(self, source))
+        spec = _BY_NAME.get(source)
+        if spec is not None and spec.per == "period":
+            spread = np.full(len(self.t), np.nan)
+            spread[0:-1:self.ticks_per_step] = values
+            return spread
+        return values.astype(int) if values.dtype == bool else values
+
     def columns(self) -> dict[str, np.ndarray]:
-        """The log as named columns, in :data:`CSV_COLUMNS` order."""
-        e, eh = self.errors, self.nominal_errors
-        rho = e - eh
-        c: dict[str, np.ndarray] = {"t": self.t, "step": self.step}
-        for i, n in enumerate(("x", "y", "z", "psi")):
-            c[n] = self.states[:, i]
-        for i, n in enumerate(("u", "w", "r")):
-            c[n] = self.inputs[:, i]
-        for i, n in enumerate(("x_d", "y_d", "z_d")):
-            c[n] = self.desired[:, i]
-        for i, n in enumerate(("e_d", "e_z", "e_o")):
-            c[n] = e[:, i]
-        for i, n in enumerate(("x_hat", "y_hat", "z_hat", "psi_hat")):
-            c[n] = self.nominal[:, i]
-        for i, n in enumerate(("rho_d", "rho_z", "rho_o")):
-            c[n] = rho[:, i]
-        c["rho_norm"] = np.linalg.norm(rho, axis=1)
-        for i, n in enumerate(("u_hat", "w_hat", "r_hat")):
-            c[n] = self.v_hat[:, i]
-        for i, n in enumerate(("kappa_u", "kappa_w", "kappa_r")):
-            c[n] = self.kappa[:, i]
-        for i, n in enumerate(("omega_1", "omega_2", "omega_3")):
-            c[n] = self.omega[:, i]
-        c["saturated"] = self.saturated.astype(int)
-        c["fallback"] = self.fallback.astype(int)
-        c["replaced"] = self.replaced.astype(int)
-        c["n_detected"] = self.n_detected
-        c["solve_ms"] = self.solve_ms
-        c["step_ms"] = self.step_ms
-        pv = np.full(len(self.t), np.nan)
-        pv[0:-1:self.ticks_per_step] = self.max_violation
-        c["plan_violation"] = pv
-        c["wall_s"] = self.wall
-        names = CSV_COLUMNS
+        """The log as named columns, in :data:`CSV_COLUMNS` order (then :data:`DYNAMIC_COLUMNS` if any)."""
+        e = self.errors
+        rho = e - self.nominal_errors
+        derived = {"t": self.t, "step": self.step, "desired": self.desired, "errors": e, "rho": rho,
+                   "rho_norm": np.linalg.norm(rho, axis=1), "omega": self.omega}
+        c: dict[str, np.ndarray] = {}
+        for source, names in _CSV_SOURCES:
+            values = self._csv_source(source, derived)
+            for i, name in enumerate(names):
+                c[name] = np.asarray(values[:, i] if values.ndim == 2 else values)
         if self.body is not None and self.thrust is not None:
-            for i, n in enumerate(DYNAMIC_COLUMNS):
-                c[n] = self.body[:, i] if i < 4 else self.thrust[:, i - 4]
-            names = CSV_COLUMNS + DYNAMIC_COLUMNS
-        return {k: np.asarray(c[k]) for k in names}
+            dynamic = np.column_stack([self.body, self.thrust])
+            c.update({name: dynamic[:, i] for i, name in enumerate(DYNAMIC_COLUMNS)})
+        return c
 
     def write_csv(self, path: str | Path) -> Path:
         """Write :meth:`columns` as CSV (header row, ``nan`` for missing values)."""
@@ -189,20 +247,10 @@ class SimulationResult:
         return self.write_csv(path)
 
     @property
-    def metrics(self) -> dict:
-        """The run's metrics (:func:`tubekit.loop.metrics.compute_metrics`; units in ``docs/reproduce.md``)."""
-        from tubekit.loop.metrics import compute_metrics
-        certified = bool(self.tightening.certified)
-        return compute_metrics(self.columns(), self.scenario,
-                               rho_bound=self.tightening.rho_tilde if certified else None,
-                               sway_bound=float(self.tightening.disturbance[2]) if certified else None,
-                               extra={"tube": self.tube, "law": self.law if self.tube else None, "sigma": self.sigma})
-
-    def plot(self):
-        """The top view of the run (a matplotlib Figure; plotting lives in :mod:`tubekit.app.plots`)."""
-        from tubekit.app.plots import top_view  # the one delegation from the core to the app layer
-        return top_view(self.scenario, [("tube" if self.tube else "baseline", self.columns())],
-                        tightening=self.tightening if self.tube else None)
+    def metrics(self) -> dict[str, Any]:
+        """The run's metrics, exactly as ``metrics.json`` holds them (:func:`tubekit.loop.metrics.run_metrics`)."""
+        from tubekit.loop.metrics import run_metrics
+        return run_metrics(self)
 
     def summary(self) -> str:
         """A few lines for the terminal."""

@@ -23,18 +23,28 @@ def bearing(e_x: np.ndarray, e_y: np.ndarray) -> np.ndarray:
     return np.arctan2(e_y, e_x)
 
 
-def error_coordinates(state: np.ndarray, p_d: np.ndarray) -> np.ndarray:
-    """Error e = [e_d, e_z, e_o] (eqs. 12-14) of ``state`` (..., 4) w.r.t. ``p_d`` (..., 3)."""
+def error_coordinates(state: np.ndarray, p_d: np.ndarray, floor: float = 0.0) -> np.ndarray:
+    """Error e = [e_d, e_z, e_o] (eqs. 12-14) of ``state`` (..., 4) w.r.t. ``p_d`` (..., 3).
+
+    The one implementation (the FHOCP, the ancillary law, the loop's log and the checks
+    all call it). ``e_d = sqrt(max(e_x^2 + e_y^2, floor^2))`` (m); with ``floor`` = 0 (default)
+    e_o is NaN where e_d = 0; the FHOCP passes a tiny floor to keep e_o finite there.
+    """
     state = np.asarray(state, dtype=float)
     p_d = np.asarray(p_d, dtype=float)
     ex = state[..., 0] - p_d[..., 0]
     ey = state[..., 1] - p_d[..., 1]
-    ez = state[..., 2] - p_d[..., 2]
     psi = state[..., 3]
-    ed = np.hypot(ex, ey)
-    with np.errstate(invalid="ignore", divide="ignore"):
-        eo = (ex * np.sin(psi) - ey * np.cos(psi)) / ed
-    return np.stack([ed, ez, eo], axis=-1)
+    out = np.empty(ex.shape + (3,))
+    np.sqrt(np.maximum(ex * ex + ey * ey, floor * floor), out=out[..., 0])
+    np.subtract(state[..., 2], p_d[..., 2], out=out[..., 1])
+    num = ex * np.sin(psi) - ey * np.cos(psi)
+    if floor > 0.0:
+        np.divide(num, out[..., 0], out=out[..., 2])
+    else:
+        with np.errstate(invalid="ignore", divide="ignore"):
+            np.divide(num, out[..., 0], out=out[..., 2])
+    return out
 
 
 def heading_cosine(state: np.ndarray, p_d: np.ndarray) -> np.ndarray:

@@ -4,8 +4,9 @@ The certificate promises, for the sampled-data loop of :mod:`tubekit.loop.closed
 (reset every δt, κ held at the ancillary rate, plans accepted by
 :mod:`tubekit.loop.plan_check`), that max_j |e_j - ê_j| / tube_j <= 1 and that e stays in
 R and v in V, as long as ‖ω_xy‖ <= ω̄_xy and |ω_z| <= ω̄_z. This module attacks
-that claim with :func:`tubekit.loop.closed_loop.simulate` itself (``disturbance=``
-override) and measures every run with :func:`tubekit.loop.promises.check_promises`:
+that claim with the loop that runs: every run is :func:`tubekit.loop.pipeline.certified_run`
+(the same pipeline as the studies and the campaign; ``disturbance=`` override), which measures
+the promises with :func:`tubekit.loop.promises.check_promises`:
 
 * **starts** on the boundary of Ē: the initial error on a face of R shrunk by the
   first arc margin, in the certified hemisphere (:func:`start_state`);
@@ -20,19 +21,21 @@ The budget counts simulations, never seconds; the search is deterministic for a 
 
 from __future__ import annotations
 
+import contextlib
 import math
 from dataclasses import dataclass, field, replace
-from typing import Any, Callable
+from typing import Any, Callable, Iterator
 
 import numpy as np
 
-from tubekit.model.ancillary import AncillaryLaw, get_law
-from tubekit.loop.closed_loop import simulate
+from tubekit.model.ancillary import LAWS, AncillaryLaw, get_law
 from tubekit.model.errors import error_coordinates, numeric
 from tubekit.exceptions import ConfigError
-from tubekit.loop.promises import Promise, check_promises
+from tubekit.loop.pipeline import certified_run
+from tubekit.loop.promises import PREMISES, Promise
 from tubekit.scenario import HEMISPHERE_SIGN, Scenario
 from tubekit.tightening import Tightening
+from tubekit.validation import duration_seconds
 
 from verify.falsify.strategies import state_from_error
 
@@ -40,7 +43,7 @@ __all__ = ["LoopRun", "ClosedLoopResult", "falsify_closed_loop", "start_state", 
            "piecewise_disturbance", "PREMISE_NAMES", "GREEDY_AXES"]
 
 #: Promises that are premises of the theorem (a run breaking one claims nothing).
-PREMISE_NAMES = ("disturbance", "recursive_feasibility")
+PREMISE_NAMES = PREMISES
 #: Greedy variants: the axis with the largest |ρ_j| / tube_j, or one fixed axis (0: e_d, 1: e_z, 2: e_o).
 GREEDY_AXES: tuple[int | None, ...] = (None, 0, 1, 2)
 #: Offspring per generation of the evolution strategy, and its mutation step (unit cube).
@@ -239,9 +242,31 @@ def greedy_disturbance(tap: list, tube: np.ndarray, omega_xy: float, omega_z: fl
 
 
 # --------------------------------------------------------------------------- one run
+@contextlib.contextmanager
+def _tapped(law: AncillaryLaw, tap: list | None) -> Iterator[None]:
+    """During the block, the law registered under ``law.name`` also records its inputs into ``tap``.
+
+    The scenario keeps naming the same law (so the certificate's design still matches); the
+    registry entry is swapped for a :class:`_StateTap` of it and restored afterwards.
+    """
+    if tap is None:
+        yield
+        return
+    previous = LAWS.get(law.name)
+    LAWS[law.name] = _StateTap(law.name, law.gain_of_jacobian, law.description, law.symbolic_gain,
+                               law.closed_form, tap=tap)
+    try:
+        yield
+    finally:
+        if previous is None:
+            LAWS.pop(law.name, None)
+        else:
+            LAWS[law.name] = previous
+
+
 @dataclass(frozen=True)
 class _Attack:
-    """Fixed context of a search: the short scenario, the certificate's Tightening and bounds."""
+    """Fixed context of a search: the short scenario (naming the law), the certificate's Tightening and bounds."""
 
     scenario: Scenario
     tightening: Tightening
@@ -251,20 +276,14 @@ class _Attack:
 
     def run(self, strategy: str, start: tuple[float, ...], disturbance: Callable, tap: list | None = None,
             sequence: tuple | None = None) -> LoopRun:
-        """Simulate from ``start`` under ``disturbance`` and measure the promises."""
-        law = self.law if tap is None else _StateTap(self.law.name, self.law.gain_of_jacobian,
-                                                      self.law.description, self.law.symbolic_gain,
-                                                      self.law.closed_form, tap=tap)
-        sc = replace(self.scenario, initial_state=start)
-        result = simulate(sc, tightening=self.tightening, law=law, progress=False, disturbance=disturbance)
-        promises = tuple(check_promises(result))
-        by_name = {p.name: p for p in promises}
-        broken = tuple(p.name for p in promises if p.name not in PREMISE_NAMES and math.isfinite(p.observed)
-                       and not p.ok)
-        vacuous = any(not by_name[n].ok for n in PREMISE_NAMES if n in by_name)
-        axes = np.nanmax(np.abs(np.asarray(result.rho)) / np.asarray(self.tightening.tube), axis=0)
-        return LoopRun(strategy, tuple(float(x) for x in start), float(by_name["tube"].observed), broken, vacuous,
-                       promises, sequence, tuple(float(a) for a in axes))
+        """Simulate from ``start`` under ``disturbance`` (:func:`certified_run`) and measure the promises."""
+        sc = self.scenario.with_changes(initial_state=start)
+        with _tapped(self.law, tap):
+            done = certified_run(sc, self.tightening, disturbance=disturbance)
+        by_name = {p.name: p for p in done.promises}
+        axes = np.nanmax(np.abs(np.asarray(done.run.rho)) / np.asarray(self.tightening.tube), axis=0)
+        return LoopRun(strategy, tuple(float(x) for x in start), float(by_name["tube"].observed), done.broken,
+                       not done.premises_held, done.promises, sequence, tuple(float(a) for a in axes))
 
 
 def _setup(scenario: Scenario, law: str | None, duration: float, certificate: Any,
@@ -273,15 +292,15 @@ def _setup(scenario: Scenario, law: str | None, duration: float, certificate: An
 
     name = scenario.controller.law if law is None else law
     law_obj = get_law(name)
-    if not (isinstance(duration, (int, float)) and math.isfinite(duration) and duration > 0):
-        raise ConfigError("duration", "a number of seconds > 0", duration)
+    duration_seconds("duration", duration)
     cert = certificate if certificate is not None else certify(scenario, name)
     tight = tightening if tightening is not None else cert.best_effort_tightening()
     if not np.all(np.asarray(tight.tube) > 0):
         raise ConfigError("tube", "a certificate with a finite one-period tube", list(tight.tube),
                           "the design has no tube to attack")
-    short = replace(scenario, duration=float(max(duration, scenario.controller.dt)))
-    wxy, wz = float(tight.disturbance[0]), float(tight.disturbance[1])
+    short = scenario.with_changes(duration=float(max(duration, scenario.controller.dt)),
+                                  controller=replace(scenario.controller, law=name))
+    wxy, wz = tight.disturbance.omega_xy, tight.disturbance.omega_z
     return _Attack(short, tight, law_obj, wxy, wz), cert
 
 

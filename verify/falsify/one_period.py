@@ -11,7 +11,7 @@ bounded Powell search from random points of the same unit cube
 (:func:`verify.falsify.strategies.period_configuration_from_unit`).
 
 :func:`falsify_closed_loop` (:mod:`verify.falsify.closed_loop`) attacks whole runs of
-:func:`tubekit.loop.closed_loop.simulate` with disturbance sequences.
+:func:`tubekit.loop.pipeline.certified_run` with disturbance sequences.
 """
 
 from __future__ import annotations
@@ -83,13 +83,13 @@ def search_space(scenario: Scenario, law: str | None = None, *, sigma: float | N
     get_law(law)
     cert = certificate if certificate is not None else certify(scenario, law)
     tight = cert.best_effort_tightening()
-    tube = tuple(float(x) for x in cert.tube["rho"])
+    tube = tuple(float(x) for x in cert.tube.rho)
     if not all(math.isfinite(x) and x > 0 for x in tube):
         raise ConfigError("tube", "a certificate with a finite one-period tube", list(tube),
                           "the design has no tube to attack")
     ctrl = scenario.controller
     ticks = int(round(ctrl.ancillary_rate_hz * ctrl.dt))
-    theta = float(cert.tube.get("theta", math.pi))
+    theta = float(cert.tube.theta)
     space = SearchSpace(
         region=cert.region, law=law, sigma=float(sigma if sigma is not None else cert.design.sigma), tube=tube,
         theta=theta if math.isfinite(theta) else math.pi, v_bar=tuple(float(x) for x in tight.v_max),

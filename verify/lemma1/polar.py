@@ -18,18 +18,24 @@ seconds of sympy time.
 
 from __future__ import annotations
 
+import hashlib
+import inspect
+import sys
 from dataclasses import dataclass
 from functools import lru_cache
 
 import sympy as sp
 
 from tubekit.model.ancillary import LAWS
-from tubekit.model.derivation import derive, symbols
+from tubekit.model.derivation import derivation_hash, derive, symbols
 from tubekit.exceptions import ConfigError, TubekitError
+
+from verify.lemma1.forms import simplified, stored_polar
 
 __all__ = [
     "PolarModel",
     "polar_model",
+    "polar_hash",
     "law_gain",
     "E_D",
     "E_Z",
@@ -150,11 +156,25 @@ def _is_rotation_form(zeta: sp.Matrix, dzeta_dtheta: sp.Matrix) -> bool:
             and (dzeta_dtheta - G * sp.Matrix([B_V, -A_V])).applyfunc(sp.simplify) == sp.zeros(3, 1))
 
 
+@lru_cache(maxsize=1)
+def polar_hash() -> str:
+    """sha-256 of :func:`tubekit.model.derivation.derivation_hash` and this module's source (no sympy work):
+    the key under which :mod:`verify.lemma1.forms` ships the derived polar model."""
+    return hashlib.sha256((derivation_hash() + inspect.getsource(sys.modules[__name__])).encode()).hexdigest()
+
+
 @lru_cache(maxsize=4)
 def polar_model(s: int) -> PolarModel:
-    """Derive the polar-form model for hemisphere sign ``s`` (-1 toward, +1 away); cached."""
+    """The polar-form model for hemisphere sign ``s`` (-1 toward, +1 away); cached.
+
+    Read from the shipped forms (:mod:`verify.lemma1.forms`) when they were generated from this
+    derivation and this module, else derived (seconds of sympy time).
+    """
     if s not in (-1, 1):
         raise ConfigError("hemisphere sign", "-1 or +1", s)
+    stored = stored_polar(s, polar_hash())
+    if stored is not None:
+        return PolarModel(s=s, **stored)
     d = derive()
     sy = symbols()
     vel = _rotated(sy["xdot_d"], sy["ydot_d"], A_V, B_V)
@@ -194,5 +214,5 @@ def law_gain(law: str, s: int) -> tuple[sp.Matrix, sp.Matrix]:
     K = sp.Matrix(gain(J))
     if K.shape != (3, 3):
         raise ConfigError("law.symbolic_gain", "a map returning a 3x3 sympy Matrix", K.shape)
-    JK = (J * K).applyfunc(sp.simplify)
+    JK = simplified("jk", J * K, lambda M: M.applyfunc(sp.simplify))
     return K, JK

@@ -1,0 +1,150 @@
+"""The design key: a canonical SHA-256 of everything the certificate's theorem reads.
+
+A certificate (:func:`verify.certify`) holds for one design: the scenario fields the
+theorem reads, the ancillary law, the gain σ and the theorem's version. The key binds
+a :class:`tubekit.tightening.Tightening` to that design, so a run can refuse a
+tightening issued for another one (:func:`require_matching`) before anything runs.
+
+The fields (:func:`design_fields`, a flat dict of dotted names, numbers as floats):
+``theorem_version``, ``law``, ``sigma``; ``limits.*``, ``trajectory.*``, ``epsilon``,
+``region.*``, ``disturbance.amplitude``, ``disturbance.constant``,
+``disturbance.sway.{gain, amplitude, bound}``, ``obstacles[i].{center, radius}``,
+``vehicle_radius``, ``sensing_range``, ``workspace``,
+``controller.{dt, horizon_steps, ancillary_rate_hz}``, ``plant.*`` (``plant.kind`` only
+on the kinematic plant). Not in the key, because the theorem does not read them: the
+name, the duration, the current's and the sway's periods, the initial state (each run's
+start is checked by the run itself: the first plan must pass the arc check), the FHOCP
+weights and modes. numpy and the standard library only: the loop checks the key without
+importing :mod:`verify`.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import math
+from typing import Any
+
+from tubekit.exceptions import ConfigError
+
+__all__ = ["THEOREM_VERSION", "design_fields", "design_key", "first_difference", "require_matching"]
+
+#: Version of the theorem a certificate states; a certificate of another version is not this design.
+THEOREM_VERSION = "sampled-data-tube/2"
+
+_SCENARIO_KEYS = ("limits", "trajectory", "epsilon", "region", "obstacles", "vehicle_radius", "sensing_range",
+                  "workspace")
+_CONTROLLER_KEYS = ("dt", "horizon_steps", "ancillary_rate_hz")
+_SWAY_KEYS = ("gain", "amplitude", "bound")
+
+
+def _canonical(value: Any) -> Any:
+    """Numbers as floats (non-finite as text), tuples as lists, nested containers alike."""
+    if isinstance(value, bool) or value is None or isinstance(value, str):
+        return value
+    if isinstance(value, (int, float)) or hasattr(value, "__float__") and not hasattr(value, "__len__"):
+        x = float(value)
+        return x if math.isfinite(x) else repr(x)
+    if isinstance(value, dict):
+        return {str(k): _canonical(v) for k, v in value.items()}
+    return [_canonical(v) for v in value]
+
+
+def _flatten(prefix: str, value: Any, out: dict[str, Any]) -> None:
+    """Dicts and lists of dicts into dotted / indexed names; other values kept whole."""
+    if isinstance(value, dict):
+        for k in value:
+            _flatten(f"{prefix}.{k}", value[k], out)
+    elif isinstance(value, (list, tuple)) and value and all(isinstance(v, dict) for v in value):
+        for i, v in enumerate(value):
+            _flatten(f"{prefix}[{i}]", v, out)
+    else:
+        out[prefix] = _canonical(value)
+
+
+def design_fields(scenario: Any, law: str, sigma: float) -> dict[str, Any]:
+    """The flat, canonical dict of what the theorem reads (module doc).
+
+    Parameters
+    ----------
+    scenario : tubekit.scenario.Scenario
+        The scenario (only its ``to_dict()`` is read).
+    law : str
+        Ancillary law name.
+    sigma : float
+        Ancillary gain σ of the design (1/s).
+    """
+    d = scenario.to_dict()
+    out: dict[str, Any] = {"theorem_version": THEOREM_VERSION, "law": str(law), "sigma": _canonical(sigma)}
+    for key in _SCENARIO_KEYS:
+        if key == "obstacles" and not d.get(key):
+            out["obstacles"] = []
+            continue
+        _flatten(key, d.get(key), out)
+    dist = d["disturbance"]
+    out["disturbance.amplitude"] = _canonical(dist["amplitude"])
+    out["disturbance.constant"] = _canonical(dist["constant"])
+    for k in _SWAY_KEYS:
+        out[f"disturbance.sway.{k}"] = _canonical(dist["sway"][k])
+    for k in _CONTROLLER_KEYS:
+        out[f"controller.{k}"] = _canonical(d["controller"][k])
+    plant = d.get("plant", {"kind": "kinematic"})
+    if plant.get("kind", "kinematic") == "kinematic":
+        out["plant.kind"] = "kinematic"
+    else:
+        _flatten("plant", plant, out)
+    return out
+
+
+def design_key(fields: dict[str, Any]) -> str:
+    """SHA-256 (hex) of ``fields`` as canonical JSON (keys sorted, no spaces)."""
+    text = json.dumps(_canonical(fields), sort_keys=True, separators=(",", ":"), allow_nan=False)
+    return hashlib.sha256(text.encode("utf-8")).hexdigest()
+
+
+def first_difference(found: dict[str, Any], stored: dict[str, Any]) -> tuple[str, Any, Any] | None:
+    """``(name, found value, stored value)`` of the first field that differs (``"absent"`` if missing)."""
+    for name in list(found) + [k for k in stored if k not in found]:
+        a, b = found.get(name, "absent"), stored.get(name, "absent")
+        if _canonical(a) != _canonical(b):
+            return name, a, b
+    return None
+
+
+def require_matching(scenario: Any, tightening: Any, law: str | None = None, sigma: float | None = None) -> None:
+    """Refuse a tightening certified for another design than ``scenario``'s (nothing runs then).
+
+    Parameters
+    ----------
+    scenario : tubekit.scenario.Scenario
+        The scenario about to run.
+    tightening : tubekit.tightening.Tightening
+        Its tightening; one without a design key (the untightened baseline) is not checked.
+    law : str, optional
+        The law the run uses (default the scenario's).
+    sigma : float, optional
+        The σ the run uses (1/s); default the scenario's declared σ, else the tightening's.
+
+    Raises
+    ------
+    ConfigError
+        ``design_key.<field>`` naming the first differing field, with the scenario's and the
+        certificate's values.
+    """
+    stored_key = getattr(tightening, "design_key", None)
+    if stored_key is None:
+        return
+    declared = scenario.controller.sigma
+    run_sigma = sigma if sigma is not None else (declared if declared is not None else tightening.sigma)
+    found = design_fields(scenario, law if law is not None else scenario.controller.law, float(run_sigma))
+    if design_key(found) == stored_key:
+        return
+    stored = dict(getattr(tightening, "design_fields", None) or {})
+    diff = first_difference(found, stored)
+    if diff is None:
+        raise ConfigError("design_key", f"the key of the scenario's design ({design_key(found)[:16]}...)",
+                          stored_key, "the certificate's key does not match its own fields: it was edited")
+    name, here, there = diff
+    raise ConfigError(f"design_key.{name}", f"the certificate's value {there!r} (it was issued for another design)",
+                      here, "the scenario and law the run uses differ from those the certificate was issued for; "
+                            "certify this scenario (tubekit certify) and use that certificate")

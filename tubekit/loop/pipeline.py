@@ -1,0 +1,117 @@
+"""One certified run: simulate → metrics (one convention) → promises, as a typed result.
+
+:func:`certified_run` is the run part of every study that runs the loop under a certificate's
+tightening: ``tubekit reproduce`` / ``simulate`` (tube and baseline), the dynamic-plant part of
+``reproduce``, each run of ``tubekit campaign`` and each run of the closed-loop falsifier
+(:mod:`verify.falsify.closed_loop`). Obtaining the tightening (certifying, or taking a given
+certificate) is the caller's step: the core never imports :mod:`verify`. The verdict is the
+tightening's own ``certified`` flag, the one place it is stored.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Any
+
+from tubekit.loop.closed_loop import run_closed_loop
+from tubekit.loop.metrics import run_metrics
+from tubekit.loop.promises import PREMISES, Promise, check_promises
+from tubekit.loop.result import SimulationResult
+from tubekit.plant.base import OmegaOverride
+from tubekit.scenario import Scenario
+from tubekit.tightening import Tightening
+
+__all__ = ["CertifiedRun", "certified_run"]
+
+
+@dataclass(frozen=True)
+class CertifiedRun:
+    """A finished run with its metrics (as ``metrics.json`` holds them) and the promises measured on it.
+
+    Attributes
+    ----------
+    run : SimulationResult
+        The closed-loop log.
+    promises : tuple of Promise
+        What the certificate promises, measured (empty for the baseline).
+    metrics : dict
+        :func:`tubekit.loop.metrics.run_metrics` of ``run`` (equal to ``run.metrics``).
+    """
+
+    run: SimulationResult
+    promises: tuple[Promise, ...]
+    metrics: dict[str, Any]
+
+    @property
+    def certified(self) -> bool:
+        """The tightening the run used came from a certified certificate."""
+        return bool(self.run.tightening.certified)
+
+    @property
+    def promises_kept(self) -> bool:
+        """Every promise (premises included) held; True for the baseline, which is promised nothing."""
+        return all(p.ok for p in self.promises)
+
+    @property
+    def premises_held(self) -> bool:
+        """The theorem's premises (:data:`tubekit.loop.promises.PREMISES`) held on the run."""
+        return all(p.ok for p in self.promises if p.name in PREMISES)
+
+    @property
+    def broken(self) -> tuple[str, ...]:
+        """Names of the non-premise promises broken (a NaN figure, e.g. sway under an override, is skipped)."""
+        return tuple(p.name for p in self.promises
+                     if p.name not in PREMISES and math.isfinite(p.observed) and not p.ok)
+
+    @property
+    def ratio(self) -> float:
+        """max_j |e_j - ê_j| / tube_j over the run (1 = the certified tube; inf for a zero tube; NaN: baseline)."""
+        tube = [p for p in self.promises if p.name == "tube"]
+        return float(tube[0].observed) if tube else math.nan
+
+    def check(self) -> bool:
+        """False only when a certified run broke a promise of its certificate (exit 4 of the CLI)."""
+        return not (self.certified and not self.promises_kept)
+
+    def summary(self) -> str:
+        """One line: the run, its verdict and the broken promises."""
+        kind = "tube" if self.run.tube else "baseline"
+        verdict = ("certified" if self.certified else "not certified") if self.run.tube else "no certificate"
+        line = (f"{kind} run of {self.run.scenario.name!r} ({verdict}): min clearance "
+                f"{self.metrics['min_clearance']}, min e_d {self.metrics['min_e_d']:.4g} m, "
+                f"tube ratio {self.metrics['max_rho_ratio']}")
+        failed = [p.name for p in self.promises if not p.ok]
+        return line + (f"; not kept: {', '.join(failed)}" if failed else "")
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-ready: the metrics (promises included)."""
+        return dict(self.metrics)
+
+
+def certified_run(scenario: Scenario, tightening: Tightening, *, tube: bool = True,
+                  disturbance: OmegaOverride | None = None, solver_factory: Any = None, progress: bool = False,
+                  label: str | None = None) -> CertifiedRun:
+    """Simulate ``scenario`` under ``tightening``, measure it in the one convention and check its promises.
+
+    Parameters
+    ----------
+    scenario : Scenario
+        What to run; its law, FHOCP mode and plant kind are the scenario's.
+    tightening : Tightening
+        The certificate's (or best-effort, or untightened) sets; σ and the verdict are its own.
+    tube : bool
+        ``False`` runs the baseline (nominal MPC alone; no promises).
+    disturbance : callable, optional
+        ``disturbance(t) -> omega`` (m/s) replacing the scenario's current + sway.
+    solver_factory : callable, optional
+        ``factory(scenario, tightening)`` returning the FHOCP solver; default :class:`tubekit.fhocp.FHOCP`.
+    progress : bool
+        A progress bar on a terminal.
+    label : str, optional
+        Progress-bar label.
+    """
+    run = run_closed_loop(scenario, tightening, tube=tube, progress=progress, label=label,
+                          solver_factory=solver_factory, disturbance=disturbance)
+    promises = tuple(check_promises(run)) if tube else ()
+    return CertifiedRun(run=run, promises=promises, metrics=run_metrics(run, promises))

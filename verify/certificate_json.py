@@ -1,0 +1,123 @@
+"""A certificate as JSON and back: :meth:`Certificate.to_dict` / :meth:`Certificate.from_dict`, and the checksum.
+
+The dict holds the typed parts (each with its own ``to_dict`` / ``from_dict``), the
+numbers derived from them (``certified``, ``kappa_bar``, ``e_bar``, ``failures``,
+``not_evaluated``: written for readers, recomputed on reading, re-checked by
+:mod:`verify.recheck`), the design key and fields (:mod:`tubekit.design_key`) and a
+``checksum``: SHA-256 over the canonical JSON of every other entry but ``elapsed_s``
+(keys sorted, no spaces, numbers as Python writes them). The checksum is an integrity
+check, not a signature: anyone can recompute it after an edit; it tells an accidental or
+naive edit from the issued file, and :mod:`verify.recheck` re-derives everything else.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import math
+from typing import Any
+
+from tubekit.design_key import THEOREM_VERSION
+from tubekit.exceptions import ConfigError
+from tubekit.jsonable import to_jsonable
+
+from verify.design import Condition, Design, DisturbanceBounds
+from verify.gains import GainBounds
+from verify.parts import SigmaChoice, block, item, integer, number, numbers, text, texts
+from verify.region import Region
+from verify.sampled import HorizonMargins, PeriodTube, TubeProblem
+
+__all__ = ["certificate_to_dict", "certificate_from_dict", "checksum_of", "NOT_CHECKSUMMED", "TUBE_FORM"]
+
+#: Entries outside the checksum: the checksum itself and the wall time (the one non-deterministic number).
+NOT_CHECKSUMMED = ("checksum", "elapsed_s")
+#: What the tube block describes (written beside the numbers).
+TUBE_FORM = "box: |e_j - e_hat_j| <= rho_j within every FHOCP period (deviation restarts at 0)"
+
+
+def checksum_of(d: dict) -> str:
+    """SHA-256 (hex) of the canonical JSON of ``d`` without :data:`NOT_CHECKSUMMED`."""
+    content = {k: v for k, v in d.items() if k not in NOT_CHECKSUMMED}
+    text_ = json.dumps(content, sort_keys=True, separators=(",", ":"), allow_nan=False, ensure_ascii=False)
+    return hashlib.sha256(text_.encode("utf-8")).hexdigest()
+
+
+def certificate_to_dict(cert: Any) -> dict:
+    """The JSON dict of a :class:`verify.certificate.Certificate` (module doc)."""
+    d = cert.design
+    tube = d.tube.to_dict()
+    tube["form"] = TUBE_FORM
+    e_bar = cert.e_bar
+    out = to_jsonable({
+        "certified": cert.certified, "scenario": cert.scenario_name, "law": cert.law, "theorem": cert.theorem,
+        "theorem_version": THEOREM_VERSION, "region": cert.region.to_dict(),
+        "disturbance": cert.disturbance.to_dict(), "gains": cert.gains.to_dict(), "sigma": cert.sigma.to_dict(),
+        "problem": d.problem.to_dict(), "tube": tube,
+        "margins": None if d.margins is None else d.margins.to_dict(), "v_bar": cert.v_bar,
+        "kappa_bar": cert.kappa_bar, "e_bar": None if e_bar is None else e_bar.to_dict(),
+        "arc_rates": list(d.rates), "horizon": {"steps": cert.horizon_steps, "dt": cert.dt},
+        "limits": list(cert.limits), "conditions": [c.to_dict() for c in cert.conditions],
+        "failures": [{k: v for k, v in c.to_dict().items() if k != "ok"} for c in cert.failures],
+        "not_evaluated": list(cert.not_evaluated), "assumptions": list(cert.assumptions),
+        "premises": list(cert.premises), "scenario_data": cert.scenario_data,
+        "design_key": cert.design_key, "design_fields": cert.design_fields,
+        "elapsed_s": round(cert.elapsed_s, 3),
+    })
+    if cert.paper_route is not None:
+        out["paper_route"] = to_jsonable(cert.paper_route.to_dict())
+    out["checksum"] = checksum_of(out)
+    return out
+
+
+def _conditions(d: dict) -> tuple[Condition, ...]:
+    conds = item(d, "conditions", "certificate")
+    if not isinstance(conds, list):
+        raise ConfigError("certificate.conditions", "a list of conditions", type(conds).__name__)
+    return tuple(Condition.from_dict(c, f"certificate.conditions[{i}]") for i, c in enumerate(conds))
+
+
+def _design(d: dict, sigma: SigmaChoice) -> Design:
+    """The chosen design: σ, problem, tube, margins, V̄, conditions, its score (from ``tried``), arc rates."""
+    margins = item(d, "margins", "certificate")
+    v_bar = item(d, "v_bar", "certificate")
+    score = next((t.score for t in sigma.tried if t.sigma == sigma.value), None)
+    return Design(sigma=sigma.value, problem=TubeProblem.from_dict(block(d, "problem", "certificate")),
+                  tube=PeriodTube.from_dict(block(d, "tube", "certificate")),
+                  margins=None if margins is None else HorizonMargins.from_dict(block(d, "margins", "certificate")),
+                  v_bar=None if v_bar is None else numbers(d, "v_bar", "certificate", 3, none=None),
+                  conditions=_conditions(d), score=-math.inf if score is None else score,
+                  rates=numbers(d, "arc_rates", "certificate", 4))
+
+
+def _route(d: dict) -> Any:
+    if d.get("paper_route") is None:
+        return None
+    from verify.lemma1.route import PaperRoute
+    return PaperRoute.from_dict(block(d, "paper_route", "certificate"))
+
+
+def certificate_from_dict(cls: type, d: Any) -> Any:
+    """The ``cls`` (:class:`verify.certificate.Certificate`) of :func:`certificate_to_dict`'s dict (exact inverse).
+
+    Raises
+    ------
+    ConfigError
+        Naming the first missing or mistyped key (``certificate.<key>``).
+    """
+    if not isinstance(d, dict):
+        raise ConfigError("certificate", "a JSON object", type(d).__name__)
+    sigma = SigmaChoice.from_dict(block(d, "sigma", "certificate"))
+    horizon = block(d, "horizon", "certificate")
+    fields = block(d, "design_fields", "certificate")
+    return cls(
+        scenario_name=text(d, "scenario", "certificate"), law=text(d, "law", "certificate"),
+        region=Region.from_dict(block(d, "region", "certificate")),
+        gains=GainBounds.from_dict(block(d, "gains", "certificate")),
+        disturbance=DisturbanceBounds.from_dict(block(d, "disturbance", "certificate")),
+        design=_design(d, sigma), tried=sigma.tried, sigma_source=sigma.source,
+        elapsed_s=number(d, "elapsed_s", "certificate"),
+        horizon_steps=integer(horizon, "steps", "certificate.horizon"),
+        dt=number(horizon, "dt", "certificate.horizon"),
+        assumptions=texts(d, "assumptions", "certificate"), premises=texts(d, "premises", "certificate"),
+        limits=numbers(d, "limits", "certificate", 3, none=None),
+        scenario_data=block(d, "scenario_data", "certificate"), design_fields=dict(fields), paper_route=_route(d))

@@ -28,6 +28,7 @@ from typing import Any
 import numpy as np
 
 from tubekit.exceptions import ConfigError
+from tubekit.model.backup import BackupPlan
 from tubekit.scenario import Scenario
 
 __all__ = ["Tightening", "MARGIN_COLUMNS", "RegionBounds", "DisturbanceBound"]
@@ -126,6 +127,11 @@ class Tightening:
         SHA-256 of the design (:func:`tubekit.design_key.design_key`); None: not checked.
     design_fields : dict or None
         The fields the key hashes, to name the first one that differs.
+    backup : BackupPlan or None
+        The certified backup law and safe set (None: no backup; the loop then replays the last
+        plan and, once it is exhausted, has no certified input).
+    tiers : dict or None
+        Which tier of promise the certificate gives, e.g. ``{"safe": True, "tracking": False}``.
     """
 
     v_max: np.ndarray
@@ -145,6 +151,8 @@ class Tightening:
     law: str | None = None
     design_key: str | None = None
     design_fields: dict | None = None
+    backup: BackupPlan | None = None
+    tiers: dict | None = None
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "region", RegionBounds.of(self.region))

@@ -26,7 +26,7 @@ import numpy as np
 from tubekit.exceptions import ConfigError
 from tubekit.validation import nonnegative, positive
 
-__all__ = ["StationKeeping", "SafeSet", "line_of_sight_angle", "axis_angle", "station_keeping_input"]
+__all__ = ["StationKeeping", "SafeSet", "BackupPlan", "line_of_sight_angle", "axis_angle", "station_keeping_input"]
 
 
 def _sat(x: float) -> float:
@@ -125,3 +125,28 @@ class SafeSet:
     def handover_radius(self) -> float:
         """Horizontal distance (m) within which every heading lies in S."""
         return self.level - self.shape
+
+
+@dataclass(frozen=True)
+class BackupPlan:
+    """The certified backup handed to the loop: the law, its safe set and the hand-over it was proved for.
+
+    Attributes
+    ----------
+    law : StationKeeping
+        The station-keeping law.
+    safe_set : SafeSet
+        Its invariant set about the anchor (the end of the last accepted plan).
+    handover : (float, float)
+        Largest horizontal distance and depth error (m) from the anchor when the backup takes over
+        (the replayed plan's last position and depth margins).
+    """
+
+    law: StationKeeping
+    safe_set: SafeSet
+    handover: tuple[float, float] = (0.0, 0.0)
+
+    def footprint(self, vehicle_radius: float) -> tuple[float, float]:
+        """(horizontal radius, half height) (m) of the safe set inflated by the vehicle ball."""
+        return self.safe_set.radius + vehicle_radius, self.safe_set.depth + vehicle_radius
+

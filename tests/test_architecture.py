@@ -1,4 +1,11 @@
-"""The layering rules of issue 10, checked on the source: core <- solver and plant <- verify <- app.
+"""The layering rules of ``docs/architecture.md``, checked on the source as package-prefix rules.
+
+The layers, from the ground up: ``tubekit.exceptions`` / ``validation`` / ``version``, then
+``tubekit.model``, then the configuration (``scenario``, ``tightening``, ``checks``,
+``design_key``), then the run (``tubekit.plant`` and ``tubekit.fhocp``, then ``tubekit.loop``);
+``verify`` needs the model and the configuration, and only ``verify.falsify`` runs the loop;
+``tubekit.app`` (with the ``python -m tubekit`` shim) sits on top and is the only layer that
+parses arguments, plots, or joins tubekit and verify.
 
 Every module of ``tubekit/`` and ``verify/`` is parsed with :mod:`ast` (no import
 is executed); its imports are every ``import`` / ``from ... import`` statement
@@ -6,7 +13,7 @@ anywhere in the file (module level, inside functions, under ``if TYPE_CHECKING``
 every ``importlib.import_module("...")`` / ``__import__("...")`` call with a
 literal name, and every string literal that is exactly the dotted name of a
 submodule (a registry such as ``{"falsify": "verify.falsify.one_period"}`` imported by name
-later). See ``docs/architecture.md``.
+later). A failure lists every offender as ``path:line -> imported name``.
 """
 
 from __future__ import annotations
@@ -17,13 +24,24 @@ import sys
 from dataclasses import dataclass
 from functools import lru_cache
 from pathlib import Path
+from typing import Callable, Iterable
 
 ROOT = Path(__file__).resolve().parents[1]
 PACKAGES = ("tubekit", "verify")
 APP = "tubekit.app"
+#: The app layer: tubekit.app and the ``python -m tubekit`` shim that hands over to its CLI.
+APP_LAYER = (APP, "tubekit.__main__")
 GUI_AND_CLI = ("argparse", "matplotlib", "mpl_toolkits")
+MODEL = "tubekit.model"
+MODEL_MAY_IMPORT = (MODEL, "tubekit.exceptions", "tubekit.validation", "tubekit.version")
+CONFIGURATION = ("tubekit.scenario", "tubekit.tightening", "tubekit.checks", "tubekit.design_key")
+RUN_AND_APP = ("tubekit.plant", "tubekit.fhocp", "tubekit.loop", APP)
+PLANT_AND_SOLVER = ("tubekit.plant", "tubekit.fhocp")
+LOOP = "tubekit.loop"
+THE_RUN = ("tubekit.plant", "tubekit.fhocp", LOOP)
+FALSIFIERS = "verify.falsify"
 MAX_MODULE_LINES = 500
-MAX_FUNCTION_LINES = 100
+MAX_FUNCTION_LINES = 80
 
 
 @dataclass(frozen=True)
@@ -121,27 +139,75 @@ def _within(name: str, prefix: str) -> bool:
     return name == prefix or name.startswith(prefix + ".")
 
 
+def _within_any(name: str, prefixes: tuple[str, ...]) -> bool:
+    """True if dotted ``name`` is inside one of ``prefixes``."""
+    return any(_within(name, prefix) for prefix in prefixes)
+
+
 def _is_app(name: str) -> bool:
-    return _within(name, APP)
+    return _within_any(name, APP_LAYER)
 
 
 def _is_core(name: str) -> bool:
     return _within(name, "tubekit") and not _is_app(name)
 
 
-def _offenders(rule) -> list[str]:
-    """``path:line imports target`` for every import for which ``rule(module, target)`` is true.
+def _is_first_party(name: str) -> bool:
+    return _within_any(name, PACKAGES)
 
+
+def _offenders(rule: Callable[[str, str], bool], among: Iterable[Module] | None = None) -> list[str]:
+    """``path:line -> target`` for every import for which ``rule(module, target)`` is true.
+
+    ``among`` defaults to every module of the two packages (the checker's self-tests pass fakes).
     One entry a line: the shortest offending target of the statement (``matplotlib.figure``,
     not also ``matplotlib.figure.Figure``).
     """
     first: dict[tuple[str, int], str] = {}
-    for m in modules().values():
+    for m in modules().values() if among is None else among:
         for imp in imports(m):
             key = (m.rel, imp.line)
             if rule(m.name, imp.target) and (key not in first or len(imp.target) < len(first[key])):
                 first[key] = imp.target
-    return [f"{rel}:{line} imports {target}" for (rel, line), target in sorted(first.items())]
+    return [f"{rel}:{line} -> {target}" for (rel, line), target in sorted(first.items())]
+
+
+# --------------------------------------------------------------------------- the rules as predicates
+# Each rule is ``rule(importing module, imported target) -> True when the import breaks it``; the
+# tests below apply it to the real tree and the checker's self-tests to fake modules.
+def model_reaches_above(mod: str, target: str) -> bool:
+    """tubekit.model imports, of the two packages, only itself, exceptions, validation and version."""
+    return _within(mod, MODEL) and _is_first_party(target) and not _within_any(target, MODEL_MAY_IMPORT)
+
+
+def configuration_reaches_the_run(mod: str, target: str) -> bool:
+    """scenario / tightening / checks / design_key import no plant, fhocp, loop or app."""
+    return _within_any(mod, CONFIGURATION) and _within_any(target, RUN_AND_APP)
+
+
+def plant_or_solver_reaches_the_loop(mod: str, target: str) -> bool:
+    """tubekit.plant and tubekit.fhocp import no tubekit.loop."""
+    return _within_any(mod, PLANT_AND_SOLVER) and _within(target, LOOP)
+
+
+def imports_the_app_layer(mod: str, target: str) -> bool:
+    """Nothing outside the app layer (tubekit.app and the ``python -m tubekit`` shim) imports tubekit.app."""
+    return not _is_app(mod) and _within(target, APP)
+
+
+def core_imports_verify(mod: str, target: str) -> bool:
+    """The tubekit core (tubekit outside the app layer) imports no verify."""
+    return _is_core(mod) and _within(target, "verify")
+
+
+def verify_runs_the_loop(mod: str, target: str) -> bool:
+    """verify outside verify.falsify imports no tubekit.plant, tubekit.fhocp, tubekit.loop."""
+    return _within(mod, "verify") and not _within(mod, FALSIFIERS) and _within_any(target, THE_RUN)
+
+
+def gui_or_cli_outside_the_app(mod: str, target: str) -> bool:
+    """argparse, matplotlib and mpl_toolkits are imported only in the app layer."""
+    return not _is_app(mod) and _within_any(target, GUI_AND_CLI)
 
 
 def _owning_module(target: str) -> str | None:
@@ -199,24 +265,46 @@ def _report(rule: str, offenders: list[str]) -> str:
 def test_the_packages_are_found():
     """Guard: the walk sees both packages (an empty walk would pass every rule)."""
     names = set(modules())
-    assert {"tubekit", "verify", "tubekit.scenario", "verify.region"} <= names, sorted(names)
+    assert {"tubekit", "verify", "tubekit.scenario", "verify.region", "tubekit.model.errors",
+            "tubekit.loop.result", "tubekit.app.cli", "verify.falsify.closed_loop"} <= names, sorted(names)
 
 
-def test_argparse_and_matplotlib_only_in_the_app_layer():
-    offenders = _offenders(lambda mod, target: not _is_app(mod)
-                           and any(_within(target, lib) for lib in GUI_AND_CLI))
-    assert not offenders, _report(f"{', '.join(GUI_AND_CLI)} may be imported only under tubekit/app/", offenders)
+def test_the_model_imports_nothing_above_it():
+    offenders = _offenders(model_reaches_above)
+    assert not offenders, _report(f"tubekit.model may import only {', '.join(MODEL_MAY_IMPORT)}", offenders)
+
+
+def test_the_configuration_imports_no_plant_solver_loop_or_app():
+    offenders = _offenders(configuration_reaches_the_run)
+    assert not offenders, _report(f"{', '.join(CONFIGURATION)} must not import {', '.join(RUN_AND_APP)}",
+                                  offenders)
+
+
+def test_plant_and_fhocp_import_no_loop():
+    offenders = _offenders(plant_or_solver_reaches_the_loop)
+    assert not offenders, _report(f"{' and '.join(PLANT_AND_SOLVER)} must not import {LOOP}", offenders)
+
+
+def test_nothing_outside_the_app_layer_imports_it():
+    offenders = _offenders(imports_the_app_layer)
+    assert not offenders, _report(f"only {' and '.join(APP_LAYER)} may import {APP} (lazy imports included)",
+                                  offenders)
 
 
 def test_the_core_never_imports_verify():
-    offenders = _offenders(lambda mod, target: _is_core(mod) and _within(target, "verify"))
+    offenders = _offenders(core_imports_verify)
     assert not offenders, _report("the tubekit core (tubekit/ outside tubekit/app/) must not import verify",
                                   offenders)
 
 
-def test_verify_never_imports_the_app_layer():
-    offenders = _offenders(lambda mod, target: _within(mod, "verify") and _is_app(target))
-    assert not offenders, _report("verify must not import tubekit.app", offenders)
+def test_verify_runs_the_loop_only_in_the_falsifiers():
+    offenders = _offenders(verify_runs_the_loop)
+    assert not offenders, _report(f"verify outside {FALSIFIERS} must not import {', '.join(THE_RUN)}", offenders)
+
+
+def test_argparse_and_matplotlib_only_in_the_app_layer():
+    offenders = _offenders(gui_or_cli_outside_the_app)
+    assert not offenders, _report(f"{', '.join(GUI_AND_CLI)} may be imported only under tubekit/app/", offenders)
 
 
 def test_no_import_cycles():
@@ -229,23 +317,29 @@ def test_no_module_over_the_line_limit():
     assert not offenders, _report(f"modules over {MAX_MODULE_LINES} lines", offenders)
 
 
-def test_no_function_over_the_hard_line_limit():
+def long_functions(among: Iterable[Module] | None = None) -> list[str]:
+    """``path:line name: N lines`` for every function (methods and nested ones too) over the limit."""
     offenders = []
-    for m in modules().values():
+    for m in modules().values() if among is None else among:
         for node in ast.walk(m.tree):
             if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef)):
                 length = node.end_lineno - node.lineno + 1
                 if length > MAX_FUNCTION_LINES:
                     offenders.append(f"{m.rel}:{node.lineno} {node.name}: {length} lines")
-    assert not offenders, _report(f"functions over {MAX_FUNCTION_LINES} lines (hard limit)", sorted(offenders))
+    return sorted(offenders)
 
 
-def test_importing_the_packages_loads_no_matplotlib():
-    code = "import sys, tubekit, verify; print('matplotlib' in sys.modules)"
+def test_no_function_over_the_line_limit():
+    offenders = long_functions()
+    assert not offenders, _report(f"functions over {MAX_FUNCTION_LINES} lines", offenders)
+
+
+def test_importing_the_packages_loads_no_matplotlib_and_no_sympy():
+    code = "import sys, tubekit, verify; print(sorted(m for m in ('matplotlib', 'sympy') if m in sys.modules))"
     run = subprocess.run([sys.executable, "-c", code], cwd=ROOT, capture_output=True, text=True, timeout=300)
     assert run.returncode == 0, f"`python -c {code!r}` failed:\n{run.stderr}"
-    assert run.stdout.strip() == "False", (f"`import tubekit, verify` loads matplotlib (printed "
-                                           f"{run.stdout.strip()!r}); plotting belongs in tubekit/app/")
+    assert run.stdout.strip() == "[]", (f"`import tubekit, verify` loads {run.stdout.strip()}: plotting belongs "
+                                        f"in tubekit/app/, the sympy derivation is imported only on use")
 
 
 # --------------------------------------------------------------------------- the checker itself
@@ -269,3 +363,55 @@ def test_relative_imports_resolve_inside_packages():
     pkg = Module(name="tubekit.fhocp", path=ROOT / "tubekit/fhocp/__init__.py", is_package=True,
                  tree=ast.parse("from .result import R\n"), lines=1)
     assert {imp.target for imp in imports(pkg)} == {"tubekit.fhocp.result", "tubekit.fhocp.result.R"}
+
+
+def _fake(name: str, source: str, is_package: bool = False) -> Module:
+    """A module that is not on disk, parsed from ``source``, for the checker's self-tests."""
+    rel = name.replace(".", "/") + ("/__init__.py" if is_package else ".py")
+    return Module(name=name, path=ROOT / rel, is_package=is_package, tree=ast.parse(source),
+                  lines=len(source.splitlines()))
+
+
+def test_the_app_rule_catches_a_lazy_import_from_the_loop():
+    """``SimulationResult.plot()`` importing ``tubekit.app.plots`` inside the method (as it did) breaks the rule."""
+    lazy = _fake("tubekit.loop.result", "class SimulationResult:\n    def plot(self):\n"
+                 "        from tubekit.app.plots import plot_run\n        return plot_run(self)\n")
+    relative = _fake("tubekit.loop.result", "def plot(run):\n    from ..app import plots\n")
+    by_name = _fake("verify.report", "import importlib\n\ndef f():\n"
+                    "    return importlib.import_module('tubekit.app.plots')\n")
+    assert _offenders(imports_the_app_layer, among=[lazy]) == ["tubekit/loop/result.py:3 -> tubekit.app.plots"]
+    assert _offenders(imports_the_app_layer, among=[relative]) == ["tubekit/loop/result.py:2 -> tubekit.app.plots"]
+    assert _offenders(imports_the_app_layer, among=[by_name]) == ["verify/report.py:4 -> tubekit.app.plots"]
+    inside = _fake("tubekit.app.study", "from tubekit.app.plots import plot_run\nfrom . import output\n")
+    shim = _fake("tubekit.__main__", "def run():\n    from tubekit.app.cli import main\n")
+    assert _offenders(imports_the_app_layer, among=[inside, shim]) == []
+
+
+def test_the_layer_rules_flag_only_what_they_name():
+    model = _fake("tubekit.model.kinematics", "from tubekit.validation import positive\n"
+                  "from tubekit.model import errors\nfrom .. import scenario\nimport tubekit\n"
+                  "def f():\n    import verify.region\n")
+    assert _offenders(model_reaches_above, among=[model]) == [
+        "tubekit/model/kinematics.py:3 -> tubekit.scenario", "tubekit/model/kinematics.py:4 -> tubekit",
+        "tubekit/model/kinematics.py:6 -> verify.region"]
+    config = _fake("tubekit.design_key", "from tubekit.model import errors\nfrom tubekit.fhocp.result import Status\n")
+    assert _offenders(configuration_reaches_the_run, among=[config]) == [
+        "tubekit/design_key.py:2 -> tubekit.fhocp.result"]
+    solver = _fake("tubekit.fhocp.scp", "from tubekit.plant import base\nfrom tubekit.loop.sensing import x\n")
+    assert _offenders(plant_or_solver_reaches_the_loop, among=[solver]) == [
+        "tubekit/fhocp/scp.py:2 -> tubekit.loop.sensing"]
+    checker = _fake("verify.design", "from tubekit.scenario import Scenario\nimport tubekit.loop.plan_check\n")
+    falsifier = _fake("verify.falsify.closed_loop", "import tubekit.loop.plan_check\n")
+    assert _offenders(verify_runs_the_loop, among=[checker, falsifier]) == [
+        "verify/design.py:2 -> tubekit.loop.plan_check"]
+    core = _fake("tubekit.loop.promises", "def f():\n    import matplotlib.pyplot as plt\n    import verify\n")
+    assert _offenders(gui_or_cli_outside_the_app, among=[core]) == ["tubekit/loop/promises.py:2 -> matplotlib.pyplot"]
+    assert _offenders(core_imports_verify, among=[core]) == ["tubekit/loop/promises.py:3 -> verify"]
+
+
+def test_the_function_limit_counts_methods_and_stops_at_the_limit():
+    assert (MAX_MODULE_LINES, MAX_FUNCTION_LINES) == (500, 80), "the house rules' limits (issue 19)"
+    at_limit = "def f():\n" + "    x = 1\n" * (MAX_FUNCTION_LINES - 1)
+    over = "class C:\n    def g(self):\n" + "        x = 1\n" * MAX_FUNCTION_LINES
+    fake = [_fake("tubekit.a", at_limit), _fake("tubekit.b", over)]
+    assert long_functions(among=fake) == [f"tubekit/b.py:2 g: {MAX_FUNCTION_LINES + 1} lines"]

@@ -1,4 +1,4 @@
-"""Kinematics, input limits and the sway model settings (evaluated in tests/test_plant.py)."""
+"""Kinematics, input limits and the sway model settings (evaluated in tests/test_plant_kinematic.py)."""
 
 from __future__ import annotations
 

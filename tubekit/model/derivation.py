@@ -13,7 +13,7 @@ The numeric versions (:mod:`tubekit.model.errors`, numpy only) are *generated
 once* from this derivation (sympy printing with common-subexpression elimination)
 into the shipped module :mod:`tubekit.model._generated_dynamics`, so that no sympy work
 runs at import or at run time; ``python -m tubekit.model.derivation`` regenerates it and
-``tests/test_derivation.py`` checks that the shipped code equals the derivation
+``tests/test_model_derivation.py`` checks that the shipped code equals the derivation
 (source hash, text and values).
 """
 

@@ -43,3 +43,10 @@ def tightening(scenario=SC) -> Tightening:
     return Tightening(v_max=scenario.limits.vector.copy(), e_d_min=scenario.epsilon + 0.05,
                       e_o_max=reg.e_o_max, e_z_max=reg.e_z_max, e_d_max=reg.e_d_max,
                       obstacle_margin=0.05, rho_tilde=0.05, sigma=0.0)
+
+
+def backup_plan():
+    """A station-keeping backup (the values verify.backup.design_backup certifies on the paper's bounds):
+    safe radius c = 0.8 m, shape 0.45, depth 0.1 m; footprint (1.0, 0.3) m with the 0.2 m vehicle."""
+    from tubekit.model.backup import BackupPlan, SafeSet, StationKeeping
+    return BackupPlan(StationKeeping(0.2, 0.5, 0.05, 0.3, 0.05), SafeSet(0.8, 0.45, 0.1), handover=(0.35, 0.1))

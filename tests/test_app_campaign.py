@@ -209,3 +209,28 @@ def test_a_campaign_on_an_existing_scheduler_survives_a_killed_worker(serial, tm
     assert [r["run"] for r in rows] == list(range(runs))
     assert _without_wall(rows[:RUNS]) == _without_wall(read_rows(serial))
     assert json.loads((out / "summary.json").read_text())["scheduler"] == address
+
+
+# ---- issue 21: dense clusters, the backup and the tiers -------------------------------------------------
+CLUSTER_SAMPLES = """
+[sample]
+"obstacles" = { cluster = { count = [4, 7], radius = [0.3, 0.4], gap = [0.01, 0.05], center = [[0.8, 2.2, 0.0], [1.2, 2.6, 0.0]], margin = 0.15 } }
+"""
+
+
+def test_a_cluster_campaign_reports_safety_backup_and_tracking(tmp_path):
+    """Clusters on the path at 2-6 s: the summary counts safety breaks (none), backup time and tiers."""
+    head = f'scenario = "{SCENARIO.as_posix()}"\nruns = 3\nseed = 5\nduration = 6.0\n'
+    summary = run_campaign(load_spec(_spec(tmp_path, 3, CLUSTER_SAMPLES, head)), tmp_path / "out", workers=1,
+                           progress=False)
+    rows = read_rows(tmp_path / "out")
+    assert summary["safety_broken_safe_tier"] == 0
+    assert summary["safe_tier_runs"] == sum(r["safe_tier"] for r in rows)
+    engaged = [r for r in rows if r["backup_s"] > 0]
+    assert summary["backup"]["runs_engaged"] == len(engaged)
+    assert summary["backup"]["share_of_simulated_time"] == pytest.approx(sum(r["backup_s"] for r in rows) / 18.0)
+    assert all(r["replaced_steps"] >= round(r["backup_s"] / 0.1) - 1 for r in rows)  # the backup follows a replay
+    table = pq.read_table(tmp_path / "out" / "runs.parquet").to_pylist()
+    assert {"obstacles.count", "backup_s", "safety_broken", "safe_tier", "tracking_tier"} <= set(table[0])
+    assert [json.loads(r["obstacles"]) and r["obstacles.count"] for r in table] == \
+        [len(json.loads(r["obstacles"])) for r in table]

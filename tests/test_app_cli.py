@@ -67,6 +67,8 @@ def _fake_certify(scenario, law=None):
         certified = False
         failures = [SimpleNamespace(condition="fake")]
         disturbance = SimpleNamespace(gamma=0.02)  # read by the dynamic-plant part of reproduce
+        tiers = {"safe": False, "tracking": False}
+        tier_failures = {"safe": ("fake",), "tracking": ("fake",)}
 
         def to_dict(self):
             return {"certified": False, "fake": True}

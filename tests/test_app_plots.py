@@ -136,3 +136,51 @@ def test_plot_run_is_the_figure_of_a_run():
     assert any("position tube" in text for text in labels)  # a tube run shows its tube
     with pytest.raises(ConfigError, match="run: expected a tubekit.SimulationResult"):
         plot_run(run.columns())
+
+
+# ---- the backup and the tiers on the figures (issue 21) -----------------------------------------------------
+def _backup_columns():
+    t = np.arange(0.0, 10.01, 0.5)
+    active = np.zeros(t.size)
+    active[4:8] = 1.0    # 2.0 s .. 4.0 s (ends at the first tick following a plan)
+    active[-3:] = 1.0    # 9.0 s .. the end
+    return {"t": t, "backup_active": active}
+
+
+def test_backup_stretches_are_the_active_intervals():
+    from tubekit.app.plots import backup_stretches
+
+    assert backup_stretches(_backup_columns()) == [(2.0, 4.0), (9.0, 10.0)]
+    assert backup_stretches({"t": np.arange(3.0)}) == []
+
+
+def test_the_backup_is_shaded_once_per_stretch_with_one_legend_entry():
+    from matplotlib.figure import Figure
+
+    from tubekit.app.plots import backup_stretches, shade_backup
+
+    ax = Figure().add_subplot()
+    shade_backup(ax, backup_stretches(_backup_columns()))
+    assert len(ax.patches) == 2
+    labels = [p.get_label() for p in ax.patches if p.get_label() and not p.get_label().startswith("_")]
+    assert labels == ["backup law active (station keeping)"]
+
+
+def test_tier_title_names_the_failed_conditions_of_a_tier_not_given():
+    from tubekit.app.plots import tier_title
+
+    assert tier_title({"safe": True, "tracking": False}, {"tracking": ["keep_up", "yaw_budget"]}) == \
+        "safe: certified; tracking: not certified (keep_up, yaw_budget)"
+    assert tier_title({"safe": True, "tracking": True}) == "safe: certified; tracking: certified"
+    assert "nothing is promised" in tier_title(None)
+
+
+def test_a_long_tier_line_is_wrapped_below_the_title():
+    from tubekit.app.plots import title_lines
+
+    tiers = "safe: certified; tracking: not certified (" + ", ".join(f"condition_{k}" for k in range(20)) + ")"
+    text = title_lines("Tracking errors", tiers, width=60)
+    lines = text.splitlines()
+    assert lines[0] == "Tracking errors" and all(len(line) <= 60 for line in lines[1:])
+    assert " ".join(lines[1:]) == tiers
+    assert title_lines("Tracking errors", None) == "Tracking errors"

@@ -32,6 +32,8 @@ class FakeCertificate:
         self.scenario, self.certified = scenario, certified
         self.failures = [] if certified else [SimpleNamespace(condition="fake")]
         self.disturbance = SimpleNamespace(gamma=0.02)  # what the dynamic part of reproduce reads
+        self.tiers = {"safe": certified, "tracking": certified}
+        self.tier_failures = {"safe": () if certified else ("fake",), "tracking": () if certified else ("fake",)}
 
     def to_dict(self):
         return {"certified": self.certified, "fake": True, "rho": 0.03}
@@ -43,7 +45,7 @@ class FakeCertificate:
         base = Tightening.untightened(self.scenario)  # the verdict and gamma travel in the tightening
         return dataclasses.replace(base, sigma=0.5, rho_tilde=0.03, e_d_min=self.scenario.epsilon + 0.03,
                                    obstacle_margin=0.02, v_max=base.v_max * 0.9, certified=self.certified,
-                                   disturbance=(0.0, 0.0, self.disturbance.gamma))
+                                   disturbance=(0.25, 0.15, self.disturbance.gamma))  # covers the current
 
 
 def _fake_certify(certified=False):
@@ -272,7 +274,7 @@ def test_metrics_json_is_the_runs_metrics_key_for_key(certified, tmp_path, monke
     assert isinstance(result, StudyResult) and result.to_dict() == stored
     assert {k: v for k, v in stored.items() if k not in STUDY_KEYS} == result.tube.run.metrics
     assert stored["baseline"] == result.baseline.run.metrics
-    dynamic_only = ("failures", "vehicle", "tracking_bound")
+    dynamic_only = ("failures", "vehicle", "tracking_bound", "tiers_report")
     assert {k: v for k, v in stored["dynamic"].items() if k not in dynamic_only} == result.dynamic.run.metrics
     assert stored["sway_bound"] == 0.02 and stored["max_rho_ratio"] is None and "promises" in stored
     # the fake certified certificate's zero tube is broken by any disturbed run: check() fails only then

@@ -35,7 +35,8 @@ def test_fields_name_what_the_theorem_reads():
     assert f["obstacles[0].center"] == [3.0, 0.0, 0.0] and f["obstacles[1].radius"] == 0.4
     assert f["disturbance.sway.bound"] == 0.02 and f["controller.ancillary_rate_hz"] == 100.0
     assert f["plant.kind"] == "kinematic" and f["workspace"] == [[-10.0, -10.0, -5.0], [10.0, 10.0, 5.0]]
-    for absent in ("name", "duration", "initial_state", "disturbance.period", "disturbance.sway.period",
+    assert f["duration"] == 100.0     # target_in_workspace reads it
+    for absent in ("name", "initial_state", "disturbance.period", "disturbance.sway.period",
                    "controller.Q", "controller.terminal_level", "controller.fhocp_mode"):
         assert absent not in f
 
@@ -61,6 +62,7 @@ CHANGED = [
     ("obstacles[2].center", lambda s: (replace(s, obstacles=s.obstacles + (Obstacle((0.0, 8.0, 0.0), 0.4),)),
                                        "corrected", 3.125)),
     ("sensing_range", lambda s: (replace(s, sensing_range=2.0), "corrected", 3.125)),
+    ("duration", lambda s: (replace(s, duration=150.0), "corrected", 3.125)),
 ]
 
 
@@ -74,14 +76,13 @@ def test_a_changed_input_changes_the_key_and_is_named(name, change):
 
 UNREAD = [
     lambda s: replace(s, name="other"),
-    lambda s: replace(s, duration=7.0),
     lambda s: replace(s, initial_state=(0.0, 2.0, 0.0, 0.3)),
     lambda s: replace(s, disturbance=replace(s.disturbance, period=3.0)),
     lambda s: replace(s, controller=replace(s.controller, Q=(2.0, 2.0, 1.0), fhocp_mode="converged")),
 ]
 
 
-@pytest.mark.parametrize("change", UNREAD, ids=["name", "duration", "initial_state", "period", "weights"])
+@pytest.mark.parametrize("change", UNREAD, ids=["name", "initial_state", "period", "weights"])
 def test_what_the_theorem_does_not_read_keeps_the_key(change):
     assert design_key(design_fields(change(SC), "corrected", 3.125)) == design_key(design_fields(SC, "corrected",
                                                                                                  3.125))
@@ -91,6 +92,22 @@ def test_a_matching_tightening_and_the_baseline_pass():
     require_matching(SC, _tight())
     require_matching(SC, Tightening.untightened(SC))                     # no key: not checked
     require_matching(replace(SC, duration=3.0, initial_state=(0.0, 2.5, 0.0, 0.0)), _tight())
+
+
+def test_a_longer_run_than_certified_is_refused_a_shorter_one_is_covered():
+    """The target stays in the workspace over [0, 100 s], hence over any shorter run, not a longer one."""
+    require_matching(replace(SC, duration=99.9), _tight())
+    with pytest.raises(ConfigError, match=r"design_key\.duration: .*100\.0.*received 100\.1"):
+        require_matching(replace(SC, duration=100.1), _tight())
+
+
+def test_a_safe_only_tightening_runs_at_its_own_sigma_zero():
+    """A safe-only tightening (sigma = 0, no feedback) is bound to sigma 0 even when the scenario declares one."""
+    declared = replace(SC, controller=replace(SC.controller, sigma=6.25))
+    safe = _tight(SC, sigma=0.0, tiers={"safe": True, "tracking": False})
+    require_matching(declared, safe)
+    with pytest.raises(ConfigError, match=r"design_key\.sigma"):
+        require_matching(declared, _tight(SC, sigma=0.0, tiers={"safe": True, "tracking": True}))
 
 
 MISMATCH = [

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import builtins
+import dataclasses
 
 import numpy as np
 import pytest
@@ -10,7 +11,11 @@ import pytest
 from tubekit import NotAvailableError
 from tubekit.fhocp import FHOCP, ScpOptions
 
-from .fhocp_cases import SC, tightening
+from tubekit.loop.plan_check import plan_arcs
+from tubekit.loop.terminal import terminal_condition
+
+from .fhocp_cases import SC, backup_plan, tightening
+from .fhocp_cases import STATES as CASES
 from .fhocp_cases import RUN_STATES as STATES
 
 
@@ -93,3 +98,16 @@ def test_sqpmethod_peer_solves_the_same_nlp():
     assert not a.fallback and a.status in ("optimal", "optimal_inaccurate")
     assert abs(a.merit - b.merit) <= 1e-2 * max(1.0, abs(b.merit))
     assert not sqp.solve(t + SC.controller.dt, np.array(state), SC.obstacles).fallback  # dual warm start
+
+
+def test_ipopt_carries_the_backup_terminal_rows_where_they_bind():
+    """The same sensed-region case as the SCP's: with a 1.2 m sensing range the plan end must stay within
+    0.195 m of the start; IPOPT meets the rows that the free plan breaks."""
+    from tubekit.fhocp.ipopt import IpoptFHOCP
+    sc = SC.with_changes(sensing_range=1.2)
+    t, s = CASES[0]
+    s = np.asarray(s, dtype=float)
+    res = IpoptFHOCP(sc, dataclasses.replace(tightening(sc), backup=backup_plan())).solve(t, s, ())
+    end = plan_arcs(s, res.inputs, sc.controller.dt, 1)[-1, -1]
+    check = terminal_condition(end[:3], backup_plan(), sc.vehicle_radius, (), sc.workspace, s[:3], sc.sensing_range)
+    assert check.ok and check.slack < 5e-3 and res.violations["backup_terminal"] <= 1e-6   # it binds

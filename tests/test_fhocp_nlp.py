@@ -2,17 +2,20 @@
 
 from __future__ import annotations
 
+import dataclasses
+import math
+
 import numpy as np
 import pytest
 
 from tubekit.model.kinematics import dsinc
-from tubekit.fhocp.nlp import (FhocpNlp, discrete_step, eo_linearisation, obstacle_array, rollout,
+from tubekit.fhocp.nlp import (BackupTerminal, FhocpNlp, discrete_step, eo_linearisation, obstacle_array, rollout,
                                select_obstacles, sinc, step_linearisation)
 from tubekit.model.kinematics import nominal_kinematics
 from tubekit.scenario import Obstacle, paper_scenario
 from tubekit.tightening import Tightening
 
-from .fhocp_cases import tightening
+from .fhocp_cases import backup_plan, tightening
 
 SC = paper_scenario()
 TIGHT = Tightening(v_max=np.array([0.3, 0.2, 0.4]), e_d_min=0.3, e_o_max=0.8, e_z_max=0.9, e_d_max=2.9,
@@ -124,3 +127,25 @@ def test_step_and_eo_linearisations_match_finite_differences():
         s2 = s.copy()
         s2[:, col] += h
         assert np.allclose((nlp.errors(s2, ref)[:, 2] - e0) / h, g[row], atol=1e-5)
+
+
+# ---- the backup's terminal rows (issue 21) ----------------------------------------------------------------
+
+def test_the_backup_terminal_rows_come_from_the_tightenings_backup():
+    assert FhocpNlp.from_scenario(SC, tightening()).backup_terminal is None
+    bt = FhocpNlp.from_scenario(SC, dataclasses.replace(tightening(), backup=backup_plan())).backup_terminal
+    # footprint (0.8 + 0.2, 0.1 + 0.2); sphere hypot(1.0, 0.3) (no obstacle margin at the exact end); R_bar - r = 1.3
+    assert bt.footprint == pytest.approx((1.0, 0.3)) and bt.sphere == pytest.approx(math.hypot(1.0, 0.3))
+    assert bt.safe == pytest.approx((0.8, 0.1)) and bt.sensed_bound == pytest.approx(1.3)
+
+
+def test_the_backup_terminal_violation_is_the_worst_row():
+    bt = BackupTerminal(sphere=1.0, footprint=(0.9, 0.2), safe=(0.5, 0.1), sensed_bound=2.0)
+    p0, pn = np.zeros(3), np.array([1.0, 0.0, 0.0])
+    assert bt.violation(p0, pn, np.zeros((0, 4)), None) == 0.0   # spread hypot(1.5, 0.1) < 2
+    obstacle = np.array([[2.5, 0.0, 0.0, 0.6]])                  # 1.5 m away, needs 1.6
+    assert bt.violation(p0, pn, obstacle, None) == pytest.approx(0.1)
+    walls = np.array([[-5.0, -5.0, -5.0], [1.8, 5.0, 5.0]])     # x <= 1.8 - 0.9 = 0.9
+    assert bt.violation(p0, pn, np.zeros((0, 4)), walls) == pytest.approx(0.1)
+    far = np.array([2.0, 0.0, 0.4])                              # hypot(2.5, 0.5) - 2
+    assert bt.violation(p0, far, np.zeros((0, 4)), None) == pytest.approx(math.hypot(2.5, 0.5) - 2.0)

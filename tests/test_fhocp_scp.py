@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import warnings
 
@@ -11,8 +12,10 @@ import pytest
 from tubekit import ConfigError, Obstacle, ShapeError
 from tubekit.fhocp import FHOCP, FallbackWarning, FhocpResult, ScpOptions
 from tubekit.fhocp.nlp import rollout, select_obstacles
+from tubekit.loop.plan_check import plan_arcs
+from tubekit.loop.terminal import terminal_condition
 
-from .fhocp_cases import OBSTACLES, SC, STATES, tightening
+from .fhocp_cases import OBSTACLES, SC, STATES, backup_plan, tightening
 
 
 @pytest.fixture(scope="module")
@@ -246,3 +249,48 @@ def test_default_obstacle_slots_from_the_scenario():
     close = SC.with_changes(obstacles=(Obstacle((3.0, 0.0, 0.0), 0.4), Obstacle((3.0, 2.0, 0.0), 0.4)))
     assert obstacle_slots(close) == 2
     assert obstacle_slots(SC.with_changes(obstacles=())) == 1
+
+
+# ---- the backup's terminal condition as a constraint (issue 21) -------------------------------------------
+
+def _end_check(sc, state, res, obstacles):
+    end = plan_arcs(state, res.inputs, sc.controller.dt, 1)[-1, -1]
+    return terminal_condition(end[:3], backup_plan(), sc.vehicle_radius, obstacles, sc.workspace, state[:3],
+                              sc.sensing_range)
+
+
+@pytest.mark.parametrize("mode", ["realtime", "converged"])
+def test_the_terminal_rows_keep_the_plan_end_in_the_sensed_region(mode):
+    """With a 1.2 m sensing range the safe set fits only within 0.195 m of the start: the free plan goes 0.32 m."""
+    sc = SC.with_changes(sensing_range=1.2)
+    t, s = STATES[0]
+    s = np.asarray(s, dtype=float)
+    free = FHOCP(sc, tightening(sc), mode=mode).solve(t, s, ())
+    bound = FHOCP(sc, dataclasses.replace(tightening(sc), backup=backup_plan()), mode=mode).solve(t, s, ())
+    assert _end_check(sc, s, free, ()).reason == "sensed region" and not _end_check(sc, s, free, ()).ok
+    held = _end_check(sc, s, bound, ())
+    assert held.ok and held.slack < 1e-3          # it binds
+    assert bound.violations["backup_terminal"] <= 1e-9 and "backup_terminal" not in free.violations
+
+
+@pytest.mark.parametrize("mode", ["realtime", "converged"])
+def test_the_terminal_rows_keep_the_footprint_off_an_obstacle_ahead(mode):
+    """An obstacle 0.9 m beyond the free plan's end, clear of every node: only the terminal rows see it."""
+    t, s = STATES[0]
+    s = np.asarray(s, dtype=float)
+    free = FHOCP(SC, tightening(SC), mode="converged").solve(t, s, ())
+    end = plan_arcs(s, free.inputs, SC.controller.dt, 1)[-1, -1]
+    ahead = (end[:2] - s[:2]) / np.linalg.norm(end[:2] - s[:2])
+    ob = (Obstacle((end[0] + 0.9 * ahead[0], end[1] + 0.9 * ahead[1], end[2]), 0.3),)
+    without = FHOCP(SC, tightening(SC), mode=mode).solve(t, s, ob)
+    with_rows = FHOCP(SC, dataclasses.replace(tightening(SC), backup=backup_plan()), mode=mode).solve(t, s, ob)
+    assert without.violations["obstacle"] == 0.0 and not _end_check(SC, s, without, ob).ok
+    assert _end_check(SC, s, with_rows, ob).ok and with_rows.violations["backup_terminal"] <= 1e-9
+
+
+def test_without_a_backup_the_problem_is_unchanged():
+    solver = FHOCP(SC, tightening(SC))
+    names = {v.name() for v in solver.problem.variables()}
+    assert "slack_backup" not in names and not any(n.startswith("rt") for n in solver.parameters)
+    with_backup = FHOCP(SC, dataclasses.replace(tightening(SC), backup=backup_plan()))
+    assert "slack_backup" in {v.name() for v in with_backup.problem.variables()}

@@ -16,6 +16,7 @@ from tubekit.fhocp import FhocpResult
 from tubekit.loop.metrics import read_trajectory_csv
 from tubekit.model.kinematics import SwayModel
 from tubekit.scenario import Disturbance
+from tubekit.model.backup import BackupPlan, SafeSet, StationKeeping, station_keeping_input
 
 
 def _scenario(duration=5.0, **dist):
@@ -322,3 +323,68 @@ def test_bad_run_inputs(kwargs, match):
         run_closed_loop(sc, _tightening(sc, 1.0), solver_factory=Pursuit, progress=False, **kwargs)
     with pytest.raises(ConfigError, match="scenario"):
         run_closed_loop(sc.to_dict(), _tightening(sc, 1.0), solver_factory=Pursuit, progress=False)
+
+
+# ---- phases: accept, replay, backup, resume (issue 21) --------------------------------------------------
+
+BACKUP = BackupPlan(StationKeeping(0.2, 0.5, 0.05, 0.3, 0.05), SafeSet(0.8, 0.45, 0.1), handover=(0.35, 0.1))
+
+
+def _safe_only(sc, backup=BACKUP):
+    """Arc check on positions only (tracking not certified), zero margins, with or without a backup."""
+    n = sc.controller.horizon_steps
+    return dataclasses.replace(Tightening.untightened(sc), margins=np.zeros((n, 4)), backup=backup,
+                               tiers={"safe": True, "tracking": False})
+
+
+def test_the_backup_takes_over_when_the_replay_is_exhausted_and_tracking_resumes():
+    sc = _scenario(duration=4.0)
+    n = sc.controller.horizon_steps
+    fail = range(5, 25)   # periods 5..24 fail; the plan of period 4 replays for n - 1 periods, then the backup
+
+    def factory(s, t):
+        return Pursuit(s, t, nan_at=fail)
+    res = run_closed_loop(sc, tightening=_safe_only(sc), solver_factory=factory, progress=False)
+    m = res.ticks_per_step
+    per_period = res.backup_active[:-1:m]
+    want = np.zeros(sc.steps, dtype=bool)
+    want[5 + n - 1:25] = True
+    np.testing.assert_array_equal(per_period, want)
+    assert np.all(res.backup_active[(5 + n - 1) * m:25 * m]) and not np.any(res.backup_active[25 * m:])
+    # the backup law, never the zero input, about the nominal end of the plan accepted at period 4
+    on = res.backup_active[:-1]
+    assert np.all(np.linalg.norm(res.inputs[:-1][on], axis=1) > 0.0) and not np.any(res.saturated)
+    state4 = res.states[4 * m]
+    plan4 = Pursuit(sc, None).solve(0.4, state4, ()).inputs  # the stand-in's plan depends only on t, state
+    end = state4
+    for v in plan4:
+        end = nominal_arc(end, v, np.array([sc.controller.dt]))[-1]
+    np.testing.assert_allclose(res.backup_anchor[:-1][on], np.tile(end[:3], (int(on.sum()), 1)), atol=1e-12)
+    assert np.all(np.isnan(res.backup_anchor[:-1][~on]))
+    metrics = res.metrics
+    assert metrics["backup_engagements"] == 1
+    assert metrics["backup_s"] == pytest.approx((25 - (5 + n - 1)) * sc.controller.dt)
+
+
+def test_the_backup_law_is_the_station_keeping_input_at_every_tick():
+    sc = _scenario(duration=2.0)
+    res = run_closed_loop(sc, tightening=_safe_only(sc), progress=False,
+                          solver_factory=lambda s, t: Pursuit(s, t, nan_at=range(1, 100)))
+    on = np.flatnonzero(res.backup_active[:-1])
+    assert on.size > 0
+    for i in on[::7]:
+        want = station_keeping_input(BACKUP.law, tuple(res.states[i]), tuple(res.backup_anchor[i]))
+        np.testing.assert_allclose(res.inputs[i], want, atol=1e-15)
+        assert np.all(res.kappa[i] == 0.0)
+
+
+def test_without_a_backup_the_exhausted_replay_keeps_the_zero_input_and_says_so(caplog):
+    sc = _scenario(duration=2.0)
+    with caplog.at_level("WARNING", logger="tubekit.loop.closed_loop"):
+        res = run_closed_loop(sc, tightening=_safe_only(sc, backup=None), progress=False,
+                              solver_factory=lambda s, t: Pursuit(s, t, nan_at=range(1, 100)))
+    n = sc.controller.horizon_steps
+    m = res.ticks_per_step
+    assert not np.any(res.backup_active)
+    np.testing.assert_array_equal(res.v_hat[(1 + n - 1) * m:-1], 0.0)
+    assert sum("no backup" in r.getMessage() for r in caplog.records) == 1   # once per engagement

@@ -17,6 +17,7 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 from tubekit.loop.plan_check import PlanCheck, check_plan, plan_arcs
+from tubekit.model.backup import BackupPlan, SafeSet, StationKeeping
 from tubekit.scenario import Obstacle
 from tubekit.tightening import Tightening
 
@@ -130,3 +131,55 @@ def test_plan_arcs_are_the_exact_unicycle(u, r, w, psi0):
     np.testing.assert_allclose(arcs[..., 1], y, atol=1e-9)
     np.testing.assert_allclose(arcs[..., 2], 0.5 + w * t, atol=1e-12)
     np.testing.assert_allclose(arcs[..., 3], psi, atol=1e-12)
+
+
+# ---- the terminal condition (tightening.backup) and the safe-only tier ------------------------------------
+# PLAN ends at p* = (-1.68, 3, 0), sensed from X0 (0.32 m away). The backup's footprint with the 0.2 m vehicle
+# radius is R_f = 0.8 + 0.2 = 1.0 m, H_f = 0.1 + 0.2 = 0.3 m; its sensed spread hypot(0.32 + 0.8, 0.1).
+
+BACKUP = BackupPlan(StationKeeping(0.2, 0.5, 0.05, 0.3, 0.05), SafeSet(0.8, 0.45, 0.1), handover=(0.35, 0.1))
+END = np.array([-1.68, 3.0, 0.0])
+
+
+def test_a_plan_meeting_the_terminal_condition_is_accepted(stationary):
+    far = Obstacle((-6.0, -6.0, 0.0), 0.4)
+    res = check_plan(stationary, _tight(backup=BACKUP), 0.0, X0, PLAN, [far], sign=-1)
+    assert res.ok and res.where == "terminal: sensed region"
+    assert res.slack == pytest.approx(1.5 - 0.2 - math.hypot(0.32 + 0.8, 0.1))
+
+
+def test_an_obstacle_inside_the_terminal_cylinder_rejects_the_plan(stationary):
+    # 1.29 m beside the end: 0.29 m from the cylinder, radius 0.3 -> -0.01; the path itself passes 0.79 m clear
+    near_end = Obstacle((END[0], END[1] + 1.29, 0.0), 0.3)
+    assert check_plan(stationary, _tight(), 0.0, X0, PLAN, [near_end], sign=-1).ok
+    res = check_plan(stationary, _tight(backup=BACKUP), 0.0, X0, PLAN, [near_end], sign=-1)
+    assert not res.ok and res.where == "terminal: obstacle 0" and res.slack == pytest.approx(-0.01)
+
+
+def test_a_terminal_cylinder_across_a_wall_rejects_the_plan(stationary):
+    walled = stationary.with_changes(workspace=((-10.0, -10.0, -5.0), (-0.69, 10.0, 5.0)))
+    assert check_plan(walled, _tight(), 0.0, X0, PLAN, [], sign=-1).ok
+    res = check_plan(walled, _tight(backup=BACKUP), 0.0, X0, PLAN, [], sign=-1)
+    assert not res.ok and res.where == "terminal: workspace" and res.slack == pytest.approx(-0.01)
+
+
+def test_a_terminal_set_beyond_the_sensed_region_rejects_the_plan(stationary):
+    short_sight = stationary.with_changes(sensing_range=1.3)
+    assert check_plan(short_sight, _tight(), 0.0, X0, PLAN, [], sign=-1).ok
+    res = check_plan(short_sight, _tight(backup=BACKUP), 0.0, X0, PLAN, [], sign=-1)
+    assert not res.ok and res.where == "terminal: sensed region"
+    assert res.slack == pytest.approx(1.3 - 0.2 - math.hypot(1.12, 0.1))
+
+
+def test_without_the_tracking_tier_only_position_constraints_are_checked(stationary):
+    # e_o_max = 0.01 against a plan heading 0.2 rad off the line of sight: e ∈ R fails, positions are fine
+    x0 = np.array([-2.0, 3.0, 0.0, 0.2])
+    tight = _tight(e_o_max=0.01, region=np.array([0.5, 3.0, 1.0, 0.01]), backup=BACKUP)
+    assert check_plan(stationary, tight, 0.0, x0, PLAN, [], sign=-1).where == "|e_o|"
+    safe_only = _tight(e_o_max=0.01, region=np.array([0.5, 3.0, 1.0, 0.01]), backup=BACKUP,
+                       tiers={"safe": True, "tracking": False})
+    res = check_plan(stationary, safe_only, 0.0, x0, PLAN, [], sign=-1)
+    assert res.ok and res.where.startswith("terminal")
+    blocked = Obstacle((-1.5, 4.2, 0.0), 0.3)  # 0.15 m from the footprint about the end (-1.686, 3.064)
+    res = check_plan(stationary, safe_only, 0.0, x0, PLAN, [blocked], sign=-1)
+    assert not res.ok and res.where == "terminal: obstacle 0"

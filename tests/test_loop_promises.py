@@ -46,7 +46,9 @@ def _run(stationary, **changes) -> SimulationResult:
         kappa=np.zeros((rows, 3)), inputs=inputs, omega=omega, saturated=np.zeros(rows, dtype=bool),
         fallback=np.zeros(rows, dtype=bool), replaced=np.zeros(rows, dtype=bool), n_detected=np.zeros(rows, int),
         solve_ms=np.zeros(rows), step_ms=np.zeros(rows), wall=np.zeros(rows), rejected=np.zeros(STEPS, dtype=bool),
-        plan_age=np.zeros(STEPS, dtype=int), plan_slack=np.zeros(STEPS))
+        plan_age=np.zeros(STEPS, dtype=int), plan_slack=np.zeros(STEPS),
+            backup_active=np.zeros(rows, dtype=bool),
+            backup_anchor=np.full((rows, 3), np.nan))
     fields.update(changes)
     return SimulationResult(**fields)
 
@@ -67,7 +69,7 @@ def test_a_clean_run_keeps_every_promise(stationary):
     assert by["region"].observed == pytest.approx(0.5)     # |e_o| = 0 against 0.5 is the smallest slack
     for p in promises:
         d = p.to_dict()
-        assert set(d) == {"name", "observed", "bound", "ok", "detail"}
+        assert set(d) == {"name", "observed", "bound", "ok", "detail", "tier", "depends_on", "given"}
 
 
 def test_a_deviation_beyond_the_tube_breaks_tube(stationary):

@@ -149,3 +149,17 @@ def test_make_plant_kinds():
     assert isinstance(make_plant(sc, kind="dynamic"), DynamicPlant)
     with pytest.raises(ConfigError, match="plant"):
         make_plant(sc, kind="hovercraft")
+
+
+def test_the_omega_peak_covers_every_tick_and_the_stages_between():
+    """ω at the ticks (omega_series) is the first RK4 stage of each tick, so the peak over every stage
+    evaluation is at least the largest tick value; the between-tick stages can only add to it."""
+    sc = paper_scenario().with_changes(plant=PlantSettings("dynamic"))
+    plant = DynamicPlant(sc)
+    assert plant.omega_peak() == (0.0, 0.0)
+    commands = _commands(30)
+    states = np.vstack([[0.0, 0.0, 0.0, 0.0], _run(plant, commands, 2)])
+    omega = plant.omega_series(np.arange(31) * 0.01, states, np.vstack([commands, [np.nan] * 3]))[:-1]
+    peak_xy, peak_z = plant.omega_peak()
+    assert peak_xy >= np.max(np.hypot(omega[:, 0], omega[:, 1])) - 1e-12
+    assert peak_z >= np.max(np.abs(omega[:, 2])) - 1e-12

@@ -148,3 +148,16 @@ def test_omega_series_matches_omega_per_tick_and_skips_nan_inputs():
         np.testing.assert_array_equal(out[i], plant.omega(t[i], states[i], inputs[i]))
     assert np.all(np.isnan(out[-1]))
     assert plant.current_at(0.3) == tuple(plant.current(0.3))
+
+
+def test_the_omega_peak_is_over_every_stage_evaluation():
+    """An override of 0.5 m/s horizontally (0.3, 0.4) and -0.2 m/s vertically except at the tick
+    instants t = 0, 0.01 (where it is zero): only the RK4 stages between the ticks see it."""
+    def between(t):
+        return np.zeros(3) if min(abs(t), abs(t - 0.01)) < 1e-9 else np.array([0.3, 0.4, -0.2])
+
+    plant = Plant(paper_scenario().disturbance, override=between)
+    assert plant.omega_peak() == (0.0, 0.0)
+    plant.step(0.0, np.zeros(4), np.array([0.2, 0.0, 0.1]), 0.01, 1)   # stages at 0, 0.005, 0.005, 0.01
+    assert plant.omega_peak() == pytest.approx((0.5, 0.2))
+    assert np.all(plant.omega_series(np.array([0.0, 0.01]), np.zeros((2, 4)), np.zeros((2, 3))) == 0.0)

@@ -119,3 +119,46 @@ def test_period_configurations_in_sets(cfg):
 def test_period_configurations_reject_empty_start():
     with pytest.raises(ConfigError, match="start"):
         vs.period_configurations(REGION, ((1.0, 0.5), (-1, 1), (-0.5, 0.5)), [0.3, 0.2, 0.4], (0.1, 0.1))
+
+
+# ---- scenario families against certified designs (issue 21) ----------------------------------------------
+def _family_base():
+    import verify
+    from tubekit import load_scenario
+    return load_scenario(verify.SCENARIOS_DIR / "paper_currents.toml").with_changes(duration=8.0)
+
+
+_FAMILY_BASE = _family_base()
+
+
+def _no_safety_promise_broken(scenario):
+    import verify
+    from tubekit.loop.pipeline import certified_run
+    from verify.falsify.backup_loop import safety_broken
+    cert = verify.certify(scenario)
+    if not cert.certified:
+        return
+    sim = certified_run(scenario, cert.tightening)
+    assert safety_broken(sim) == (), sim.summary()
+    assert sim.check(), sim.summary()
+
+
+@pytest.mark.parametrize("family", [vs.obstacles_beyond_sensing, vs.obstacles_on_path, vs.obstacle_clusters,
+                                    vs.obstacles_between_end_and_target, vs.blocked_starts])
+def test_scenario_families_break_no_safety_promise(family):
+    """Property: on every certified design a family builds, the run keeps every promise of the safe tier
+    (no collision, inside the workspace, v in V never clipped) and CertifiedRun.check() holds."""
+    from hypothesis import settings
+
+    @settings(max_examples=2)
+    @given(family(_FAMILY_BASE))
+    def check(scenario):
+        _no_safety_promise_broken(scenario)
+    check()
+
+
+@given(vs.backup_attack_scenarios(_FAMILY_BASE))
+def test_backup_attack_scenarios_are_valid(scenario):
+    """Property: the union of the families builds scenarios that keep the base's trajectory and limits."""
+    assert scenario.trajectory == _FAMILY_BASE.trajectory and scenario.limits == _FAMILY_BASE.limits
+    assert len(scenario.obstacles) <= 7

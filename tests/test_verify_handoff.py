@@ -12,6 +12,7 @@ import math
 import numpy as np
 import pytest
 
+from tubekit.model.backup import BackupPlan
 from tubekit.scenario import paper_scenario
 from tubekit.tightening import DisturbanceBound, RegionBounds, Tightening
 from verify import NotCertifiedError, certify
@@ -35,6 +36,33 @@ def test_certified_tightening_is_the_certificate(pc_cert):
     assert t.disturbance == DisturbanceBound(omega_xy=d.omega_xy, omega_z=d.omega_z, sway=d.gamma)
     assert t.law == c.law == "corrected" and t.design_key == c.design_key and len(t.design_key) == 64
     assert t.design_fields == c.design_fields and t.design_fields["law"] == "corrected"
+    assert t.tiers == {"safe": True, "tracking": True}
+    b = c.backup
+    assert t.backup == BackupPlan(law=b.law, safe_set=b.safe_set, handover=(m.position[-1], m.e_z[-1]))
+
+
+@pytest.fixture(scope="module")
+def blind_cert():
+    """The paper's scenario with a sensing range of 0.6 m: T ||V|| + M_pos + r_bar > 0.6, so neither tier certifies."""
+    return certify(paper_scenario().with_changes(sensing_range=0.6))
+
+
+def test_safe_only_tightening(paper_cert):
+    """Tracking fails, safety holds: sigma = 0, inputs up to V, zero e-columns (not enforced), the certified
+    position margins, node bounds = R, obstacle margin = last position margin + ||(u, w)|| dt / 2."""
+    c = paper_cert
+    t = c.tightening
+    assert t.certified and t.tiers == {"safe": True, "tracking": False}
+    assert t.sigma == 0.0 and np.all(t.tube == 0) and t.rho_tilde == 0.0
+    np.testing.assert_array_equal(t.v_max, [0.4, 0.3, 0.5])
+    m = c.safe_design.margins
+    np.testing.assert_array_equal(t.margins[:, :3], np.zeros((8, 3)))
+    np.testing.assert_array_equal(t.margins[:, 3], m.position)
+    assert (t.e_d_min, t.e_d_max, t.e_z_max, t.e_o_max) == (0.1, 3.0, 1.0, 0.9)
+    assert t.obstacle_margin == pytest.approx(m.position[-1] + 0.05 * 0.5)
+    assert t.backup.handover == (m.position[-1], m.e_z[-1]) and t.backup.safe_set == c.backup.safe_set
+    best = c.best_effort_tightening()
+    assert best.tiers == t.tiers and np.array_equal(best.margins, t.margins) and best.sigma == 0.0
 
 
 def test_node_constraints_are_the_last_margin_plus_the_allowance(pc_cert):
@@ -51,18 +79,21 @@ def test_node_constraints_are_the_last_margin_plus_the_allowance(pc_cert):
     assert t.e_o_max >= 0.25 * 0.5 - 1e-15     # at least a quarter of R's half-width is kept
 
 
-def test_uncertified_tightening_needs_consent(paper_cert):
+def test_uncertified_tightening_needs_consent(blind_cert):
+    assert blind_cert.tiers == {"safe": False, "tracking": False}
     with pytest.raises(NotCertifiedError, match="is not certified .*best_effort_tightening"):
-        paper_cert.tightening
+        blind_cert.tightening
 
 
 @pytest.mark.parametrize("fraction", [0.5, 0.9, 1.0])
-def test_best_effort_tightening(paper_cert, fraction):
+def test_best_effort_tightening(blind_cert, fraction):
     """Best effort: each input limit >= max(fraction V_i, keep-up need), <= V_i; nodes keep a quarter of R."""
+    paper_cert = blind_cert
     t = paper_cert.best_effort_tightening(min_input_fraction=fraction)
     v = np.array([0.4, 0.3, 0.5])
     need = np.array([min(3 * math.pi / 25 + 0.12, 0.4), min(0.1, 0.3), 0.0])
     assert not t.certified and t.design_key == paper_cert.design_key and t.law == paper_cert.law
+    assert t.tiers == {"safe": False, "tracking": False} and t.backup is not None   # never the zero input
     assert np.all(t.v_max <= v + 1e-15) and np.all(t.v_max >= np.maximum(fraction * v, need) - 1e-15)
     assert t.v_max[0] == pytest.approx(0.4)    # the keep-up need (0.497 m/s) is above u_max
     reg = paper_scenario().region
@@ -122,6 +153,20 @@ def test_the_matching_certificate_runs(pc_cert):
     from tubekit.loop.closed_loop import run_closed_loop
     with pytest.raises(AssertionError, match="the loop started"):
         run_closed_loop(_pc(), tightening=pc_cert.tightening, progress=False, solver_factory=_MustNotSolve)
+
+
+def test_the_safe_only_tightening_matches_its_scenario(paper_cert):
+    """The safe-only tightening (sigma = 0) is bound to the paper's scenario and gets past the key check;
+    a run longer than the certified 100 s is refused by the duration the target was checked over."""
+    from tubekit.design_key import require_matching
+    from tubekit.exceptions import ConfigError
+    from tubekit.loop.closed_loop import run_closed_loop
+    sc = paper_scenario()
+    assert paper_cert.design_fields["sigma"] == 0.0 and paper_cert.tightening.sigma == 0.0
+    with pytest.raises(AssertionError, match="the loop started"):
+        run_closed_loop(sc, tightening=paper_cert.tightening, progress=False, solver_factory=_MustNotSolve)
+    with pytest.raises(ConfigError, match=r"design_key\.duration"):
+        require_matching(sc.with_changes(duration=120.0), paper_cert.tightening)
 
 
 def test_a_certificate_over_another_region_is_bound_to_it(pc_cert):

@@ -149,6 +149,20 @@ TAMPERING = [
     ("paper", lambda d: _set(d, ("failures",), []), "failures", True),
     ("pc", lambda d: _set(d, ("assumptions",), d["assumptions"][:1]), "assumptions", True),
     ("pc", lambda d: _set(d, ("premises",), []), "premises", True),
+    # the backup (stored law and safe set re-certified with the derived bounds and margins), the tiers
+    ("pc", lambda d: _set(d, ("backup", "safe_set", "level"), 0.3), "backup.safe_set", True),
+    ("pc", lambda d: _set(d, ("backup", "law", "surge"), 0.1), "backup.law", True),
+    ("pc", _scale(("backup", "omega_xy"), 0.5), "backup.omega_xy", True),
+    ("pc", _scale(("backup", "handover"), 0.5), "backup.handover", True),
+    ("pc", _scale(("backup", "rate_bound"), 2.0), "backup.rate_bound", True),
+    ("pc", lambda d: _set(d, ("backup",), None), "backup", True),
+    ("paper", lambda d: _set(d, ("tiers", "tracking"), True), "tiers.tracking", True),
+    ("paper", _scale(("safe_design", "margins", "position"), 0.5), "safe_design.margins.position", True),
+    ("paper", _scale(("safe_design", "tube", "p_xy"), 0.5), "safe_design.tube.p_xy", True),
+    ("paper", lambda d: _set(d, ("safe_design",), None), "safe_design", True),
+    ("paper", lambda d: _set(d, ("safe_design", "conditions"), [c for c in d["safe_design"]["conditions"]
+                                                                if c["condition"] != "safe_only.sensing"]),
+     "conditions[safe_only.sensing]", True),
     # the checksum left stale: it speaks first
     ("pc", lambda d: _set(d, ("scenario_data", "limits", "u_max"), 0.1), "checksum", False),
     ("pc", _scale(("tube", "rho"), 0.9), "checksum", False),
@@ -178,7 +192,7 @@ def test_the_table_covers_every_block():
     heads = {t[2].split(".")[0].split("[")[0].split(" ")[0] for t in TAMPERING}
     assert {"design_fields", "design_key", "theorem_version", "problem", "region", "disturbance", "gains", "sigma",
             "tube", "margins", "v_bar", "kappa_bar", "e_bar", "arc_rates", "horizon", "conditions", "certified",
-            "failures", "assumptions", "premises", "checksum"} <= heads
+            "failures", "assumptions", "premises", "checksum", "backup", "tiers", "safe_design"} <= heads
     assert {"design_fields.law", "design_fields.limits.u_max", "design_fields.sigma"} <= {t[2] for t in TAMPERING}
     assert len(TAMPERING) >= 25
 

@@ -4,14 +4,15 @@ from __future__ import annotations
 
 from tubekit.scenario import paper_scenario
 from verify import certify
-from verify.report import certificate_text
+from verify.report import certificate_text, tiers_line
 
 
 def test_certified_text(pc_cert):
     text = pc_cert.summary()
     assert text == certificate_text(pc_cert)
     first = text.splitlines()[0]
-    assert "'paper-currents'" in first and "'corrected'" in first and first.endswith(": CERTIFIED")
+    assert "'paper-currents'" in first and "'corrected'" in first
+    assert first.endswith(": CERTIFIED -- safe: certified; tracking: certified")
     assert "FAIL" not in text and text.count("[ok  ]") == len(pc_cert.conditions)
     for c in pc_cert.conditions:
         assert f"{c.condition}: {c.inequality}" in text
@@ -38,5 +39,25 @@ def test_text_without_a_tube():
     c = certify(sc.with_changes(disturbance=type(sc.disturbance)(amplitude=(2.0, 2.0, 2.0))))
     text = c.summary()
     assert "One-period tube: none (" in text and "diverge" in text
-    assert "V_bar" not in text and "Per-arc margins" not in text
+    assert "V_bar = [" not in text and "Per-arc margins" not in text   # no V-bar line of the tracking design
     assert "[FAIL] tube" in text
+
+
+def test_the_tiers_and_the_backup_are_printed(pc_cert, paper_cert):
+    assert tiers_line(pc_cert) == "safe: certified; tracking: certified"
+    text = paper_cert.summary()
+    failed = ", ".join(paper_cert.tier_failures["tracking"])
+    assert tiers_line(paper_cert) == f"safe: certified; tracking: not certified ({failed})"
+    assert failed.startswith("keep_up[u], yaw_budget")
+    assert text.splitlines()[0].endswith(tiers_line(paper_cert))
+    b = paper_cert.backup
+    assert "backup (station keeping): certified" in text
+    assert f"horizontal radius {b.safe_set.radius:.3f} m" in text and "Safe-only design (sigma = 0" in text
+    assert f"hand-over: within {b.handover[0]:.4g} m horizontally" in text
+    for c in paper_cert.tier_conditions["safe"]:
+        assert c.condition in text.split("depends on: ")[1].splitlines()[0]
+
+
+def test_a_certificate_without_the_safe_tier_names_its_failures():
+    c = certify(paper_scenario().with_changes(sensing_range=0.6))
+    assert tiers_line(c).startswith("safe: not certified (safe_only.sensing")

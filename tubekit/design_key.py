@@ -9,11 +9,14 @@ The fields (:func:`design_fields`, a flat dict of dotted names, numbers as float
 ``theorem_version``, ``law``, ``sigma``; ``limits.*``, ``trajectory.*``, ``epsilon``,
 ``region.*``, ``disturbance.amplitude``, ``disturbance.constant``,
 ``disturbance.sway.{gain, amplitude, bound}``, ``obstacles[i].{center, radius}``,
-``vehicle_radius``, ``sensing_range``, ``workspace``,
+``vehicle_radius``, ``sensing_range``, ``workspace``, ``duration`` (the target must stay in
+the workspace over the run, ``target_in_workspace``),
 ``controller.{dt, horizon_steps, ancillary_rate_hz}``, ``plant.*`` (``plant.kind`` only
-on the kinematic plant). Not in the key, because the theorem does not read them: the
-name, the duration, the current's and the sway's periods, the initial state (each run's
-start is checked by the run itself: the first plan must pass the arc check), the FHOCP
+on the kinematic plant). A run shorter than the certified duration is covered
+(:func:`require_matching` accepts it). The backup law and its safe set are derived from
+these (ω̄, V, the ancillary rate, the margins), so they need no field of their own. Not in
+the key, because the theorem does not read them: the name, the current's and the sway's
+periods, the initial state (each run's start is checked by the run itself), the FHOCP
 weights and modes. numpy and the standard library only: the loop checks the key without
 importing :mod:`verify`.
 """
@@ -30,10 +33,10 @@ from tubekit.exceptions import ConfigError
 __all__ = ["THEOREM_VERSION", "design_fields", "design_key", "first_difference", "require_matching"]
 
 #: Version of the theorem a certificate states; a certificate of another version is not this design.
-THEOREM_VERSION = "sampled-data-tube/2"
+THEOREM_VERSION = "sampled-data-tube+backup/3"
 
 _SCENARIO_KEYS = ("limits", "trajectory", "epsilon", "region", "obstacles", "vehicle_radius", "sensing_range",
-                  "workspace")
+                  "workspace", "duration")
 _CONTROLLER_KEYS = ("dt", "horizon_steps", "ancillary_rate_hz")
 _SWAY_KEYS = ("gain", "amplitude", "bound")
 
@@ -111,6 +114,14 @@ def first_difference(found: dict[str, Any], stored: dict[str, Any]) -> tuple[str
     return None
 
 
+def _shorter_run_is_covered(found: dict[str, Any], stored: dict[str, Any]) -> None:
+    """A run no longer than the certified duration is covered (the target stays in the workspace over a
+    sub-interval too): ``found["duration"]`` takes the stored value then."""
+    a, b = found.get("duration"), stored.get("duration")
+    if isinstance(a, float) and isinstance(b, float) and a <= b:
+        found["duration"] = b
+
+
 def require_matching(scenario: Any, tightening: Any, law: str | None = None, sigma: float | None = None) -> None:
     """Refuse a tightening certified for another design than ``scenario``'s (nothing runs then).
 
@@ -123,7 +134,8 @@ def require_matching(scenario: Any, tightening: Any, law: str | None = None, sig
     law : str, optional
         The law the run uses (default the scenario's).
     sigma : float, optional
-        The σ the run uses (1/s); default the scenario's declared σ, else the tightening's.
+        The σ the run uses (1/s); default the scenario's declared σ, else the tightening's; a safe-only
+        tightening (``tiers == {"safe": True, "tracking": False}``) runs at its own σ = 0.
 
     Raises
     ------
@@ -135,11 +147,16 @@ def require_matching(scenario: Any, tightening: Any, law: str | None = None, sig
     if stored_key is None:
         return
     declared = scenario.controller.sigma
-    run_sigma = sigma if sigma is not None else (declared if declared is not None else tightening.sigma)
+    safe_only = getattr(tightening, "tiers", None) == {"safe": True, "tracking": False}
+    if sigma is not None:
+        run_sigma = sigma
+    else:
+        run_sigma = tightening.sigma if safe_only or declared is None else declared
     found = design_fields(scenario, law if law is not None else scenario.controller.law, float(run_sigma))
+    stored = dict(getattr(tightening, "design_fields", None) or {})
+    _shorter_run_is_covered(found, stored)
     if design_key(found) == stored_key:
         return
-    stored = dict(getattr(tightening, "design_fields", None) or {})
     diff = first_difference(found, stored)
     if diff is None:
         raise ConfigError("design_key", f"the key of the scenario's design ({design_key(found)[:16]}...)",

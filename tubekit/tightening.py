@@ -120,7 +120,8 @@ class Tightening:
         The certificate's ``omega_xy``, ``omega_z`` and ``sway`` bound γ̄ (m/s); zeros for the baseline
         (3 numbers in that order are accepted).
     certified : bool
-        True only when it comes from a certified certificate.
+        True only when it comes from a certificate whose safe tier is certified (``tiers`` says
+        whether tracking is too).
     law : str or None
         The ancillary law it was certified for (None: the baseline).
     design_key : str or None
@@ -128,10 +129,12 @@ class Tightening:
     design_fields : dict or None
         The fields the key hashes, to name the first one that differs.
     backup : BackupPlan or None
-        The certified backup law and safe set (None: no backup; the loop then replays the last
-        plan and, once it is exhausted, has no certified input).
+        The backup law and safe set (certified when ``tiers["safe"]``; a best-effort tightening
+        carries the uncertified design). None: no backup (the untightened baseline).
     tiers : dict or None
         Which tier of promise the certificate gives, e.g. ``{"safe": True, "tracking": False}``.
+        A safe-only tightening (tracking False) has σ = 0, ``v_max`` = V, a zero tube and margins
+        whose e-columns are zero (not enforced: only the position constraints are checked).
     """
 
     v_max: np.ndarray

@@ -38,6 +38,7 @@ from tubekit.model.backup import SafeSet, StationKeeping
 from tubekit.validation import nonnegative, positive
 from verify.design import Condition
 from verify.intervals import enclose, lower, upper
+from verify.parts import block, bound, integer, item, number, numbers
 
 __all__ = ["BackupCertificate", "planar_rate_bound", "certify_backup", "design_backup",
            "BACKUP_MAX_BOXES"]
@@ -60,6 +61,7 @@ class BackupCertificate:
     rate_sampled: float
     boxes: int
     conditions: tuple[Condition, ...]
+    handover: tuple[float, float] = (0.0, 0.0)
 
     @property
     def certified(self) -> bool:
@@ -76,7 +78,23 @@ class BackupCertificate:
         return {"law": asdict(self.law), "safe_set": asdict(self.safe_set), "omega_xy": self.omega_xy,
                 "omega_z": self.omega_z, "tick": self.tick, "rate_bound": self.rate_bound,
                 "rate_sampled": self.rate_sampled, "boxes": self.boxes, "certified": self.certified,
-                "conditions": [c.to_dict() for c in self.conditions]}
+                "handover": list(self.handover), "conditions": [c.to_dict() for c in self.conditions]}
+
+    @classmethod
+    def from_dict(cls, d: dict, where: str = "certificate.backup") -> "BackupCertificate":
+        """Inverse of :meth:`to_dict` (``certified`` is recomputed; ConfigError naming the key)."""
+        law_ = _typed(StationKeeping, block(d, "law", where), f"{where}.law",
+                      ("surge", "yaw_rate", "yaw_band", "heave", "heave_band"))
+        safe_ = _typed(SafeSet, block(d, "safe_set", where), f"{where}.safe_set", ("level", "shape", "depth"))
+        conds = item(d, "conditions", where)
+        if not isinstance(conds, list):
+            raise ConfigError(f"{where}.conditions", "a list of conditions", type(conds).__name__)
+        return cls(law=law_, safe_set=safe_, omega_xy=number(d, "omega_xy", where),
+                   omega_z=number(d, "omega_z", where), tick=number(d, "tick", where),
+                   rate_bound=bound(d, "rate_bound", where), rate_sampled=number(d, "rate_sampled", where),
+                   boxes=integer(d, "boxes", where),
+                   conditions=tuple(Condition.from_dict(c, f"{where}.conditions[{i}]") for i, c in enumerate(conds)),
+                   handover=numbers(d, "handover", where, 2))
 
     def summary_lines(self) -> list[str]:
         """Human-readable lines for a certificate's text."""
@@ -89,6 +107,16 @@ class BackupCertificate:
                 f"ω̄_xy {self.omega_xy:.4g} m/s, ω̄_z {self.omega_z:.4g} m/s",
                 f"  sup V̇ on the level set <= {self.rate_bound:.4g} m/s (sampled {self.rate_sampled:.4g}, "
                 f"{self.boxes} intervals)"]
+
+
+def _typed(cls: type, d: dict, where: str, keys: tuple[str, ...]):
+    """``cls(**numbers)`` from ``d``, a ConfigError naming ``where.key`` when a value is refused."""
+    try:
+        return cls(**{k: number(d, k, where) for k in keys})
+    except ConfigError as exc:
+        if exc.field.startswith(where):
+            raise
+        raise ConfigError(f"{where}.{exc.field.split('.')[-1]}", exc.expected, exc.received) from None
 
 
 def _tick_distance(law: StationKeeping, safe: SafeSet, omega_xy: float, tick: float) -> float:
@@ -201,7 +229,8 @@ def certify_backup(law: StationKeeping, safe: SafeSet, *, omega_xy: float, omega
     rate, boxes = planar_rate_bound(law, safe, wxy, h, max_boxes)
     conditions = _conditions(law, safe, (wxy, wz), tuple(float(x) for x in limits), h, handover, rate)
     return BackupCertificate(law=law, safe_set=safe, omega_xy=wxy, omega_z=wz, tick=h, rate_bound=rate,
-                             rate_sampled=_rate_sampled(law, safe, wxy), boxes=boxes, conditions=conditions)
+                             rate_sampled=_rate_sampled(law, safe, wxy), boxes=boxes, conditions=conditions,
+                             handover=handover)
 
 
 def _candidates(limits: tuple[float, float, float], omega_xy: float) -> list[tuple[float, float]]:

@@ -6,17 +6,22 @@
 2. :func:`verify.design.disturbance_bounds` — ω̄_xy, ω̄_z, γ̄ from the models;
 3. :func:`sigma_candidates` then :func:`verify.design.evaluate_design` for each σ —
    the one-period tube, the per-arc margins, V̄ and every named condition;
+   (:func:`verify.tiers.tracking_design`: with the workspace conditions of :mod:`verify.workspace`);
 4. :func:`choose_design` — the certified design with the largest normalised slack
-   (or, when none certifies, the best uncertified one, for a best-effort run).
+   (or, when none certifies, the best uncertified one, for a best-effort run);
+5. :func:`verify.tiers.safe_only_design` — when the chosen design does not certify, the
+   safe tier's own design at σ = 0 (position margins only);
+6. :func:`verify.tiers.backup_of` — the backup law and its safe set
+   (:func:`verify.backup.design_backup`), proved for the hand-over of the margins in use.
 
-The theorem (``docs/verify.md``, "The sampled-data theorem"): if every condition
-holds, then in the loop of :mod:`tubekit.loop.closed_loop` — reset at every sample,
-κ held at the ancillary rate, v̂ held over each period, plans accepted only when
-:mod:`tubekit.loop.plan_check` verifies their arcs against the per-arc margins and the
-previous accepted plan replayed otherwise — the real error stays in R, e_d >= ε,
-the input stays in V (never saturates), the vehicle ball never touches an
-obstacle, and |e_j - ê_j| <= tube_j within every period, provided the two
-*premises* hold (checked in every run, see :attr:`Certificate.premises`).
+The theorem (``docs/verify.md``, section 3) has two tiers (:attr:`Certificate.tiers`):
+**safe** — in the loop of :mod:`tubekit.loop.closed_loop` (plans accepted only when
+:mod:`tubekit.loop.plan_check` verifies their arcs and the terminal condition, the
+previous plan replayed otherwise, the backup law once the replay is exhausted) the
+vehicle ball never touches an obstacle nor leaves the workspace and v ∈ V is never
+clipped, for all time, given only the disturbance bound; **tracking** — while a plan is
+followed, the real error stays in R, e_d >= ε and |e_j - ê_j| <= tube_j within every
+period, given the premises (:attr:`Certificate.premises`).
 """
 
 from __future__ import annotations
@@ -36,17 +41,21 @@ from tubekit.jsonable import to_jsonable
 from tubekit.scenario import Scenario
 from tubekit.tightening import Tightening
 
-from verify.design import Condition, Design, DisturbanceBounds, disturbance_bounds, evaluate_design
+from verify.backup import BackupCertificate
+from verify.design import Condition, Design, DisturbanceBounds, disturbance_bounds
 from verify.gains import GainBounds, gain_bounds
 from verify.parts import EBar, SigmaChoice, SigmaTrial
 from verify.region import Region
 from verify.sampled import HorizonMargins, PeriodTube
+from verify.tiers import backup_of, key_sigma, safe_only_design, tier_conditions, tracking_design
 
 __all__ = ["Condition", "Certificate", "NotCertifiedError", "certify", "sigma_candidates", "choose_design",
            "certificate_fields", "paper_route_of", "ASSUMPTIONS", "PREMISES", "THEOREM"]
 
 THEOREM = ("sampled-data tube under the nominal reset: one-period box tube (verify.sampled), per-arc margins of "
-           "the replayed candidate (verify.sampled.horizon_margins), exact arc acceptance (tubekit.loop.plan_check)")
+           "the replayed candidate (verify.sampled.horizon_margins), exact arc acceptance with the terminal "
+           "condition (tubekit.loop.plan_check), the certified station-keeping backup (verify.backup); tiers "
+           "safe and tracking (verify.tiers)")
 
 #: Outside the model: what no certificate about eq. (11) can check.
 ASSUMPTIONS = (
@@ -59,9 +68,11 @@ ASSUMPTIONS = (
 
 #: Premises of the theorem that depend on the run, checked in every run (tubekit.loop.promises).
 PREMISES = (
-    "recursive_feasibility: an accepted FHOCP plan at t = 0 and at least one in every N consecutive samples "
-    "(the replayed candidate covers N - 1 samples; past that no terminal set is certified).",
-    "disturbance: ||omega_xy(t)|| <= omega_bar_xy and |omega_z(t)| <= omega_bar_z at every step of the run.",
+    "recursive_feasibility (tracking tier only): the tracking promises hold while a plan is followed (accepted, "
+    "or replayed for at most N - 1 samples); while the backup law is active only the safe tier is promised. "
+    "The safe tier does not depend on it.",
+    "disturbance (both tiers): ||omega_xy(t)|| <= omega_bar_xy and |omega_z(t)| <= omega_bar_z at all times "
+    "(the supremum over each period, not only at the ticks).",
 )
 
 
@@ -105,6 +116,10 @@ class Certificate:
         when ``certify`` was given another region); :attr:`design_key` is their hash.
     paper_route : object or None
         The paper's Lemma-1 route (``verify.lemma1.route.PaperRoute``) when available: a report, not the verdict.
+    backup : BackupCertificate or None
+        The backup law, its safe set and the proof (``backup_*`` conditions).
+    safe_design : Design or None
+        The safe tier's design at σ = 0 when the chosen (tracking) design does not certify, else None.
     """
 
     scenario_name: str
@@ -124,17 +139,40 @@ class Certificate:
     scenario_data: dict = field(default_factory=dict)
     design_fields: dict = field(default_factory=dict)
     paper_route: Any = None
+    backup: BackupCertificate | None = None
+    safe_design: Design | None = None
 
     # ------------------------------------------------------------------ status
     @property
     def conditions(self) -> tuple[Condition, ...]:
-        """Every checked inequality of the chosen design."""
-        return self.design.conditions
+        """Every checked inequality: the chosen design's, the safe-only design's (``safe_only.*``), the backup's."""
+        extra = self.safe_design.conditions if self.safe_design is not None else ()
+        return self.design.conditions + extra + (self.backup.conditions if self.backup is not None else ())
+
+    @property
+    def tier_conditions(self) -> dict[str, tuple[Condition, ...]]:
+        """For each tier (``safe``, ``tracking``) the conditions it depends on (``verify.tiers.tier_conditions``)."""
+        return tier_conditions(self.design, self.safe_design, self.backup)
+
+    @property
+    def tiers(self) -> dict[str, bool]:
+        """``{"safe": bool, "tracking": bool}``: a tier is certified when every condition it depends on holds."""
+        return {k: all(c.ok is True for c in v) for k, v in self.tier_conditions.items()}
+
+    @property
+    def key_sigma(self) -> float:
+        """σ (1/s) of the tightening handed out, the one :attr:`design_fields` holds (0 for a safe-only one)."""
+        return key_sigma(self.design, self.safe_design, self.backup)
+
+    @property
+    def tier_failures(self) -> dict[str, tuple[str, ...]]:
+        """For each tier, the names of the conditions it depends on that do not hold."""
+        return {k: tuple(c.condition for c in v if c.ok is not True) for k, v in self.tier_conditions.items()}
 
     @property
     def certified(self) -> bool:
-        """True when every condition holds (none failed, none left unevaluated)."""
-        return self.design.certified
+        """True when both tiers are certified (every condition holds; none failed, none left unevaluated)."""
+        return all(self.tiers.values())
 
     @property
     def is_certified(self) -> bool:
@@ -224,11 +262,12 @@ class Certificate:
     def tightening(self) -> Tightening:
         """The certified :class:`tubekit.tightening.Tightening` (see :mod:`verify.handoff`).
 
-        Raises :class:`NotCertifiedError` when the design is not certified: use
-        :meth:`best_effort_tightening` for a run that carries no guarantee.
+        Raises :class:`NotCertifiedError` when not even the safe tier is certified: use
+        :meth:`best_effort_tightening` for a run that carries no guarantee. When only the safe tier
+        is certified, the safe-only tightening (``tiers == {"safe": True, "tracking": False}``).
         """
         from verify.handoff import tightening_of
-        if not self.certified:
+        if not self.tiers["safe"]:
             names = ", ".join(f.condition for f in self.failures) or ", ".join(self.not_evaluated)
             raise NotCertifiedError(f"scenario '{self.scenario_name}' with law '{self.law}' is not certified "
                                     f"(failed: {names}); use best_effort_tightening() for a run without a "
@@ -236,7 +275,7 @@ class Certificate:
         return tightening_of(self)
 
     def best_effort_tightening(self, min_input_fraction: float = 0.5) -> Tightening:
-        """The certified tightening when certified; otherwise a best-effort one, flagged ``certified=False``.
+        """The certified tightening when a tier is certified; otherwise a best-effort one, flagged ``certified=False``.
 
         Parameters
         ----------
@@ -331,8 +370,10 @@ def certify(scenario: Scenario, law: str | AncillaryLaw | None = None, *, region
     gains = gain_bounds(law, region, max_boxes=max_boxes)
     dist = disturbance_bounds(scenario)
     sigmas, source = sigma_candidates(scenario)
-    designs = [evaluate_design(scenario, region, gains, s, dist) for s in sigmas]
+    designs = [tracking_design(scenario, region, gains, s, dist) for s in sigmas]
     best = choose_design(designs)
+    safe = None if best.certified else safe_only_design(scenario, region, gains, dist)
+    backup = backup_of(scenario, dist, (safe or best).margins)
     tried = tuple(SigmaTrial(sigma=d.sigma, certified=d.certified, score=d.score if math.isfinite(d.score) else None,
                              failed=tuple(c.condition for c in d.failures)) for d in designs)
     ctrl = scenario.controller
@@ -342,8 +383,8 @@ def certify(scenario: Scenario, law: str | AncillaryLaw | None = None, *, region
                        elapsed_s=round(time.perf_counter() - t0, 3), horizon_steps=ctrl.horizon_steps, dt=ctrl.dt,
                        limits=tuple(float(x) for x in scenario.limits.vector),
                        scenario_data=to_jsonable(scenario.to_dict()), assumptions=assumptions,
-                       design_fields=certificate_fields(scenario, law, best.sigma, region),
-                       paper_route=paper_route_of(scenario, law, region))
+                       design_fields=certificate_fields(scenario, law, key_sigma(best, safe, backup), region),
+                       paper_route=paper_route_of(scenario, law, region), backup=backup, safe_design=safe)
 
 
 def certificate_fields(scenario: Scenario, law: str, sigma: float, region: Region) -> dict:

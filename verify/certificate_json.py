@@ -21,13 +21,16 @@ from tubekit.design_key import THEOREM_VERSION
 from tubekit.exceptions import ConfigError
 from tubekit.jsonable import to_jsonable
 
+from verify.backup import BackupCertificate
+from verify.tiers import SAFE_PREFIX
 from verify.design import Condition, Design, DisturbanceBounds
 from verify.gains import GainBounds
 from verify.parts import SigmaChoice, block, item, integer, number, numbers, text, texts
 from verify.region import Region
 from verify.sampled import HorizonMargins, PeriodTube, TubeProblem
 
-__all__ = ["certificate_to_dict", "certificate_from_dict", "checksum_of", "NOT_CHECKSUMMED", "TUBE_FORM"]
+__all__ = ["certificate_to_dict", "certificate_from_dict", "checksum_of", "design_to_dict", "design_from_dict",
+           "tiers_to_dict", "NOT_CHECKSUMMED", "TUBE_FORM"]
 
 #: Entries outside the checksum: the checksum itself and the wall time (the one non-deterministic number).
 NOT_CHECKSUMMED = ("checksum", "elapsed_s")
@@ -62,6 +65,9 @@ def certificate_to_dict(cert: Any) -> dict:
         "premises": list(cert.premises), "scenario_data": cert.scenario_data,
         "design_key": cert.design_key, "design_fields": cert.design_fields,
         "elapsed_s": round(cert.elapsed_s, 3),
+        "backup": None if cert.backup is None else cert.backup.to_dict(),
+        "safe_design": None if cert.safe_design is None else design_to_dict(cert.safe_design),
+        "tiers": tiers_to_dict(cert),
     })
     if cert.paper_route is not None:
         out["paper_route"] = to_jsonable(cert.paper_route.to_dict())
@@ -69,11 +75,42 @@ def certificate_to_dict(cert: Any) -> dict:
     return out
 
 
-def _conditions(d: dict) -> tuple[Condition, ...]:
-    conds = item(d, "conditions", "certificate")
+def tiers_to_dict(cert: Any) -> dict:
+    """``{safe, tracking, depends_on: {tier: [names]}, failed: {tier: [names]}}`` (derived; re-checked by recheck)."""
+    tc = cert.tier_conditions
+    return {**cert.tiers, "depends_on": {k: [c.condition for c in v] for k, v in tc.items()},
+            "failed": {k: list(v) for k, v in cert.tier_failures.items()}}
+
+
+def design_to_dict(d: Design) -> dict:
+    """A design as its own block (the safe-only design): σ, problem, tube, margins, V̄, conditions, arc rates."""
+    return {"sigma": d.sigma, "problem": d.problem.to_dict(), "tube": d.tube.to_dict(),
+            "margins": None if d.margins is None else d.margins.to_dict(),
+            "v_bar": None if d.v_bar is None else list(d.v_bar), "conditions": [c.to_dict() for c in d.conditions],
+            "arc_rates": list(d.rates)}
+
+
+def design_from_dict(d: Any, where: str = "certificate.safe_design") -> Design:
+    """Inverse of :func:`design_to_dict` (score -inf: a design outside the σ sweep)."""
+    margins, v_bar = item(d, "margins", where), item(d, "v_bar", where)
+    return Design(sigma=number(d, "sigma", where), problem=TubeProblem.from_dict(block(d, "problem", where)),
+                  tube=PeriodTube.from_dict(block(d, "tube", where)),
+                  margins=None if margins is None else HorizonMargins.from_dict(block(d, "margins", where)),
+                  v_bar=None if v_bar is None else numbers(d, "v_bar", where, 3, none=None),
+                  conditions=_conditions(d, where), score=-math.inf, rates=numbers(d, "arc_rates", where, 4))
+
+
+def _conditions(d: dict, where: str = "certificate") -> tuple[Condition, ...]:
+    conds = item(d, "conditions", where)
     if not isinstance(conds, list):
-        raise ConfigError("certificate.conditions", "a list of conditions", type(conds).__name__)
-    return tuple(Condition.from_dict(c, f"certificate.conditions[{i}]") for i, c in enumerate(conds))
+        raise ConfigError(f"{where}.conditions", "a list of conditions", type(conds).__name__)
+    return tuple(Condition.from_dict(c, f"{where}.conditions[{i}]") for i, c in enumerate(conds))
+
+
+def _design_conditions(d: dict) -> tuple[Condition, ...]:
+    """The chosen design's conditions: the stored list without the safe-only (``safe_only.*``) and backup
+    (``backup*``) ones, which their own blocks hold."""
+    return tuple(c for c in _conditions(d) if not c.condition.startswith((SAFE_PREFIX, "backup")))
 
 
 def _design(d: dict, sigma: SigmaChoice) -> Design:
@@ -85,7 +122,7 @@ def _design(d: dict, sigma: SigmaChoice) -> Design:
                   tube=PeriodTube.from_dict(block(d, "tube", "certificate")),
                   margins=None if margins is None else HorizonMargins.from_dict(block(d, "margins", "certificate")),
                   v_bar=None if v_bar is None else numbers(d, "v_bar", "certificate", 3, none=None),
-                  conditions=_conditions(d), score=-math.inf if score is None else score,
+                  conditions=_design_conditions(d), score=-math.inf if score is None else score,
                   rates=numbers(d, "arc_rates", "certificate", 4))
 
 
@@ -120,4 +157,8 @@ def certificate_from_dict(cls: type, d: Any) -> Any:
         dt=number(horizon, "dt", "certificate.horizon"),
         assumptions=texts(d, "assumptions", "certificate"), premises=texts(d, "premises", "certificate"),
         limits=numbers(d, "limits", "certificate", 3, none=None),
-        scenario_data=block(d, "scenario_data", "certificate"), design_fields=dict(fields), paper_route=_route(d))
+        scenario_data=block(d, "scenario_data", "certificate"), design_fields=dict(fields), paper_route=_route(d),
+        backup=None if item(d, "backup", "certificate") is None else BackupCertificate.from_dict(
+            block(d, "backup", "certificate")),
+        safe_design=None if item(d, "safe_design", "certificate") is None else design_from_dict(
+            block(d, "safe_design", "certificate")))

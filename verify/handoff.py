@@ -10,14 +10,26 @@ each input limit kept at >= max(``min_input_fraction`` · V_i, the keep-up need)
 and each node constraint keeping >= a quarter of R's half-width; flagged
 ``certified=False`` — it carries no guarantee.
 
-Both carry what they were certified for: the law, the certificate's design key and its fields
-(:mod:`tubekit.design_key`), so a run of another design refuses them before it starts.
+Safe only (the tracking tier does not certify, the safe tier does, :attr:`Certificate.tiers`): the
+safe-only design at σ = 0 (:func:`verify.tiers.safe_only_design`): ``v_max`` = V (no feedback,
+nothing to reserve), ``sigma`` = 0, ``tube`` = 0, margins whose e-columns are zero (not enforced:
+plan acceptance checks only the position constraints) and whose position column is the
+certified position margins, node bounds = R itself, ``obstacle_margin`` = the largest position
+margin plus its inter-node allowance; ``certified`` = True, ``tiers`` = ``{"safe": True,
+"tracking": False}``.
+
+Every tightening carries ``tiers`` and the backup (:class:`tubekit.model.backup.BackupPlan`: the
+law, its safe set, the hand-over it was proved for) when the certificate has one — also a best-effort
+one (then the backup is not certified either, ``tiers`` says so). ``certified`` is True when the
+safe tier is certified. All carry what they were certified for: the law, the certificate's design
+key and its fields (:mod:`tubekit.design_key`), so a run of another design refuses them before it starts.
 """
 
 from __future__ import annotations
 
 import numpy as np
 
+from tubekit.model.backup import BackupPlan
 from tubekit.tightening import DisturbanceBound, RegionBounds, Tightening
 
 __all__ = ["tightening_of", "MIN_KEPT_FRACTION"]
@@ -61,10 +73,42 @@ def _node_bounds(cert, margins: np.ndarray, rates: np.ndarray) -> dict[str, floa
             "obstacle_margin": float(worst[3])}
 
 
-def tightening_of(cert, min_input_fraction: float = 0.5) -> Tightening:
-    """The Tightening of ``cert`` (certified or best effort, see the module doc)."""
-    d = cert.design
+def _backup_plan(cert) -> BackupPlan | None:
+    b = cert.backup
+    return None if b is None else BackupPlan(law=b.law, safe_set=b.safe_set, handover=tuple(b.handover))
+
+
+def _common(cert) -> dict:
     reg = cert.region
+    return dict(region=RegionBounds(epsilon=reg.e_d[0], e_d_max=reg.e_d[1], e_z_max=min(-reg.e_z[0], reg.e_z[1]),
+                                    e_o_max=min(-reg.e_o[0], reg.e_o[1])),
+                disturbance=DisturbanceBound(omega_xy=cert.disturbance.omega_xy, omega_z=cert.disturbance.omega_z,
+                                             sway=cert.disturbance.gamma),
+                law=cert.law, design_key=cert.design_key, design_fields=dict(cert.design_fields),
+                backup=_backup_plan(cert), tiers=dict(cert.tiers))
+
+
+def _safe_only(cert) -> Tightening:
+    """The safe-only tightening (module doc)."""
+    d = cert.safe_design
+    m = d.margins
+    n = len(m.position)
+    margins = np.column_stack([np.zeros(n), np.zeros(n), np.zeros(n), np.asarray(m.position, dtype=float)])
+    rates = np.asarray(d.rates, dtype=float)
+    common = _common(cert)
+    reg = common["region"]
+    return Tightening(v_max=np.asarray(cert.limits, dtype=float), e_d_min=reg.epsilon, e_d_max=reg.e_d_max,
+                      e_z_max=reg.e_z_max, e_o_max=reg.e_o_max,
+                      obstacle_margin=float(m.position[-1] + 0.5 * cert.dt * rates[3]), rho_tilde=0.0, sigma=0.0,
+                      margins=margins, rates=rates, tube=np.zeros(3), certified=True, **common)
+
+
+def tightening_of(cert, min_input_fraction: float = 0.5) -> Tightening:
+    """The Tightening of ``cert`` (certified, safe only, or best effort, see the module doc)."""
+    tiers = cert.tiers
+    if tiers["safe"] and not tiers["tracking"] and cert.safe_design is not None:
+        return _safe_only(cert)
+    d = cert.design
     has_tube = d.tube.certified and d.margins is not None
     margins = (np.column_stack([d.margins.e_d, d.margins.e_z, d.margins.e_o, d.margins.position])
                if has_tube else np.zeros((0, 4)))
@@ -75,9 +119,4 @@ def tightening_of(cert, min_input_fraction: float = 0.5) -> Tightening:
     tube = np.asarray(d.tube.rho, dtype=float) if d.tube.certified else np.zeros(3)
     return Tightening(v_max=_input_limits(cert, min_input_fraction), rho_tilde=float(np.linalg.norm(tube)),
                       sigma=float(d.sigma), margins=margins, rates=rates, tube=tube,
-                      region=RegionBounds(epsilon=reg.e_d[0], e_d_max=reg.e_d[1], e_z_max=min(-reg.e_z[0], reg.e_z[1]),
-                                          e_o_max=min(-reg.e_o[0], reg.e_o[1])),
-                      disturbance=DisturbanceBound(omega_xy=cert.disturbance.omega_xy,
-                                                   omega_z=cert.disturbance.omega_z, sway=cert.disturbance.gamma),
-                      certified=bool(cert.certified), law=cert.law, design_key=cert.design_key,
-                      design_fields=dict(cert.design_fields), **nodes)
+                      certified=bool(tiers["safe"]), **_common(cert), **nodes)

@@ -13,8 +13,9 @@
    speeds, N and δ, the disturbance bounds (:func:`verify.design.disturbance_bounds`), the σ
    candidates, the stored gain bounds re-proved in Arb (:func:`verify.gains.prove_gain_bounds`,
    a smaller box budget), the tube fixed point, the per-arc margins, V̄, κ̄, Ē, the arc rates
-   and every condition (:func:`verify.design.evaluate_design`), the verdict, the premises and
-   assumptions.
+   and every condition (:func:`verify.tiers.tracking_design`), the verdict, the premises and
+   assumptions; the backup — the stored law and safe set re-certified with the re-derived bounds
+   and margins — the safe-only design and the tiers (:mod:`verify.rederive_tiers`).
 
 A stored number *stronger* than the derived one (a smaller bound, a larger V̄ or Ē, a
 verdict ``ok`` where the derivation fails) is a disagreement naming the field (exit 3); a

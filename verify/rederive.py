@@ -91,13 +91,14 @@ def _region(scenario: Scenario, cert: Any):
     return Region.from_scenario(scenario, **kw)
 
 
-def _key(raw: dict, cert: Any, scenario: Scenario, region: Any, led: Ledger) -> None:
-    """The stored key against its own fields and against the key of the stored scenario, law and σ."""
+def _key(raw: dict, cert: Any, scenario: Scenario, region: Any, led: Ledger, sigma: float) -> None:
+    """The stored key against its own fields and against the key of the stored scenario, law and the derived
+    σ of the tightening handed out (:func:`verify.tiers.key_sigma`)."""
     from verify.certificate import certificate_fields
     stored_key = raw.get("design_key")
     led.check("design_key", stored_key == cert.design_key, stored_key, cert.design_key,
               "the hash of the stored design_fields", by="design key")
-    derived = certificate_fields(scenario, cert.law, cert.design.sigma, region)
+    derived = certificate_fields(scenario, cert.law, sigma, region)
     diff = first_difference(derived, cert.design_fields)
     name = "design_fields" if diff is None else f"design_fields.{diff[0]}"
     led.check(name, diff is None and design_key(derived) == cert.design_key, None if diff is None else diff[2],
@@ -178,11 +179,12 @@ def _e_bar(raw: dict, region: Any, design: Any, led: Ledger) -> None:
         led.at_most(f"e_bar.{k}[1]", pair[1], hi)
 
 
-def _verdicts(raw: dict, cert: Any, design: Any, scenario: Scenario, led: Ledger) -> None:
-    """Each condition's verdict, the failure list, the certified flag, the premises and assumptions."""
+def _verdicts(raw: dict, cert: Any, design: Any, derived: tuple, scenario: Scenario, led: Ledger) -> None:
+    """Each condition's verdict (``derived``: every derived condition, the tiers'), the failure list, the
+    certified flag, the premises and assumptions."""
     from verify.certificate import ASSUMPTIONS, PREMISES, _dynamic_assumptions, _is_dynamic
     stored = {c.condition: c for c in cert.conditions}
-    for c in design.conditions:
+    for c in derived:
         s = stored.get(c.condition)
         if s is None:
             led.check(f"conditions[{c.condition}]", False, "missing", c.ok, "every condition of the theorem stored")
@@ -191,19 +193,20 @@ def _verdicts(raw: dict, cert: Any, design: Any, scenario: Scenario, led: Ledger
                   "a verdict not stronger than derived")
         if s.ok is not True and c.ok is True:
             led.notes.append(f"conditions[{c.condition}]: stored {s.ok}, derived True")
-    extra = sorted(set(stored) - {c.condition for c in design.conditions})
+    extra = sorted(set(stored) - {c.condition for c in derived})
     if extra:
         led.notes.append(f"stored conditions not in the theorem: {extra}")
-    derived_failed = {c.condition for c in design.conditions if c.ok is False}
+    derived_failed = {c.condition for c in derived if c.ok is False}
     listed = {f.get("condition") for f in raw.get("failures") or [] if isinstance(f, dict)}
     led.check("failures", derived_failed <= listed, sorted(listed), sorted(derived_failed),
               "every derived failure listed")
-    unevaluated = [c.condition for c in design.conditions if c.ok is None]
+    unevaluated = [c.condition for c in derived if c.ok is None]
     led.check("not_evaluated", set(unevaluated) <= set(raw.get("not_evaluated") or []), raw.get("not_evaluated"),
               unevaluated, "every condition not evaluated listed")
     claimed = raw.get("certified") is True
-    led.check("certified", not claimed or (design.certified and cert.certified), raw.get("certified"),
-              design.certified, "not stronger than the derived conditions")
+    everything = all(c.ok is True for c in derived)
+    led.check("certified", not claimed or (everything and cert.certified), raw.get("certified"),
+              everything, "not stronger than the derived conditions (both tiers)")
     dist = cert.disturbance
     assumptions = ASSUMPTIONS + (_dynamic_assumptions(scenario, dist) if _is_dynamic(scenario) else ())
     led.equal("assumptions", list(cert.assumptions), list(assumptions))
@@ -216,7 +219,9 @@ def _verdicts(raw: dict, cert: Any, design: Any, scenario: Scenario, led: Ledger
 
 def rederive(raw: dict, cert: Any, led: Ledger, gain_boxes: int) -> None:
     """Every re-check after the checksum (module doc), appended to ``led`` in order."""
-    from verify.design import disturbance_bounds, evaluate_design, tube_problem
+    from verify.design import disturbance_bounds, tube_problem
+    from verify.rederive_tiers import check_tiers, derive_tiers
+    from verify.tiers import key_sigma, tier_conditions, tracking_design
     from tubekit.model.ancillary import get_law
     scenario = _scenario(cert)
     try:
@@ -228,13 +233,19 @@ def rederive(raw: dict, cert: Any, led: Ledger, gain_boxes: int) -> None:
     except ConfigError as exc:
         raise ConfigError(f"certificate.design_fields.region_override ({exc.field})", exc.expected,
                           exc.received) from None
-    _key(raw, cert, scenario, region, led)
     dist = disturbance_bounds(scenario)
+    sigma = cert.design.sigma
+    design = tracking_design(scenario, region, cert.gains, sigma, dist)
+    tiers = derive_tiers(cert, scenario, region, dist, design)
+    safe, backup = tiers.safe, tiers.backup
+    _key(raw, cert, scenario, region, led, key_sigma(design, safe, backup))
     _inputs(raw, cert, scenario, region, dist, led)
     _gains(cert, region, gain_boxes, led)
-    sigma = cert.design.sigma
     _problem(cert, tube_problem(scenario, region, cert.gains, sigma, dist), led)
-    design = evaluate_design(scenario, region, cert.gains, sigma, dist)
     _tube(raw, cert, design, led)
     _e_bar(raw, region, design, led)
-    _verdicts(raw, cert, design, scenario, led)
+    check_tiers(raw, cert, design, tiers, led)
+    derived = tier_conditions(design, safe, backup)
+    backup_part = derived["tracking"][len(design.conditions):]
+    every = design.conditions + (safe.conditions if safe is not None else ()) + backup_part
+    _verdicts(raw, cert, design, every, scenario, led)

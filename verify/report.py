@@ -5,7 +5,7 @@ from __future__ import annotations
 import math
 from typing import Any
 
-__all__ = ["certificate_text"]
+__all__ = ["certificate_text", "tiers_line"]
 
 
 def _f(x: Any, d: int = 4) -> str:
@@ -44,24 +44,51 @@ def _tube_lines(cert) -> list[str]:
     return out
 
 
+def tiers_line(cert) -> str:
+    """``safe: certified; tracking: not certified (keep_up[u], yaw_budget)``: each tier, the failed conditions."""
+    tiers, failed = cert.tiers, cert.tier_failures
+    return "; ".join(f"{k}: certified" if tiers[k] else f"{k}: not certified ({', '.join(failed[k])})"
+                     for k in ("safe", "tracking"))
+
+
+def _tier_lines(cert) -> list[str]:
+    out = [f"Tiers: {tiers_line(cert)}",
+           "  safe (no collision, inside the workspace, v in V never clipped, for all time; premise: the "
+           "disturbance bound) depends on: " + ", ".join(c.condition for c in cert.tier_conditions["safe"]),
+           "  tracking (e in R, e_d >= epsilon, the tube, while a plan is followed) depends on: every condition "
+           "of the chosen design and the backup's"]
+    if cert.safe_design is not None:
+        m = cert.safe_design.margins
+        out.append(f"Safe-only design (sigma = 0, no feedback, inputs up to V): position tube "
+                   f"{_f(cert.safe_design.tube.p_xy)} m per period; position margins {_vec(m.position, 3)} m "
+                   "(e-coordinate margins not required)")
+    if cert.backup is not None:
+        out += cert.backup.summary_lines()
+        out.append(f"  hand-over: within {_f(cert.backup.handover[0])} m horizontally, "
+                   f"{_f(cert.backup.handover[1])} m in depth of the anchor (the last arc's margins)")
+    return out
+
+
 def certificate_text(cert) -> str:
     """Human-readable certificate: verdict, region, disturbance, tube, conditions, premises, assumptions."""
     n_fail = len(cert.failures)
     status = "CERTIFIED" if cert.certified else f"NOT CERTIFIED ({n_fail} failed condition{'s' * (n_fail != 1)})"
     dist = cert.disturbance
-    lines = [f"tubekit certificate: scenario '{cert.scenario_name}', law '{cert.law}': {status}",
+    lines = [f"tubekit certificate: scenario '{cert.scenario_name}', law '{cert.law}': {status} -- {tiers_line(cert)}",
              "Theorem: the sampled-data loop as it runs (nominal reset every period, kappa held at the ancillary "
-             "rate, plans accepted by the exact arc check, the previous plan replayed otherwise).",
+             "rate, plans accepted by the exact arc check and the terminal condition, the previous plan replayed "
+             "otherwise, the certified backup law once the replay is exhausted).",
              "Region R (every bound holds over it):", cert.region.describe(),
              f"Disturbance: ||omega_xy|| <= {_f(dist.omega_xy)} m/s, |omega_z| <= {_f(dist.omega_z)} m/s "
              f"(sway gamma_bar = {_f(dist.gamma)} m/s from the sway model over V; declared {_f(dist.declared_sway)})"]
     lines += _tube_lines(cert)
+    lines += _tier_lines(cert)
     lines.append("Conditions:")
     for c in cert.conditions:
         tag = {True: "ok  ", False: "FAIL", None: "n/a "}[c.ok]
         lines.append(f"  [{tag}] {c.condition}: {c.inequality}: {_f(c.lhs, 6)} vs {_f(c.rhs, 6)}"
                      + (f"  ({c.detail})" if c.detail and c.ok is not True else ""))
-    lines.append("Premises (checked in every run; a run that breaks one exits 4):")
+    lines.append("Premises (checked in every run; a premise failure is reported as such, never as a broken promise):")
     lines.extend(f"  - {p}" for p in cert.premises)
     lines.append("Assumptions (outside the model):")
     lines.extend(f"  - {a}" for a in cert.assumptions)

@@ -40,8 +40,9 @@ __all__ = ["RunTask", "simulate_task", "certify_plans", "open_client", "run_camp
 
 LOGGER = logging.getLogger("tubekit.campaign")
 #: Per-run metric columns of ``runs.parquet`` (after run, seed and the sampled values).
-METRIC_COLUMNS = ("certified", "max_rho_ratio", "min_clearance", "min_e_d", "tracking_rmse", "saturated_steps",
-                  "violated", "premises_held", "broken", "worst_sequence", "error", "wall_s")
+METRIC_COLUMNS = ("certified", "safe_tier", "tracking_tier", "max_rho_ratio", "min_clearance", "min_e_d",
+                  "tracking_rmse", "saturated_steps", "replaced_steps", "backup_s", "backup_engagements",
+                  "violated", "safety_broken", "premises_held", "broken", "worst_sequence", "error", "wall_s")
 #: Figures written under ``DIR/figures/``.
 FIGURES = ("ecdf.png", "worst_runs.png")
 #: Retries of a run whose worker raised or died (dask ``retries``).
@@ -88,7 +89,18 @@ def _figures_of(sim: Any) -> dict[str, Any]:
     return {"max_rho_ratio": sim.ratio, "min_clearance": float(metrics["min_clearance"]),
             "min_e_d": float(metrics["min_e_d"]), "tracking_rmse": float(metrics["tracking_rmse"]),
             "saturated_steps": int(metrics["saturated_steps"]), "broken": list(sim.broken),
+            "replaced_steps": int(metrics["replaced_steps"]), "backup_s": float(metrics["backup_s"]),
+            "backup_engagements": int(metrics["backup_engagements"]),
+            "safety_broken": [p.name for p in sim.promises if p.tier == "safe" and p.name in sim.broken],
             "premises_held": sim.premises_held}
+
+
+def _tiers_of(tightening: Tightening) -> dict[str, bool]:
+    """``safe_tier`` and ``tracking_tier``: the tiers the run's certificate gives."""
+    from tubekit.loop.promises import tiers_given
+
+    given = tiers_given(tightening)
+    return {"safe_tier": bool(given.get("safe")), "tracking_tier": bool(given.get("tracking"))}
 
 
 def simulate_task(task: RunTask) -> dict[str, Any]:
@@ -98,9 +110,11 @@ def simulate_task(task: RunTask) -> dict[str, Any]:
         sims = _simulate_all(task)
     except TubekitError as exc:  # a run that cannot be simulated is recorded, not retried
         return {"run": task.run, "seed": task.seed, "certified": bool(task.tightening.certified),
-                "max_rho_ratio": None, "min_clearance": None, "min_e_d": None, "tracking_rmse": None,
-                "saturated_steps": None, "violated": False, "premises_held": False, "broken": "",
-                "worst_sequence": -1, "error": str(exc).splitlines()[0], "wall_s": time.perf_counter() - started}
+                **_tiers_of(task.tightening), "max_rho_ratio": None, "min_clearance": None, "min_e_d": None,
+                "tracking_rmse": None, "saturated_steps": None, "replaced_steps": None, "backup_s": None,
+                "backup_engagements": None, "violated": False, "safety_broken": "", "premises_held": False,
+                "broken": "", "worst_sequence": -1, "error": str(exc).splitlines()[0],
+                "wall_s": time.perf_counter() - started}
     return _row_of(task, sims, started)
 
 
@@ -109,12 +123,14 @@ def _row_of(task: RunTask, sims: list[Any], started: float) -> dict[str, Any]:
     figures = [_figures_of(sim) for sim in sims]
     worst = int(np.argmax([f["max_rho_ratio"] for f in figures]))
     return {"run": task.run, "seed": task.seed, "certified": bool(task.tightening.certified),
-            "max_rho_ratio": figures[worst]["max_rho_ratio"],
+            **_tiers_of(task.tightening), "max_rho_ratio": figures[worst]["max_rho_ratio"],
             "min_clearance": min(f["min_clearance"] for f in figures),
             "min_e_d": min(f["min_e_d"] for f in figures),
             "tracking_rmse": max(f["tracking_rmse"] for f in figures),
             "saturated_steps": max(f["saturated_steps"] for f in figures),
+            **{k: max(f[k] for f in figures) for k in ("replaced_steps", "backup_s", "backup_engagements")},
             "violated": any(f["broken"] for f in figures),
+            "safety_broken": ",".join(sorted({n for f in figures for n in f["safety_broken"]})),
             "premises_held": all(f["premises_held"] for f in figures),
             "broken": ",".join(sorted({n for f in figures for n in f["broken"]})),
             "worst_sequence": worst, "error": "", "wall_s": time.perf_counter() - started}
@@ -193,7 +209,9 @@ def _flat_values(values: dict[str, Any]) -> dict[str, Any]:
     """Sampled values as columns; a vector ``key`` becomes ``key[0]``, ``key[1]``, ..."""
     flat: dict[str, Any] = {}
     for key, value in values.items():
-        if isinstance(value, list):
+        if isinstance(value, list) and value and isinstance(value[0], dict):  # a sampled obstacle set
+            flat.update({f"{key}.count": len(value), key: json.dumps(value)})
+        elif isinstance(value, list):
             flat.update({f"{key}[{i}]": v for i, v in enumerate(value)})
         else:
             flat[key] = value
@@ -240,6 +258,29 @@ def _worst(rows: list[dict], count: int = 10) -> list[dict]:
     return [{**{k: r[k] for k in keep}, "values": {k: r[k] for k in values}} for r in ranked[:count]]
 
 
+def _tier_summary(rows: list[dict], seconds_per_run: float) -> dict[str, Any]:
+    """Safety (must be 0), the backup's activity and the tracking tier over the runs (issue 21); a row's
+    ``backup_s`` is its worst simulation's, so ``share_of_simulated_time`` is per run's duration."""
+    safe = [r for r in rows if r.get("safe_tier")]
+    tracking = [r for r in rows if r.get("tracking_tier")]
+    engaged = [r for r in rows if (r.get("backup_s") or 0) > 0]
+    simulated = seconds_per_run * len(rows)
+    return {
+        "safe_tier_runs": len(safe), "tracking_tier_runs": len(tracking),
+        "safety_broken": sum(bool(r.get("safety_broken")) for r in rows),
+        "safety_broken_safe_tier": sum(bool(r.get("safety_broken")) for r in safe),
+        "tracking_broken_tracking_tier": sum(bool(r["broken"]) and r["broken"] != r.get("safety_broken")
+                                             for r in tracking),
+        "backup": {"runs_engaged": len(engaged), "fraction_engaged": len(engaged) / len(rows) if rows else None,
+                   "seconds_total": float(sum(r["backup_s"] for r in engaged)),
+                   "share_of_simulated_time": (float(sum(r["backup_s"] for r in engaged)) / simulated
+                                               if simulated else None),
+                   "seconds_per_engaged_run": _quantiles(engaged, "backup_s"),
+                   "engagements_per_engaged_run": _quantiles(engaged, "backup_engagements")},
+        "runs_with_replaced_steps": sum((r.get("replaced_steps") or 0) > 0 for r in rows),
+    }
+
+
 def summarise(rows: list[dict], spec: CampaignSpec, certs: dict[str, Tightening], facts: dict) -> dict[str, Any]:
     """``summary.json``: the largest max_rho_ratio beside the certified radius (1 in the tube's box norm), counts."""
     certified = [r for r in rows if r["certified"]]
@@ -257,11 +298,12 @@ def summarise(rows: list[dict], spec: CampaignSpec, certs: dict[str, Tightening]
         "largest_max_rho_ratio": largest[0] if largest else None,
         "largest_max_rho_ratio_certified": largest_cert[0] if largest_cert else None,
         "violations": sum(bool(r["violated"]) for r in rows),
-        "violations_certified": sum(bool(r["violated"]) and r["premises_held"] for r in certified),
+        "violations_certified": sum(bool(r["violated"]) for r in certified),  # of a given tier, its premises held
         "premise_failures": sum(not r["premises_held"] for r in rows),
         "errors": sum(bool(r["error"]) for r in rows),
+        **_tier_summary(rows, spec.duration),
         "metrics": {k: _quantiles(rows, k) for k in ("max_rho_ratio", "min_clearance", "min_e_d", "tracking_rmse",
-                                                     "saturated_steps", "wall_s")},
+                                                     "saturated_steps", "replaced_steps", "backup_s", "wall_s")},
         "worst_runs": _worst(rows),
         **facts,
     }
@@ -273,7 +315,9 @@ def summary_line(summary: dict, out: str | Path) -> str:
     return (f"{summary['runs']} runs ({summary['computed_runs']} computed), {summary['certified_runs']} certified; "
             f"largest max_rho_ratio {top.get('max_rho_ratio')} (run {top.get('run')}, seed {top.get('seed')}) vs "
             f"certified radius 1; violations {summary['violations']} ({summary['violations_certified']} of a "
-            f"certified run with its premises held); wrote {out}")
+            f"certified run with its premises held); safety promises broken {summary['safety_broken_safe_tier']} "
+            f"(of {summary['safe_tier_runs']} runs with the safe tier); backup engaged in "
+            f"{summary['backup']['runs_engaged']} runs, {summary['backup']['seconds_total']:.4g} s in all; wrote {out}")
 
 
 def write_figures(out: Path, rows: list[dict], epsilon: float) -> list[Path]:
@@ -284,9 +328,9 @@ def write_figures(out: Path, rows: list[dict], epsilon: float) -> list[Path]:
     folder.mkdir(exist_ok=True)
     panels = (("max_rho_ratio", 1.0, "certified radius"), ("min_clearance", 0.0, "contact"),
               ("min_e_d", epsilon, "epsilon"), ("tracking_rmse", None, ""), ("saturated_steps", None, ""),
-              ("wall_s", None, ""))
-    fig = Figure(figsize=(11, 6.5), layout="constrained")
-    for ax, (key, bound, label) in zip(fig.subplots(2, 3).ravel(), panels):
+              ("replaced_steps", None, ""), ("backup_s", None, ""), ("wall_s", None, ""))
+    fig = Figure(figsize=(14, 6.5), layout="constrained")
+    for ax, (key, bound, label) in zip(fig.subplots(2, 4).ravel(), panels):
         x = np.sort([float(r[key]) for r in rows if r.get(key) is not None and np.isfinite(float(r[key]))])
         ax.step(np.r_[x[:1], x], np.arange(x.size + 1) / max(x.size, 1), where="post", color="C0")
         if bound is not None:

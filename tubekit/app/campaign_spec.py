@@ -15,6 +15,11 @@ A spec names a base scenario, how many runs, one seed and what to sample::
     [falsify]                          # optional
     sequences = 2                      # random piecewise-constant disturbances per run
 
+``obstacles`` takes a third kind, a cluster drawn afresh for every run (:func:`draw_cluster`)::
+
+    "obstacles" = { cluster = { count = [3, 7], radius = [0.15, 0.4], gap = [0.01, 0.3],
+                                center = [[-1.0, 2.0, -0.2], [1.0, 4.0, 0.2]], margin = 0.15 } }
+
 Run ``k`` gets its own seed, ``SeedSequence(seed).spawn(runs)[k]`` reduced to one integer
 (:func:`run_seed`); its samples are drawn from ``default_rng([run_seed, 0])`` in the sorted order
 of the keys, its disturbance sequences (worker side) from ``default_rng([run_seed, 1])``. Run ``k``
@@ -39,7 +44,8 @@ from tubekit.exceptions import ConfigError, TubekitError
 from tubekit.scenario import Scenario, load_scenario, paper_scenario, read_toml, scenario_from_dict
 
 __all__ = ["Distribution", "CampaignSpec", "RunPlan", "load_spec", "spec_from_dict", "run_seed",
-           "certificate_key", "spec_from_stored", "require_dependencies", "NOT_CERTIFICATE_INPUTS", "SPEC_KEYS"]
+           "certificate_key", "spec_from_stored", "require_dependencies", "NOT_CERTIFICATE_INPUTS", "SPEC_KEYS",
+           "draw_cluster", "CLUSTER_KEYS"]
 
 #: Top-level keys of a spec.
 SPEC_KEYS = ("scenario", "runs", "seed", "duration", "sample", "falsify")
@@ -47,6 +53,13 @@ SPEC_KEYS = ("scenario", "runs", "seed", "duration", "sample", "falsify")
 NOT_CERTIFICATE_INPUTS = ("name", "duration", "disturbance.period")
 #: Upper bound on ``runs`` (a typo guard; 10^6 run files is already a lot).
 MAX_RUNS = 1_000_000
+#: Keys of an ``obstacles = { cluster = {...} }`` entry (``margin`` optional, m).
+CLUSTER_KEYS = ("count", "radius", "gap", "center", "margin")
+#: Hexagonal lattice offsets (units of the spacing): the centre, its 6 neighbours, then the next 12.
+_HEX = ([(0.0, 0.0)] + [(math.cos(k * math.pi / 3), math.sin(k * math.pi / 3)) for k in range(6)]
+        + [(2 * math.cos(k * math.pi / 3), 2 * math.sin(k * math.pi / 3)) for k in range(6)]
+        + [(math.sqrt(3) * math.cos(k * math.pi / 3 + math.pi / 6), math.sqrt(3) * math.sin(k * math.pi / 3 + math.pi / 6))
+           for k in range(6)])
 
 
 @dataclass(frozen=True)
@@ -59,7 +72,9 @@ class Distribution:
     options: tuple = ()
 
     def draw(self, rng: np.random.Generator) -> Any:
-        """One value: a float, a list of floats (vector uniform) or one of ``options``."""
+        """One value: a float, a list of floats (vector uniform), one of ``options`` or a cluster's obstacles."""
+        if self.kind == "cluster":
+            return draw_cluster(dict(self.options), rng)
         if self.kind == "choice":
             return self.options[int(rng.integers(len(self.options)))]
         value = rng.uniform(np.asarray(self.low, dtype=float), np.asarray(self.high, dtype=float))
@@ -67,6 +82,8 @@ class Distribution:
 
     def to_dict(self) -> dict:
         """The TOML form: ``{uniform = [lo, hi]}`` or ``{choice = [...]}``."""
+        if self.kind == "cluster":
+            return {"cluster": {k: v for k, v in self.options if k != "vehicle_radius"}}
         return {"choice": list(self.options)} if self.kind == "choice" else {"uniform": [self.low, self.high]}
 
 
@@ -116,6 +133,8 @@ class CampaignSpec:
         data["duration"] = self.duration
         for key, value in values.items():
             _set_dotted(data, key, value)
+        if any(dist.kind == "cluster" for _, dist in self.sample):
+            data["obstacles"] = values["obstacles"] = _clear_of_start(data)  # the row records what ran
         try:
             scenario = scenario_from_dict(data)
         except TubekitError as exc:
@@ -125,6 +144,50 @@ class CampaignSpec:
                 raise ConfigError("sample", "values the scenario accepts", values, str(exc)) from None
             raise ConfigError(f"sample.{field}", "a value the scenario accepts", values[field], str(exc)) from None
         return RunPlan(run, seed, values, scenario)
+
+
+def draw_cluster(params: dict, rng: np.random.Generator) -> list[dict]:
+    """Obstacles ``[{center, radius}]`` of one cluster: ``count`` (integers lo..hi) equal spheres of ``radius``
+    on a hexagonal lattice (horizontal, random rotation) about a ``center`` drawn in its box, neighbours
+    ``(2 (vehicle_radius + margin) + 2 radius)(1 + gap)`` apart (``vehicle_radius`` and ``margin`` in
+    ``params``): separated as ``certify`` requires when the position margin is at most ``margin``."""
+    count = int(rng.integers(int(params["count"][0]), int(params["count"][1]) + 1))
+    radius = float(rng.uniform(*params["radius"]))
+    gap = float(rng.uniform(*params["gap"]))
+    centre = rng.uniform(np.asarray(params["center"][0], dtype=float), np.asarray(params["center"][1], dtype=float))
+    turn = float(rng.uniform(0.0, math.pi / 3))
+    spacing = (2 * (params["vehicle_radius"] + params.get("margin", 0.0)) + 2 * radius) * (1.0 + gap)
+    c, s = math.cos(turn), math.sin(turn)
+    return [{"center": [float(centre[0] + spacing * (a * c - b * s)), float(centre[1] + spacing * (a * s + b * c)),
+                        float(centre[2])], "radius": radius} for a, b in _HEX[:count]]
+
+
+def _clear_of_start(data: dict) -> list[dict]:
+    """The sampled obstacles that leave the start's vehicle ball clear (a start inside one certifies nothing)."""
+    start = np.asarray(data["initial_state"][:3], dtype=float)
+    rbar = float(data["vehicle_radius"])
+    return [o for o in data.get("obstacles", [])
+            if np.linalg.norm(np.asarray(o["center"], dtype=float) - start) > o["radius"] + rbar]
+
+
+def _cluster(field: str, params: Any, base: dict) -> Distribution:
+    """Validate ``{ cluster = { count, radius, gap, center, margin } }``; ``vehicle_radius`` from the base."""
+    if not isinstance(params, dict) or set(params) - set(CLUSTER_KEYS) or set(CLUSTER_KEYS[:4]) - set(params):
+        raise ConfigError(field, f"a table with the keys {list(CLUSTER_KEYS[:4])} (and optionally 'margin')", params)
+    count = params["count"]
+    if not (isinstance(count, list) and len(count) == 2 and all(isinstance(n, int) and not isinstance(n, bool)
+                                                                for n in count) and 1 <= count[0] <= count[1] <= len(_HEX)):
+        raise ConfigError(f"{field}.count", f"[lo, hi] integers with 1 <= lo <= hi <= {len(_HEX)}", count)
+    for name, low in (("radius", 1e-9), ("gap", 0.0)):
+        pair = _uniform(f"{field}.{name}", params[name], None)
+        if pair.low < low:
+            raise ConfigError(f"{field}.{name}", f"[lo, hi] with lo >= {low:g}", params[name])
+    _uniform(f"{field}.center", params["center"], [0.0, 0.0, 0.0])
+    margin = _number(f"{field}.margin", params.get("margin", 0.0))
+    if margin < 0:
+        raise ConfigError(f"{field}.margin", "a number >= 0 (m)", margin)
+    options = {**params, "margin": margin, "vehicle_radius": float(base["vehicle_radius"])}
+    return Distribution("cluster", options=tuple(sorted(options.items())))
 
 
 def require_dependencies() -> None:
@@ -195,8 +258,11 @@ def _uniform(field: str, bounds: Any, base: Any) -> Distribution:
 
 def _distribution(key: str, entry: Any, base: dict) -> Distribution:
     field = f"sample.{key}"
+    if key == "obstacles" and isinstance(entry, dict) and list(entry) == ["cluster"]:
+        return _cluster(f"{field}.cluster", entry["cluster"], base)
     if not isinstance(entry, dict) or len(entry) != 1 or next(iter(entry)) not in ("uniform", "choice"):
-        raise ConfigError(field, "{ uniform = [lo, hi] } or { choice = [...] }", entry)
+        raise ConfigError(field, "{ uniform = [lo, hi] } or { choice = [...] }"
+                          + (" or { cluster = {...} }" if key == "obstacles" else ""), entry)
     current = _get_dotted(base, key)
     if "uniform" in entry:
         return _uniform(f"{field}.uniform", entry["uniform"], current)

@@ -23,6 +23,8 @@ from tubekit.loop.pipeline import CertifiedRun, certified_run
 from tubekit.loop.result import SimulationResult
 from tubekit.scenario import Scenario
 from tubekit.app.certified import certify_design
+from tubekit.app.plots import backup_stretches, shade_backup, title_lines
+from tubekit.app.tiers import report_title, tier_report
 
 __all__ = ["run_dynamic", "comparison_figure", "DYNAMIC_FILES"]
 
@@ -37,8 +39,12 @@ def _dynamic_scenario(scenario: Scenario) -> Scenario:
 
 
 def comparison_figure(scenario: Scenario, kinematic: SimulationResult, dynamic: SimulationResult,
-                      gamma: float) -> Figure:
-    """Path, e_d, sway against γ̄ and thrust against its limits: kinematic and dynamic tube runs."""
+                      gamma: float, tiers: str | None = None) -> Figure:
+    """Path, e_d, sway against γ̄ and thrust against its limits: kinematic and dynamic tube runs.
+
+    ``tiers`` (the dynamic certificate's, :func:`tubekit.app.plots.tier_title`) is a title line; the
+    dynamic run's backup-active stretches are shaded on its time axes.
+    """
     fig = Figure(figsize=(12, 8.5), layout="constrained")
     ax = fig.subplots(2, 2)
     runs = (("kinematic plant", kinematic, "tab:blue"), ("dynamic plant (REMUS 100)", dynamic, "tab:purple"))
@@ -65,10 +71,14 @@ def comparison_figure(scenario: Scenario, kinematic: SimulationResult, dynamic: 
     ax[1, 1].axhline(1.0, color="tab:red", ls="--", lw=1.0, label="limit")
     ax[1, 1].axhline(-1.0, color="tab:red", ls="--", lw=1.0)
     ax[1, 1].set(xlabel="t (s)", ylabel="thrust / limit", title="thrust against its limits")
+    stretches = backup_stretches(dynamic.columns())
+    for n, a in enumerate((ax[0, 1], ax[1, 0], ax[1, 1])):
+        shade_backup(a, stretches, label=n == 0)
     for a in ax.flat:
         a.grid(alpha=0.3)
         a.legend(fontsize=9, loc="best")
-    fig.suptitle(f"{scenario.name}: tube controller, kinematic vs dynamic plant", fontsize=13)
+    head = f"{scenario.name}: tube controller, kinematic vs dynamic plant"
+    fig.suptitle(title_lines(head, tiers, width=140), fontsize=11)
     return fig
 
 
@@ -77,7 +87,7 @@ def run_dynamic(scenario: Scenario, staging: Path, kinematic: SimulationResult,
     """Certify and run the dynamic plant; write its files into ``staging``; return the run and its metrics.
 
     The metrics are the run's (``run.metrics``) plus ``failures`` (the certificate's failed
-    conditions), ``vehicle`` and ``tracking_bound``.
+    conditions), ``vehicle``, ``tracking_bound`` and ``tiers_report`` (:func:`tubekit.app.tiers.tier_report`).
     """
     scd = _dynamic_scenario(scenario)
     design = certify_design(scd)
@@ -87,6 +97,8 @@ def run_dynamic(scenario: Scenario, staging: Path, kinematic: SimulationResult,
     metrics = dyn.to_dict()
     metrics.update(failures=[f.condition for f in design.certificate.failures], vehicle=scd.plant.vehicle,
                    tracking_bound=list(scd.plant.tracking_bound))
+    metrics["tiers_report"] = tier_report(design.certificate, metrics)
     gamma = float(design.tightening.disturbance.sway)
-    comparison_figure(scd, kinematic, dyn.run, gamma).savefig(staging / "dynamic_vs_kinematic.png", dpi=100)
+    figure = comparison_figure(scd, kinematic, dyn.run, gamma, tiers=report_title(metrics["tiers_report"]))
+    figure.savefig(staging / "dynamic_vs_kinematic.png", dpi=100)
     return dyn, metrics

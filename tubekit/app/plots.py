@@ -7,6 +7,7 @@ columns (as from ``trajectory.csv``), so figures can be redrawn from the CSVs.
 
 from __future__ import annotations
 
+import textwrap
 from pathlib import Path
 from typing import TYPE_CHECKING, Mapping, Sequence
 
@@ -42,6 +43,10 @@ __all__ = [
     "FIGURE_FILES",
     "envelope_figure",
     "plot_envelope",
+    "backup_stretches",
+    "shade_backup",
+    "tier_title",
+    "title_lines",
 ]
 
 #: File names written by :func:`plot_all`.
@@ -58,6 +63,47 @@ CLEARANCE_LINEAR_M = 0.01
 def run_style(i: int) -> dict:
     """Line style of the ``i``-th run (0: the tube run, 1: the baseline)."""
     return dict(_STYLE.get(i, dict(lw=1.0)))
+
+
+def backup_stretches(columns: Mapping[str, np.ndarray]) -> list[tuple[float, float]]:
+    """(start, end) times (s) of the stretches in which the backup law ran (column ``backup_active``; none
+    when the column is absent). A stretch ends at the first tick that follows a plan again."""
+    active = columns.get("backup_active")
+    if active is None:
+        return []
+    on = np.asarray(active, dtype=float) > 0.5
+    t = np.asarray(columns["t"], dtype=float)
+    edges = np.diff(np.r_[0, on.astype(int), 0])
+    return [(float(t[a]), float(t[min(b, len(t) - 1)])) for a, b in zip(np.flatnonzero(edges == 1),
+                                                                      np.flatnonzero(edges == -1))]
+
+
+def shade_backup(ax, stretches: Sequence[tuple[float, float]], *, label: bool = True) -> None:
+    """Shade the backup-active stretches (grey) on a time axis; one legend entry when ``label``."""
+    for n, (a, b) in enumerate(stretches):
+        ax.axvspan(a, b, color="0.5", alpha=0.18, lw=0, zorder=0,
+                   label="backup law active (station keeping)" if label and n == 0 else None)
+
+
+def title_lines(head: str, tiers: str | None, width: int = 110) -> str:
+    """``head`` and the tier line below it, wrapped at ``width`` characters (a long list of failed conditions)."""
+    if not tiers:
+        return head
+    wrapped = textwrap.fill(tiers, width)
+    return f"{head}\n{wrapped}" if head else wrapped
+
+
+def tier_title(tiers: Mapping[str, bool] | None, failures: Mapping[str, Sequence[str]] | None = None) -> str:
+    """The title line of the tiers: ``safe: certified; tracking: not certified (keep_up, yaw_budget)``."""
+    if tiers is None:
+        return "no certificate (baseline only): nothing is promised"
+    parts = []
+    for name in ("safe", "tracking"):
+        ok = bool(tiers.get(name, False))
+        failed = list((failures or {}).get(name, ()))
+        reason = f" ({', '.join(failed)})" if failed and not ok else ""
+        parts.append(f"{name}: {'certified' if ok else 'not certified'}{reason}")
+    return "; ".join(parts)
 
 
 def _desired_curve(scenario: Scenario, t_end: float) -> np.ndarray:
@@ -175,6 +221,12 @@ def top_view(scenario: Scenario, runs: Sequence[Run], *, tightening: Tightening 
         _draw_tube_band(ax, runs[0][1], half, rf"position tube: $\hat p$ $\pm$ obstacle margin {half:.3g} m "
                                               f"({'certified' if certified else 'best effort, NOT certified'})")
     _draw_path_with_time(ax, scenario, runs, _tick_interval(t_end))
+    if runs and "backup_active" in runs[0][1]:
+        c = runs[0][1]
+        on = np.asarray(c["backup_active"], dtype=float) > 0.5
+        if np.any(on):
+            ax.plot(np.asarray(c["x"])[on], np.asarray(c["y"])[on], ".", color="0.35", ms=2.5, zorder=4,
+                    label=f"{runs[0][0]}: backup law active")
     ax.set_title(f"Top view ({scenario.name})")
     fit_canvas(fig, ax)
     ax.legend(**_LEGEND_OUTSIDE)
@@ -199,6 +251,7 @@ def errors_figure(scenario: Scenario, runs: Sequence[Run]) -> Figure:
             ax.plot(c["t"], c[key], label=label, **run_style(i))
         ax.set_ylabel(lab)
         ax.grid(alpha=0.3)
+        shade_backup(ax, backup_stretches(runs[0][1]) if runs else [], label=ax is axes[0])
     axes[0].axhline(scenario.epsilon, color="tab:red", ls="--", lw=1.0, label=rf"$\epsilon$ = {scenario.epsilon:g} m")
     axes[0].set_yscale("log")
     axes[0].legend(fontsize=8)
@@ -245,6 +298,7 @@ def inputs_figure(scenario: Scenario, runs: Sequence[Run], *, tightening: Tighte
         elif tight is not None:
             ax.plot([], [], ls="none", label=r"$\bar V = V$ on this axis (no tightening)")
         ax.set_ylim(-1.15 * b, 1.15 * b)
+        shade_backup(ax, backup_stretches(runs[0][1]) if runs else [], label=n == 0)
         ax.set_ylabel(lab)
         ax.grid(alpha=0.3)
     axes[0].legend(**_LEGEND_OUTSIDE)
@@ -264,6 +318,7 @@ def rho_figure(runs: Sequence[Run], rho_tilde: float | None, certified: bool) ->
         lab = (rf"$\tilde\rho$ = {rho_tilde:.3g} (certified)" if certified
                else rf"$\tilde\rho$ = {rho_tilde:.3g} (best effort, NOT certified)")
         ax.axhline(rho_tilde, color="tab:red", ls="--" if certified else ":", lw=1.2, label=lab)
+    shade_backup(ax, backup_stretches(runs[0][1]) if runs else [])
     ax.set_xlabel("t (s)")
     ax.set_ylabel(r"$\|\rho\| = \|e - \hat e\|$")
     ax.set_title("Deviation from the nominal (ρ resets to 0 at every FHOCP sample)")
@@ -328,6 +383,7 @@ def clearance_figure(scenario: Scenario, runs: Sequence[Run]) -> Figure:
             ax.plot([c["t"][j]], [gap[j]], "v", color=run_style(i).get("color"), mec="k", ms=7,
                     label=f"{label}: min {1e3 * gap[j]:+.1f} mm at t = {float(c['t'][j]):.1f} s")
     ax.axhline(0.0, color="tab:red", ls="--", lw=1.0, label="contact")
+    shade_backup(ax, backup_stretches(runs[0][1]) if runs else [])
     if scenario.obstacles:
         ax.set_yscale("symlog", linthresh=CLEARANCE_LINEAR_M, linscale=1.0)
         bottom = -max(0.02, 2.0 * abs(lowest))
@@ -343,10 +399,12 @@ def clearance_figure(scenario: Scenario, runs: Sequence[Run]) -> Figure:
 
 def plot_all(out_dir: str | Path, scenario: Scenario, runs: Sequence[Run], *,
              rho_tilde: float | None = None, certified: bool = False, dpi: int = 110,
-             tightening: Tightening | None = None) -> list[Path]:
+             tightening: Tightening | None = None, tiers: str | None = None) -> list[Path]:
     """Write every figure of :data:`FIGURE_FILES` into ``out_dir``; returns the paths.
 
-    ``tightening`` (optional) adds the position tube to the top view and the bounds of V̄ to the inputs.
+    ``tightening`` (optional) adds the position tube to the top view and the bounds of V̄ to the inputs;
+    ``tiers`` (optional, :func:`tier_title`) is added as a title line to every figure. The first run's
+    backup-active stretches are shaded on every time axis and marked on the top view.
     """
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
@@ -355,6 +413,9 @@ def plot_all(out_dir: str | Path, scenario: Scenario, runs: Sequence[Run], *,
             view_3d(scenario, runs), clearance_figure(scenario, runs))
     paths = []
     for name, fig in zip(FIGURE_FILES, figs):
+        if tiers:
+            head = fig.get_suptitle()
+            fig.suptitle(title_lines(head, tiers), fontsize=9 if head else 10)
         p = out / name
         fig.savefig(p, dpi=dpi)
         paths.append(p)

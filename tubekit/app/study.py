@@ -9,7 +9,8 @@ the output directory:
 * ``trajectory.csv`` / ``baseline_trajectory.csv`` (columns: see
   :data:`tubekit.loop.result.CSV_COLUMNS`),
 * ``metrics.json`` (tube metrics at the top level, ``baseline`` nested,
-  ``acceptance`` for ``reproduce``),
+  ``acceptance`` for ``reproduce``, ``tiers_report``: which tier the certificate gives and which
+  promise depends on what, :func:`tubekit.app.tiers.tier_report`),
 * ``certificate.json`` and ``certificate.txt``, ``scenario.json``,
 * the figures of :data:`tubekit.app.plots.FIGURE_FILES` (and, with
   ``animate=True``, the animation of :func:`tubekit.app.animate.animate_top_view`).
@@ -22,7 +23,8 @@ checked first (:func:`tubekit.checks.check_run_inputs` and the output path), the
 written into a temporary directory next to ``out`` that replaces ``out`` in one rename at the end
 (:class:`tubekit.app.output.StagedOutput`): a failed or interrupted run leaves the previous results
 untouched. Diagnostics go to the ``logging`` logger of this module; the results (comparison table,
-promises, acceptance, ``wrote ...``) are printed on stdout.
+replaced steps and backup time, tiers, promises, acceptance, ``wrote ...``) are printed on stdout. The
+figures carry the tiers as a title line and shade the stretches in which the backup law ran.
 """
 
 from __future__ import annotations
@@ -45,6 +47,7 @@ from tubekit.app import QUICK_S
 from tubekit.app.certified import CertifiedDesign, certify_design
 from tubekit.app.output import StagedOutput, check_output_dir
 from tubekit.app.plots import plot_all
+from tubekit.app.tiers import activity_line, report_title, tier_lines, tier_report
 
 __all__ = [
     "run_study",
@@ -66,7 +69,7 @@ OUTPUT_FILES: tuple[str, ...] = ("trajectory.csv", "baseline_trajectory.csv", "m
                                  "certificate.txt", "scenario.json")
 #: Keys of ``metrics.json`` that are the study's, not the tube run's (every other key is ``run.metrics``'s).
 STUDY_KEYS: tuple[str, ...] = ("baseline", "e_d_peaks", "certify_s", "closed_loop", "dynamic", "total_wall_s",
-                               "acceptance")
+                               "acceptance", "tiers_report")
 
 Echo = Callable[[str], None]
 
@@ -179,9 +182,10 @@ def write_runs(out: Path, scenario: Scenario, design: CertifiedDesign, tube: Cer
     base.run.write_csv(out / "baseline_trajectory.csv")
     tube_cols, base_cols = tube.run.columns(), base.run.columns()
     tight = design.tightening
-    plot_all(out, scenario, [("tube", tube_cols), ("baseline", base_cols)], rho_tilde=float(tight.rho_tilde),
-             certified=design.certified, tightening=tight)
     metrics = tube.to_dict()
+    metrics["tiers_report"] = tier_report(design.certificate, metrics)
+    plot_all(out, scenario, [("tube", tube_cols), ("baseline", base_cols)], rho_tilde=float(tight.rho_tilde),
+             certified=design.certified, tightening=tight, tiers=report_title(metrics["tiers_report"]))
     metrics["baseline"] = base.to_dict()
     metrics["e_d_peaks"] = e_d_peaks(tube_cols["e_d"], tube_cols["t"])
     metrics["certify_s"] = design.certify_s
@@ -208,16 +212,31 @@ def comparison_table(tube: dict[str, Any], base: dict[str, Any]) -> str:
     return "\n".join(lines)
 
 
+def _mark(p: dict[str, Any], broken: set[str]) -> str:
+    """``ok``, ``BROKEN`` (a given tier, its premises held: exit 4) or why a failed figure claims nothing."""
+    if p["ok"]:
+        return "ok"
+    if p["name"] in broken:
+        return "BROKEN"
+    if p.get("tier") == "premise":
+        return "premise failed"
+    return "no: tier not given" if not p.get("given", True) else "no: a premise failed"
+
+
 def promise_lines(metrics: dict[str, Any]) -> list[str]:
-    """Each promise of the certificate with its numbers; says plainly when a certified one is broken."""
+    """Each promise with its tier, numbers and premises; says plainly when a promise of a given tier broke."""
     certified = metrics["certified"]
-    lines = ["promises of the certificate (certified):" if certified
+    broken = set(metrics.get("promises_broken") or ())
+    lines = ["promises of the certificate, by tier:" if certified
              else "figures a certificate would promise (NOT certified: nothing is claimed):"]
     for p in metrics["promises"]:
-        mark = "ok  " if p["ok"] else ("BROKEN" if certified else "no  ")
-        lines.append(f"  [{mark}] {p['name']}: {_fmt(p['observed'])} vs {_fmt(p['bound'])}  ({p['detail']})")
-    if certified and not metrics["promises_kept"]:
-        lines.append("CERTIFIED PROMISE BROKEN: the run violates what the certificate guarantees (exit 4)")
+        tier = p.get("tier", "")
+        needs = f"; depends on {', '.join(p['depends_on'])}" if p.get("depends_on") else ""
+        lines.append(f"  [{_mark(p, broken) if certified else ('ok' if p['ok'] else 'no')}] {tier} {p['name']}: "
+                     f"{_fmt(p['observed'])} vs {_fmt(p['bound'])}  ({p['detail']}{needs})")
+    if certified and broken:
+        lines.append(f"CERTIFIED PROMISE BROKEN ({', '.join(sorted(broken))}): the run violates what the "
+                     "certificate guarantees (exit 4)")
     return lines
 
 
@@ -239,7 +258,8 @@ def _dynamic_lines(dyn: dict[str, Any]) -> list[str]:
             + f"; min clearance {_fmt(dyn['min_clearance'])} m, min e_d {_fmt(dyn['min_e_d'])} m, "
               f"sway max {_fmt(dyn.get('sway_max'))} vs {_fmt(dyn.get('sway_bound'))} m/s, velocity-loop error max "
               f"{dyn.get('velocity_error_max')}")
-    return [head, *promise_lines(dyn)]
+    extra = ["  " + line for line in tier_lines(dyn["tiers_report"])] if "tiers_report" in dyn else []
+    return [head, "  " + activity_line(dyn), *extra, *promise_lines(dyn)]
 
 
 @dataclass(frozen=True)
@@ -275,7 +295,10 @@ class StudyResult:
 
     def summary(self) -> str:
         """The comparison table, the promises, the dynamic-plant line and the acceptance, one item a line."""
-        lines = [comparison_table(self.metrics, self.metrics["baseline"]), *promise_lines(self.metrics)]
+        lines = [comparison_table(self.metrics, self.metrics["baseline"]), activity_line(self.metrics)]
+        if "tiers_report" in self.metrics:
+            lines += tier_lines(self.metrics["tiers_report"])
+        lines += promise_lines(self.metrics)
         if "dynamic" in self.metrics:
             lines += _dynamic_lines(self.metrics["dynamic"])
         if "acceptance" in self.metrics:

@@ -16,6 +16,11 @@
   (unless the terminal set is "hard");
 * terminal set F = {||e_N||_P <= terminal_level} as a second-order cone,
   "soft" (default, exact penalty), "hard" or "off";
+* with a backup (``nlp.backup_terminal``), its terminal rows at the last node, sharing one
+  exact-penalty slack: each obstacle's half-space at p_N with the radius enlarged by the
+  footprint's sphere (the same normal as the node's obstacle row), the workspace box shrunk
+  by the footprint, and the sensed region as second-order cones (constant data: the frame's
+  origin is the measured position); none of it is built without a backup;
 * a box trust region on the input step, intersected with the input box.
 
 The problem is built once; :meth:`ConvexSubproblem.linearise` writes every parameter
@@ -120,6 +125,7 @@ class ConvexSubproblem:
         """Build the cvxpy problem (once); creation order fixes the compiled data layout."""
         N = self.nlp.n
         params: dict[str, cp.Parameter] = {}
+        self._params = params
 
         def par(name: str, size: int) -> cp.Parameter:
             params[name] = cp.Parameter(size, name=name)
@@ -136,7 +142,12 @@ class ConvexSubproblem:
         cons += self._box_rows(par, v, slack)
         terminal_rows, sig_t = self._terminal_rows(par, v)
         cons += terminal_rows
-        self.problem = cp.Problem(cp.Minimize(self._objective(par, v, slack, sig_t)), cons)
+        objective = self._objective(par, v, slack, sig_t)
+        if self.nlp.backup_terminal is not None:
+            backup_rows, sig_b = self._backup_rows(par, v)
+            cons += backup_rows
+            objective = objective + self.nlp.penalty * sig_b
+        self.problem = cp.Problem(cp.Minimize(objective), cons)
         self._params = params
         self._vars = v
 
@@ -199,6 +210,26 @@ class ConvexSubproblem:
             return [sig_t >= 0, cp.SOC(nlp.terminal_level + sig_t, terminal_vec)], sig_t
         return [cp.SOC(cp.Constant(nlp.terminal_level), terminal_vec)], None
 
+    def _backup_rows(self, par: _Par, v: dict) -> tuple[list, cp.Variable]:
+        """The backup's terminal rows at the last node (module doc) and their shared slack."""
+        nlp, N = self.nlp, self.nlp.n
+        bt = nlp.backup_terminal
+        x, y, z = v["x"][N - 1], v["y"][N - 1], v["z"][N - 1]
+        sig_b = cp.Variable(name="slack_backup")
+        cons = [sig_b >= 0]
+        for j in range(self.max_obstacles):
+            ox, oy, oz = (self._params[f"{a}{j}"][N - 1] for a in ("ox", "oy", "oz"))
+            cons.append(ox * x + oy * y + oz * z + sig_b >= par(f"rt{j}", 1))
+        if nlp.workspace is not None:
+            wt = par("wT", 6)
+            cons += [x + sig_b >= wt[0], y + sig_b >= wt[1], z + sig_b >= wt[2],
+                     x - sig_b <= wt[3], y - sig_b <= wt[4], z - sig_b <= wt[5]]
+        spread = cp.Variable(2, name="backup_spread")
+        cons += [cp.SOC(spread[0] - bt.safe[0], cp.hstack([x, y])),
+                 spread[1] >= z + bt.safe[1], spread[1] >= -z + bt.safe[1],
+                 cp.SOC(bt.sensed_bound + sig_b, spread)]
+        return cons, sig_b
+
     def _objective(self, par: _Par, v: dict, slack: dict, sig_t: cp.Variable | None) -> cp.Expression:
         """Quadratic tracking cost + input cost + exact penalties.
 
@@ -243,7 +274,9 @@ class ConvexSubproblem:
                   "bounds": ["ulo", "uhi", "wlo", "whi", "rlo", "rhi"],
                   "obs": [f"{a}{j}" for j in range(M) for a in ("ox", "oy", "oz", "ro")],
                   "walls": ["wsx", "wbx", "wsy", "wby"] if nlp.workspace is not None else [],
-                  "c0": ["c0"]}
+                  "c0": ["c0"],
+                  "obsT": [f"rt{j}" for j in range(M)] if nlp.backup_terminal is not None else [],
+                  "wallT": ["wT"] if nlp.backup_terminal is not None and nlp.workspace is not None else []}
         self._gidx = {g: np.concatenate([self._cols[n] for n in names]) if names else np.zeros(0, dtype=int)
                       for g, names in groups.items()}
 
@@ -336,6 +369,11 @@ class ConvexSubproblem:
                 if -lo[i] < hi[i]:
                     walls[2 * i], walls[2 * i + 1] = -1.0, -lo[i]
             self.param_vector[self._gidx["walls"]] = np.repeat(walls, N)
+            if nlp.backup_terminal is not None:
+                r_f, h_f = nlp.backup_terminal.footprint
+                pad = np.array([r_f, r_f, h_f])
+                self.param_vector[self._gidx["wallT"]] = np.concatenate([nlp.workspace[0] + pad - o,
+                                                                         nlp.workspace[1] - pad - o])
         self.param_vector[self._gidx["step"]] = st.ravel()
 
     def _write_obstacles(self, s: np.ndarray, obs: np.ndarray, o: np.ndarray) -> None:
@@ -355,6 +393,9 @@ class ConvexSubproblem:
             ob[:k, :3] = n.transpose(0, 2, 1)
             ob[:k, 3] = obs[:, 3:4] + self.nlp.clearance + np.einsum("jnc,jc->jn", n, c)
         self.param_vector[self._gidx["obs"]] = ob.ravel()
+        if self.nlp.backup_terminal is not None:  # the last node's half-space with the footprint's sphere
+            self.param_vector[self._gidx["obsT"]] = ob[:, 3, -1] + np.where(
+                np.arange(self.max_obstacles) < k, self.nlp.backup_terminal.sphere - self.nlp.clearance, 0.0)
 
     def _write_input_bounds(self, v: np.ndarray, radius: float) -> None:
         """The input box V-bar intersected with the trust region |v_new - v| <= radius V-bar."""

@@ -64,6 +64,7 @@ IPOPT_STATUS: dict[str, Status] = {
     "Insufficient_Memory": Status.SOLVER_ERROR,
     "Internal_Error": Status.SOLVER_ERROR,
 }
+_B_FLOOR = 1e-3  # m: smallest reach of the smooth sensed-region row (backup terminal rows)
 _TINY = 1e-12  # inside square roots: keeps them smooth at 0 (changes values by < 1e-11)
 
 
@@ -168,16 +169,19 @@ class IpoptFHOCP:
         nlp = self.nlp
         N, M = nlp.n, self.max_obstacles
         n_t = 1 if nlp.terminal == "soft" else 0
+        n_b = 1 if nlp.backup_terminal is not None else 0
         sym = {"V": ca.SX.sym("v", 3, N), "S": ca.SX.sym("s", 4, N),       # S: s_1..s_N
                "sig": ca.SX.sym("sig", 4, N),                              # e_d_min, obstacle, e_o, box
-               "sig_t": ca.SX.sym("sig_t", n_t), "s0": ca.SX.sym("s0", 4),
+               "sig_t": ca.SX.sym("sig_t", n_t), "sig_b": ca.SX.sym("sig_b", n_b), "s0": ca.SX.sym("s0", 4),
                "ref": ca.SX.sym("ref", 3, N + 1), "obs": ca.SX.sym("obs", 5, M)}  # cx, cy, cz, radius, active
         states = [sym["s0"]] + [sym["S"][:, k] for k in range(N)]
         rows = _Rows()
         cost = self._shooting(ca, sym, states, rows)
         self._path_constraints(ca, sym, states, rows)
         cost = self._terminal(ca, sym, states[N], rows, cost)
-        x = ca.vertcat(ca.vec(sym["V"]), ca.vec(sym["S"]), ca.vec(sym["sig"]), sym["sig_t"])
+        if n_b:
+            cost = self._backup_rows(ca, sym, states[N], rows, cost)
+        x = ca.vertcat(ca.vec(sym["V"]), ca.vec(sym["S"]), ca.vec(sym["sig"]), sym["sig_t"], sym["sig_b"])
         p = ca.vertcat(sym["s0"], ca.vec(sym["ref"]), ca.vec(sym["obs"]))
         self._solver = ca.nlpsol(f"fhocp_{self.nlp_solver}", self.nlp_solver,
                                  {"x": x, "p": p, "f": cost, "g": ca.vertcat(*rows.g)}, self._options(extra))
@@ -190,7 +194,7 @@ class IpoptFHOCP:
         self._lbx[7 * N:] = 0.0  # slacks
         self._lbg = np.array(rows.lbg)
         self._ubg = np.array(rows.ubg)
-        self._n_t = n_t
+        self._n_t, self._n_b = n_t, n_b
 
     def _shooting(self, ca: Any, sym: dict, states: list, rows: _Rows) -> Any:
         """Exact-step defects s_{k+1} - F(s_k, v_k) = 0 and the stage cost (left rectangle rule)."""
@@ -241,6 +245,27 @@ class IpoptFHOCP:
         if n_t:
             cost += nlp.terminal_penalty * sig_t[0]
         return cost
+
+    def _backup_rows(self, ca: Any, sym: dict, s_n: Any, rows: _Rows, cost: Any) -> Any:
+        """The backup's terminal rows at s_N with their shared slack (as :class:`FhocpNlp` states them)."""
+        nlp, obs, sig_b, s0 = self.nlp, sym["obs"], sym["sig_b"][0], sym["s0"]
+        bt = nlp.backup_terminal
+        for j in range(self.max_obstacles):
+            d = s_n[:3] - obs[:3, j]
+            rows.nonpositive([obs[4, j] * (obs[3, j] + bt.sphere - ca.sqrt(ca.dot(d, d) + _TINY)) - sig_b])
+        if nlp.workspace is not None:
+            pad = (bt.footprint[0], bt.footprint[0], bt.footprint[1])
+            for i in range(3):
+                rows.nonpositive([nlp.workspace[0][i] + pad[i] - s_n[i] - sig_b,
+                                  s_n[i] - nlp.workspace[1][i] + pad[i] - sig_b])
+        # the sensed-region row, smooth: hypot(d + c, |dz| + Z) <= ||s_N - s_0|| + hypot(c, Z) (triangle
+        # inequality), so ||s_N - s_0|| <= b = R_bar - r - hypot(c, Z) suffices; written as (||.||^2 - b^2) / 2b,
+        # which is ||.|| - b to first order (m), with b floored at 1 mm and the shortfall added
+        b = max(bt.sensed_bound - math.hypot(*bt.safe), _B_FLOOR)
+        reach2 = (s_n[0] - s0[0]) ** 2 + (s_n[1] - s0[1]) ** 2 + (s_n[2] - s0[2]) ** 2
+        shortfall = b - (bt.sensed_bound - math.hypot(*bt.safe))
+        rows.nonpositive([(reach2 - b * b) / (2.0 * b) + shortfall - sig_b])
+        return cost + nlp.penalty * sig_b
 
     def _options(self, extra: dict) -> dict:
         """CasADi/IPOPT options: quiet, tol 1e-8, optional dual warm start, then ``extra``."""
@@ -331,7 +356,8 @@ class IpoptFHOCP:
         ps = ev.per_step
         return np.concatenate([guess.ravel(), s_guess[1:].ravel(),
                                np.stack([ps["e_d_min"], ps["obstacle"], ps["e_o"], ps["box"]], axis=1).ravel(),
-                               [ev.violations["terminal"]] * self._n_t])
+                               [ev.violations["terminal"]] * self._n_t,
+                               [ev.violations.get("backup_terminal", 0.0)] * self._n_b])
 
     def _parameters(self, s0: np.ndarray, ref: np.ndarray, obs: np.ndarray) -> np.ndarray:
         """p: the measured state, the reference and the obstacle slots (inactive: far away, switched off)."""

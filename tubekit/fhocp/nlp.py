@@ -37,6 +37,18 @@ NLP (k = 0..N-1 stages, e_k = error_coordinates(s_k, p_d(t + k dt)))::
          lo + r_bar + margin - sig_box,k <= p_k <= hi - r_bar - margin + sig_box,k,
          ||e_N||_P <= terminal_level + sig_T,   all sig >= 0.
 
+With a certified backup (``tightening.backup``, :class:`BackupTerminal`) the last node also carries
+the backup's terminal condition, softened by one slack sig_B (weight mu) shared by its rows::
+
+         ||p_N - c_j|| >= r_j + hypot(R_f, H_f) - sig_B     (each obstacle j),
+         lo + (R_f, R_f, H_f) - sig_B <= p_N <= hi - (R_f, R_f, H_f) + sig_B,
+         hypot(||p_N,xy - p_0,xy|| + c, |z_N - z_0| + Z) <= R_bar - r_bar + sig_B,
+
+(R_f, H_f) the safe set's footprint, c and Z its radius and depth, p_0 the measured position:
+the sphere of radius hypot(R_f, H_f) contains the footprint's cylinder, so a plan meeting these
+rows meets :func:`tubekit.loop.terminal.terminal_condition`'s obstacle part, which
+``tubekit.loop.plan_check`` then checks exactly.
+
 Q, R, P are diagonal (the scenario's 3-vectors). The slacks are exact
 (l1) penalties: whenever the hard-constrained problem is feasible and
 ``mu`` exceeds its multipliers the two have the same minimisers; the
@@ -61,7 +73,7 @@ from tubekit.validation import as_vector, choice, positive
 
 __all__ = ["TERMINAL_MODES", "discrete_step", "rollout",
            "step_linearisation", "STEP_LINEARISATION_ROWS", "eo_linearisation", "obstacle_array",
-           "select_obstacles", "FhocpNlp", "NlpEvaluation"]
+           "select_obstacles", "FhocpNlp", "NlpEvaluation", "BackupTerminal"]
 
 TERMINAL_MODES: tuple[str, ...] = TerminalMode.values()
 _ED_FLOOR = 1e-9  # guards e_o = (...)/e_d against e_d = 0 (m)
@@ -244,6 +256,53 @@ class NlpEvaluation:
 
 
 @dataclass(frozen=True)
+class BackupTerminal:
+    """The backup's terminal condition as the FHOCP carries it at the last node (module doc).
+
+    Attributes
+    ----------
+    sphere : float
+        hypot(R_f, H_f) (m): added to each obstacle radius at p_N (no obstacle margin: p_N is the
+        plan's exact nominal end, the point the exact check reads).
+    footprint : (float, float)
+        (R_f, H_f) (m): the workspace box shrunk by it holds p_N.
+    safe : (float, float)
+        (c, Z) (m): the safe set's radius and depth, for the sensed-region row.
+    sensed_bound : float
+        R_bar - vehicle radius (m).
+    """
+
+    sphere: float
+    footprint: tuple[float, float]
+    safe: tuple[float, float]
+    sensed_bound: float
+
+    @classmethod
+    def of(cls, scenario: Scenario, tightening: Tightening) -> "BackupTerminal | None":
+        """The terminal rows of ``tightening.backup`` on ``scenario`` (None without a backup)."""
+        backup = tightening.backup
+        if backup is None:
+            return None
+        r_f, h_f = backup.footprint(scenario.vehicle_radius)
+        return cls(sphere=math.hypot(r_f, h_f), footprint=(r_f, h_f),
+                   safe=(backup.safe_set.radius, backup.safe_set.depth),
+                   sensed_bound=scenario.sensing_range - scenario.vehicle_radius)
+
+    def violation(self, p0: np.ndarray, pn: np.ndarray, obstacles: np.ndarray,
+                  workspace: np.ndarray | None) -> float:
+        """Largest violation (m, >= 0) of the rows at the end position ``pn`` sensed from ``p0``."""
+        worst = 0.0
+        if len(obstacles):
+            dist = np.linalg.norm(obstacles[:, :3] - pn[None, :], axis=1)
+            worst = max(worst, float(np.max(obstacles[:, 3] + self.sphere - dist)))
+        if workspace is not None:
+            pad = np.array([self.footprint[0], self.footprint[0], self.footprint[1]])
+            worst = max(worst, float(np.max(workspace[0] + pad - pn)), float(np.max(pn - workspace[1] + pad)))
+        spread = math.hypot(math.hypot(pn[0] - p0[0], pn[1] - p0[1]) + self.safe[0], abs(pn[2] - p0[2]) + self.safe[1])
+        return max(worst, spread - self.sensed_bound)
+
+
+@dataclass(frozen=True)
 class FhocpNlp:
     """The discretised FHOCP (see the module docstring) with all its constants.
 
@@ -273,6 +332,9 @@ class FhocpNlp:
         workspace) and mu_T (soft terminal set). Default mu_T = mu / 20: the safety
         slacks outrank the terminal set, so an unreachable F never pulls the plan into
         an obstacle (with mu_T = mu the paper's default run grazed an obstacle by 14 mm).
+    backup_terminal : BackupTerminal or None
+        The backup's terminal rows at the last node (None: none, the problem of a tightening
+        without a backup).
     """
 
     dt: float
@@ -291,6 +353,7 @@ class FhocpNlp:
     terminal_level: float = 2.0
     penalty: float = 1e3
     terminal_penalty: float = 50.0
+    backup_terminal: BackupTerminal | None = None
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "dt", positive("dt", self.dt))
@@ -340,7 +403,8 @@ class FhocpNlp:
                    e_o_max=tightening.e_o_max, clearance=scenario.vehicle_radius + margin,
                    workspace=ws, terminal=terminal, terminal_level=c.terminal_level,
                    penalty=penalty,
-                   terminal_penalty=penalty / 20.0 if terminal_penalty is None else terminal_penalty)
+                   terminal_penalty=penalty / 20.0 if terminal_penalty is None else terminal_penalty,
+                   backup_terminal=BackupTerminal.of(scenario, tightening))
 
     @property
     def n(self) -> int:
@@ -405,7 +469,11 @@ class FhocpNlp:
             merit += self.terminal_penalty * term
         violations = {"e_d_min": float(vmax[0]), "obstacle": float(vmax[1]), "e_o": float(vmax[2]),
                       "box": float(vmax[3]), "terminal": term, "input": inp, "dynamics": dyn}
-        mv = max(float(vmax.max()), term, inp, dyn)
+        if self.backup_terminal is not None:
+            backup = max(0.0, self.backup_terminal.violation(states[0, :3], states[n, :3], obstacles, self.workspace))
+            merit += self.penalty * backup
+            violations["backup_terminal"] = backup
+        mv = max(violations.values())
         if not (math.isfinite(cost) and math.isfinite(mv) and math.isfinite(merit)):
             cost, merit, mv = math.inf, math.inf, math.inf
         per_step = {"e_d_min": viol[0], "obstacle": viol[1], "e_o": viol[2], "box": viol[3]}

@@ -29,9 +29,14 @@ tightening's. A variant is a changed scenario (``scenario.with_changes(...)``) o
 (``dataclasses.replace(tightening, sigma=...)``).
 
 Fallbacks: a FHOCP result flagged ``fallback`` is used (its first input) and
-counted; a result whose first input is not finite, or a :class:`SolverError`,
-is replaced by the previous successful plan shifted by the steps elapsed (zero
-input once that plan is exhausted) and counted as ``replaced``. A non-finite κ
+counted; a result whose first input is not finite, a :class:`SolverError` or a plan
+the arc check (with the terminal condition) rejects is replaced by the last accepted
+plan shifted by the steps elapsed and counted as ``replaced``. Once that plan is
+exhausted the backup law (:func:`tubekit.model.backup.station_keeping_input`, held
+over each tick, no κ) runs about the anchor p* = the nominal end of the last accepted
+plan (:class:`tubekit.loop.memory.PlanMemory`), logged as ``backup_active``, until a
+plan is accepted again; only a tightening without a backup keeps the zero input
+(logged as a warning). A non-finite κ
 (J singular) is replaced by zero and counted. Nothing non-finite reaches the
 plant.
 
@@ -44,6 +49,7 @@ applied at that tick uses the reset nominal (ρ = 0).
 from __future__ import annotations
 
 import enum
+import logging
 import math
 import sys
 import time
@@ -57,7 +63,9 @@ from tubekit.design_key import require_matching
 from tubekit.checks import require_one_period
 from tubekit.model.ancillary import AncillaryLaw, get_law
 from tubekit.exceptions import ConfigError, SolverError
-from tubekit.loop.plan_check import check_plan
+from tubekit.loop.memory import ZERO_INPUT, PlanMemory
+from tubekit.loop.plan_check import check_plan, plan_arcs
+from tubekit.model.backup import station_keeping_input
 from tubekit.plant.base import OmegaOverride, PlantModel
 from tubekit.plant.factory import make_plant
 from tubekit.plant.kinematic import nominal_arc
@@ -78,8 +86,8 @@ __all__ = [
 ]
 
 
-_ZERO_INPUT = np.zeros(3)
-_ZERO_INPUT.setflags(write=False)
+_ZERO_INPUT = ZERO_INPUT
+_LOG = logging.getLogger(__name__)
 
 
 # ---- setup ------------------------------------------------------------------------------
@@ -173,42 +181,6 @@ class _Clock:
 
 # ---- the "never pass NaN on" rule -----------------------------------------------------
 
-@dataclass
-class PlanMemory:
-    """The last good plan and its age, to replace a FHOCP result that cannot be applied.
-
-    Attributes
-    ----------
-    plan : array (N, 3) or None
-        Inputs of the last non-fallback, finite plan (m/s, m/s, rad/s).
-    age : int
-        Sampling periods elapsed since ``plan`` was computed.
-    """
-
-    plan: np.ndarray | None = None
-    age: int = 0
-
-    def remember(self, result: FhocpResult, accepted: bool = False) -> bool:
-        """Keep the plan of a usable result when it is a good one; return its ``fallback`` flag.
-
-        ``accepted`` (it passed :func:`tubekit.loop.plan_check.check_plan`) makes any finite plan a good one.
-        """
-        is_fallback = bool(result.fallback)
-        plan = np.asarray(result.inputs, dtype=float)
-        if (accepted or not is_fallback) and plan.ndim == 2 and np.all(np.isfinite(plan)):
-            self.plan, self.age = plan, 0
-        else:
-            self.age += 1
-        return is_fallback
-
-    def replacement(self) -> np.ndarray:
-        """v̂ (3,) replacing an unusable result: the last good plan shifted by its age, else zero."""
-        self.age += 1
-        if self.plan is not None and self.age < len(self.plan):
-            return self.plan[self.age].copy()
-        return _ZERO_INPUT.copy()
-
-
 def saturate(v: tuple[float, float, float],
              limits: tuple[float, float, float]) -> tuple[tuple[float, float, float], bool]:
     """Clip ``v`` to the box |v_i| <= limits_i (m/s, m/s, rad/s); return (v, whether it was clipped)."""
@@ -249,12 +221,14 @@ class _Log(LogArrays):
 
 @dataclass
 class _Period:
-    """What one sampling period applies: the held v̂, its flags and the nominal arc (ticks + 1, 4)."""
+    """What one sampling period applies: the held v̂, its flags, the nominal arc (ticks + 1, 4) and,
+    while the backup law runs, its anchor p* (m; the arc is NaN then)."""
 
     v_hat: np.ndarray
     fallback: bool
     replaced: bool
     arc: np.ndarray
+    anchor: tuple[float, float, float] | None = None
 
 
 # ---- the loop ---------------------------------------------------------------------------
@@ -290,12 +264,37 @@ class _ClosedLoop:
         self.log.record_solve(k, k * self.clock.ticks, result, time.perf_counter() - c0)
         accepted = usable and self.accept(k, tk, xk, result, known)
         if accepted:
-            flagged = self.memory.remember(result, accepted=self.tightening.horizon_arcs > 0)
+            checked = self.tightening.horizon_arcs > 0
+            end = self.plan_end(xk, result.inputs) if checked else None
+            flagged = self.memory.remember(result, accepted=checked, end=end)
             self.log.plan_age[k] = self.memory.age
             return first, flagged, False
         v_hat = self.memory.replacement()
         self.log.plan_age[k] = self.memory.age
         return v_hat, True, True
+
+    def plan_end(self, xk: np.ndarray, inputs: np.ndarray) -> np.ndarray:
+        """The nominal end state (4,) of an accepted plan over the certified horizon (the backup's anchor)."""
+        plan = np.asarray(inputs, dtype=float)[:self.tightening.horizon_arcs]
+        return plan_arcs(xk, plan, self.scenario.controller.dt, 1)[-1, -1]
+
+    def backup_anchor(self, k: int, xk: np.ndarray) -> np.ndarray | None:
+        """p* (3,) for period ``k`` when the replayed plan is exhausted and a backup exists, else None.
+
+        Without an accepted plan yet, p* is the measured position (no terminal condition was checked
+        there). Without a backup the loop keeps the zero input and logs it.
+        """
+        if not self.memory.exhausted:
+            return None
+        if self.tightening.backup is None:
+            if self.tightening.horizon_arcs > 0 and self.memory.age == (len(self.memory.plan) if
+                                                                         self.memory.plan is not None else 1):
+                _LOG.warning("period %d: the replayed plan is exhausted and the tightening has no backup: "
+                             "zero input until a plan is accepted (no certified input)", k)
+            return None
+        if self.memory.anchor is None:
+            self.memory.anchor = np.asarray(xk, dtype=float)[:3].copy()
+        return self.memory.anchor
 
     def accept(self, k: int, tk: float, xk: np.ndarray, result: FhocpResult, known: tuple[Obstacle, ...]) -> bool:
         """Exact arc check of the plan against the certificate's margins (always True without margins)."""
@@ -315,7 +314,10 @@ class _ClosedLoop:
             return _ZERO_INPUT
 
     def run_ticks(self, k: int, x: tuple, period: _Period) -> tuple[tuple, float]:
-        """Ticks of period ``k``: ancillary law, saturation, plant. Returns (state, ancillary time in s)."""
+        """Ticks of period ``k``: ancillary law (or the backup law), saturation, plant.
+
+        Returns (state, controller time spent on the law in s).
+        """
         clock, log = self.clock, self.log
         i0, h = k * clock.ticks, clock.plant_step
         vh = tuple(float(c) for c in period.v_hat)
@@ -324,7 +326,11 @@ class _ClosedLoop:
             i = i0 + j
             xs = np.asarray(x)
             log.states[i] = xs
-            if self.sigma > 0.0:
+            if period.anchor is not None:
+                v = station_keeping_input(self.tightening.backup.law, x, period.anchor)
+                log.kappa[i] = 0.0
+                log.v_hat[i] = v
+            elif self.sigma > 0.0:
                 a0 = time.perf_counter()
                 kap = self.ancillary(i, xs, period.arc[j])
                 law_s += time.perf_counter() - a0
@@ -348,6 +354,9 @@ class _ClosedLoop:
         log.nominal[i0] = nominal_before if k > 0 else xk
         log.nominal[i0 + 1:i0 + m] = period.arc[1:m]
         log.v_hat[i0:i0 + m] = period.v_hat
+        log.backup_active[i0:i0 + m] = period.anchor is not None
+        if period.anchor is not None:
+            log.backup_anchor[i0:i0 + m] = period.anchor
 
     def run_period(self, k: int, x: tuple, nominal_before: np.ndarray,
                    wall0: float) -> tuple[tuple, np.ndarray]:
@@ -360,7 +369,11 @@ class _ClosedLoop:
         c0 = time.perf_counter()
         known = self.sense(xk)
         v_hat, flagged, replaced = self.solve(k, float(self.clock.t[i0]), xk, known)
-        period = _Period(v_hat, flagged, replaced, nominal_arc(xk, v_hat, self.clock.tau))
+        anchor = self.backup_anchor(k, xk) if replaced else None
+        if anchor is None:
+            period = _Period(v_hat, flagged, replaced, nominal_arc(xk, v_hat, self.clock.tau))
+        else:  # phase 3: no nominal is followed while the backup law runs
+            period = _Period(v_hat, flagged, replaced, np.full((m + 1, 4), np.nan), tuple(map(float, anchor)))
         control_s = time.perf_counter() - c0
         self.log_period(k, xk, period, nominal_before)
         x, law_s = self.run_ticks(k, x, period)
@@ -433,6 +446,8 @@ def run_closed_loop(scenario: Scenario, tightening: Tightening | None = None, *,
                 bar.close()
     loop.log.states[-1] = np.asarray(x)
     loop.log.nominal[-1] = nominal_end
+    loop.log.backup_active[-1] = loop.log.backup_active[-2]  # the final state is reached under the last period's law
+    loop.log.backup_anchor[-1] = loop.log.backup_anchor[-2]
     return _result(loop, tube, wall0, disturbance is not None)
 
 
@@ -452,4 +467,6 @@ def _result(loop: _ClosedLoop, tube: bool, wall0: float, overridden: bool) -> Si
         replaced=log.replaced, n_detected=log.n_detected, solve_ms=log.solve_ms, step_ms=log.step_ms,
         wall=log.wall, statuses=log.statuses, iterations=log.iterations, max_violation=log.max_violation,
         kappa_failures=log.kappa_failures, wall_s=wall_s, rejected=log.rejected, plan_age=log.plan_age,
-        plan_slack=log.plan_slack, omega_overridden=overridden, body=body, thrust=thrust)
+        plan_slack=log.plan_slack, backup_active=log.backup_active, backup_anchor=log.backup_anchor,
+        omega_overridden=overridden, body=body,
+        thrust=thrust, omega_peak=loop.plant.omega_peak())

@@ -17,7 +17,10 @@ centre), so each can be recomputed from the two files. Definitions (units m, s):
 * ``obstacle_passes``: per obstacle, net passes of its bearing about the
   circle centre (see :func:`obstacle_passes`); null like ``encirclements``.
 * ``tracking_rmse``: sqrt(mean ‖p − p_d‖²) over samples (3-D position error).
-* ``max_rho``: max over samples of ‖ρ‖ = ‖e − ê‖ (error units, see closed_loop).
+* ``max_rho``: max over samples of ‖ρ‖ = ‖e − ê‖ (error units, see closed_loop; the ticks while
+  the backup law runs have no nominal and are skipped).
+* ``backup_s``, ``backup_engagements``: seconds the backup law ran and how many times it took
+  over (column ``backup_active``; :func:`backup_figures`).
 * ``sway_max``: max over samples of |sway| (m/s): the hull's v_b on the dynamic plant (column
   ``v_b``), else the component of ω − δ(t) normal to the heading (the sway model's v_s);
   ``sway_bound``: the certificate's γ̄ (null when none was given).
@@ -49,7 +52,7 @@ from typing import Any, Mapping, Sequence
 import numpy as np
 
 from tubekit.jsonable import json_number
-from tubekit.loop.promises import Promise, RunLog, check_promises
+from tubekit.loop.promises import Promise, RunLog, broken_promises, check_promises, tiers_given
 from tubekit.plant.kinematic import Plant
 from tubekit.scenario import Obstacle, Scenario
 from tubekit.model.trajectory import Circle
@@ -57,6 +60,7 @@ from tubekit.model.errors import error_coordinates
 
 __all__ = [
     "rho_period_peaks",
+    "backup_figures",
     "clearance",
     "input_ratio",
     "encirclements",
@@ -77,11 +81,13 @@ __all__ = [
 METRIC_KEYS: tuple[str, ...] = (
     "scenario", "duration_s", "steps", "obstacles", "vehicle_radius", "min_clearance", "min_e_d",
     "epsilon", "max_input_ratio", "saturated_steps", "encirclements", "tracking_rmse", "max_rho",
-    "rho_bound", "step_ms_median", "step_ms_p95", "wall_s", "sway_max", "sway_bound",
+    "rho_bound", "step_ms_median", "step_ms_p95", "wall_s", "sway_max", "sway_bound", "backup_s",
+    "backup_engagements",
 )
 #: Keys :func:`run_metrics` adds to :func:`compute_metrics` (every run has them; the baseline's promises are empty).
 RUN_KEYS: tuple[str, ...] = ("tube", "law", "sigma", "kappa_failures", "checks", "certified", "rho_tilde_used",
-                             "tube_box", "promises", "promises_kept", "max_rho_ratio")
+                             "tube_box", "promises", "promises_kept", "promises_broken", "max_rho_ratio",
+                             "tiers")
 
 
 def clearance(positions: np.ndarray, obstacles: Sequence[Obstacle | Mapping[str, Any]],
@@ -178,6 +184,16 @@ def intervals_below(t: np.ndarray, values: np.ndarray, threshold: float) -> list
         out.append({"t_start": float(t[a]), "t_end": float(t[b - 1]), "t_min": float(t[k]),
                     "min": float(v[k]), "depth": float(threshold - v[k])})
     return out
+
+
+def backup_figures(t: np.ndarray, active: np.ndarray | None) -> dict[str, Any]:
+    """``backup_s`` (s the backup law ran: active ticks × tick length) and ``backup_engagements``
+    (times it took over); zeros for a log without the ``backup_active`` column."""
+    if active is None or len(t) < 2:
+        return {"backup_s": 0.0, "backup_engagements": 0}
+    on = np.asarray(active[:-1], dtype=float) > 0.5
+    starts = int(on[0]) + int(np.sum(on[1:] & ~on[:-1])) if on.size else 0
+    return {"backup_s": float(np.sum(on) * (t[1] - t[0])), "backup_engagements": starts}
 
 
 def percentile_ms(values: np.ndarray, q: float) -> float | None:
@@ -277,8 +293,7 @@ def compute_metrics(columns: Mapping[str, np.ndarray], scenario: Scenario, *,
     m = {
         "scenario": scenario.name,
         "duration_s": float(t[-1] - t[0]),
-        "steps": int(np.sum(first)),
-        "obstacles": obstacles,
+        "steps": int(np.sum(first)), "obstacles": obstacles,
         "vehicle_radius": scenario.vehicle_radius,
         "min_clearance": _finite_or_none(float(clr[i_clr])),
         "min_clearance_t": float(t[i_clr]),
@@ -295,6 +310,7 @@ def compute_metrics(columns: Mapping[str, np.ndarray], scenario: Scenario, *,
         "saturated_ticks": int(np.sum(sat)),
         "fallback_steps": int(np.sum((c["fallback"] > 0.5) & first)),
         "replaced_steps": int(np.sum((c["replaced"] > 0.5) & first)),
+        **backup_figures(t, c.get("backup_active")),
         "encirclements": enc,
         "desired_encirclements": enc_d,
         "encirclement_center": center,
@@ -317,14 +333,18 @@ def compute_metrics(columns: Mapping[str, np.ndarray], scenario: Scenario, *,
 
 
 def promise_figures(promises: Sequence[Promise]) -> dict[str, Any]:
-    """``promises`` (JSON-ready), ``promises_kept`` and ``max_rho_ratio`` (null when infinite) of a tube run.
+    """``promises`` (JSON-ready), ``promises_kept``, ``promises_broken`` and ``max_rho_ratio`` of a tube run.
 
-    The baseline (no promises) has ``promises`` empty and the other two null.
+    ``promises_kept``: every figure (premises included) held; ``promises_broken``: the names
+    :func:`tubekit.loop.promises.broken_promises` gives (a given tier, its premises held: exit 4);
+    ``max_rho_ratio`` null when infinite. The baseline (no promises) has ``promises`` and
+    ``promises_broken`` empty and the other two null.
     """
     if not promises:
-        return {"promises": [], "promises_kept": None, "max_rho_ratio": None}
+        return {"promises": [], "promises_kept": None, "promises_broken": [], "max_rho_ratio": None}
     tube = [p for p in promises if p.name == "tube"]
     return {"promises": [p.to_dict() for p in promises], "promises_kept": all(p.ok for p in promises),
+            "promises_broken": list(broken_promises(promises)),
             "max_rho_ratio": json_number(tube[0].observed) if tube else None}
 
 
@@ -346,7 +366,7 @@ def run_metrics(run: RunLog, promises: Sequence[Promise] | None = None) -> dict[
         promises = check_promises(run)
     m = compute_metrics(run.columns(), run.scenario, rho_bound=float(tight.rho_tilde) if certified else None,
                         sway_bound=float(tight.disturbance.sway) if run.tube else None, extra=run.facts)
-    m.update(certified=certified, rho_tilde_used=float(tight.rho_tilde),
+    m.update(certified=certified, rho_tilde_used=float(tight.rho_tilde), tiers=tiers_given(tight),
              tube_box=[float(x) for x in np.asarray(tight.tube, dtype=float)], **promise_figures(promises))
     return m
 

@@ -16,7 +16,7 @@ from typing import Any
 
 from tubekit.loop.closed_loop import run_closed_loop
 from tubekit.loop.metrics import run_metrics
-from tubekit.loop.promises import PREMISES, Promise, check_promises
+from tubekit.loop.promises import PREMISES, Promise, broken_promises, check_promises, tiers_given
 from tubekit.loop.result import SimulationResult
 from tubekit.plant.base import OmegaOverride
 from tubekit.scenario import Scenario
@@ -60,9 +60,15 @@ class CertifiedRun:
 
     @property
     def broken(self) -> tuple[str, ...]:
-        """Names of the non-premise promises broken (a NaN figure, e.g. sway under an override, is skipped)."""
-        return tuple(p.name for p in self.promises
-                     if p.name not in PREMISES and math.isfinite(p.observed) and not p.ok)
+        """Names of the promises broken (:func:`tubekit.loop.promises.broken_promises`): of a tier the
+        certificate gave, with every premise it depends on held (a NaN figure, e.g. sway under an
+        override, is skipped). A premise failure is never a broken promise."""
+        return broken_promises(self.promises)
+
+    @property
+    def tiers(self) -> dict[str, bool]:
+        """Which tiers of promise the run's certificate gives (``{"safe": ..., "tracking": ...}``)."""
+        return tiers_given(self.run.tightening)
 
     @property
     def ratio(self) -> float:
@@ -71,18 +77,28 @@ class CertifiedRun:
         return float(tube[0].observed) if tube else math.nan
 
     def check(self) -> bool:
-        """False only when a certified run broke a promise of its certificate (exit 4 of the CLI)."""
-        return not (self.certified and not self.promises_kept)
+        """False only when a certified run broke a promise of a tier its certificate gave, with that
+        promise's premises held (exit 4 of the CLI)."""
+        return not (self.certified and self.broken)
 
     def summary(self) -> str:
-        """One line: the run, its verdict and the broken promises."""
+        """One line: the run, its verdict by tier, the backup time, the broken promises and failed premises."""
         kind = "tube" if self.run.tube else "baseline"
-        verdict = ("certified" if self.certified else "not certified") if self.run.tube else "no certificate"
+        if not self.run.tube:
+            verdict = "no certificate"
+        elif self.certified:
+            verdict = "certified: " + ", ".join(f"{tier} {'given' if ok else 'not given'}"
+                                                 for tier, ok in self.tiers.items())
+        else:
+            verdict = "not certified"
         line = (f"{kind} run of {self.run.scenario.name!r} ({verdict}): min clearance "
                 f"{self.metrics['min_clearance']}, min e_d {self.metrics['min_e_d']:.4g} m, "
-                f"tube ratio {self.metrics['max_rho_ratio']}")
-        failed = [p.name for p in self.promises if not p.ok]
-        return line + (f"; not kept: {', '.join(failed)}" if failed else "")
+                f"tube ratio {self.metrics['max_rho_ratio']}, backup {self.metrics['backup_s']:.3g} s")
+        premises = [p.name for p in self.promises if p.name in PREMISES and not p.ok]
+        other = [p.name for p in self.promises if p.name not in PREMISES and not p.ok and p.name not in self.broken]
+        return (line + (f"; broken: {', '.join(self.broken)}" if self.broken else "")
+                + (f"; premises failed: {', '.join(premises)}" if premises else "")
+                + (f"; not kept (not promised): {', '.join(other)}" if other else ""))
 
     def to_dict(self) -> dict[str, Any]:
         """JSON-ready: the metrics (promises included)."""

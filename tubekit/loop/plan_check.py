@@ -11,11 +11,19 @@ follows), that
   |e_o| <= e_o_max - M_o[j], and the heading stays in the certified hemisphere;
 * the vehicle ball inflated by M_pos[j] is clear of every known obstacle and
   inside the workspace;
+* when the tightening has a backup (``tightening.backup``), the plan's nominal end position
+  meets the terminal condition (:func:`tubekit.loop.terminal.terminal_condition`: the backup's
+  safe set there, inflated by the vehicle ball, is clear of every known obstacle, inside the
+  workspace and inside the region sensed from ``x0``);
 
 at ``samples_per_arc + 1`` points per arc, each constraint tightened further by
 rate · spacing / 2 with the certificate's bound on its rate along an arc
 (:attr:`Tightening.rates`), so the check covers the whole arc, not only its
 samples. A plan that fails is replaced by the previous accepted plan, replayed.
+
+When ``tightening.tiers`` says tracking is not certified (``{"tracking": False}``: the safe-only
+design), only the position constraints are checked (V̄, obstacles, workspace, terminal condition,
+sensing), not e ∈ R nor the hemisphere.
 """
 
 from __future__ import annotations
@@ -29,9 +37,10 @@ import numpy as np
 from tubekit.model.errors import error_coordinates, heading_cosine
 from tubekit.plant.kinematic import nominal_arc
 from tubekit.scenario import Obstacle, Scenario
+from tubekit.loop.terminal import terminal_condition
 from tubekit.tightening import Tightening
 
-__all__ = ["PlanCheck", "check_plan", "plan_arcs"]
+__all__ = ["PlanCheck", "check_plan", "plan_arcs", "tracking_checked"]
 
 #: Points per arc of the check (plus the arc's end).
 SAMPLES_PER_ARC = 10
@@ -80,6 +89,21 @@ def _position_slacks(scenario: Scenario, pos: np.ndarray, margin: np.ndarray,
     return out
 
 
+def tracking_checked(tight: Tightening) -> bool:
+    """False when ``tight.tiers`` says tracking is not certified (then e ∈ R is not checked)."""
+    return not (isinstance(tight.tiers, dict) and tight.tiers.get("tracking") is False)
+
+
+def _terminal_slack(scenario: Scenario, tight: Tightening, x0: np.ndarray, end: np.ndarray,
+                    obstacles: Sequence[Obstacle]) -> dict[str, np.ndarray]:
+    """The terminal condition's slack (m) under "terminal: <part>", empty without a backup."""
+    if tight.backup is None:
+        return {}
+    check = terminal_condition(end[:3], tight.backup, scenario.vehicle_radius, obstacles, scenario.workspace,
+                               np.asarray(x0, dtype=float)[:3], scenario.sensing_range)
+    return {f"terminal: {check.reason}": np.array([check.slack if check.ok else min(check.slack, -1e-12)])}
+
+
 def check_plan(scenario: Scenario, tight: Tightening, t0: float, x0: np.ndarray, inputs: np.ndarray,
                obstacles: Sequence[Obstacle], sign: int, samples: int = SAMPLES_PER_ARC) -> PlanCheck:
     """Verify a plan (module doc). ``sign`` is the certified hemisphere (-1 toward, +1 away, 0 both)."""
@@ -99,7 +123,9 @@ def check_plan(scenario: Scenario, tight: Tightening, t0: float, x0: np.ndarray,
     cos_rel = heading_cosine(arcs, desired)
     pad = 0.5 * (dt / samples) * np.asarray(tight.rates, dtype=float)
     m = np.asarray(tight.margins, dtype=float)
-    slacks = _error_slacks(tight, e, cos_rel, m, pad, sign)
+    slacks = _error_slacks(tight, e, cos_rel, m, pad, sign) if tracking_checked(tight) else {}
+    slacks.update(_terminal_slack(scenario, tight, x0, arcs[-1, -1], obstacles))
     slacks.update(_position_slacks(scenario, arcs[..., :3], m[:, 3:4] + pad[3], obstacles))
-    worst_name, worst = min(((k, float(np.min(v))) for k, v in slacks.items()), key=lambda kv: kv[1])
-    return PlanCheck(ok=worst >= 0.0 and math.isfinite(worst), slack=worst, where=worst_name)
+    worst_name, worst = min(((k, float(np.min(v))) for k, v in slacks.items()), key=lambda kv: kv[1],
+                            default=("nothing to check", math.inf))
+    return PlanCheck(ok=worst >= 0.0 and not math.isnan(worst), slack=worst, where=worst_name)

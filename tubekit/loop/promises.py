@@ -12,18 +12,27 @@ Each :class:`Promise` compares an observed figure with the certificate's bound:
 * ``sway`` — max |v_s| applied <= γ̄ (on the dynamic plant: max |v_b| of the hull, γ̄ its ISS bound);
 * ``velocity_loop`` (dynamic plant only) — the assumption of ``docs/plant.md``: max |u_b - u|,
   |w_b - w|, |r_b - r| within ``scenario.plant.tracking_bound`` (observed = the largest ratio, <= 1);
-* the premises: ``disturbance`` (‖ω_xy‖ <= ω̄_xy, |ω_z| <= ω̄_z) and ``recursive_feasibility``
-  (a plan accepted at t = 0, and the replayed candidate never older than N - 1 periods).
+* the premises: ``disturbance`` (‖ω_xy‖ <= ω̄_xy, |ω_z| <= ω̄_z over every evaluation of ω the
+  plant's integrator made, between ticks included, and at the logged ticks) and
+  ``recursive_feasibility`` (a plan accepted at t = 0, and the replayed candidate never older than
+  N - 1 periods).
 
-A run of a *certified* scenario that breaks any of them is a broken promise; an uncertified run
-reports the same figures and claims nothing.
+Tiers (:data:`TIER_OF`). The *safe* promises (``clearance``, ``workspace``, ``inputs``, ``sway``,
+``velocity_loop``) hold for all time with only the ``disturbance`` premise when the tightening has a
+backup (without one, they also need ``recursive_feasibility``, the old theorem). The *tracking*
+promises (``tube``, ``region``, ``epsilon``) are measured only while a plan is followed (not while the
+backup law runs, column ``backup_active``) and depend on both premises. Each :class:`Promise` carries
+its ``tier``, ``depends_on`` and whether the certificate ``given`` its tier (``tightening.tiers``;
+None: every tier of a certified tightening). :func:`broken_promises` names the promises a run broke:
+only those of a given tier whose premises held; a premise failure is never a broken promise. An
+uncertified run reports the same figures and claims nothing.
 """
 
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
-from typing import Protocol
+from dataclasses import dataclass, replace
+from typing import Protocol, Sequence
 
 import numpy as np
 
@@ -33,10 +42,16 @@ from tubekit.plant.kinematic import Plant
 from tubekit.scenario import HEMISPHERE_SIGN, Scenario
 from tubekit.tightening import Tightening
 
-__all__ = ["Promise", "check_promises", "RunLog", "PREMISES"]
+__all__ = ["Promise", "check_promises", "RunLog", "PREMISES", "TIER_OF", "premises_of", "tiers_given",
+           "broken_promises"]
 
-#: Promises that are premises of the theorem: a run breaking one claims nothing.
+#: Promises that are premises of the theorem: a run breaking one claims nothing of the tiers resting on it.
 PREMISES: tuple[str, ...] = ("disturbance", "recursive_feasibility")
+
+#: The tier of every promise ("premise" for the premises).
+TIER_OF: dict[str, str] = {"clearance": "safe", "workspace": "safe", "inputs": "safe", "sway": "safe",
+                           "velocity_loop": "safe", "tube": "tracking", "region": "tracking",
+                           "epsilon": "tracking", "disturbance": "premise", "recursive_feasibility": "premise"}
 
 
 class RunLog(Protocol):
@@ -51,6 +66,8 @@ class RunLog(Protocol):
     inputs: np.ndarray
     omega: np.ndarray
     saturated: np.ndarray
+    backup_active: np.ndarray
+    omega_peak: tuple[float, float] | None
     replaced: np.ndarray
     rejected: np.ndarray
     plan_age: np.ndarray
@@ -81,13 +98,17 @@ class Promise:
     bound: float
     ok: bool
     detail: str
+    tier: str = "safe"
+    depends_on: tuple[str, ...] = ()
+    given: bool = True
 
     def to_dict(self) -> dict:
         """JSON-ready copy (non-finite numbers as None)."""
         def num(x: float) -> float | None:
             return float(x) if math.isfinite(float(x)) else None
         return {"name": self.name, "observed": num(self.observed), "bound": num(self.bound), "ok": self.ok,
-                "detail": self.detail}
+                "detail": self.detail, "tier": self.tier, "depends_on": list(self.depends_on),
+                "given": self.given}
 
 
 def _at_most(name: str, observed: float, bound: float, detail: str) -> Promise:
@@ -98,9 +119,17 @@ def _at_least(name: str, observed: float, bound: float, detail: str) -> Promise:
     return Promise(name, float(observed), float(bound), bool(observed >= bound), detail)
 
 
+def _following(run: RunLog) -> np.ndarray:
+    """Boolean mask of the ticks at which a plan is followed (the backup law is not running)."""
+    active = getattr(run, "backup_active", None)
+    if active is None or len(active) != len(run.t):
+        return np.ones(len(run.t), dtype=bool)
+    return ~np.asarray(active, dtype=bool)
+
+
 def _tube(run: RunLog) -> Promise:
     tube = np.asarray(run.tightening.tube, dtype=float)
-    rho = np.abs(run.rho)
+    rho = np.abs(run.rho)[_following(run)]
     ratio = np.max(rho / np.where(tube > 0, tube, np.inf), axis=1) if np.all(tube > 0) else np.full(len(rho), np.inf)
     worst = float(np.nanmax(ratio)) if len(ratio) else 0.0
     return _at_most("tube", worst, 1.0, f"max_j |e_j - e_hat_j| / tube_j, tube = {np.round(tube, 6).tolist()}")
@@ -109,15 +138,20 @@ def _tube(run: RunLog) -> Promise:
 def _region(run: RunLog) -> list[Promise]:
     reg = run.tightening.region
     eps, ed_max, ez_max, eo_max = reg.epsilon, reg.e_d_max, reg.e_z_max, reg.e_o_max
-    e = run.errors
+    on = _following(run)
+    e = run.errors[on]
+    if not len(e):
+        return [Promise("region", math.nan, 0.0, True, "no tick follows a plan (the backup law ran throughout)"),
+                Promise("epsilon", math.nan, eps, True, "no tick follows a plan (the backup law ran throughout)")]
     slack = np.min(np.column_stack([e[:, 0] - eps, ed_max - e[:, 0], ez_max - np.abs(e[:, 1]),
                                     eo_max - np.abs(e[:, 2])]))
-    cos_rel = heading_cosine(run.states, run.desired)
+    cos_rel = heading_cosine(run.states[on], run.desired[on])
     sign = HEMISPHERE_SIGN.get(run.scenario.region.heading, 0)
     hem = float(np.min(sign * cos_rel)) if sign else 1.0
     return [_at_least("region", float(min(slack, hem if hem <= 0 else slack)), 0.0,
-                      "smallest slack of e in R (e_d, |e_z|, |e_o| bounds, heading hemisphere)"),
-            _at_least("epsilon", float(np.min(e[:, 0])), eps, "min e_d (m) >= epsilon")]
+                      "smallest slack of e in R (e_d, |e_z|, |e_o| bounds, heading hemisphere) "
+                      "while a plan is followed"),
+            _at_least("epsilon", float(np.min(e[:, 0])), eps, "min e_d (m) >= epsilon while a plan is followed")]
 
 
 def _inputs(run: RunLog) -> Promise:
@@ -164,10 +198,15 @@ def _disturbance(run: RunLog) -> list[Promise]:
         sway = [abs(plant.sway_velocity(float(t), x, v))
                 for t, x, v in zip(run.t[:-1], run.states[:-1], run.inputs[:-1])]
         sway_promise = _at_most("sway", max(sway, default=0.0), gamma + tol, "max |v_s| applied (m/s) vs gamma_bar")
+    peak_xy = float(np.nanmax(np.hypot(om[:, 0], om[:, 1]), initial=0.0))
+    peak_z = float(np.nanmax(np.abs(om[:, 2]), initial=0.0))
+    stages = getattr(run, "omega_peak", None)
+    if stages is not None:  # every RK4 stage of the plant: the disturbance it received between ticks too
+        peak_xy, peak_z = max(peak_xy, float(stages[0])), max(peak_z, float(stages[1]))
     return [sway_promise,
-            _at_most("disturbance", float(max(np.max(np.hypot(om[:, 0], om[:, 1]) - wxy - tol),
-                                              np.max(np.abs(om[:, 2]) - wz - tol))), 0.0,
-                     "premise: max over the run of ||omega_xy|| - omega_bar_xy and |omega_z| - omega_bar_z")]
+            _at_most("disturbance", max(peak_xy - wxy - tol, peak_z - wz - tol), 0.0,
+                     f"premise: max over the whole run (every integrator stage) of ||omega_xy|| - omega_bar_xy "
+                     f"and |omega_z| - omega_bar_z; peaks {peak_xy:.4g}, {peak_z:.4g} m/s")]
 
 
 def _velocity_loop(run: RunLog) -> list[Promise]:
@@ -190,9 +229,44 @@ def _feasibility(run: RunLog) -> Promise:
     first_ok = len(age) > 0 and age[0] == 0 and not bool(run.replaced[0])
     oldest = int(age.max()) if len(age) else 0
     return Promise("recursive_feasibility", float(oldest), float(max(n - 1, 0)),
-                   bool(first_ok and oldest <= n - 1),
-                   f"premise: oldest replayed plan (periods); rejected plans = {int(np.sum(run.rejected))}; "
+                   bool(first_ok and oldest <= max(n - 1, 0)),
+                   f"premise (of tracking; of safety too without a backup): oldest replayed plan (periods); "
+                   f"rejected plans = {int(np.sum(run.rejected))}; "
                    f"accepted at t = 0: {first_ok}")
+
+
+def premises_of(tier: str, tightening: Tightening) -> tuple[str, ...]:
+    """The premises a promise of ``tier`` rests on: the safe tier needs only the disturbance bound when
+    the tightening has a backup; tracking (and safety without a backup) also needs recursive feasibility."""
+    if tier == "premise":
+        return ()
+    if tier == "safe" and tightening.backup is not None:
+        return ("disturbance",)
+    return PREMISES
+
+
+def tiers_given(tightening: Tightening) -> dict[str, bool]:
+    """Which tiers the certificate gives: ``tightening.tiers`` or, when None, every tier iff certified."""
+    given = {"safe": bool(tightening.certified), "tracking": bool(tightening.certified)}
+    if isinstance(tightening.tiers, dict):
+        given.update({k: bool(v) and bool(tightening.certified) for k, v in tightening.tiers.items()})
+    return given
+
+
+def broken_promises(promises: Sequence[Promise]) -> tuple[str, ...]:
+    """Names of the promises broken: of a given tier, not ok, a figure (NaN: not applicable), every
+    premise it depends on held."""
+    held = {p.name: p.ok for p in promises if p.tier == "premise"}
+    return tuple(p.name for p in promises
+                 if p.tier != "premise" and p.given and not p.ok and not math.isnan(p.observed)
+                 and all(held.get(name, True) for name in p.depends_on))
+
+
+def _annotate(promise: Promise, tightening: Tightening, given: dict[str, bool]) -> Promise:
+    """``promise`` with its tier, the premises it depends on and whether its tier was given."""
+    tier = TIER_OF.get(promise.name, "safe")
+    return replace(promise, tier=tier, depends_on=premises_of(tier, tightening),
+                   given=given.get(tier, True) if tier != "premise" else True)
 
 
 def check_promises(run: RunLog) -> list[Promise]:
@@ -207,5 +281,7 @@ def check_promises(run: RunLog) -> list[Promise]:
         raise ConfigError("run", "a tube run with a certificate's Tightening (tubekit.simulate(scenario, "
                           "certificate))", "a run without a certificate (the baseline)",
                           "the baseline is promised nothing")
-    return [_tube(run), *_region(run), _inputs(run), *_geometry(run), *_disturbance(run), *_velocity_loop(run),
-            _feasibility(run)]
+    raw = [_tube(run), *_region(run), _inputs(run), *_geometry(run), *_disturbance(run), *_velocity_loop(run),
+           _feasibility(run)]
+    given = tiers_given(run.tightening)
+    return [_annotate(p, run.tightening, given) for p in raw]

@@ -61,6 +61,10 @@ LOG_FIELDS: tuple[LogField, ...] = (
     LogField("saturated", "tick", 0, bool, False, ("saturated",), "v left V and was clipped"),
     LogField("fallback", "tick", 0, bool, False, ("fallback",), "the period's FHOCP result was a fallback"),
     LogField("replaced", "tick", 0, bool, False, ("replaced",), "the period's FHOCP input was replaced"),
+    LogField("backup_active", "tick", 0, bool, False, ("backup_active",),
+             "the backup law ran at this tick (the replayed plan was exhausted)"),
+    LogField("backup_anchor", "tick", 3, float, np.nan, ("anchor_x", "anchor_y", "anchor_z"),
+             "the backup's anchor p* (m) while it runs, NaN otherwise"),
     LogField("n_detected", "tick", 0, int, 0, ("n_detected",), "obstacles known to the map"),
     LogField("solve_ms", "tick", 0, float, np.nan, ("solve_ms",), "FHOCP solve time (ms), first tick of a period"),
     LogField("step_ms", "tick", 0, float, np.nan, ("step_ms",), "controller time per period (ms), first tick"),
@@ -99,7 +103,8 @@ _DERIVED: dict[str, tuple[str, ...]] = {
 }
 #: Where each group of ``trajectory.csv`` columns comes from, in column order.
 _CSV_ORDER: tuple[str, ...] = ("t", "step", "states", "inputs", "desired", "errors", "nominal", "rho", "rho_norm",
-                               "v_hat", "kappa", "omega", "saturated", "fallback", "replaced", "n_detected",
+                               "v_hat", "kappa", "omega", "saturated", "fallback", "replaced", "backup_active",
+                               "backup_anchor", "n_detected",
                                "solve_ms", "step_ms", "max_violation", "wall")
 _CSV_SOURCES: tuple[tuple[str, tuple[str, ...]], ...] = tuple(
     (src, _DERIVED[src] if src in _DERIVED else _BY_NAME[src].csv) for src in _CSV_ORDER)
@@ -119,6 +124,8 @@ class SimulationResult(LogArrays):
     Per-tick arrays have K + 1 rows (K = steps * ticks per step; the last row is
     the final state at t = duration with NaN inputs). Units: m, rad, s, m/s, rad/s.
     ``body`` (u_b, v_b, w_b, r_b) and ``thrust`` (X, Z, N) are set by the dynamic plant only.
+    ``omega_peak`` is the largest ‖ω_xy‖ and |ω_z| (m/s) over every evaluation of ω the plant's
+    integrator made (every RK4 stage, between ticks included): the disturbance the plant received.
     """
 
     scenario: Scenario
@@ -138,6 +145,7 @@ class SimulationResult(LogArrays):
     omega_overridden: bool = False
     body: np.ndarray | None = None
     thrust: np.ndarray | None = None
+    omega_peak: tuple[float, float] | None = None
 
     # ---- derived -------------------------------------------------------------------
     @property

@@ -39,6 +39,10 @@ class PlantModel(Protocol):
         """ω = ẋ − f(x) v (K + 1, 3), m/s, at the logged ticks."""
         ...
 
+    def omega_peak(self) -> tuple[float, float]:
+        """Largest ‖ω_xy‖ and |ω_z| (m/s) over every evaluation of ω the integrator made so far."""
+        ...
+
     def history(self) -> tuple[np.ndarray | None, np.ndarray | None]:
         """Body velocities and thrusts at every tick (``None, None`` for a plant without a body)."""
         ...

@@ -100,6 +100,7 @@ class DynamicPlant:
         self._tau_inv = 1.0 / p.thruster_time_constant
         self.state: tuple[float, ...] | None = None  # (u, v, w, r, X, Z, N, I_u, I_w, I_r)
         self._log: list[tuple[float, ...]] = []
+        self._peak = [0.0, 0.0]  # largest ||omega_xy||, |omega_z| over every evaluation (m/s)
 
     # ---- the model ---------------------------------------------------------------------
     def current_at(self, t: float) -> tuple[float, float, float]:
@@ -131,8 +132,21 @@ class DynamicPlant:
         err = (command[0] - u, command[1] - w, command[2] - r)
         # conditional integration: hold the integral while its channel saturates in the error's direction
         integ = tuple(0.0 if s and c * e > 0.0 else e for s, c, e in zip(saturated, cmd, err))
+        self._record_omega(c1 - err[0] * cp - v * sp, c2 - err[0] * sp + v * cp, c3 - err[1])
         return (u * cp - v * sp + c1, u * sp + v * cp + c2, w + c3, r, *acc,
                 *((ci - ti) * self._tau_inv for ci, ti in zip(cmd, tau)), *integ)
+
+    def _record_omega(self, o1: float, o2: float, o3: float) -> None:
+        """Keep the largest ‖ω_xy‖, |ω_z| (m/s) of ω = ẋ − f(x) v seen by the integrator."""
+        oxy = math.hypot(o1, o2)
+        if oxy > self._peak[0]:
+            self._peak[0] = oxy
+        if abs(o3) > self._peak[1]:
+            self._peak[1] = abs(o3)
+
+    def omega_peak(self) -> tuple[float, float]:
+        """Largest ‖ω_xy‖ and |ω_z| (m/s) over every evaluation the integrator made (every RK4 stage)."""
+        return self._peak[0], self._peak[1]
 
     def _start(self, command: Sequence[float]) -> tuple[float, ...]:
         nu = (float(command[0]), 0.0, float(command[1]), float(command[2]))

@@ -69,6 +69,7 @@ class Plant:
         sway = disturbance.sway
         self._sway_gain, self._sway_amplitude = float(sway.gain), float(sway.amplitude)
         self._sway_rate = 2.0 * math.pi / sway.period
+        self._peak = [0.0, 0.0]  # largest ||omega_xy||, |omega_z| over every evaluation (m/s)
 
     @classmethod
     def of(cls, scenario: Scenario, override: OmegaOverride | None = None) -> Plant:
@@ -101,6 +102,12 @@ class Plant:
         u, w, r = v
         psi = x[3]
         o1, o2, o3 = self._omega(t, psi, u, r)
+        peak = self._peak
+        oxy = math.hypot(o1, o2)
+        if oxy > peak[0]:
+            peak[0] = oxy
+        if abs(o3) > peak[1]:
+            peak[1] = abs(o3)
         return (u * math.cos(psi) + o1, u * math.sin(psi) + o2, w + o3, r)
 
     # ---- public API ---------------------------------------------------------------------
@@ -147,6 +154,10 @@ class Plant:
     def step_tuple(self, t: float, x: Sequence[float], v: Sequence[float], h: float, n: int) -> Floats4:
         """:meth:`step` on float tuples, without arrays (the closed loop's inner loop)."""
         return rk4_tuple(self._rhs, t, tuple(x), v, h, n)
+
+    def omega_peak(self) -> tuple[float, float]:
+        """Largest ‖ω_xy‖ and |ω_z| (m/s) over every evaluation the integrator made (every RK4 stage)."""
+        return self._peak[0], self._peak[1]
 
     def history(self) -> tuple[None, None]:
         """No body velocities or thrusts: the kinematic plant has no hull."""

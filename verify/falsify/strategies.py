@@ -29,9 +29,10 @@ import numpy as np
 from hypothesis import strategies as st
 
 from tubekit.exceptions import ConfigError
-from tubekit.scenario import Obstacle
+from tubekit.scenario import Obstacle, Scenario
 from tubekit.model.trajectory import Circle, Helix, Line, Trajectory, Waypoints
 
+from verify.falsify import scenarios as families
 from verify.falsify.invariance import TubeConfiguration
 from verify.region import Region
 
@@ -53,6 +54,12 @@ __all__ = [
     "period_configuration_from_unit",
     "period_configurations",
     "PERIOD_DIM",
+    "obstacles_beyond_sensing",
+    "obstacles_on_path",
+    "obstacle_clusters",
+    "obstacles_between_end_and_target",
+    "blocked_starts",
+    "backup_attack_scenarios",
 ]
 
 _unit = st.floats(0.0, 1.0, allow_nan=False, allow_infinity=False)
@@ -311,3 +318,39 @@ def obstacle_sets(draw, vehicle_radius: float = 0.2, max_obstacles: int = 4, max
         jitter = (gap / 2 - 1e-6) * _unit_vector(draw(_unit), draw(_unit)) * draw(_unit) * 0.99
         out.append(Obstacle(tuple(center + jitter), radius))
     return tuple(out)
+
+
+# ------------------------------------------------------------------ scenario families (issue 21)
+def _family(name: str, scenario: Scenario) -> st.SearchStrategy[Scenario]:
+    build = families.FAMILIES[name]
+    return _units(families.FAMILY_DIMS[name]).map(lambda u: build(scenario, u))
+
+
+def obstacles_beyond_sensing(scenario: Scenario) -> st.SearchStrategy[Scenario]:
+    """``scenario`` with one obstacle whose surface lies just beyond the start's sensing range, on the way."""
+    return _family("beyond_sensing", scenario)
+
+
+def obstacles_on_path(scenario: Scenario) -> st.SearchStrategy[Scenario]:
+    """``scenario`` with up to three obstacles centred on the desired path."""
+    return _family("on_path", scenario)
+
+
+def obstacle_clusters(scenario: Scenario) -> st.SearchStrategy[Scenario]:
+    """``scenario`` with a tight hexagonal cluster of 3-7 obstacles near the path."""
+    return _family("cluster", scenario)
+
+
+def obstacles_between_end_and_target(scenario: Scenario) -> st.SearchStrategy[Scenario]:
+    """``scenario`` with an obstacle between a plan's end and the target."""
+    return _family("between_end_and_target", scenario)
+
+
+def blocked_starts(scenario: Scenario) -> st.SearchStrategy[Scenario]:
+    """``scenario`` started just behind an obstacle between it and the target (no FHOCP plan may exist)."""
+    return _family("blocked_start", scenario)
+
+
+def backup_attack_scenarios(scenario: Scenario) -> st.SearchStrategy[Scenario]:
+    """Any of the five families above (:mod:`verify.falsify.scenarios`)."""
+    return st.one_of(*(_family(name, scenario) for name in families.FAMILIES))

@@ -1,0 +1,83 @@
+"""tubekit.app.campaign_spec: the ``obstacles = { cluster = {...} }`` distribution (issue 21)."""
+
+from __future__ import annotations
+
+import itertools
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from tubekit.exceptions import ConfigError
+from tubekit.app.campaign_spec import draw_cluster, spec_from_dict, spec_from_stored
+
+ROOT = Path(__file__).resolve().parents[1]
+SCENARIO = (ROOT / "verify" / "scenarios" / "paper_currents.toml").as_posix()
+CLUSTER = {"count": [3, 7], "radius": [0.15, 0.4], "gap": [0.01, 0.3],
+           "center": [[0.5, 1.2, -0.2], [2.6, 2.9, 0.2]], "margin": 0.15}
+
+
+def _spec(cluster=None, **sample):
+    entry = {"obstacles": {"cluster": CLUSTER if cluster is None else cluster}, **sample}
+    return spec_from_dict({"scenario": SCENARIO, "runs": 30, "seed": 4, "duration": 5.0, "sample": entry})
+
+
+def test_clusters_are_separated_as_certify_requires_and_clear_of_the_start():
+    spec = _spec(**{"initial_state": {"uniform": [[-1.1, 2.7, -0.3, -0.2], [-0.6, 3.3, 0.3, 0.2]]}})
+    counts = []
+    for k in range(30):
+        sc = spec.plan(k).scenario
+        counts.append(len(sc.obstacles))
+        start = np.asarray(sc.initial_state[:3])
+        for o in sc.obstacles:
+            assert np.linalg.norm(np.subtract(o.center, start)) > o.radius + sc.vehicle_radius
+            assert 0.15 <= o.radius <= 0.4
+        for a, b in itertools.combinations(sc.obstacles, 2):
+            gap = np.linalg.norm(np.subtract(a.center, b.center))
+            assert gap > 2 * (sc.vehicle_radius + 0.15) + a.radius + b.radius
+    assert min(counts) >= 1 and max(counts) <= 7 and len(set(counts)) > 2
+
+
+def test_neighbours_are_at_most_the_drawn_gap_apart():
+    params = {**CLUSTER, "count": [7, 7], "gap": [0.1, 0.1], "vehicle_radius": 0.2}
+    obstacles = draw_cluster(params, np.random.default_rng(0))
+    r = obstacles[0]["radius"]
+    spacing = (2 * (0.2 + 0.15) + 2 * r) * 1.1
+    d = [np.linalg.norm(np.subtract(obstacles[0]["center"], o["center"])) for o in obstacles[1:]]
+    assert len(obstacles) == 7 and np.allclose(d, spacing)
+
+
+def test_the_cluster_spec_round_trips_through_campaign_json():
+    spec = _spec()
+    again = spec_from_stored(spec.to_dict())
+    assert again.fingerprint == spec.fingerprint
+    assert again.plan(3).scenario.obstacles == spec.plan(3).scenario.obstacles
+
+
+@pytest.mark.parametrize("cluster, field", [
+    ({**CLUSTER, "extra": 1}, "sample.obstacles.cluster"),
+    ({k: v for k, v in CLUSTER.items() if k != "gap"}, "sample.obstacles.cluster"),
+    ({**CLUSTER, "count": [0, 3]}, "sample.obstacles.cluster.count"),
+    ({**CLUSTER, "count": [3, 40]}, "sample.obstacles.cluster.count"),
+    ({**CLUSTER, "count": [3.0, 4]}, "sample.obstacles.cluster.count"),
+    ({**CLUSTER, "radius": [0.0, 0.2]}, "sample.obstacles.cluster.radius"),
+    ({**CLUSTER, "gap": [0.3, 0.1]}, "sample.obstacles.cluster.gap"),
+    ({**CLUSTER, "center": [[0, 0], [1, 1]]}, "sample.obstacles.cluster.center"),
+    ({**CLUSTER, "margin": -0.1}, "sample.obstacles.cluster.margin"),
+])
+def test_a_bad_cluster_names_its_field(cluster, field):
+    with pytest.raises(ConfigError, match=field.replace(".", r"\.")):
+        _spec(cluster)
+
+
+def test_cluster_is_only_for_obstacles():
+    with pytest.raises(ConfigError, match=r"sample\.initial_state"):
+        spec_from_dict({"scenario": SCENARIO, "runs": 2, "seed": 1,
+                        "sample": {"initial_state": {"cluster": CLUSTER}}})
+
+
+def test_the_recorded_obstacles_are_those_that_ran():
+    spec = _spec(**{"initial_state": {"uniform": [[0.5, 1.2, -0.1, 0.0], [2.6, 2.9, 0.1, 0.0]]}})
+    for k in range(10):
+        plan = spec.plan(k)
+        assert [tuple(o["center"]) for o in plan.values["obstacles"]] == [o.center for o in plan.scenario.obstacles]

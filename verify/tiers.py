@@ -1,0 +1,182 @@
+"""The two tiers of promise, the safe-only design at σ = 0 and the backup of a certificate.
+
+* **tracking** (e ∈ R, e_d >= ε, the tube, while a plan is followed): every condition of the
+  tracking design (:func:`tracking_design` = :func:`verify.design.evaluate_design` plus the
+  workspace conditions of :mod:`verify.workspace`) and the backup's conditions;
+* **safe** (no collision, inside the workspace, v ∈ V never clipped, for all time; premise: the
+  disturbance bound only): the backup's conditions (:func:`backup_of`) and, from the design
+  whose margins the loop uses, the conditions in :data:`SAFE_CONDITIONS` (the sway bound, the
+  tube, V̄ non-empty, sensing, obstacle separation).
+
+When the tracking design does not certify, :func:`safe_only_design` gives the safe tier its own
+design at σ = 0: no ancillary feedback, so v = v̂ ∈ V = V̄ and nothing saturates; under the reset
+the heading of the kinematic plant sees no disturbance (|ψ − ψ̂| <= Δr δ, Δr the dynamic plant's
+yaw error, 0 on the kinematic one), so the one-period position tube is ‖Δp_xy‖ <= (ω̄_xy + ū Δr δ) δ,
+|Δz| <= ω̄_z δ (:func:`position_tube`) and the replay margins follow from
+:func:`verify.sampled.horizon_margins`; its e-columns are reported, never required.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+
+import numpy as np
+from flint import arb
+
+from tubekit.model.backup import SafeSet, StationKeeping
+from tubekit.scenario import Scenario
+
+from verify.backup import BackupCertificate, certify_backup, design_backup
+from verify.design import Condition, Design, DisturbanceBounds, arc_rates, evaluate_design, input_tightening, \
+    state_conditions, sway_condition, tube_problem
+from verify.gains import GainBounds
+from verify.intervals import lower, upper
+from verify.region import Region
+from verify.sampled import HorizonMargins, PeriodTube, _asin_ratio, horizon_margins
+from verify.workspace import initial_workspace, target_in_workspace
+
+__all__ = ["SAFE_CONDITIONS", "SAFE_PREFIX", "is_safe_condition", "tracking_design", "position_tube",
+           "safe_only_design", "backup_of", "recertify_backup", "initial_backup", "tier_conditions",
+           "tiers_of", "key_sigma"]
+
+#: Names (or name prefixes ending in "[") of the tracking design's conditions the safe tier depends on.
+SAFE_CONDITIONS = ("sway_bound", "tube", "v_bar[", "sensing", "obstacles[")
+#: Prefix of the safe-only design's conditions in a certificate's list.
+SAFE_PREFIX = "safe_only."
+
+
+def is_safe_condition(name: str) -> bool:
+    """True when the condition ``name`` of a design is one the safe tier depends on."""
+    base = name[len(SAFE_PREFIX):] if name.startswith(SAFE_PREFIX) else name
+    return base in SAFE_CONDITIONS or any(base.startswith(p) for p in SAFE_CONDITIONS if p.endswith("["))
+
+
+def tracking_design(scenario: Scenario, region: Region, gains: GainBounds, sigma: float,
+                    dist: DisturbanceBounds) -> Design:
+    """:func:`verify.design.evaluate_design` plus ``initial_workspace`` and ``target_in_workspace``."""
+    d = evaluate_design(scenario, region, gains, sigma, dist)
+    m0 = d.margins.position[0] if d.margins is not None else 0.0
+    extra = (initial_workspace(scenario, m0), target_in_workspace(scenario))
+    return dataclasses.replace(d, conditions=d.conditions + extra)
+
+
+def position_tube(p) -> PeriodTube:
+    """The one-period tube at σ = 0 (module doc): Cartesian bounds, and ρ from them (ρ_d <= ‖Δp_xy‖,
+    ρ_z <= |Δz|, ρ_o <= |Δψ| + asin(‖Δp_xy‖ / ε))."""
+    d = arb(p.period)
+    psi = arb(p.yaw_rate_error) * d
+    pxy = (arb(p.omega_xy) + arb(p.u_max) * psi) * d
+    pz = arb(p.omega_z) * d
+    theta = _asin_ratio(pxy, arb(p.eps))
+    rho_o = psi + theta if theta.is_finite() else arb("inf")
+    return PeriodTube(rho=(upper(pxy), upper(pz), upper(rho_o)), theta=upper(theta), p_xy=upper(pxy),
+                      p_z=upper(pz), psi=upper(psi), kappa=(0.0, 0.0, 0.0), certified=True, iterations=0,
+                      reason="", contraction=0.0)
+
+
+def _renamed(conds: list[Condition]) -> tuple[Condition, ...]:
+    return tuple(dataclasses.replace(c, condition=SAFE_PREFIX + c.condition) for c in conds)
+
+
+def safe_only_design(scenario: Scenario, region: Region, gains: GainBounds, dist: DisturbanceBounds) -> Design:
+    """The safe tier's design at σ = 0 (module doc); its conditions are prefixed :data:`SAFE_PREFIX`."""
+    p = tube_problem(scenario, region, gains, 0.0, dist)
+    tube = position_tube(p)
+    m = horizon_margins(p, tube, scenario.controller.horizon_steps)
+    inp, v_bar = input_tightening(p, tube, dist)
+    states = state_conditions(scenario, region, p, m, v_bar)
+    pos = m.position[-1]
+    conds = [sway_condition(dist),
+             Condition("position_tube", "M_pos,N-1 finite: ||dp_xy|| <= (omega_bar_xy + u_max dr delta) delta, "
+                       "|dz| <= omega_bar_z delta per period at sigma = 0", pos, math.inf, math.isfinite(pos),
+                       f"p_xy {tube.p_xy:.4g} m, p_z {tube.p_z:.4g} m per period")]
+    conds += [c for c in inp if c.condition.startswith("v_bar[")]
+    conds += [c for c in states if c.condition == "sensing" or c.condition.startswith("obstacles[")]
+    return Design(sigma=0.0, problem=p, tube=tube, margins=m, v_bar=tuple(v_bar), conditions=_renamed(conds),
+                  score=-math.inf, rates=arc_rates(p))
+
+
+def _handover(m: HorizonMargins | None) -> tuple[float, float]:
+    """(horizontal, depth) hand-over distance (m): the last arc's position and e_z margins."""
+    if m is None or not (math.isfinite(m.position[-1]) and math.isfinite(m.e_z[-1])):
+        return (math.inf, math.inf)
+    return (m.position[-1], m.e_z[-1])
+
+
+def initial_backup(scenario: Scenario, law: StationKeeping, safe: SafeSet) -> Condition:
+    """``backup_initial``: the backup anchored at the start keeps the vehicle clear and inside the workspace.
+
+    The start is the anchor (d = 0: in S); the cylinder of the safe set inflated by the vehicle ball,
+    (R_f, H_f) = (c + r̄, Z + r̄), is clear of every obstacle of the scenario:
+    hypot(max(0, ‖o_xy − p0_xy‖ − R_f), max(0, |o_z − z0| − H_f)) − r_o > 0, and inside the workspace.
+    """
+    p0 = [arb(x) for x in scenario.initial_state[:3]]
+    rf, hf = arb(safe.level) + arb(scenario.vehicle_radius), arb(safe.depth) + arb(scenario.vehicle_radius)
+    slack = math.inf
+    for o in scenario.obstacles:
+        h = ((arb(o.center[0]) - p0[0]) ** 2 + (arb(o.center[1]) - p0[1]) ** 2).sqrt() - rf
+        v = abs(arb(o.center[2]) - p0[2]) - hf
+        h, v = (h if h > 0 else arb(0)), (v if v > 0 else arb(0))
+        slack = min(slack, lower((h * h + v * v).sqrt() - arb(o.radius)))
+    if scenario.workspace is not None:
+        lo, hi = scenario.workspace
+        for j, half in ((0, rf), (1, rf), (2, hf)):
+            slack = min(slack, lower(p0[j] - half - arb(lo[j])), lower(arb(hi[j]) - p0[j] - half))
+    return Condition("backup_initial", "the safe set about the start, inflated by r_bar, clear of every obstacle "
+                     "and inside the workspace (smallest clearance > 0)", slack, 0.0, slack > 0.0,
+                     "the backup anchored at the start is safe: no plan is needed at t = 0")
+
+
+def backup_of(scenario: Scenario, dist: DisturbanceBounds, margins: HorizonMargins | None) -> BackupCertificate:
+    """:func:`verify.backup.design_backup` for ``scenario`` (ω̄ of ``dist``, V, tick 1/f, hand-over from
+    ``margins``), with ``backup_initial`` appended to its conditions."""
+    limits = tuple(float(x) for x in scenario.limits.vector)
+    tick = 1.0 / float(scenario.controller.ancillary_rate_hz)
+    hand = _handover(margins)
+    bc = design_backup(omega_xy=dist.omega_xy, omega_z=dist.omega_z, limits=limits, tick=tick,
+                       handover=hand if math.isfinite(hand[0]) else (0.0, 0.0))
+    if not math.isfinite(hand[0]):
+        bc = certify_backup(bc.law, bc.safe_set, omega_xy=dist.omega_xy, omega_z=dist.omega_z, limits=limits,
+                            tick=tick, handover=(np.finfo(float).max, np.finfo(float).max))
+    return _with_initial(scenario, bc)
+
+
+def recertify_backup(scenario: Scenario, law: StationKeeping, safe: SafeSet, dist: DisturbanceBounds,
+                     margins: HorizonMargins | None) -> BackupCertificate:
+    """:func:`verify.backup.certify_backup` of a stored law and safe set with the derived bounds and margins."""
+    hand = _handover(margins)
+    big = np.finfo(float).max
+    bc = certify_backup(law, safe, omega_xy=dist.omega_xy, omega_z=dist.omega_z,
+                        limits=tuple(float(x) for x in scenario.limits.vector),
+                        tick=1.0 / float(scenario.controller.ancillary_rate_hz),
+                        handover=hand if math.isfinite(hand[0]) else (big, big))
+    return _with_initial(scenario, bc)
+
+
+def _with_initial(scenario: Scenario, bc: BackupCertificate) -> BackupCertificate:
+    return dataclasses.replace(bc, conditions=bc.conditions + (initial_backup(scenario, bc.law, bc.safe_set),))
+
+
+def tier_conditions(design: Design, safe_design: Design | None,
+                    backup: BackupCertificate | None) -> dict[str, tuple[Condition, ...]]:
+    """The conditions each tier depends on (module doc); ``safe_design`` replaces the tracking design's
+    safe conditions when given. A missing backup leaves both tiers uncertified (an empty backup part is
+    represented by a failed ``backup`` condition)."""
+    bk = backup.conditions if backup is not None else (
+        Condition("backup", "a certified backup law", None, None, False, "no backup"),)
+    safe_src = safe_design.conditions if safe_design is not None else tuple(
+        c for c in design.conditions if is_safe_condition(c.condition))
+    return {"safe": tuple(safe_src) + tuple(bk), "tracking": tuple(design.conditions) + tuple(bk)}
+
+
+def tiers_of(design: Design, safe_design: Design | None, backup: BackupCertificate | None) -> dict[str, bool]:
+    """``{"safe": bool, "tracking": bool}``: every condition of the tier holds."""
+    return {k: all(c.ok is True for c in v) for k, v in tier_conditions(design, safe_design, backup).items()}
+
+
+def key_sigma(design: Design, safe_design: Design | None, backup: BackupCertificate | None) -> float:
+    """The σ (1/s) of the tightening a certificate hands out, which its design key holds: 0 for the
+    safe-only design, else the chosen design's."""
+    safe_only = safe_design is not None and tiers_of(design, safe_design, backup) == {"safe": True, "tracking": False}
+    return 0.0 if safe_only else float(design.sigma)

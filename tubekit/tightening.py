@@ -22,7 +22,7 @@ Two layers of data:
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, fields
 from typing import Any
 
 import numpy as np
@@ -50,41 +50,42 @@ def _numbers(name: str, value: Any, n: int) -> list[float]:
     return out
 
 
+class _NamedNumbers:
+    """A frozen record of floats that also reads from (and gives) the plain numbers in field order."""
+
+    _FIELD = "tightening"
+
+    @classmethod
+    def of(cls, value: Any) -> Any:
+        """The record itself, or one built from its numbers in field order (ConfigError otherwise)."""
+        return value if isinstance(value, cls) else cls(*_numbers(cls._FIELD, value, len(fields(cls))))
+
+    def as_tuple(self) -> tuple[float, ...]:
+        """The numbers in field order."""
+        return tuple(getattr(self, f.name) for f in fields(self))
+
+
 @dataclass(frozen=True)
-class RegionBounds:
+class RegionBounds(_NamedNumbers):
     """R as the loop uses it: e_d in [epsilon, e_d_max] (m), |e_z| <= e_z_max (m), |e_o| <= e_o_max."""
+
+    _FIELD = "tightening.region"
 
     epsilon: float = 0.0
     e_d_max: float = 0.0
     e_z_max: float = 0.0
     e_o_max: float = 0.0
 
-    @classmethod
-    def of(cls, value: Any) -> "RegionBounds":
-        """A RegionBounds, or one from 4 numbers (epsilon, e_d_max, e_z_max, e_o_max)."""
-        return value if isinstance(value, cls) else cls(*_numbers("tightening.region", value, 4))
-
-    def as_tuple(self) -> tuple[float, float, float, float]:
-        """(epsilon, e_d_max, e_z_max, e_o_max)."""
-        return (self.epsilon, self.e_d_max, self.e_z_max, self.e_o_max)
-
 
 @dataclass(frozen=True)
-class DisturbanceBound:
+class DisturbanceBound(_NamedNumbers):
     """The certificate's ω̄_xy, ω̄_z and sway bound γ̄ (m/s); zeros for the baseline."""
+
+    _FIELD = "tightening.disturbance"
 
     omega_xy: float = 0.0
     omega_z: float = 0.0
     sway: float = 0.0
-
-    @classmethod
-    def of(cls, value: Any) -> "DisturbanceBound":
-        """A DisturbanceBound, or one from 3 numbers (omega_xy, omega_z, sway)."""
-        return value if isinstance(value, cls) else cls(*_numbers("tightening.disturbance", value, 3))
-
-    def as_tuple(self) -> tuple[float, float, float]:
-        """(omega_xy, omega_z, sway)."""
-        return (self.omega_xy, self.omega_z, self.sway)
 
 
 @dataclass(frozen=True)

@@ -28,6 +28,7 @@ import numpy as np
 
 from tubekit.exceptions import ConfigError
 from tubekit.model.backup import BackupPlan, axis_angle, line_of_sight_angle, station_keeping_input
+from verify.falsify.outcome import SearchOutcome
 
 __all__ = ["backup_lyapunov", "handover_start", "simulate_backup", "BackupRun", "BackupAttack",
            "falsify_backup", "BACKUP_START_DIM"]
@@ -132,6 +133,11 @@ class BackupRun:
         """The run left the certified safe set (V > c or |z − z*| > Z)."""
         return self.level_ratio > 1.0 or self.depth_ratio > 1.0
 
+    @property
+    def counterexample(self) -> bool:
+        """The run left the safe set: a counterexample to the backup certificate."""
+        return self.left
+
     def to_dict(self) -> dict:
         """JSON form."""
         return {"strategy": self.strategy, "start": list(self.start), "level_ratio": self.level_ratio,
@@ -139,7 +145,7 @@ class BackupRun:
 
 
 @dataclass(frozen=True)
-class BackupAttack:
+class BackupAttack(SearchOutcome):
     """Outcome of :func:`falsify_backup`: the worst run (largest V / c) over ``simulations`` runs."""
 
     omega_bar: tuple[float, float]
@@ -148,15 +154,6 @@ class BackupAttack:
     seed: int
     worst: BackupRun
     runs: tuple[BackupRun, ...] = field(repr=False, default=())
-
-    @property
-    def found(self) -> bool:
-        """A run left the safe set: a counterexample to the backup certificate."""
-        return any(r.left for r in self.runs)
-
-    def check(self) -> bool:
-        """True when the safe set survived every run."""
-        return not self.found
 
     def summary(self) -> str:
         """Readable text."""

@@ -34,6 +34,7 @@ from tubekit.validation import duration_seconds
 
 from verify.falsify.backup import backup_lyapunov
 from verify.falsify.closed_loop import piecewise_disturbance
+from verify.falsify.outcome import SearchOutcome
 
 __all__ = ["BackupLoopRun", "BackupLoopResult", "falsify_backup_loop", "push_disturbance", "safety_broken",
            "backup_figures"]
@@ -108,7 +109,7 @@ class BackupLoopRun:
 
 
 @dataclass(frozen=True)
-class BackupLoopResult:
+class BackupLoopResult(SearchOutcome):
     """Outcome of :func:`falsify_backup_loop`: the worst run and how often the backup engaged."""
 
     scenario: str
@@ -116,15 +117,6 @@ class BackupLoopResult:
     seed: int
     worst: BackupLoopRun
     runs: tuple[BackupLoopRun, ...] = field(repr=False, default=())
-
-    @property
-    def found(self) -> bool:
-        """A certified run broke a safety promise."""
-        return any(r.counterexample for r in self.runs)
-
-    def check(self) -> bool:
-        """True when no certified run broke a safety promise."""
-        return not self.found
 
     def summary(self) -> str:
         """Readable text."""

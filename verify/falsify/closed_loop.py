@@ -32,6 +32,7 @@ from tubekit.model.ancillary import LAWS, AncillaryLaw, get_law
 from tubekit.model.errors import error_coordinates, numeric
 from tubekit.exceptions import ConfigError
 from tubekit.loop.pipeline import certified_run
+from verify.falsify.outcome import SearchOutcome
 from tubekit.loop.promises import PREMISES, Promise
 from tubekit.scenario import HEMISPHERE_SIGN, Scenario
 from tubekit.tightening import Tightening
@@ -90,7 +91,7 @@ class LoopRun:
 
 
 @dataclass(frozen=True)
-class ClosedLoopResult:
+class ClosedLoopResult(SearchOutcome):
     """Outcome of :func:`falsify_closed_loop`: the worst run and the tightness figure."""
 
     scenario: str
@@ -115,15 +116,6 @@ class ClosedLoopResult:
         """Largest |rho_j| / tube_j per axis over the runs whose premises held (tightness per axis)."""
         valid = [r.axis_ratios for r in self.runs if not r.vacuous] or [self.worst.axis_ratios]
         return tuple(float(np.nanmax([a[j] for a in valid])) for j in range(3))
-
-    @property
-    def found(self) -> bool:
-        """A counterexample was found."""
-        return any(r.counterexample for r in self.runs)
-
-    def check(self) -> bool:
-        """True when the certificate survived: no run with ratio > 1 or a broken promise."""
-        return not self.found
 
     def summary(self) -> str:
         """Readable text."""

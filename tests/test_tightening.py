@@ -82,3 +82,18 @@ def test_region_and_disturbance_are_named_and_accept_numbers_in_order():
 def test_bad_region_or_disturbance_is_refused(changes, field):
     with pytest.raises(ConfigError, match=field):
         _plain(**changes)
+
+
+def test_only_a_certified_backup_imposes_the_terminal_condition():
+    """A best-effort backup (tiers say safe: False) replaces the zero input but does not gate plans."""
+    from dataclasses import replace
+
+    from tubekit.model.backup import BackupPlan, SafeSet, StationKeeping
+    from tubekit.scenario import paper_scenario
+
+    plan = BackupPlan(StationKeeping(0.2, 0.5, 0.05, 0.3, 0.04), SafeSet(0.75, 0.4, 0.08), (0.1, 0.05))
+    base = Tightening.untightened(paper_scenario())
+    assert replace(base, backup=plan).terminal_backup is plan  # no tiers stated: enforced
+    assert replace(base, backup=plan, tiers={"safe": True, "tracking": False}).terminal_backup is plan
+    assert replace(base, backup=plan, tiers={"safe": False, "tracking": False}).terminal_backup is None
+    assert base.terminal_backup is None

@@ -163,6 +163,18 @@ class Tightening:
         object.__setattr__(self, "disturbance", DisturbanceBound.of(self.disturbance))
 
     @property
+    def terminal_backup(self) -> BackupPlan | None:
+        """The backup whose safe set every accepted plan must end in (the terminal condition).
+
+        None without a backup, and None for a backup the certificate did not certify (``tiers`` says
+        ``safe: False``, e.g. a best-effort tightening): its law still replaces the zero input once a
+        replayed plan is exhausted, but a safe set that is not proved cannot make plans wait for it.
+        """
+        if self.backup is None or not (self.tiers or {}).get("safe", True):
+            return None
+        return self.backup
+
+    @property
     def horizon_arcs(self) -> int:
         """Number of arcs with certified margins (0: no arc check)."""
         return int(np.asarray(self.margins).shape[0])

@@ -14,8 +14,9 @@ Safe only (the tracking tier does not certify, the safe tier does, :attr:`Certif
 safe-only design at σ = 0 (:func:`verify.tiers.safe_only_design`): ``v_max`` = V (no feedback,
 nothing to reserve), ``sigma`` = 0, ``tube`` = 0, margins whose e-columns are zero (not enforced:
 plan acceptance checks only the position constraints) and whose position column is the
-certified position margins, node bounds = R itself, ``obstacle_margin`` = the largest position
-margin plus its inter-node allowance; ``certified`` = True, ``tiers`` = ``{"safe": True,
+certified position margins, FHOCP node bounds on e those of the best-effort tracking design (not
+promised, not checked at acceptance; they keep plans off ε), ``obstacle_margin`` = the largest
+position margin plus its inter-node allowance; ``certified`` = True, ``tiers`` = ``{"safe": True,
 "tracking": False}``.
 
 Every tightening carries ``tiers`` and the backup (:class:`tubekit.model.backup.BackupPlan`: the
@@ -95,12 +96,26 @@ def _safe_only(cert) -> Tightening:
     n = len(m.position)
     margins = np.column_stack([np.zeros(n), np.zeros(n), np.zeros(n), np.asarray(m.position, dtype=float)])
     rates = np.asarray(d.rates, dtype=float)
-    common = _common(cert)
-    reg = common["region"]
-    return Tightening(v_max=np.asarray(cert.limits, dtype=float), e_d_min=reg.epsilon, e_d_max=reg.e_d_max,
-                      e_z_max=reg.e_z_max, e_o_max=reg.e_o_max,
+    nodes = _tracking_nodes(cert)
+    return Tightening(v_max=np.asarray(cert.limits, dtype=float), e_d_min=nodes["e_d_min"], e_d_max=nodes["e_d_max"],
+                      e_z_max=nodes["e_z_max"], e_o_max=nodes["e_o_max"],
                       obstacle_margin=float(m.position[-1] + 0.5 * cert.dt * rates[3]), rho_tilde=0.0, sigma=0.0,
-                      margins=margins, rates=rates, tube=np.zeros(3), certified=True, **common)
+                      margins=margins, rates=rates, tube=np.zeros(3), certified=True, **_common(cert))
+
+
+def _tracking_nodes(cert) -> dict[str, float]:
+    """The FHOCP's e-node bounds of a safe-only tightening: the best-effort ones of the tracking design.
+
+    Nothing is promised about e there (plan acceptance checks positions only); keeping the tracking
+    design's margins at the nodes keeps the plans' e_d off ε as the best-effort run would.
+    """
+    d = cert.design
+    if not (d.tube.certified and d.margins is not None):
+        reg = cert.region
+        return {"e_d_min": reg.e_d[0], "e_d_max": reg.e_d[1], "e_z_max": min(-reg.e_z[0], reg.e_z[1]),
+                "e_o_max": min(-reg.e_o[0], reg.e_o[1])}
+    margins = _clamped(cert, np.column_stack([d.margins.e_d, d.margins.e_z, d.margins.e_o, d.margins.position]))
+    return _node_bounds(cert, np.where(np.isfinite(margins), margins, 0.0), np.asarray(d.rates, dtype=float))
 
 
 def tightening_of(cert, min_input_fraction: float = 0.5) -> Tightening:

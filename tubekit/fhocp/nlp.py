@@ -279,8 +279,8 @@ class BackupTerminal:
 
     @classmethod
     def of(cls, scenario: Scenario, tightening: Tightening) -> "BackupTerminal | None":
-        """The terminal rows of ``tightening.backup`` on ``scenario`` (None without a backup)."""
-        backup = tightening.backup
+        """The terminal rows of ``tightening.terminal_backup`` on ``scenario`` (None without a certified backup)."""
+        backup = tightening.terminal_backup
         if backup is None:
             return None
         r_f, h_f = backup.footprint(scenario.vehicle_radius)

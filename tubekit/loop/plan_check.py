@@ -11,7 +11,7 @@ follows), that
   |e_o| <= e_o_max - M_o[j], and the heading stays in the certified hemisphere;
 * the vehicle ball inflated by M_pos[j] is clear of every known obstacle and
   inside the workspace;
-* when the tightening has a backup (``tightening.backup``), the plan's nominal end position
+* when the tightening has a certified backup (``tightening.terminal_backup``), the plan's nominal end position
   meets the terminal condition (:func:`tubekit.loop.terminal.terminal_condition`: the backup's
   safe set there, inflated by the vehicle ball, is clear of every known obstacle, inside the
   workspace and inside the region sensed from ``x0``);
@@ -97,9 +97,9 @@ def tracking_checked(tight: Tightening) -> bool:
 def _terminal_slack(scenario: Scenario, tight: Tightening, x0: np.ndarray, end: np.ndarray,
                     obstacles: Sequence[Obstacle]) -> dict[str, np.ndarray]:
     """The terminal condition's slack (m) under "terminal: <part>", empty without a backup."""
-    if tight.backup is None:
+    if tight.terminal_backup is None:
         return {}
-    check = terminal_condition(end[:3], tight.backup, scenario.vehicle_radius, obstacles, scenario.workspace,
+    check = terminal_condition(end[:3], tight.terminal_backup, scenario.vehicle_radius, obstacles, scenario.workspace,
                                np.asarray(x0, dtype=float)[:3], scenario.sensing_range)
     return {f"terminal: {check.reason}": np.array([check.slack if check.ok else min(check.slack, -1e-12)])}
 

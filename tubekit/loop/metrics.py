@@ -250,6 +250,16 @@ def _velocity_error_max(c: Mapping[str, np.ndarray]) -> list[float | None] | Non
     return [_nanmax_or_none(np.abs(err[:, j])) for j in range(3)]
 
 
+def _circle_figures(pos: np.ndarray, des: np.ndarray, scenario: Scenario) -> tuple[Any, Any, Any, Any]:
+    """(centre, encirclements, desired encirclements, obstacle passes) of a circular target; Nones otherwise."""
+    traj = scenario.trajectory
+    if not isinstance(traj, Circle):  # Helix is a Circle
+        return None, None, None, None
+    center = [float(traj.center[0]), float(traj.center[1])]
+    return (center, encirclements(pos, center, traj.rate), encirclements(des, center, traj.rate),
+            obstacle_passes(pos, center, traj.rate, scenario.obstacles))
+
+
 def compute_metrics(columns: Mapping[str, np.ndarray], scenario: Scenario, *,
                     rho_bound: float | None = None, sway_bound: float | None = None,
                     extra: Mapping[str, Any] | None = None) -> dict[str, Any]:
@@ -281,14 +291,7 @@ def compute_metrics(columns: Mapping[str, np.ndarray], scenario: Scenario, *,
     i_ed = int(np.argmin(e_d))
     ratio = input_ratio(inputs[applied], lim)
     sat = c["saturated"] > 0.5
-    traj = scenario.trajectory
-    if isinstance(traj, Circle):  # Helix is a Circle
-        center = [float(traj.center[0]), float(traj.center[1])]
-        enc = encirclements(pos, center, traj.rate)
-        enc_d = encirclements(des, center, traj.rate)
-        passes = obstacle_passes(pos, center, traj.rate, scenario.obstacles)
-    else:
-        center, enc, enc_d, passes = None, None, None, None
+    center, enc, enc_d, passes = _circle_figures(pos, des, scenario)
     first = np.isfinite(c["step_ms"])
     m = {
         "scenario": scenario.name,

@@ -28,6 +28,7 @@ import numpy as np
 
 from tubekit.exceptions import ConfigError
 from tubekit.model.backup import BackupPlan, axis_angle, line_of_sight_angle, station_keeping_input
+from tubekit.plant.kinematic import rk4_tuple
 from verify.falsify.outcome import SearchOutcome
 
 __all__ = ["backup_lyapunov", "handover_start", "simulate_backup", "BackupRun", "BackupAttack",
@@ -66,17 +67,14 @@ def handover_start(plan: BackupPlan, unit: np.ndarray) -> np.ndarray:
 
 
 def _rk4_tick(state: np.ndarray, v: tuple[float, float, float], omega: np.ndarray, tick: float) -> np.ndarray:
-    """The kinematic plant over one tick, ``v`` and ``omega`` held (RK4, :data:`_SUBSTEPS` steps)."""
-    def rhs(x: np.ndarray) -> np.ndarray:
-        return np.array([v[0] * math.cos(x[3]) + omega[0], v[0] * math.sin(x[3]) + omega[1], v[1] + omega[2], v[2]])
-    h = tick / _SUBSTEPS
-    for _ in range(_SUBSTEPS):
-        k1 = rhs(state)
-        k2 = rhs(state + 0.5 * h * k1)
-        k3 = rhs(state + 0.5 * h * k2)
-        k4 = rhs(state + h * k3)
-        state = state + h / 6.0 * (k1 + 2 * k2 + 2 * k3 + k4)
-    return state
+    """The kinematic plant ẋ = f(x) v + ω over one tick, ``v`` and ``omega`` held: the plant's own RK4
+    (:func:`tubekit.plant.kinematic.rk4_tuple`, :data:`_SUBSTEPS` steps)."""
+    w1, w2, w3 = (float(c) for c in omega)
+
+    def rhs(t: float, x: tuple, vv: tuple) -> tuple[float, float, float, float]:
+        return (vv[0] * math.cos(x[3]) + w1, vv[0] * math.sin(x[3]) + w2, vv[1] + w3, vv[2])
+
+    return np.array(rk4_tuple(rhs, 0.0, tuple(map(float, state)), v, tick / _SUBSTEPS, _SUBSTEPS))
 
 
 def simulate_backup(plan: BackupPlan, start: np.ndarray, adversary: Adversary, *, tick: float,

@@ -64,7 +64,7 @@ from tubekit.checks import require_one_period
 from tubekit.model.ancillary import AncillaryLaw, get_law
 from tubekit.exceptions import ConfigError, SolverError
 from tubekit.loop.memory import ZERO_INPUT, PlanMemory
-from tubekit.loop.plan_check import check_plan, plan_arcs
+from tubekit.loop.plan_check import PlanCheck, check_plan
 from tubekit.model.backup import station_keeping_input
 from tubekit.plant.base import OmegaOverride, PlantModel
 from tubekit.plant.factory import make_plant
@@ -262,21 +262,15 @@ class _ClosedLoop:
         except SolverError:
             first, usable = _ZERO_INPUT, False
         self.log.record_solve(k, k * self.clock.ticks, result, time.perf_counter() - c0)
-        accepted = usable and self.accept(k, tk, xk, result, known)
-        if accepted:
+        check = self.accept(k, tk, xk, result, known) if usable else None
+        if check is not None and check.ok:
             checked = self.tightening.horizon_arcs > 0
-            end = self.plan_end(xk, result.inputs) if checked else None
-            flagged = self.memory.remember(result, accepted=checked, end=end)
+            flagged = self.memory.remember(result, accepted=checked, end=check.end)
             self.log.plan_age[k] = self.memory.age
             return first, flagged, False
         v_hat = self.memory.replacement()
         self.log.plan_age[k] = self.memory.age
         return v_hat, True, True
-
-    def plan_end(self, xk: np.ndarray, inputs: np.ndarray) -> np.ndarray:
-        """The nominal end state (4,) of an accepted plan over the certified horizon (the backup's anchor)."""
-        plan = np.asarray(inputs, dtype=float)[:self.tightening.horizon_arcs]
-        return plan_arcs(xk, plan, self.scenario.controller.dt, 1)[-1, -1]
 
     def backup_anchor(self, k: int, xk: np.ndarray) -> np.ndarray | None:
         """p* (3,) for period ``k`` when the replayed plan is exhausted and a backup exists, else None.
@@ -296,14 +290,18 @@ class _ClosedLoop:
             self.memory.anchor = np.asarray(xk, dtype=float)[:3].copy()
         return self.memory.anchor
 
-    def accept(self, k: int, tk: float, xk: np.ndarray, result: FhocpResult, known: tuple[Obstacle, ...]) -> bool:
-        """Exact arc check of the plan against the certificate's margins (always True without margins)."""
+    def accept(self, k: int, tk: float, xk: np.ndarray, result: FhocpResult,
+               known: tuple[Obstacle, ...]) -> PlanCheck:
+        """Exact arc check of the plan against the certificate's margins (ok, with no end, without margins).
+
+        The check's ``end`` is the accepted plan's nominal end: the backup's anchor.
+        """
         if self.tightening.horizon_arcs == 0:
-            return True
+            return PlanCheck(True, math.inf, "no margins")
         check = check_plan(self.scenario, self.tightening, tk, xk, result.inputs, known, self.sign)
         self.log.plan_slack[k] = check.slack
         self.log.rejected[k] = not check.ok
-        return check.ok
+        return check
 
     def ancillary(self, i: int, xs: np.ndarray, x_hat: np.ndarray) -> np.ndarray:
         """κ (3,) at tick ``i``; zero (and counted) when the law fails."""

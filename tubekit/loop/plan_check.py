@@ -48,11 +48,13 @@ SAMPLES_PER_ARC = 10
 
 @dataclass(frozen=True)
 class PlanCheck:
-    """Outcome of :func:`check_plan`: ``ok``, the smallest slack (error units or m) and where it is."""
+    """Outcome of :func:`check_plan`: ``ok``, the smallest slack (error units or m), where it is, and
+    the plan's nominal end state ``end`` (4,) over the certified horizon (None when not rolled out)."""
 
     ok: bool
     slack: float
     where: str
+    end: np.ndarray | None = None
 
 
 def plan_arcs(x0: np.ndarray, inputs: np.ndarray, dt: float, samples: int) -> np.ndarray:
@@ -128,4 +130,4 @@ def check_plan(scenario: Scenario, tight: Tightening, t0: float, x0: np.ndarray,
     slacks.update(_position_slacks(scenario, arcs[..., :3], m[:, 3:4] + pad[3], obstacles))
     worst_name, worst = min(((k, float(np.min(v))) for k, v in slacks.items()), key=lambda kv: kv[1],
                             default=("nothing to check", math.inf))
-    return PlanCheck(ok=worst >= 0.0 and not math.isnan(worst), slack=worst, where=worst_name)
+    return PlanCheck(ok=worst >= 0.0 and not math.isnan(worst), slack=worst, where=worst_name, end=arcs[-1, -1])

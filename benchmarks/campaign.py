@@ -26,7 +26,8 @@ import time
 from pathlib import Path
 
 from tubekit.app.campaign import RunTask, certify_plans, open_client, simulate_task
-from tubekit.app.campaign_spec import certificate_key, spec_from_dict
+from tubekit.app.campaign_spec import spec_from_dict
+from tubekit.app.certified import input_key
 
 __all__ = ["measure", "main"]
 
@@ -40,7 +41,7 @@ def _tasks(runs: int, duration: float) -> list[RunTask]:
                                       "disturbance.period": {"uniform": [8.0, 20.0]}}})
     plans = [spec.plan(k) for k in range(runs)]
     certs = certify_plans(plans)
-    return [RunTask(p.run, p.seed, p.scenario, certs[certificate_key(p.scenario)], 0) for p in plans]
+    return [RunTask(p.run, p.seed, p.scenario, certs[input_key(p.scenario)], 0) for p in plans]
 
 
 def _timed(workers: int, tasks: list[RunTask]) -> dict:

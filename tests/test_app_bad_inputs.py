@@ -71,7 +71,7 @@ CASES = [
     # sizes
     Case("duration-1e9", "duration", 'duration = 1e9\n'),
     Case("duration-1e6", "duration", 'duration = 1e6\n'),
-    Case("rate-1e9-hz", "duration", '[controller]\nancillary_rate_hz = 1e9\n'),
+    Case("rate-1e9-hz", "controller.ancillary_rate_hz", '[controller]\nancillary_rate_hz = 1e9\n'),
     Case("cli-duration-1e9", "duration", args=("--duration", "1e9")),
     Case("cli-duration-nan", "--duration", args=("--duration", "nan")),
     Case("duration-nan", "duration", 'duration = nan\n'),
@@ -115,6 +115,49 @@ CASES = [
     Case("certify-json-in-missing-dir", "--json", toml=None, command="certify",
          args=("--json", "nowhere/cert.json"), out=""),
     Case("audit-json-is-a-directory", "--json", toml=None, command="audit", args=("--json", "."), out=""),
+    # issue 24 item 1: products and counts that overflow, huge counts, output formats -- before any work
+    Case("duration-1e308", "duration", 'duration = 1e308\n'),
+    Case("cli-duration-max-float", "--duration", args=("--duration", "1.7976931348623157e308")),
+    Case("reproduce-duration-1e308", "--duration", toml=None, command="reproduce", args=("--duration", "1e308")),
+    Case("rate-times-dt-overflows", "controller.ancillary_rate_hz",
+         '[controller]\ndt = 10.0\nancillary_rate_hz = 1e308\nhorizon_steps = 1\n'),
+    Case("current-1e200", "disturbance.constant", '[disturbance]\nconstant = [1e200, 0.0, 0.0]\n'),
+    Case("envelope-plot-xyz", "--plot", toml=None, command="envelope", args=("--plot", "out.xyz"), out=""),
+    Case("certify-max-boxes-1e12", "--max-boxes", toml=None, command="certify", args=("--max-boxes", "10" * 6),
+         out=""),
+    Case("audit-samples-1e9", "--samples", toml=None, command="audit", args=("--samples", "1000000000"), out=""),
+    Case("falsify-budget-1e9", "--budget", toml=None, command="falsify", args=("--budget", "1000000000"), out=""),
+    Case("falsify-seed-negative", "--seed", toml=None, command="falsify", args=("--seed", "-1"), out=""),
+    Case("falsify-duration-1e308", "--duration", toml=None, command="falsify",
+         args=("--closed-loop", "--duration", "1e308"), out=""),
+    Case("campaign-workers-0", "--workers", command="campaign", args=("--workers", "0")),
+    Case("falsify-sigma-1e308", "--sigma", toml=None, command="falsify", args=("--sigma", "1e308"), out=""),
+    Case("sigma-1e308", "controller.sigma", '[controller]\nsigma = 1e308\n', command="certify", out=""),
+    Case("envelope-eps-1e308", "--eps", toml=None, command="envelope", args=("--eps", "1e308"), out=""),
+    # item 2: strict types; a target that leaves the workspace; one validation for every command
+    Case("duration-string", "duration", 'duration = "100"\n'),
+    Case("duration-bool", "duration", 'duration = true\n'),
+    Case("name-number", "name", 'name = 5\n'),
+    Case("horizon-bool", "controller.horizon_steps", '[controller]\nhorizon_steps = true\n'),
+    Case("circle-1e6", "trajectory", '[trajectory]\nkind = "circle"\nradius = 1e6\n'),
+    Case("certify-circle-1e6", "trajectory", '[trajectory]\nkind = "circle"\nradius = 1e6\n', command="certify",
+         out=""),
+    Case("certify-start-on-target", "initial_state", 'initial_state = [0.0, 3.0, 0.2, 0.0]\n', command="certify",
+         out=""),
+    Case("envelope-start-on-target", "initial_state", 'initial_state = [0.0, 3.0, 0.2, 0.0]\n',
+         command="envelope", out=""),
+    Case("falsify-start-on-target", "initial_state", 'initial_state = [0.0, 3.0, 0.2, 0.0]\n', command="falsify",
+         out=""),
+    Case("certify-duration-string", "duration", 'duration = "100"\n', command="certify", out=""),
+    # item 3: the error names the right field
+    Case("line-wrong-key", "['start', 'velocity']", '[trajectory]\nkind = "line"\nvel = [0.1, 0.0, 0.0]\n'),
+    Case("dt-1e-9", "controller.dt", '[controller]\ndt = 1e-9\n'),
+    # item 12: --law is one option everywhere
+    Case("simulate-law-unknown", "--law", args=("--law", "nonsense")),
+    Case("certify-law-unknown", "--law", command="certify", args=("--law", "nonsense"), out=""),
+    Case("falsify-law-unknown", "--law", command="falsify", args=("--law", "nonsense"), out=""),
+    Case("falsify-duration-without-closed-loop", "--duration", toml=None, command="falsify",
+         args=("--duration", "2"), out=""),
 ]
 
 
@@ -155,7 +198,7 @@ def test_bad_input(case: Case, tmp_path, monkeypatch, capsys):
 
 
 def test_table_is_large_enough():
-    assert len(CASES) >= 30
+    assert len(CASES) >= 60
 
 
 @pytest.mark.parametrize("text, field", [("\x00\xff binary", "CONFIG"), ("duration = 1e9\n", "duration")])
@@ -169,3 +212,26 @@ def test_bad_input_through_the_console_script(text, field, tmp_path):
     err = proc.stderr.strip()
     assert field in err and "Traceback" not in err and len(err.splitlines()) == 1
     assert not out.exists()
+
+
+@pytest.mark.parametrize("argv, field", [
+    (["simulate", "{cfg}", "--out", "{out}", "--duration", "1.7976931348623157e308"], "--duration"),
+    (["envelope", "--plot", "{out}.xyz"], "--plot"),
+    (["certify", "{cfg}"], "initial_state"),
+    (["simulate", "{cfg}", "--out", "{out}"], "initial_state"),
+])
+def test_issue_24_frictions_through_the_console_script(argv, field, tmp_path):
+    """Issue 24 items 1-2 as a user meets them: exit 2, one line naming the field, no traceback, nothing written.
+
+    The CONFIG puts the start exactly on the target (simulate and certify refuse it alike)."""
+    cfg = tmp_path / "on_target.toml"
+    cfg.write_text("initial_state = [0.0, 3.0, 0.2, 0.0]\n" if field == "initial_state" else "duration = 2.0\n")
+    out = tmp_path / "out"
+    args = [a.format(cfg=cfg, out=out) for a in argv]
+    before = _snapshot(tmp_path)
+    proc = subprocess.run([sys.executable, "-m", "tubekit.app.cli", *args], capture_output=True, text=True,
+                          timeout=600, cwd=tmp_path)  # a hang guard, not a verdict
+    err = proc.stderr.strip()
+    assert proc.returncode == 2, err
+    assert len(err.splitlines()) == 1 and field in err and "Traceback" not in err
+    assert _snapshot(tmp_path) == before

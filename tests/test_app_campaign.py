@@ -139,11 +139,43 @@ def test_an_interrupted_campaign_resumes_without_recomputing_finished_runs(seria
     for k in range(0, RUNS, 2):  # the state an interruption leaves: half the runs stored
         (out / "runs" / f"run_{k:06d}.json").unlink()
     kept = {p.name: p.stat().st_mtime_ns for p in (out / "runs").iterdir()}
+    certificates = {p.name: p.stat().st_mtime_ns for p in (out / "certificates").iterdir()}
     summary = run_campaign(load_spec(_spec(tmp_path)), out, workers=1, progress=False)
     assert summary["computed_runs"] == RUNS // 2 and summary["skipped_runs"] == RUNS - RUNS // 2
     assert {p.name: p.stat().st_mtime_ns for p in (out / "runs").iterdir() if p.name in kept} == kept
+    assert {p.name: p.stat().st_mtime_ns for p in (out / "certificates").iterdir()} == certificates  # reused
     assert _without_wall(read_rows(out)) == _without_wall(read_rows(serial))
     assert pq.read_table(out / "runs.parquet").num_rows == RUNS
+
+
+def test_each_distinct_certificate_is_stored_once_and_the_summary_gives_the_throughput(serial, tmp_path):
+    from tubekit.app.certified import read_cached
+
+    spec = load_spec(_spec(tmp_path))
+    plans = [spec.plan(k) for k in range(RUNS)]
+    distinct = {certificate_key(p.scenario) for p in plans}
+    stored = sorted((serial / "certificates").glob("*.json"))
+    assert len(stored) == len(distinct) >= 2
+    assert all(read_cached(serial / "certificates", p.scenario).certified for p in plans)
+    summary = json.loads((serial / "summary.json").read_text())
+    assert summary["distinct_certificates"] == len(distinct)
+    rate = summary["throughput"]
+    assert rate["simulated_s"] == RUNS * 2.0 * 2  # duration 2 s, the scenario's current and one sequence
+    assert rate["runs_per_minute"] == pytest.approx(60 * RUNS / summary["campaign_wall_s"])
+    assert rate["simulated_s_per_wall_s"] == pytest.approx(RUNS * 4.0 / summary["campaign_wall_s"])
+
+
+def test_a_stored_certificate_edited_after_issue_is_refused_exit_2(serial, tmp_path, capsys):
+    out = tmp_path / "out"
+    shutil.copytree(serial, out)
+    (out / "runs" / "run_000000.json").unlink()
+    path = sorted((out / "certificates").glob("*.json"))[0]
+    data = json.loads(path.read_text())
+    path.write_text(json.dumps({**data, "scenario": "edited"}), encoding="utf-8")
+    assert main(["campaign", str(_spec(tmp_path)), "--out", str(out), "--no-progress"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert f"{path.name}.checksum: expected the SHA-256 of the content" in err and len(err.splitlines()) == 1
+    assert not (out / "runs" / "run_000000.json").exists()
 
 
 def test_another_spec_into_the_same_directory_is_refused(serial, tmp_path, capsys):

@@ -157,3 +157,149 @@ def test_bad_input_exits_2_in_a_subprocess(tmp_path):
                          capture_output=True, text=True)
     assert out.returncode == 2 and len(out.stderr.strip().splitlines()) == 1
     assert out.stderr.startswith("tubekit simulate: error: CONFIG")
+
+
+# ---- issue 24 item 4: the campaign without its extra --------------------------------------------------------
+
+def _without_dask(monkeypatch):
+    import importlib.util
+
+    import tubekit.app.commands_study as commands_study
+
+    real = importlib.util.find_spec
+    monkeypatch.setattr(commands_study.importlib.util, "find_spec",
+                        lambda name, *a: None if name in ("distributed", "pyarrow") else real(name, *a))
+
+
+def test_campaign_help_lists_every_argument_without_dask(monkeypatch, capsys):
+    _without_dask(monkeypatch)
+    with pytest.raises(SystemExit):
+        main(["campaign", "--help"])
+    out = capsys.readouterr().out
+    assert all(word in out for word in ("SPEC", "--out DIR", "--workers N", "--scheduler", "--no-progress"))
+    assert 'pip install -e ".[campaign]"' in " ".join(out.split())  # argparse wraps the epilog
+
+
+def test_campaign_without_dask_is_one_line_naming_the_extra(monkeypatch, capsys, tmp_path):
+    _without_dask(monkeypatch)
+    spec = tmp_path / "small.toml"
+    spec.write_text("runs = 2\n")
+    assert main(["campaign", str(spec), "--out", str(tmp_path / "x")]) == 1
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and err.startswith("tubekit campaign: not available: distributed and pyarrow")
+    assert err.endswith('Try: pip install -e ".[campaign]"') and "Traceback" not in err
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["small.toml"]
+
+
+# ---- issue 24 item 10: a lock on --out ------------------------------------------------------------------------
+
+class _Done:
+    def check(self) -> bool:
+        return True
+
+
+def _fake_study(seen: list):
+    def run_study(scenario, out, **kwargs):
+        seen.append(sorted(p.name for p in out.parent.iterdir()))
+        return _Done()
+    return run_study
+
+
+def _simulate(tmp_path) -> list[str]:
+    cfg = tmp_path / "ok.toml"
+    cfg.write_text("duration = 2.0\n")
+    return ["simulate", str(cfg), "--out", str(tmp_path / "out"), "--no-progress"]
+
+
+def test_a_run_holds_the_lock_and_removes_it(tmp_path, monkeypatch):
+    import tubekit.app.study as study
+
+    seen: list = []
+    monkeypatch.setattr(study, "run_study", _fake_study(seen))
+    assert main(_simulate(tmp_path)) == 0
+    assert ".out.lock" in seen[0] and not (tmp_path / ".out.lock").exists()
+
+
+def test_the_lock_is_removed_on_errors(tmp_path, monkeypatch, capsys):
+    import tubekit.app.study as study
+    from tubekit.exceptions import SolverError
+
+    def failing(scenario, out, **kwargs):
+        assert (tmp_path / ".out.lock").exists()
+        raise SolverError("no plan")
+    monkeypatch.setattr(study, "run_study", failing)
+    assert main(_simulate(tmp_path)) == 1
+    assert not (tmp_path / ".out.lock").exists()
+
+
+def test_a_stale_lock_of_a_dead_process_is_taken_over(tmp_path, monkeypatch):
+    import tubekit.app.study as study
+
+    dead = subprocess.run([sys.executable, "-c", "import os; print(os.getpid())"], capture_output=True, text=True)
+    (tmp_path / ".out.lock").write_text(dead.stdout)  # that process has exited
+    seen: list = []
+    monkeypatch.setattr(study, "run_study", _fake_study(seen))
+    assert main(_simulate(tmp_path)) == 0
+    assert seen and not (tmp_path / ".out.lock").exists()
+
+
+def test_a_second_concurrent_run_refuses_with_one_line(tmp_path):
+    """Another process holds the lock (tubekit.app.output.OutputLock, as a run does): simulate exits 2 at once."""
+    holder = subprocess.Popen(
+        [sys.executable, "-c", "import sys, time\nfrom pathlib import Path\nfrom tubekit.app.output import OutputLock\n"
+         f"with OutputLock(Path({str(tmp_path / 'out')!r})):\n    print('locked', flush=True)\n"
+         "    sys.stdin.readline()\n"],
+        stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True)
+    try:
+        assert holder.stdout.readline().strip() == "locked"
+        lock = (tmp_path / ".out.lock").read_text()
+        proc = subprocess.run([sys.executable, "-m", "tubekit.app.cli", *_simulate(tmp_path)], capture_output=True,
+                              text=True, timeout=600)  # a hang guard, not a verdict
+        err = proc.stderr.strip()
+        assert proc.returncode == 2 and len(err.splitlines()) == 1 and "Traceback" not in err
+        assert err.startswith("tubekit simulate: error: --out: expected a directory no other tubekit run is writing")
+        assert f"pid {holder.pid}" in err
+        assert (tmp_path / ".out.lock").read_text() == lock and not (tmp_path / "out").exists()
+    finally:
+        holder.communicate("\n", timeout=60)
+    assert holder.returncode == 0 and not (tmp_path / ".out.lock").exists()
+
+
+# ---- issue 24 item 3: a full disk is the machine's fault: exit 1, the path ------------------------------------
+
+def test_a_full_disk_exits_1_naming_the_path(tmp_path, monkeypatch, capsys):
+    import errno
+
+    import tubekit.app.study as study
+    from tubekit.app.output import StagedOutput
+
+    def run_study(scenario, out, **kwargs):
+        with StagedOutput(out) as staged:
+            (staged.path / "metrics.json").write_text("{}")
+            raise OSError(errno.ENOSPC, "No space left on device")  # a write() names no file
+    monkeypatch.setattr(study, "run_study", run_study)
+    assert main(_simulate(tmp_path)) == 1
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1
+    assert err.startswith(f"tubekit simulate: cannot write {tmp_path / 'out'}: No space left on device")
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["ok.toml"]  # no staging directory, no lock left
+
+
+# ---- issue 24 item 11: Ctrl-C in a campaign: the workers ignore it, the client stops them ------------------
+
+def _child_sigint() -> str:
+    probe = "import signal; print('ignored' if signal.getsignal(signal.SIGINT) is signal.SIG_IGN else 'handled')"
+    return subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True).stdout.strip()
+
+
+def test_processes_started_in_the_block_ignore_ctrl_c():
+    """A dask worker spawned inside ``children_ignore_interrupts`` has SIGINT ignored (no KeyboardInterrupt
+    traceback of its own); the parent's handler is back after the block."""
+    import signal
+
+    from tubekit.app.exit_codes import children_ignore_interrupts
+
+    before, child_before = signal.getsignal(signal.SIGINT), _child_sigint()
+    with children_ignore_interrupts():
+        assert _child_sigint() == "ignored"
+    assert signal.getsignal(signal.SIGINT) is before and _child_sigint() == child_before

@@ -112,3 +112,76 @@ def test_envelope_cli_quick_writes_json_and_plot(tmp_path, capsys):
     assert 0 < d["ratio_min"] <= 1
     assert png.stat().st_size > 1000
     assert "ratio" in capsys.readouterr().out
+
+
+# ---- issue 24 item 12: certify -v, falsify on an uncertified scenario, --law the same everywhere ----------
+
+def test_certify_verbose_lists_every_sigma_tried_with_its_failures(capsys):
+    assert main(["certify", "-v"]) == 3
+    out = capsys.readouterr().out
+    cert = certify(paper_scenario())
+    assert f"Designs tried ({len(cert.tried)}):" in out
+    for trial in cert.tried:
+        assert f"{len(trial.failed)} failed: {', '.join(trial.failed)}" in out
+    assert main(["certify"]) == 3 and "Designs tried" not in capsys.readouterr().out
+
+
+def test_certify_quiet_prints_no_summary(capsys):
+    assert main(["certify", "-q"]) == 3
+    assert capsys.readouterr().out == ""
+
+
+class _FakeSpace:
+    def __init__(self, certified: bool) -> None:
+        self.certified = certified
+
+
+class _FakeResult:
+    def __init__(self, found: bool, certified: bool) -> None:
+        self.found, self.space = found, _FakeSpace(certified)
+
+    def summary(self) -> str:
+        return "COUNTEREXAMPLE found" if self.found else "no counterexample"
+
+    def to_dict(self) -> dict:
+        return {"found": self.found}
+
+
+@pytest.mark.parametrize("found, certified, code, note", [
+    (False, True, 0, False), (True, True, 3, False), (False, False, 3, True), (True, False, 3, True),
+])
+def test_falsify_says_when_it_tested_a_best_effort_tube(found, certified, code, note, monkeypatch, capsys):
+    """0 only when a certified scenario resists; an uncertified one exits 3 and says its tube promises nothing."""
+    import verify.falsify.one_period as one_period
+
+    monkeypatch.setattr(one_period, "falsify", lambda *a, **k: _FakeResult(found, certified))
+    assert main(["falsify", "--budget", "1"]) == code
+    out = capsys.readouterr().out
+    assert ("tested its best-effort tube, which promises nothing" in out) is note
+
+
+LAW_COMMANDS = ("reproduce", "simulate", "certify", "envelope", "falsify")
+
+
+def test_law_is_one_option_everywhere():
+    """``--law NAME``, one help, validated by one function (the bad-input table checks each refusal)."""
+    from tubekit.app.cli import build_parser
+
+    sub = next(a for a in build_parser()._actions if a.dest == "command")
+    laws = []
+    for name in LAW_COMMANDS:
+        action = next(a for a in sub.choices[name]._actions if a.dest == "law")
+        laws.append((action.metavar, action.choices, action.help, action.default))
+    assert len(set(laws)) == 1 and laws[0][0] == "NAME" and laws[0][1] is None
+
+
+def test_quiet_help_is_per_subcommand():
+    from tubekit.app.cli import build_parser
+
+    sub = next(a for a in build_parser()._actions if a.dest == "command")
+
+    def quiet(name):
+        return next(a.help for a in sub.choices[name]._actions if a.dest == "quiet")
+    assert "no summary" in quiet("certify")
+    assert all("certify" not in quiet(name) and "summary" not in quiet(name) for name in sub.choices
+               if name != "certify")

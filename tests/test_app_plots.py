@@ -59,20 +59,79 @@ def _tightening(sc, margin=0.1):
     return replace(base, obstacle_margin=margin, v_max=base.v_max * 0.8, rho_tilde=0.05)
 
 
-def test_top_view_tube_time_ticks_markers_and_outside_legend(short_run):
+def _legend_texts(fig) -> list[str]:
+    return [t.get_text() for ax in fig.axes if ax.get_legend() for t in ax.get_legend().get_texts()]
+
+
+def test_top_view_tube_time_ticks_markers_and_a_legend_beside_the_view(short_run):
     sc, cols = short_run
     fig = top_view(sc, [("baseline", cols)], tightening=_tightening(sc))
     from matplotlib.backends.backend_agg import FigureCanvasAgg
 
     FigureCanvasAgg(fig).draw()
     ax = fig.axes[0]
-    labels = [t.get_text() for t in ax.get_legend().get_texts()]
+    labels = _legend_texts(fig)
     assert any("position tube" in s for s in labels)
     assert any(s.startswith("start") for s in labels) and any(s.startswith("end of baseline") for s in labels)
     assert any("sensing range" in s for s in labels)
     assert any(t.get_text().endswith(" s") for t in ax.texts)  # time ticks on the path
-    legend_box = ax.get_legend().get_window_extent()
-    assert legend_box.x0 >= ax.get_window_extent().x1  # the legend sits outside the axes
+    legend = next(a.get_legend() for a in fig.axes if a.get_legend())
+    assert legend.get_window_extent().x0 >= ax.get_window_extent().x1  # the legend sits beside the view
+    assert max(t.get_fontsize() for t in legend.get_texts()) <= 7  # small: the view keeps the canvas
+
+
+def test_top_view_side_view_shows_the_closest_approach_in_mm(short_run):
+    """The side view's marker sits at the run's smallest clearance, computed here from the positions."""
+    sc, cols = short_run
+    fig = top_view(sc, [("baseline", cols)])
+    p = np.column_stack([cols["x"], cols["y"], cols["z"]])
+    gaps = np.min([np.linalg.norm(p - np.asarray(o.center), axis=1) - o.radius - sc.vehicle_radius
+                   for o in sc.obstacles], axis=0)
+    label = f"baseline: min clearance {1e3 * gaps.min():+.1f} mm"
+    assert label in _legend_texts(fig)
+    side = [a for a in fig.axes if a.get_xlabel().startswith("horizontal distance")]
+    assert side and side[0].child_axes, "no zoomed inset on the closest approach"
+
+
+def _rho_columns():
+    """Two periods of 4 ticks (9 rows); the pre-reset peak of a period is logged on its last row."""
+    t = np.arange(9) * 0.025
+    step = np.array([0, 0, 0, 0, 1, 1, 1, 1, 2])
+    rho = {"rho_d": [0, .01, -.05, .02, .03, 0, .04, -.08, .06], "rho_z": [0, .1, .1, .1, .1, .2, .2, .2, .2],
+           "rho_o": [0, 0, 0, 0, .3, 0, 0, 0, -.1]}
+    return {"t": t, "step": step, **{k: np.array(v) for k, v in rho.items()}, "backup_active": np.zeros(9)}
+
+
+def test_rho_figure_plots_the_per_axis_box_ratio():
+    """Per axis, the per-period peak of |rho_j| / tube_j: rows 1..4 and 5..8, by hand."""
+    from tubekit.app.plots import rho_figure
+
+    fig = rho_figure([("tube", _rho_columns())], (0.1, 0.25, 0.4), True)
+    want = {0: [0.5, 0.8], 1: [0.4, 0.8], 2: [0.75, 0.25]}
+    for j, ax in enumerate(fig.axes):
+        data = [ln.get_ydata() for ln in ax.get_lines() if ln.get_label().startswith("tube")]
+        assert np.allclose(data[0], want[j])
+        assert any(np.allclose(ln.get_ydata(), 1.0) for ln in ax.get_lines())  # the box the promise checks
+    assert "largest 0.8" in fig.get_suptitle()
+
+
+def test_rho_figure_without_a_tube_shows_the_deviation_itself():
+    from tubekit.app.plots import rho_figure
+
+    fig = rho_figure([("tube", _rho_columns())], (0.0, 0.0, 0.0), False)
+    data = [ln.get_ydata() for ln in fig.axes[0].get_lines() if ln.get_label().startswith("tube")]
+    assert np.allclose(data[0], [0.05, 0.08]) and "(m)" in fig.axes[0].get_ylabel()
+    assert "nothing promised" in fig.get_suptitle()
+
+
+def test_rho_figure_leaves_out_the_backup_ticks():
+    from tubekit.app.plots import rho_figure
+
+    cols = _rho_columns()
+    cols["backup_active"][7] = 1.0  # the -0.08 of e_d is under the backup law: not promised, not drawn
+    data = [ln.get_ydata() for ln in rho_figure([("tube", cols)], (0.1, 0.25, 0.4), True).axes[0].get_lines()
+            if ln.get_label().startswith("tube")]
+    assert np.allclose(data[0], [0.5, 0.6])
 
 
 def test_period_envelope_is_min_max_per_period(short_run):
@@ -117,6 +176,24 @@ def test_animation_gif(tmp_path, short_run):
     assert paths[0].name == ANIMATION_GIF
     with Image.open(paths[0]) as gif:
         assert gif.n_frames == 8
+        first = np.asarray(gif.convert("RGB"))
+        gif.seek(7)
+        last = np.asarray(gif.convert("RGB"))
+    assert first.shape == last.shape and not np.array_equal(first, last)  # the vehicle moved
+
+
+def test_animation_legend_is_readable_and_below_the_view(short_run):
+    """The GIF's legend: at least 9 pt, below the axes and inside the figure."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+
+    from tubekit.app.animate import _build_frame
+
+    sc, cols = short_run
+    fig, lines, balls, _, _, _ = _build_frame(sc, [("baseline", cols)])
+    legend = fig.legends[0]
+    assert min(t.get_fontsize() for t in legend.get_texts()) >= 9  # readable at the GIF's size
+    FigureCanvasAgg(fig).draw()
+    assert legend.get_window_extent().y1 <= fig.axes[0].get_window_extent().y0  # below the axes, inside
 
 
 def test_plot_run_is_the_figure_of_a_run():

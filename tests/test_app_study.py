@@ -274,7 +274,7 @@ def test_metrics_json_is_the_runs_metrics_key_for_key(certified, tmp_path, monke
     assert isinstance(result, StudyResult) and result.to_dict() == stored
     assert {k: v for k, v in stored.items() if k not in STUDY_KEYS} == result.tube.run.metrics
     assert stored["baseline"] == result.baseline.run.metrics
-    dynamic_only = ("failures", "vehicle", "tracking_bound", "tiers_report")
+    dynamic_only = ("failures", "vehicle", "velocity_loop", "tiers_report")
     assert {k: v for k, v in stored["dynamic"].items() if k not in dynamic_only} == result.dynamic.run.metrics
     assert stored["sway_bound"] == 0.02 and stored["max_rho_ratio"] is None and "promises" in stored
     # the fake certified certificate's zero tube is broken by any disturbed run: check() fails only then

@@ -5,9 +5,10 @@ from __future__ import annotations
 import pytest
 
 from tubekit.checks import (LOG_BYTES_PER_TICK, MAX_HORIZON_STEPS, MEMORY_BUDGET_BYTES, RUNS_PER_STUDY,
-                            check_horizon_and_limits, check_log_size, check_run_inputs, check_start, horizon_reach,
-                            log_bytes, require_one_period, workspace_fits, workspace_rule)
+                            check_horizon_and_limits, check_log_size, check_run_inputs, check_start, check_target,
+                            horizon_reach, log_bytes, require_one_period, workspace_fits, workspace_rule)
 from tubekit.exceptions import ConfigError
+from tubekit.model.trajectory import Circle, Line
 from tubekit.scenario import paper_scenario, scenario_from_dict
 
 
@@ -113,3 +114,28 @@ def test_fhocp_and_pre_run_check_share_the_workspace_rule():
     with pytest.raises(ConfigError, match=r"^scenario\.workspace: expected x and y extents > 2 \(vehicle_radius \+ "
                                           r"obstacle_margin \+ u_max T\)"):
         FHOCP(narrow, Tightening.untightened(narrow))
+
+
+@pytest.mark.parametrize("trajectory, instant", [
+    (Circle(radius=1e6), "p_d(0 s) = [0, 1e+06, 0] m is 1e+06 m outside"),        # the issue's circle
+    (Line(start=(0.0, 0.0, 0.0), direction_velocity=(1.0, 0.0, 0.0)), "p_d(100 s) = [100, 0, 0] m is 90 m outside"),
+])
+def test_a_target_path_that_leaves_the_workspace_is_refused(trajectory, instant):
+    """Issue 24 item 2: the target must stay in the workspace box over the run (x in [-10, 10] m, by hand)."""
+    sc = paper_scenario().with_changes(trajectory=trajectory, obstacles=(), initial_state=(-2.0, 0.0, 0.0, 0.0))
+    with pytest.raises(ConfigError, match=r"^trajectory: expected a target path p_d\(t\) inside the workspace") as err:
+        check_target(sc)
+    assert instant in str(err.value)
+
+
+def test_a_target_path_inside_the_workspace_passes():
+    line = Line(start=(0.0, 0.0, 0.0), direction_velocity=(0.05, 0.0, 0.0))  # 5 m in 100 s: inside
+    check_target(paper_scenario().with_changes(trajectory=line))
+    check_target(paper_scenario().with_changes(workspace=None, trajectory=Circle(radius=1e6)))  # no box: no check
+
+
+@pytest.mark.parametrize("duration", [1e308, 1.7976931348623157e308, 1e10])
+def test_require_one_period_refuses_counts_that_overflow(duration):
+    """Issue 24 item 1: duration / dt beyond MAX_PERIODS (or beyond a float) is a ConfigError, not OverflowError."""
+    with pytest.raises(ConfigError, match=r"^--duration: expected at most 1e\+09 FHOCP periods of 0\.1 s"):
+        require_one_period("--duration", duration, 0.1)

@@ -92,12 +92,17 @@ def test_sqpmethod_peer_solves_the_same_nlp():
         IpoptFHOCP(SC, tightening(), nlp_solver="snopt")
     t, state = STATES[0]
     N = SC.controller.horizon_steps
-    sqp = IpoptFHOCP(SC, tightening(), nlp_solver="sqpmethod", warm_start_duals=True)
+    # the paper's NLP (no rate penalty: qrqp fails on its node-to-node coupling, a fallback below)
+    sqp = IpoptFHOCP(SC, tightening(), nlp_solver="sqpmethod", warm_start_duals=True, rate_penalty=0.0)
     a = sqp.solve(t, np.array(state), SC.obstacles, initial_inputs=np.zeros((N, 3)))
-    b = IpoptFHOCP(SC, tightening()).solve(t, np.array(state), SC.obstacles, initial_inputs=np.zeros((N, 3)))
+    b = IpoptFHOCP(SC, tightening(), rate_penalty=0.0).solve(t, np.array(state), SC.obstacles,
+                                                             initial_inputs=np.zeros((N, 3)))
     assert not a.fallback and a.status in ("optimal", "optimal_inaccurate")
     assert abs(a.merit - b.merit) <= 1e-2 * max(1.0, abs(b.merit))
     assert not sqp.solve(t + SC.controller.dt, np.array(state), SC.obstacles).fallback  # dual warm start
+    coupled = IpoptFHOCP(SC, tightening(), nlp_solver="sqpmethod", rate_penalty=1.0)
+    failed = coupled.solve(t, np.array(state), SC.obstacles, initial_inputs=np.zeros((N, 3)))
+    assert np.all(np.isfinite(failed.inputs)) and (failed.fallback or failed.status == "optimal")  # no exception
 
 
 def test_ipopt_carries_the_backup_terminal_rows_where_they_bind():
@@ -111,3 +116,20 @@ def test_ipopt_carries_the_backup_terminal_rows_where_they_bind():
     end = plan_arcs(s, res.inputs, sc.controller.dt, 1)[-1, -1]
     check = terminal_condition(end[:3], backup_plan(), sc.vehicle_radius, (), sc.workspace, s[:3], sc.sensing_range)
     assert check.ok and check.slack < 5e-3 and res.violations["backup_terminal"] <= 1e-6   # it binds
+
+
+def test_ipopt_meets_the_rate_rows_and_agrees_with_the_scp():
+    """The same rate rows (steps, first node, terminal rest with a backup) and rate penalty in both backends."""
+    pytest.importorskip("casadi")
+    from tubekit.fhocp.ipopt import IpoptFHOCP
+    sc = SC.with_changes(**{"limits.rate": [1.0, 1.0, 2.0]})
+    tight = dataclasses.replace(tightening(sc), backup=backup_plan())
+    t, s = CASES[2]
+    v_last = np.array([0.35, -0.2, 0.4])
+    a = FHOCP(sc, tight, mode="converged").solve(t, np.array(s), sc.obstacles, v_last=v_last)
+    b = IpoptFHOCP(sc, tight, max_obstacles=1).solve(t, np.array(s), sc.obstacles, v_last=v_last)
+    jump = np.array(sc.limits.rate) * sc.controller.dt
+    for res in (a, b):
+        steps = np.abs(np.diff(np.vstack([v_last, res.inputs]), axis=0))
+        assert np.all(steps <= jump) and np.all(np.abs(res.inputs[-1]) <= jump)
+    assert b.status == "optimal" and abs(a.merit - b.merit) <= 1e-2 * abs(b.merit)

@@ -8,10 +8,13 @@ import warnings
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from tubekit import ConfigError, Obstacle, ShapeError
 from tubekit.fhocp import FHOCP, FallbackWarning, FhocpResult, ScpOptions
 from tubekit.fhocp.nlp import rollout, select_obstacles
+from tubekit.fhocp.rows import RATE_MARGIN
 from tubekit.loop.plan_check import plan_arcs
 from tubekit.loop.terminal import terminal_condition
 
@@ -61,7 +64,9 @@ def test_realtime_plans_along_a_run_keep_conservative_constraints():
         res = solver.solve(t, s, OBSTACLES)
         assert not res.fallback and (k == 0 or res.iterations == 1)
         v = res.violations
-        assert v["obstacle"] <= 1e-7 and v["e_d_min"] <= 1e-7     # half-spaces are inner approximations
+        # half-spaces are inner approximations of the linearised step: what remains is the rollout's
+        # departure from it, second order in the one real-time step (measured 1.4e-6 m at most here)
+        assert v["obstacle"] <= 1e-5 and v["e_d_min"] <= 1e-5
         assert v["input"] == 0.0 and v["dynamics"] <= 1e-12
         s, t = res.states[1], t + SC.controller.dt
 
@@ -294,3 +299,65 @@ def test_without_a_backup_the_problem_is_unchanged():
     assert "slack_backup" not in names and not any(n.startswith("rt") for n in solver.parameters)
     with_backup = FHOCP(SC, dataclasses.replace(tightening(SC), backup=backup_plan()))
     assert "slack_backup" in {v.name() for v in with_backup.problem.variables()}
+
+
+# ---- the command-rate rows and the rate penalty (issue 22 item 2, issue 24 item 8) -------------------------
+
+RATED = SC.with_changes(**{"limits.rate": [1.0, 1.0, 2.0]})   # J = (0.1, 0.1, 0.2): (N + 1) J covers V
+
+
+def _rows_by_hand(inputs, v_last, jump, rest):
+    """Largest excess of |step|, |v_0 - v_last| and (rest) |v_{N-1}| over J, computed here from the plan."""
+    steps = np.abs(np.diff(np.vstack([v_last, inputs]), axis=0)) - jump
+    worst = float(steps.max())
+    return max(worst, float(np.max(np.abs(inputs[-1]) - jump))) if rest else worst
+
+
+@pytest.fixture(scope="module")
+def rated():
+    tight = dataclasses.replace(tightening(RATED), backup=backup_plan())
+    return {m: FHOCP(RATED, tight, mode=m) for m in ("realtime", "converged")}
+
+
+@given(v_last=st.tuples(st.floats(-0.4, 0.4), st.floats(-0.3, 0.3), st.floats(-0.5, 0.5)),
+       case=st.sampled_from(range(len(STATES))), mode=st.sampled_from(["realtime", "converged"]))
+@settings(max_examples=20)
+def test_every_plan_meets_the_rate_rows_from_any_last_command(rated, v_last, case, mode):
+    """Property: from any v_last inside V, the plan meets (a) steps, (b) the first node and (c) the terminal
+    rest against J, within the solver's tolerance (Clarabel's 1e-7) below the imposed J (1 - RATE_MARGIN)."""
+    solver = rated[mode]
+    solver.reset()
+    t, s = STATES[case]
+    jump = np.array(RATED.limits.rate) * RATED.controller.dt
+    res = solver.solve(t, np.array(s), OBSTACLES, v_last=np.array(v_last))
+    assert _rows_by_hand(res.inputs, np.array(v_last), jump * (1 - RATE_MARGIN), True) <= 1e-7
+    assert _rows_by_hand(res.inputs, np.array(v_last), jump, True) <= 0.0 and res.violations["rate"] <= 1e-7
+    nxt = solver.solve(t + RATED.controller.dt, res.states[1], OBSTACLES, v_last=res.inputs[0])  # warm start
+    assert _rows_by_hand(nxt.inputs, res.inputs[0], jump, True) <= 0.0
+
+
+def test_without_a_backup_there_is_no_terminal_rest_and_without_a_rate_no_rows():
+    t, s = STATES[2]
+    free = FHOCP(RATED, tightening(RATED)).solve(t, np.array(s), OBSTACLES, v_last=np.zeros(3))
+    jump = np.array(RATED.limits.rate) * RATED.controller.dt
+    assert _rows_by_hand(free.inputs, np.zeros(3), jump, False) <= 0.0
+    assert not FHOCP(RATED, tightening(RATED)).nlp.terminal_rest
+    plain = FHOCP(SC, tightening(SC))
+    assert plain.nlp.rate_jump is None and "jb" not in plain.parameters
+
+
+def test_the_rate_penalty_smooths_the_plan_and_zero_restores_the_paper_cost():
+    t, s = STATES[1]
+    plain = FHOCP(SC, tightening(), mode="converged", options=ScpOptions(rate_penalty=0.0))
+    smooth = FHOCP(SC, tightening(), mode="converged", options=ScpOptions(rate_penalty=100.0))
+    a = plain.solve(t, np.array(s), OBSTACLES, v_last=np.zeros(3))
+    b = smooth.solve(t, np.array(s), OBSTACLES, v_last=np.zeros(3))
+    rough = lambda v: float(np.sum(np.diff(np.vstack([np.zeros(3), v]), axis=0) ** 2))  # noqa: E731
+    assert rough(b.inputs) < rough(a.inputs)
+    # lambda = 0: the cost is the stage + terminal cost alone, recomputed here from the plan
+    e = plain.nlp.errors(a.states, plain.nlp.reference(SC.trajectory, t))
+    w = np.vstack([np.tile(SC.controller.dt * np.array(SC.controller.Q), (len(a.inputs), 1)), SC.controller.P])
+    by_hand = float(np.sum(w * e * e) + SC.controller.dt * np.sum(np.array(SC.controller.R) * a.inputs ** 2))
+    assert a.cost == pytest.approx(by_hand, rel=1e-12)
+    with pytest.raises(ConfigError, match="rate_penalty"):
+        ScpOptions(rate_penalty=-1.0)

@@ -250,7 +250,8 @@ def test_dynamic_plant_run_logs_body_velocities_and_thrusts(tmp_path):
     cols = read_trajectory_csv(res.write_csv(tmp_path / "trajectory.csv"))
     assert tuple(cols) == CSV_COLUMNS + DYNAMIC_COLUMNS
     np.testing.assert_allclose(cols["v_b"], res.body[:, 1], rtol=1e-11, atol=1e-13)
-    assert np.all(np.abs(res.thrust) <= np.array(sc.plant.params.thrust_limits) + 1e-9)
+    limits = np.array([sc.plant.truth_params.thrust_limits_at(u) for u in res.body[:, 0]])  # fins: ∝ u²
+    assert np.all(np.abs(res.thrust) <= limits * (1 + 1e-3) + 1e-9)  # lagged by T_thr while u drifts
     # the logged omega is what moved the vehicle beyond f(x) v: current + loop error + hull sway
     assert np.all(np.isfinite(res.omega[:-1])) and np.max(np.abs(res.body[:, 1])) > 0.0
     kin_sc = sc.with_changes(**{"plant.kind": "kinematic"})
@@ -388,3 +389,33 @@ def test_without_a_backup_the_exhausted_replay_keeps_the_zero_input_and_says_so(
     assert not np.any(res.backup_active)
     np.testing.assert_array_equal(res.v_hat[(1 + n - 1) * m:-1], 0.0)
     assert sum("no backup" in r.getMessage() for r in caplog.records) == 1   # once per engagement
+
+
+# ---- the rate limit (issue 22 design (1)) --------------------------------------------------------------------
+
+class _FailingFhocp:
+    """The real FHOCP, raising SolverError in the periods ``fail`` (replay, then the backup, then resume)."""
+
+    def __init__(self, scenario, tightening, fail=range(5, 20)):
+        from tubekit.fhocp import FHOCP
+        self.inner, self.fail, self.k = FHOCP(scenario, tightening), set(fail), 0
+
+    def solve(self, t, state, obstacles, v_last=None):
+        self.k += 1
+        if self.k - 1 in self.fail:
+            raise SolverError("injected")
+        return self.inner.solve(t, state, obstacles, v_last=v_last)
+
+
+def test_with_a_rate_limit_no_command_jumps_more_than_j_between_periods():
+    """Measured on the log alone: every change of v̂ into a tracking or replayed tick (plans, replay, and the
+    resume after the backup) is at most J = rate dt; the periods 5..19 fail, so all three phases occur."""
+    sc = _scenario(duration=4.0).with_changes(**{"limits.rate": [0.5, 0.5, 1.0]})
+    res = run_closed_loop(sc, tightening=_safe_only(sc), solver_factory=_FailingFhocp, progress=False)
+    jump = np.array([0.5, 0.5, 1.0]) * sc.controller.dt
+    v, backup = res.v_hat[:-1], res.backup_active[:-1]
+    steps = np.abs(np.diff(v, axis=0))[~backup[1:]]            # into a tick that follows a plan
+    assert res.replaced.any() and backup.any() and not backup[-1]   # replay, backup, resumed tracking
+    assert np.all(steps <= jump + 1e-9), steps.max(axis=0)
+    first = np.flatnonzero(backup[:-1] & ~backup[1:])[0]          # the resume: from the backup's last command
+    assert np.all(np.abs(v[first + 1] - v[first]) <= jump + 1e-9)

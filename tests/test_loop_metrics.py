@@ -9,7 +9,7 @@ import pytest
 
 from tubekit import Circle, Line, Obstacle, paper_scenario
 from tubekit.loop.metrics import (METRIC_KEYS, clearance, compute_metrics, encirclements, input_ratio, intervals_below,
-                             obstacle_passes, read_trajectory_csv, tracking_rmse)
+                             obstacle_passes, read_trajectory_csv, tracking_rmse, sign_flips_per_s, command_jumps)
 from tubekit.plant.kinematic import Plant
 
 
@@ -160,3 +160,27 @@ def test_sway_max_from_the_log_and_sway_bound_recorded():
     assert compute_metrics(cols, sc)["sway_max"] == pytest.approx(np.max(np.abs(sway)), abs=1e-12)
     dynamic = {**cols, "v_b": np.full(len(t), -0.03)}
     assert compute_metrics(dynamic, sc)["sway_max"] == pytest.approx(0.03)
+
+
+def test_sign_flips_per_second_of_a_hand_made_signal():
+    """r = 0.3 sin(2 pi t) on [0, 10] s crosses zero at 0.5, 1.0, ..., 9.5 s: 19 flips in 10 s; u keeps its
+    sign; w flips every sample but stays below 1 % of w_max, so it is ignored; NaN samples are skipped."""
+    t = np.linspace(0.0, 10.0, 1001)
+    v = np.column_stack([0.2 + 0.1 * np.sin(t), 0.002 * (-1.0) ** np.arange(len(t)), 0.3 * np.sin(2 * np.pi * t)])
+    v[-1] = np.nan
+    got = sign_flips_per_s(t, v, [0.004, 0.003, 0.005])
+    assert got == {"u": 0.0, "w": 0.0, "r": pytest.approx(1.9)}
+    # a square wave switching at t = 0.1, 0.2, ..., 10.0 s (the last sample opens segment 100): 100 flips in 10 s
+    square = np.where(np.floor(t / 0.1 + 1e-9) % 2 == 0, 1.0, -1.0)
+    assert sign_flips_per_s(t, np.column_stack([square] * 3), [0.1] * 3)["r"] == pytest.approx(100 / 10)
+
+
+def test_command_jumps_and_the_metrics_keys():
+    v = np.array([[0.0, 0.0, 0.0], [0.1, -0.05, 0.0], [0.1, 0.05, -0.3], [np.nan, np.nan, np.nan]])
+    assert command_jumps(v) == {"u": pytest.approx(0.1), "w": pytest.approx(0.1), "r": pytest.approx(0.3)}
+    sc = paper_scenario().with_changes(duration=50.0)
+    cols = _handmade_log()
+    m = compute_metrics(cols, sc)
+    assert m["sign_flips_per_s"] == {"u": 0.0, "w": 0.0, "r": 0.0} and m["command_jump_max"] is None
+    cols.update(u_hat=cols["u"], w_hat=cols["w"], r_hat=cols["r"])
+    assert compute_metrics(cols, sc)["command_jump_max"] == {"u": 0.0, "w": 0.0, "r": 0.0}

@@ -16,7 +16,7 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from tubekit.loop.plan_check import PlanCheck, check_plan, plan_arcs
+from tubekit.loop.plan_check import RATE_TOLERANCE, PlanCheck, check_plan, check_rates, plan_arcs
 from tubekit.model.backup import BackupPlan, SafeSet, StationKeeping
 from tubekit.scenario import Obstacle
 from tubekit.tightening import Tightening
@@ -183,3 +183,42 @@ def test_without_the_tracking_tier_only_position_constraints_are_checked(station
     blocked = Obstacle((-1.5, 4.2, 0.0), 0.3)  # 0.15 m from the footprint about the end (-1.686, 3.064)
     res = check_plan(stationary, safe_only, 0.0, x0, PLAN, [blocked], sign=-1)
     assert not res.ok and res.where == "terminal: obstacle 0"
+
+
+# ---- the rate rows (issue 22 design (1)): J = rate dt = (0.1, 0.1, 0.2) with rate (1, 1, 2) ----------------
+
+RAMP = np.array([[u, 0.0, 0.0] for u in (0.05, 0.1, 0.15, 0.2, 0.2, 0.15, 0.1, 0.05)])  # steps 0.05, rests at 0.05
+
+
+def _rated(sc):
+    return sc.with_changes(**{"limits.rate": [1.0, 1.0, 2.0]})
+
+
+def _with_u(u):
+    plan = np.zeros((8, 3))
+    plan[:, 0] = u
+    return plan
+
+
+@pytest.mark.parametrize("plan, v_last, where, slack", [
+    (_with_u([0.05, 0.1, 0.3, 0.3, 0.2, 0.1, 0.05, 0.0]), None, "rate: between nodes", -0.1),   # 0.1 -> 0.3
+    (RAMP, [0.3, 0.0, 0.0], "rate: first node", -0.15),                                          # 0.3 -> 0.05
+    (_with_u([0.05, 0.1, 0.15, 0.2, 0.25, 0.25, 0.2, 0.15]), None, "rate: terminal rest", -0.05),  # ends at 0.15
+    (RAMP + [0.0, 0.0, 0.2 + 1e-8], [0.0, 0.0, 0.0], "rate: first node", -1e-8),                 # r: just over J
+])
+def test_a_plan_breaking_a_rate_row_is_rejected_naming_it(stationary, plan, v_last, where, slack):
+    res = check_plan(_rated(stationary), _tight(backup=BACKUP), 0.0, X0, plan, [], sign=-1, v_last=v_last)
+    assert not res.ok and res.where == where and res.slack == pytest.approx(slack, abs=1e-12)
+
+
+def test_rate_rows_pass_within_the_tolerance_and_only_the_rows_that_apply(stationary):
+    sc = _rated(stationary)
+    assert check_rates(sc, _tight(backup=BACKUP), RAMP, v_last=[0.0, 0.0, 0.0]).ok
+    # r = 0.2 + 5e-10 from rest: over J by less than RATE_TOLERANCE = 1e-9
+    assert check_rates(sc, _tight(backup=BACKUP), RAMP + [0.0, 0.0, 0.2 + 5e-10], v_last=[0.0, 0.0, 0.0]).ok
+    ends_moving = _with_u([0.05, 0.1, 0.15, 0.2, 0.25, 0.25, 0.2, 0.15])
+    assert check_rates(sc, _tight(), ends_moving).ok                 # no backup: no terminal rest
+    assert check_rates(sc, _tight(backup=BACKUP), RAMP).ok           # no v_last: no first-node row
+    assert check_rates(stationary, _tight(backup=BACKUP), _with_u([0.0, 0.4] * 4)).where == "no rate limit"
+    assert check_plan(sc, _tight(backup=BACKUP), 0.0, X0, RAMP, [], sign=-1, v_last=[0.0, 0.0, 0.0]).ok
+    assert 0.0 < RATE_TOLERANCE <= 1e-9

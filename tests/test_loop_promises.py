@@ -144,8 +144,8 @@ def test_disturbance_and_sway_are_checked(stationary):
 
 
 def test_dynamic_runs_check_hull_sway_and_the_velocity_loop(stationary):
-    sc = replace(stationary, plant=PlantSettings("dynamic", tracking_bound=(0.05, 0.02, 0.1)))
-    run = _run(stationary, scenario=sc)
+    sc = replace(stationary, plant=PlantSettings("dynamic"))
+    run = replace(_run(stationary, scenario=sc), tightening=_tight(velocity_loop=(0.05, 0.02, 0.1)))
     rows = len(run.t)
     body = np.zeros((rows, 4))
     thrust = np.zeros((rows, 3))
@@ -161,6 +161,8 @@ def test_dynamic_runs_check_hull_sway_and_the_velocity_loop(stationary):
     p = _promise(replace(run, body=off, thrust=thrust), "sway")
     assert not p.ok and p.observed == pytest.approx(0.03)
     assert "velocity_loop" not in {p.name for p in check_promises(run)}  # kinematic: no such promise
+    no_bound = replace(clean, tightening=_tight())
+    assert "velocity_loop" not in {p.name for p in check_promises(no_bound)}  # no certified loop bound: none
 
 
 def test_a_run_without_a_certificate_is_refused(stationary):
@@ -170,3 +172,16 @@ def test_a_run_without_a_certificate_is_refused(stationary):
     baseline = replace(_run(stationary), tube=False, sigma=0.0, tightening=Tightening.untightened(stationary))
     with pytest.raises(ConfigError, match="run: expected a tube run .* without a certificate"):
         check_promises(baseline)
+
+
+def test_a_best_effort_run_is_refused_unless_asked(stationary):
+    """Issue 24 item 9: a tube run under a tightening no certificate gave (here tube-less: zeros) is refused,
+    naming what is missing, instead of measuring an infinite tube ratio; ``uncertified=True`` measures it."""
+    from tubekit.exceptions import ConfigError
+
+    best_effort = _run(stationary, tightening=_tight(certified=False, tube=np.zeros(3)))
+    with pytest.raises(ConfigError, match=r"^run\.tightening: expected a certified tightening .* best-effort "
+                                          r"tightening, tube = \[0\.0, 0\.0, 0\.0\]"):
+        check_promises(best_effort)
+    figures = {p.name: p for p in check_promises(best_effort, uncertified=True)}
+    assert figures["tube"].observed == math.inf  # asked for: a zero tube gives an infinite ratio

@@ -10,7 +10,8 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 from tubekit.exceptions import ConfigError
-from tubekit.model.backup import SafeSet, StationKeeping, axis_angle, line_of_sight_angle, station_keeping_input
+from tubekit.model.backup import (SafeSet, StationKeeping, axis_angle, axis_shape, line_of_sight_angle,
+                                  station_keeping_input, yaw_shape)
 
 LAW = StationKeeping(surge=0.2, yaw_rate=0.5, yaw_band=0.05, heave=0.3, heave_band=0.01)
 
@@ -100,3 +101,115 @@ def test_safe_set_radii():
     s = SafeSet(level=0.75, shape=0.4, depth=0.1)
     assert s.radius == 0.75 and s.handover_radius == pytest.approx(0.35)
 
+
+
+# ---- fades and ramp (issue 22) -----------------------------------------------------------------
+
+SMOOTH = StationKeeping(surge=0.2, yaw_rate=0.5, yaw_band=0.5, heave=0.3, heave_band=0.1,
+                        surge_fade=0.4, yaw_fade=0.2, ramp=2.0)
+
+
+def test_the_command_starts_at_zero_at_the_hand_over():
+    # far from the anchor, deep and abeam: every unramped channel would be at its largest
+    assert station_keeping_input(SMOOTH, (3.0, 0.0, 1.0, math.pi / 2), (0.0, 0.0, 0.0), 0.0) == (0.0, 0.0, 0.0)
+
+
+def test_the_ramp_scales_every_channel_by_the_elapsed_fraction():
+    # d = 3 m (beyond both fades), deep (sat = 1), abeam (chi = pi/2): unramped w = -0.3, r = -0.5
+    _, w, r = station_keeping_input(SMOOTH, (3.0, 0.0, 1.0, math.pi / 2), (0.0, 0.0, 0.0), 0.5)
+    assert w == pytest.approx(-0.3 * 0.25) and r == pytest.approx(-0.5 * 0.25)
+    # facing the anchor: u = u_b s / t_r
+    u, _, _ = station_keeping_input(SMOOTH, (3.0, 0.0, 0.0, math.pi), (0.0, 0.0, 0.0), 1.5)
+    assert u == pytest.approx(0.2 * 0.75)
+
+
+def test_the_fades_scale_surge_and_yaw_by_the_distance():
+    # d = 0.1 m facing the anchor: surge 0.2 * 0.1 / 0.4; abeam at d = 0.1: yaw 0.5 * 0.1 / 0.2 (after the ramp)
+    u, _, _ = station_keeping_input(SMOOTH, (0.1, 0.0, 0.0, math.pi), (0.0, 0.0, 0.0), 10.0)
+    _, _, r = station_keeping_input(SMOOTH, (0.1, 0.0, 0.0, math.pi / 2), (0.0, 0.0, 0.0), 10.0)
+    assert u == pytest.approx(0.05) and r == pytest.approx(-0.25)
+
+
+def test_the_smaller_of_fade_and_ramp_wins():
+    # d = 0.1 m (fade 0.25) at s = 1 s (ramp 0.5): surge scaled by 0.25
+    u, _, _ = station_keeping_input(SMOOTH, (0.1, 0.0, 0.0, math.pi), (0.0, 0.0, 0.0), 1.0)
+    assert u == pytest.approx(0.2 * 0.25)
+
+
+@given(x=st.floats(-3, 3), y=st.floats(-3, 3), z=st.floats(-1, 1), psi=st.floats(-7, 7))
+def test_zero_fades_and_ramp_leave_the_law_unchanged(x, y, z, psi):
+    """Property: a law with d_0 = d_1 = t_r = 0 gives the same input at every elapsed time as without them."""
+    off = StationKeeping(0.2, 0.5, 0.05, 0.3, 0.01, surge_fade=0.0, yaw_fade=0.0, ramp=0.0)
+    for s in (0.0, 0.3, math.inf):
+        assert station_keeping_input(off, (x, y, z, psi), (0.0, 0.0, 0.0), s) == \
+            station_keeping_input(LAW, (x, y, z, psi), (0.0, 0.0, 0.0))
+
+
+def test_after_the_ramp_and_beyond_the_fades_the_law_is_the_unfaded_one():
+    unfaded = StationKeeping(0.2, 0.5, 0.5, 0.3, 0.1)
+    for state in [(1.0, 0.5, 0.05, 0.3), (-2.0, 1.0, -0.3, 2.5), (0.5, 0.0, 0.0, math.pi / 2)]:
+        assert station_keeping_input(SMOOTH, state, (0.0, 0.0, 0.0), 2.0) == pytest.approx(
+            station_keeping_input(unfaded, state, (0.0, 0.0, 0.0)))
+
+
+def test_the_law_is_continuous_at_the_anchor_with_a_fade():
+    # approaching the anchor from any heading the faded surge and yaw go to zero
+    for psi in np.linspace(-3, 3, 7):
+        u, _, r = station_keeping_input(SMOOTH, (1e-9, 0.0, 0.0, float(psi)), (0.0, 0.0, 0.0), 10.0)
+        assert abs(u) < 1e-8 and abs(r) < 1e-8
+
+
+@pytest.mark.parametrize("kwargs, match", [
+    ({"surge_fade": -0.1}, "backup.surge_fade"),
+    ({"yaw_fade": float("nan")}, "backup.yaw_fade"),
+    ({"ramp": float("inf")}, "backup.ramp"),
+])
+def test_bad_fades_and_ramps_are_refused(kwargs, match):
+    with pytest.raises(ConfigError, match=match):
+        StationKeeping(**{**dict(surge=0.2, yaw_rate=0.5, yaw_band=0.05, heave=0.3, heave_band=0.01), **kwargs})
+
+
+def test_smooth_needs_both_fades_and_the_ramp():
+    assert SMOOTH.smooth and not LAW.smooth
+    assert not StationKeeping(0.2, 0.5, 0.05, 0.3, 0.01, surge_fade=0.3, yaw_fade=0.3).smooth
+
+
+# ---- the continuous yaw law (issue 22) -------------------------------------------------------------
+
+CONT = StationKeeping(surge=0.4, yaw_rate=0.5, yaw_band=0.2, heave=0.3, heave_band=0.1, yaw_law="continuous",
+                      unstable=0.6)
+
+
+@pytest.mark.parametrize("chi, expected_r", [
+    (0.1, -0.25),        # inside (0, χ_u): ρ = 0.1/0.2, turn back onto the line of sight
+    (0.3, -0.5),         # ρ = min(1, 1.5, 1.5) = 1
+    (0.55, -0.125),      # ρ = (0.6 − 0.55)/0.2
+    (0.6, 0.0),          # the unstable zero
+    (0.65, 0.125),       # past χ_u: ρ = −0.05/0.2, turn the long way round
+    (math.pi / 2, 0.5),  # abeam: ρ = −1 on both sides
+    (-math.pi / 2 + 1e-9, 0.5),
+    (-0.1, 0.25),        # ρ(π − 0.1) = −0.1/0.2: from below, turn up to 0
+])
+def test_the_continuous_yaw_command_by_hand(chi, expected_r):
+    # the vehicle at (1, 0), the anchor at the origin: φ = ψ − π, so ψ = π + χ
+    _, _, r = station_keeping_input(CONT, (1.0, 0.0, 0.0, math.pi + chi), (0.0, 0.0, 0.0))
+    assert r == pytest.approx(expected_r, abs=1e-7)
+
+
+@given(st.floats(-4 * math.pi, 4 * math.pi), st.floats(1e-6, 0.05))
+def test_the_continuous_yaw_command_is_lipschitz_in_heading(psi, step):
+    """Property: |r(ψ + δ) − r(ψ)| <= k δ / χ_0 for every heading, across abeam included."""
+    r0 = station_keeping_input(CONT, (1.0, 0.0, 0.0, psi), (0.0, 0.0, 0.0))[2]
+    r1 = station_keeping_input(CONT, (1.0, 0.0, 0.0, psi + step), (0.0, 0.0, 0.0))[2]
+    assert abs(r1 - r0) <= 0.5 * step / 0.2 * (1 + 1e-9) + 1e-12
+
+
+def test_the_continuous_shape_by_hand():
+    # a(0) = 0, a = 1 on the plateau [0.75 χ_u, χ_u] = [0.45, 0.6], a(0.3) = (1 − cos(π 0.3/0.45))/2 = 3/4,
+    # a((χ_u + π)/2) = 1/2, a(π/2) = (1 − cos(π (π/2)/(π − 0.6)))/2
+    assert axis_shape(CONT, 0.0) == 0.0 and axis_shape(CONT, 0.6) == pytest.approx(1.0)
+    assert axis_shape(CONT, 0.5) == pytest.approx(1.0) and CONT.plateau == pytest.approx(0.45)
+    assert axis_shape(CONT, 0.3) == pytest.approx(0.75) and axis_shape(CONT, (0.6 + math.pi) / 2) == pytest.approx(0.5)
+    assert axis_shape(CONT, math.pi / 2) == pytest.approx(0.5 * (1 - math.cos(math.pi ** 2 / 2 / (math.pi - 0.6))))
+    assert axis_shape(CONT, -0.2) == axis_shape(CONT, math.pi - 0.2)  # π-periodic
+    assert axis_shape(LAW, 0.4) == pytest.approx(1 - math.cos(0.4)) and yaw_shape(CONT, 2.0) == -1.0

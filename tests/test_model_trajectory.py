@@ -69,3 +69,34 @@ def test_round_trip(traj):
 def test_config_error_is_value_error():
     with pytest.raises(ConfigError):
         trajectory_from_dict("circle")
+
+
+@pytest.mark.parametrize("table, match", [
+    ({"kind": "line", "direction_velocity": [1, 0, 0]},
+     r"^trajectory\.direction_velocity: expected one of the keys \['start', 'velocity'\] of a line trajectory"),
+    ({"kind": "line", "vel": [1, 0, 0]}, r"^trajectory\.vel: expected one of the keys \['start', 'velocity'\]"),
+    ({"kind": "circle", "duration": 5.0}, r"trajectory\.duration: .* belongs above the first table$"),
+    ({"kind": "circle", "radius": "3"}, r"^trajectory\.radius: expected a finite number, received '3'"),
+    ({"kind": ["circle"]}, r"^trajectory\.kind: expected one of"),
+])
+def test_errors_name_the_documented_key(table, match):
+    """Issue 24 item 3: a wrong key on a line lists the documented keys (``velocity``, not the Python name)."""
+    with pytest.raises(ConfigError, match=match):
+        trajectory_from_dict(table)
+
+
+def test_a_wrong_key_that_is_no_top_level_key_gets_no_hint():
+    with pytest.raises(ConfigError) as info:
+        trajectory_from_dict({"kind": "line", "vel": [1, 0, 0]})
+    assert "top-level" not in str(info.value)
+
+
+def test_line_takes_its_documented_velocity_key():
+    line = trajectory_from_dict({"kind": "line", "start": [0, 1, 2], "velocity": [0.5, 0, 0]})
+    assert line.position(2.0).tolist() == [1.0, 1.0, 2.0]  # start + 2 s x 0.5 m/s along x, by hand
+
+
+@pytest.mark.parametrize("traj", TRAJECTORIES, ids=lambda t: t.kind)
+def test_repr_holds_plain_floats(traj):
+    """Issue 24 item 9: no ``np.float64(...)`` in a trajectory's repr."""
+    assert "np." not in repr(traj) and "float64" not in repr(traj)

@@ -1,4 +1,5 @@
-"""The 4-DOF dynamic plant (issue 13): energy, terminal speed, sway sign, fast-loop limit, sway bound."""
+"""The 4-DOF dynamic plant: energy, published terminal speeds, sway sign, fast-loop limit, sway bound,
+truth against the controller's nominal model, fins' speed-dependent saturation."""
 
 from __future__ import annotations
 
@@ -14,13 +15,14 @@ from tubekit.exceptions import ConfigError
 from tubekit.model.kinematics import SwayModel
 from tubekit.plant.kinematic import Plant
 from tubekit.scenario import Disturbance
-from tubekit.model.vehicles import REMUS100, PlantSettings
-from verify.design import disturbance_bounds, hull_sway_bound
+from tubekit.model.vehicles import BLUEROV2_HEAVY, REMUS100, PlantSettings
+from verify.design import hull_sway_bound
 
 CALM = Disturbance(amplitude=(0.0, 0.0, 0.0), sway=SwayModel(gain=0.0, amplitude=0.0, bound=0.0))
+REMUS = REMUS100.nominal  # a point of the box: the default truth
 
 
-def _open_loop(nu0, tau, h: float, steps: int, p=REMUS100) -> np.ndarray:
+def _open_loop(nu0, tau, h: float, steps: int, p=REMUS) -> np.ndarray:
     """RK4 of M ν̇ = τ − n(ν) with τ = (X, Z, N) held; returns ν at every step (steps + 1, 4)."""
     def f(nu):
         return np.array(body_acceleration(p, tuple(nu), tau))
@@ -37,7 +39,7 @@ def _open_loop(nu0, tau, h: float, steps: int, p=REMUS100) -> np.ndarray:
 
 
 def test_coriolis_is_skew_symmetric_so_only_damping_changes_energy():
-    p = REMUS100.with_overrides({name: 0.0 for name in ("X_uu", "Y_vv", "Y_rr", "Z_ww", "N_vv", "N_rr", "Y_uv",
+    p = REMUS.with_overrides({name: 0.0 for name in ("X_uu", "Y_vv", "Y_rr", "Z_ww", "N_vv", "N_rr", "Y_uv",
                                                         "Y_ur_lift", "Z_uw", "N_uv_lift", "N_ur_lift")})
     rng = np.random.default_rng(1)
     for _ in range(50):
@@ -48,7 +50,7 @@ def test_coriolis_is_skew_symmetric_so_only_damping_changes_energy():
 @pytest.mark.parametrize("nu0", [(0.5, 0.1, 0.2, 0.3), (0.3, -0.2, -0.1, -0.5), (1.0, 0.0, 0.0, 0.4)])
 def test_no_thrust_no_current_kinetic_energy_does_not_increase(nu0):
     traj = _open_loop(nu0, (0.0, 0.0, 0.0), 0.01, 3000)
-    energy = np.array([kinetic_energy(REMUS100, nu) for nu in traj])
+    energy = np.array([kinetic_energy(REMUS, nu) for nu in traj])
     assert np.all(traj[:, 0] >= 0.0)  # forward motion: the lift terms dissipate (docs/plant.md)
     assert np.all(np.diff(energy) <= 1e-12 * energy[0])
     assert energy[-1] < 0.5 * energy[0]
@@ -57,7 +59,7 @@ def test_no_thrust_no_current_kinetic_energy_does_not_increase(nu0):
 @pytest.mark.parametrize("thrust", [0.5, 2.0])
 def test_constant_surge_thrust_reaches_the_speed_where_drag_balances_it(thrust):
     traj = _open_loop((0.0, 0.0, 0.0, 0.0), (thrust, 0.0, 0.0), 0.05, 8000)
-    terminal = math.sqrt(thrust / -REMUS100.X_uu)  # X = -X_u|u| u |u| (X_u = 0)
+    terminal = math.sqrt(thrust / -REMUS.X_uu)  # X = -X_u|u| u |u| (X_u = 0)
     assert traj[-1, 0] == pytest.approx(terminal, rel=1e-6)
     assert np.all(np.abs(traj[:, 1:]) < 1e-12)
 
@@ -67,13 +69,14 @@ def test_steady_turn_sway_has_the_sign_the_hull_coefficients_predict(moment):
     traj = _open_loop((0.5, 0.0, 0.0, 0.0), (1.0, 0.0, moment), 0.02, 10000)
     u, v, _, r = traj[-1]
     assert np.max(np.abs(traj[-1] - traj[-100])) < 1e-6  # steady
-    m11 = REMUS100.mass_entries[0]
-    predicted = math.copysign(1.0, (REMUS100.Y_ur_lift - m11) * u * r)  # the centripetal + fin-lift force
+    m11 = REMUS.mass_entries[0]
+    predicted = math.copysign(1.0, (REMUS.Y_ur_lift - m11) * u * r)  # the centripetal + fin-lift force
     assert math.copysign(1.0, v) == predicted and abs(v) > 1e-3
 
 
-def _scenario(**vehicle):
-    return paper_scenario().with_changes(disturbance=CALM, plant=PlantSettings("dynamic", overrides=vehicle))
+def _scenario(vehicle: str = "remus100", truth=(), **overrides):
+    plant = PlantSettings("dynamic", vehicle=vehicle, overrides=overrides, truth=truth)
+    return paper_scenario().with_changes(disturbance=CALM, plant=plant)
 
 
 def _commands(n: int) -> list[tuple[float, float, float]]:
@@ -92,7 +95,8 @@ def _run(plant, commands, substeps: int) -> np.ndarray:
 def test_fast_low_level_loop_tends_to_the_kinematic_plant():
     commands = _commands(500)
     kinematic = _run(Plant(CALM), commands, 2)
-    stiff_hull = {"Y_v": -1.0e5, "X_max": 1e5, "Z_max": 1e5, "N_max": 1e5}  # no sway: the kinematic eq. 11
+    stiff_hull = {"Y_v": -1.0e5, "X_max": 1e5, "Z_max": 1e5, "N_max": 1e5,  # no sway: the kinematic eq. 11
+                  "actuation": "thrusters", "Z_uuds": 0.0, "N_uudr": 0.0, "fin_max": 0.0}
     gaps = []
     for bandwidth, lag in ((5.0, 0.1), (50.0, 0.01), (500.0, 0.001)):
         plant = DynamicPlant(_scenario(loop_bandwidth=bandwidth, thruster_time_constant=lag, **stiff_hull))
@@ -101,12 +105,72 @@ def test_fast_low_level_loop_tends_to_the_kinematic_plant():
     assert gaps[2] < 1e-3
 
 
-def test_velocity_loop_removes_steady_error():
-    plant = DynamicPlant(_scenario())
+@pytest.mark.parametrize("truth", [(), {"X_uu": -141.0, "Y_vv": -217.0, "N_rr": -0.43, "X_udot": -2.6}])
+def test_velocity_loop_removes_steady_error_whatever_the_truth_in_the_box(truth):
+    sc = _scenario("bluerov2_heavy", truth=truth)
+    plant = DynamicPlant(sc)
+    assert plant.model == sc.plant.params.nominal and plant.params == sc.plant.truth_params
     _run(plant, [(0.3, 0.1, 0.2)] * 1000, 2)
     body, thrust = plant.history()
-    np.testing.assert_allclose(body[-1, [0, 2, 3]], [0.3, 0.1, 0.2], atol=1e-4)
-    assert np.all(np.abs(thrust) <= np.array(REMUS100.thrust_limits) + 1e-12)
+    np.testing.assert_allclose(body[-1, [0, 2, 3]], [0.3, 0.1, 0.2], atol=1e-4)  # the integral absorbs d
+    assert np.all(np.abs(thrust) <= np.array(plant.params.thrust_limits) + 1e-12)
+
+
+def test_remus_fins_saturate_at_low_speed_so_the_yaw_command_is_not_reached():
+    """At u = 0.3 m/s the rudder gives |N_uudr| u² δ_max ≈ 0.14 N m; r = 0.2 rad/s needs
+    |N_r|r|| r² ≈ 61 · 0.04 ≈ 2.5 N m (nominal): the yaw channel saturates and r falls short."""
+    plant = DynamicPlant(_scenario())
+    _run(plant, [(0.3, 0.0, 0.2)] * 1000, 2)
+    body, thrust = plant.history()
+    truth = plant.params
+    limits = np.array([truth.thrust_limits_at(u) for u in body[:, 0]])
+    assert np.all(np.abs(thrust) <= limits * (1 + 1e-3) + 1e-9)  # lagged by T_thr while u (and the limit) drift
+    assert body[-1, 0] == pytest.approx(0.3, abs=1e-3) and body[-1, 3] < 0.1
+    n_max_hand = 0.5 * (6.15 + 2.75) * 0.3 ** 2 * 0.349
+    assert np.max(np.abs(thrust[-100:, 2])) == pytest.approx(n_max_hand, rel=1e-2)
+
+
+def test_params_argument_must_be_a_point():
+    with pytest.raises(ValueError, match="point vehicle"):
+        DynamicPlant(_scenario(), params=REMUS100)
+    plant = DynamicPlant(_scenario(), params=REMUS100.interval("m") and REMUS100.sample(np.random.default_rng(0)))
+    assert plant.params.is_point and plant.model == REMUS100.nominal
+
+
+def _terminal_speed(x_u: float, x_uu: float, thrust: float) -> float:
+    """Positive root of |X_uu| u² + |X_u| u = X (by hand: the quadratic formula)."""
+    a, b = abs(x_uu), abs(x_u)
+    return (-b + math.sqrt(b * b + 4 * a * thrust)) / (2 * a)
+
+
+@pytest.mark.parametrize("source", ["prestero", "fossen"])
+def test_remus_reaches_its_published_top_speed_at_full_thrust(source):
+    """Published: REMUS 100's top speed 2.5 m/s (Fossen's remus100.m, after Allen et al. 2000). Each source's
+    (drag, full thrust) pair, integrated open loop, reaches it within 3 %."""
+    lo = source == "prestero"
+    x_uu = REMUS100.interval("X_uu")[1 if lo else 0]
+    x_max = REMUS100.interval("X_max")[0 if lo else 1]
+    p = REMUS.with_overrides({"X_uu": x_uu, "X_max": x_max})
+    traj = _open_loop((0.0, 0.0, 0.0, 0.0), (p.thrust_limits_at(2.5)[0], 0.0, 0.0), 0.05, 4000, p=p)
+    hand = _terminal_speed(p.X_u, x_uu, x_max)
+    assert traj[-1, 0] == pytest.approx(hand, rel=1e-6)
+    assert traj[-1, 0] == pytest.approx(2.5, rel=0.03)
+
+
+def test_bluerov2_heavy_box_brackets_its_published_top_speed():
+    """Published: BlueROV2 top forward speed 1.5 m/s (Blue Robotics). At the full surge limit the box's
+    terminal speeds run from the von Benzon/Wu end (high drag) to the Einarsson & Lipenitis end (low drag);
+    the published speed lies inside, and the open-loop plant reproduces both ends."""
+    x_max = BLUEROV2_HEAVY.thrust_limit_floor(0.0)[0]
+    ends = []
+    for k in (0, 1):
+        p = BLUEROV2_HEAVY.with_point({"X_u": BLUEROV2_HEAVY.interval("X_u")[k],
+                                       "X_uu": BLUEROV2_HEAVY.interval("X_uu")[k]})
+        traj = _open_loop((0.0, 0.0, 0.0, 0.0), (x_max, 0.0, 0.0), 0.01, 3000, p=p)
+        hand = _terminal_speed(p.X_u, p.X_uu, x_max)
+        assert traj[-1, 0] == pytest.approx(hand, rel=1e-6)
+        ends.append(hand)
+    assert ends[0] < 1.5 < ends[1]
 
 
 def test_hull_sway_stays_within_its_iss_bound_under_aggressive_commands():
@@ -116,12 +180,10 @@ def test_hull_sway_stays_within_its_iss_bound_under_aggressive_commands():
     plant = DynamicPlant(sc)
     _run(plant, commands, 2)
     body, _ = plant.history()
-    lim = sc.limits
-    gamma = float(hull_sway_bound(REMUS100, float(np.max(np.abs(body[:, 0]))), float(np.max(np.abs(body[:, 3])))))
-    assert np.max(np.abs(body[:, 1])) <= gamma
-    bounds = disturbance_bounds(sc)
-    assert bounds.gamma >= float(hull_sway_bound(REMUS100, lim.u_max, lim.r_max))
-    assert bounds.omega_xy > bounds.gamma and bounds.declared_sway == bounds.gamma
+    u_bar, r_bar = float(np.max(np.abs(body[:, 0]))), float(np.max(np.abs(body[:, 3])))
+    gamma = float(hull_sway_bound(plant.params, u_bar, r_bar))  # the truth: a point of the box
+    assert 0.0 < np.max(np.abs(body[:, 1])) <= gamma
+    assert float(hull_sway_bound(REMUS100, u_bar, r_bar)) >= gamma  # the box's bound covers the truth
 
 
 def test_omega_series_is_current_plus_loop_error_and_sway():

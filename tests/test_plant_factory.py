@@ -47,7 +47,7 @@ def test_the_plant_is_built_from_the_scenario_and_keeps_the_override(kind):
     if kind == "kinematic":
         assert plant.disturbance is scenario.disturbance
     else:
-        assert plant.params == scenario.plant.params
+        assert plant.params == scenario.plant.truth_params
 
 
 @pytest.mark.parametrize("kind, received", [

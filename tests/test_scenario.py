@@ -5,6 +5,7 @@ from __future__ import annotations
 import math
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from tubekit import ConfigError, TubekitError, load_scenario, paper_scenario, scenario_from_dict
@@ -216,3 +217,70 @@ def test_with_changes_accepts_dotted_nested_fields():
 def test_with_changes_errors_name_the_field(changes, match):
     with pytest.raises(ConfigError, match=match):
         paper_scenario().with_changes(**changes)
+
+
+def test_the_repr_holds_plain_floats():
+    """Issue 24 item 9: the scenario's repr reads as Python, without ``np.float64(...)``."""
+    text = repr(paper_scenario())
+    assert "np." not in text and "float64" not in text
+    assert "workspace=((-10.0, -10.0, -5.0), (10.0, 10.0, 5.0))" in text
+
+
+@pytest.mark.parametrize("table, match", [
+    ({"duration": "100"}, r"^duration: expected a finite number, received '100'"),
+    ({"duration": True}, r"^duration: expected a finite number, received True"),
+    ({"name": 5}, r"^name: expected a string, received 5"),
+    ({"controller": {"horizon_steps": True}}, r"^controller\.horizon_steps: expected an integer >= 1"),
+    ({"controller": {"law": ["paper"]}}, r"^controller\.law: expected one of"),
+    ({"initial_state": ["-0.5", 3.0, 0.2, 0.0]}, r"^initial_state: expected 4 numbers"),
+    ({"epsilon": "0.1"}, r"^epsilon: expected a finite number"),
+])
+def test_types_are_strict(table, match):
+    """Issue 24 item 2: a string or a bool where a number belongs is refused, naming the field."""
+    with pytest.raises(ConfigError, match=match):
+        scenario_from_dict(table)
+
+
+@pytest.mark.parametrize("table, match", [
+    # 1e308 s / 0.1 s overflows the period count: refused before any count is made an int
+    ({"duration": 1e308}, r"^duration: expected at most 1e\+09 FHOCP periods of 0\.1 s"),
+    # a period of 1e-9 s holds no tick of the 100 Hz ancillary law: the period is wrong, not the rate
+    ({"controller": {"dt": 1e-9}}, r"^controller\.dt: expected at least one tick 1/ancillary_rate_hz = 0\.01 s"),
+    ({"controller": {"dt": 10.0, "ancillary_rate_hz": 1e308}},
+     r"^controller\.ancillary_rate_hz: expected at most 1e\+06 ticks per period"),
+    ({"controller": {"ancillary_rate_hz": 155.0}}, r"^controller\.ancillary_rate_hz: expected a positive multiple"),
+    ({"disturbance": {"constant": [1e200, 0.0, 0.0]}},
+     r"^disturbance\.constant: expected a speed of magnitude <= 1e\+06 m/s"),
+    ({"disturbance": {"amplitude": [0.0, 1e300, 0.0]}}, r"^disturbance\.amplitude: expected a speed of magnitude"),
+])
+def test_huge_numbers_name_their_own_field(table, match):
+    """Issue 24 items 1 and 3: products that overflow are refused up front, each error naming the right field."""
+    with pytest.raises(ConfigError, match=match):
+        scenario_from_dict(table)
+
+
+# ---- limits.rate (issue 22 design (1)) ---------------------------------------------------------------------------
+
+def test_rate_limit_is_off_by_default_and_in_the_dict_only_when_set(tmp_path):
+    assert paper_scenario().limits.rate is None and "rate" not in paper_scenario().to_dict()["limits"]
+    assert paper_scenario().limits.jump(0.1) is None
+    sc = paper_scenario().with_changes(**{"limits.rate": [0.3, 0.2, 1]})
+    assert sc.limits.rate == (0.3, 0.2, 1.0) and sc.to_dict()["limits"]["rate"] == [0.3, 0.2, 1.0]
+    assert np.allclose(sc.limits.jump(0.1), [0.03, 0.02, 0.1], rtol=1e-15)
+    path = tmp_path / "rated.toml"
+    path.write_text(_to_toml(sc.to_dict()))
+    assert load_scenario(path) == sc
+
+
+@pytest.mark.parametrize("rate, match", [
+    ("0.3", r"limits\.rate: expected three numbers"),
+    ([0.3, 0.3], r"limits\.rate: expected three numbers"),
+    ([0.3, "0.3", 1.0], r"limits\.rate\[1\]: expected a number > 0"),
+    ([0.3, 0.3, 0.0], r"limits\.rate\[2\]: expected a number > 0"),
+    ([-1.0, 0.3, 1.0], r"limits\.rate\[0\]: expected a number > 0"),
+    ([0.3, math.inf, 1.0], r"limits\.rate\[1\]: expected a finite number"),
+    ([True, 0.3, 1.0], r"limits\.rate\[0\]: expected a number > 0"),
+])
+def test_rate_limit_errors_name_the_field(rate, match):
+    with pytest.raises(ConfigError, match=match):
+        scenario_from_dict({"limits": {"rate": rate}})

@@ -75,3 +75,28 @@ def test_tutorial_is_jupytext_percent_and_public_api_only(path):
     for mod in re.findall(r"^from (\S+) import|^import (\S+)", text, flags=re.M):
         name = mod[0] or mod[1]
         assert not re.search(r"\._", name), f"{path.name} imports a private module {name}"
+
+
+def _notebook(path):
+    nbformat = pytest.importorskip("nbformat")
+    return nbformat.read(str(TUTORIALS / "notebooks" / f"{path.stem}.ipynb"), as_version=4)
+
+
+@pytest.mark.parametrize("path", FILES, ids=lambda p: p.stem)
+def test_executed_notebook_cells_are_the_tutorials(path):
+    """The committed notebook runs the tutorial's current source, cell by cell (prose included)."""
+    jupytext = pytest.importorskip("jupytext")
+    source = [(c.cell_type, c.source) for c in jupytext.read(path).cells]
+    shipped = [(c.cell_type, c.source) for c in _notebook(path).cells]
+    assert shipped == source, f"{path.name} changed since its notebook was executed: run python docs/regenerate.py"
+
+
+@pytest.mark.parametrize("path", FILES, ids=lambda p: p.stem)
+def test_executed_notebook_carries_the_stored_fingerprint(path):
+    """The notebook was executed on code with the fingerprint of docs/artefacts.json (which
+    tests/test_regenerate.py recomputes): its printed certificates and runs are the code's."""
+    import json
+
+    stored = json.loads((TUTORIALS.parent / "docs" / "artefacts.json").read_text())["fingerprint"]
+    stamp = _notebook(path).metadata.get("tubekit", {}).get("fingerprint")
+    assert stamp == stored, f"{path.stem}.ipynb is stale: run python docs/regenerate.py"

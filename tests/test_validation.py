@@ -8,8 +8,9 @@ import numpy as np
 import pytest
 
 from tubekit.exceptions import ConfigError, ShapeError
-from tubekit.validation import (StrChoice, as_vector, choice, duration_seconds, finite, interval, nonnegative,
-                                nonnegative_triple, positive, positive_triple, replace_fields)
+from tubekit.validation import (StrChoice, as_vector, bounded_int, choice, duration_seconds, finite, interval,
+                                nonnegative, nonnegative_triple, period_count, positive, positive_triple,
+                                replace_fields, speed_bound, text, ticks_per_period)
 
 
 @pytest.mark.parametrize("fn, value, match", [
@@ -26,7 +27,24 @@ def test_scalar_errors(fn, value, match):
 
 
 def test_scalar_ok():
-    assert finite("x", "1.5") == 1.5 and positive("x", 2) == 2.0 and nonnegative("x", 0) == 0.0
+    assert finite("x", 1.5) == 1.5 and positive("x", 2) == 2.0 and nonnegative("x", 0) == 0.0
+    assert finite("x", np.float32(0.5)) == 0.5 and type(finite("x", np.int64(3))) is float
+
+
+@pytest.mark.parametrize("fn, value", [
+    (finite, "1.5"), (positive, "100"), (finite, None), (finite, True), (positive, np.bool_(True)),
+    (finite, 10 ** 400), (duration_seconds, "100"), (duration_seconds, False), (duration_seconds, 10 ** 400),
+])
+def test_types_are_strict(fn, value):
+    """Issue 24 item 2: a string, a bool, None or an int beyond the float range is not a number."""
+    with pytest.raises(ConfigError, match=r"^x: expected a (finite number|number of seconds > 0), received"):
+        fn("x", value)
+
+
+@pytest.mark.parametrize("value", [["1", 2, 3], np.array(["1", "2", "3"]), [1, None, 2], [10 ** 400, 0, 0]])
+def test_vectors_are_strict(value):
+    with pytest.raises(ConfigError, match="^v: expected"):
+        as_vector("v", value, 3)
 
 
 @pytest.mark.parametrize("value, exc, match", [
@@ -58,7 +76,7 @@ def test_interval_errors(value, match):
 
 
 def test_interval_ok():
-    assert interval("i", ["-1", 2]) == (-1.0, 2.0)
+    assert interval("i", [-1, 2]) == (-1.0, 2.0)
 
 
 @pytest.mark.parametrize("fn, value, match", [
@@ -141,3 +159,25 @@ def test_replace_fields_reaches_nested_fields_and_validates_them():
 def test_replace_fields_errors_name_the_field(changes, match):
     with pytest.raises(ConfigError, match=match):
         replace_fields(_Outer(), changes)
+
+
+@pytest.mark.parametrize("call, match", [
+    (lambda: period_count("d", 1e308, 0.1), r"^d: expected at most 1e\+09 FHOCP periods of 0\.1 s"),
+    (lambda: ticks_per_period("c.rate", 100.0, "c.dt", 1e-9), r"^c\.dt: expected at least one tick 1/rate = 0\.01 s"),
+    (lambda: ticks_per_period("c.rate", 1e308, "c.dt", 10.0), r"^c\.rate: expected at most 1e\+06 ticks"),
+    (lambda: ticks_per_period("c.rate", 155.0, "c.dt", 0.1), r"^c\.rate: expected a positive multiple of 1/dt"),
+    (lambda: speed_bound("v", float("inf"), [1e308]), r"^v: expected a speed of magnitude <= 1e\+06 m/s"),
+    (lambda: text("name", 5), r"^name: expected a string, received 5"),
+    (lambda: bounded_int("n", 10 ** 12, 1, 10), r"^n: expected an integer in \[1, 10\]"),
+    (lambda: bounded_int("n", True, 0, 10), r"^n: expected an integer in \[0, 10\]"),
+    (lambda: bounded_int("n", 2.0, 0, 10), r"^n: expected an integer in \[0, 10\]"),
+])
+def test_counts_and_magnitudes_are_bounded(call, match):
+    """Issue 24 item 1: a count or a product that would overflow is refused, naming the field."""
+    with pytest.raises(ConfigError, match=match):
+        call()
+
+
+def test_counts_within_bounds_pass():
+    assert ticks_per_period("r", 100.0, "dt", 0.1) == 10 and period_count("d", 100.0, 0.1) == pytest.approx(1000)
+    assert bounded_int("n", 10, 1, 10) == 10 and text("name", "x") == "x"

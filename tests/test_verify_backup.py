@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import functools
 import math
 
 import numpy as np
@@ -18,11 +19,22 @@ LAW = StationKeeping(surge=0.2, yaw_rate=0.5, yaw_band=0.05, heave=0.3, heave_ba
 SAFE = SafeSet(level=0.75, shape=0.4, depth=0.1)
 
 
-def _lyapunov(state: np.ndarray, safe: SafeSet) -> float:
-    """V = d + beta (1 - cos chi), computed here from the geometry (not from verify)."""
+@functools.lru_cache(maxsize=None)
+def _smooth_design():
+    """The smooth design on the paper's currents (5 s: computed once for this file)."""
+    return design_backup(omega_xy=0.12, omega_z=0.1, limits=LIMITS, tick=TICK, handover=(0.125, 0.08), smooth=True)
+
+
+def _lyapunov(state: np.ndarray, safe: SafeSet, unstable: float = 0.0) -> float:
+    """V = d + beta (1 - cos chi), or with χ_u > 0 the continuous law's V = d + beta a(chi) (a: half a cosine wave
+    up on [0, 0.75 χ_u], 1 up to χ_u, down on [χ_u, π]), computed here from the geometry (not from verify)."""
     d = math.hypot(state[0], state[1])
     phi = line_of_sight_angle(state[0], state[1], state[3], 0.0, 0.0)
-    return d + safe.shape * (1.0 - math.cos(axis_angle(phi)))
+    if unstable == 0.0:
+        return d + safe.shape * (1.0 - math.cos(axis_angle(phi)))
+    x = phi % math.pi
+    wave = min(1.0, x / (0.75 * unstable)) if x <= unstable else (math.pi - x) / (math.pi - unstable)
+    return d + safe.shape * 0.5 * (1.0 - math.cos(math.pi * wave))
 
 
 def _tick(state: np.ndarray, v: np.ndarray, omega: np.ndarray, h: float, n: int = 4) -> np.ndarray:
@@ -119,3 +131,126 @@ def test_a_smaller_set_is_refused_and_the_adversary_leaves_it():
     assert not cert.certified
     worst, _, _ = _adversarial_run(LAW, small, [small.handover_radius, 0.0, 0.0, math.pi / 2], 0.12, 0.1, 30.0)
     assert worst > small.level
+
+
+# ---- fades, ramp and the yaw-rate error (issue 22) ---------------------------------------------
+
+import dataclasses  # noqa: E402
+
+from verify.backup import BackupCertificate, ramp_window  # noqa: E402
+
+#: d_tick = c − β − h (u_b + ω̄_xy) = 0.75 − 0.4 − 0.01 * 0.32 = 0.3468 m on the paper's currents.
+D_TICK = 0.75 - 0.4 - 0.01 * 0.32
+FADED = dataclasses.replace(LAW, surge_fade=0.3, yaw_fade=0.3, ramp=0.5)
+DEEP = SafeSet(level=0.75, shape=0.4, depth=0.4)
+
+
+def _names(cert) -> set[str]:
+    return {c.condition for c in cert.conditions}
+
+
+def test_an_unfaded_law_keeps_the_conditions_it_had():
+    cert = certify_backup(LAW, SAFE, omega_xy=0.12, omega_z=0.1, limits=LIMITS, tick=TICK)
+    assert not {"backup_fade", "backup_ramp"} & _names(cert)
+    assert len(cert.conditions) == 8
+
+
+def test_a_faded_ramped_law_certifies_with_its_two_conditions():
+    # ramp window: (0.75 − 0.4 − 0.05)/0.32 = 0.9375 s horizontally, (0.4 − 0.02)/0.4 = 0.95 s in depth
+    cert = certify_backup(FADED, DEEP, omega_xy=0.12, omega_z=0.1, limits=LIMITS, tick=TICK, handover=(0.05, 0.02))
+    assert cert.certified, cert.summary_lines()
+    fade = next(c for c in cert.conditions if c.condition == "backup_fade")
+    ramp = next(c for c in cert.conditions if c.condition == "backup_ramp")
+    assert fade.lhs == 0.3 and fade.rhs == pytest.approx(D_TICK)
+    assert ramp.lhs == pytest.approx(0.51) and ramp.rhs == pytest.approx(0.9375)
+    assert ramp_window(FADED, DEEP, omega_xy=0.12, omega_z=0.1, tick=TICK, handover=(0.05, 0.02)) == \
+        pytest.approx(0.9375 - 0.01)
+
+
+@pytest.mark.parametrize("law, safe, failed", [
+    (dataclasses.replace(FADED, yaw_fade=0.35), DEEP, "backup_fade"),     # 0.35 > d_tick = 0.3468
+    (dataclasses.replace(FADED, ramp=0.93), DEEP, "backup_ramp"),         # 0.94 > 0.9375
+    (FADED, SafeSet(level=0.75, shape=0.4, depth=0.2), "backup_ramp"),    # (0.2 − 0.02)/0.4 = 0.45 < 0.51
+])
+def test_a_fade_or_ramp_too_long_is_refused(law, safe, failed):
+    cert = certify_backup(law, safe, omega_xy=0.12, omega_z=0.1, limits=LIMITS, tick=TICK, handover=(0.05, 0.02))
+    assert {c.condition for c in cert.failures} == {failed}
+
+
+def test_the_yaw_rate_error_widens_the_level_set_rate_and_the_ridge():
+    base, _ = planar_rate_bound(LAW, SAFE, 0.12, TICK)
+    wide, _ = planar_rate_bound(LAW, SAFE, 0.12, TICK, yaw_rate_error=0.05)
+    assert wide > base
+    # E_r = 0.2: the ridge needs (u_b sin 2Δ + ω̄_xy)/d_tick + E_r < k; 0.12/0.3468 + 0.2 > 0.5 already
+    cert = certify_backup(LAW, SAFE, omega_xy=0.12, omega_z=0.1, limits=LIMITS, tick=TICK, yaw_rate_error=0.2)
+    assert "backup_ridge" in {c.condition for c in cert.failures}
+    ridge = next(c for c in cert.conditions if c.condition == "backup_ridge")
+    assert ridge.lhs > 0.12 / D_TICK + 0.2 and "E_r" in ridge.inequality
+
+
+def test_the_smooth_certificate_round_trips_and_an_old_one_still_reads():
+    cert = certify_backup(FADED, DEEP, omega_xy=0.12, omega_z=0.1, limits=LIMITS, tick=TICK, handover=(0.05, 0.02),
+                          yaw_rate_error=0.01)
+    assert BackupCertificate.from_dict(cert.to_dict()) == cert
+    old = certify_backup(LAW, SAFE, omega_xy=0.12, omega_z=0.1, limits=LIMITS, tick=TICK).to_dict()
+    # an unfaded law at E_r = 0 writes the keys it wrote before issue 22, and reads back
+    assert set(old["law"]) == {"surge", "yaw_rate", "yaw_band", "heave", "heave_band"} and "yaw_rate_error" not in old
+    assert BackupCertificate.from_dict(old).law == LAW
+
+
+def test_a_stored_negative_ramp_is_refused_naming_it():
+    d = certify_backup(FADED, DEEP, omega_xy=0.12, omega_z=0.1, limits=LIMITS, tick=TICK).to_dict()
+    d["law"]["ramp"] = -1.0
+    with pytest.raises(ConfigError, match=r"certificate\.backup\.law\.ramp"):
+        BackupCertificate.from_dict(d)
+
+
+def test_the_smooth_design_takes_the_largest_fades_and_ramp():
+    cert = _smooth_design()
+    law, s = cert.law, cert.safe_set
+    assert cert.certified and law.smooth
+    d_tick = s.level - s.shape - TICK * (law.surge + 0.12)
+    reach = (s.level - s.shape - 0.125) / (law.surge + 0.12)
+    assert law.surge_fade == law.yaw_fade == pytest.approx(d_tick)
+    assert law.ramp == pytest.approx(reach - TICK, rel=1e-8)
+    assert s.depth >= 0.08 + reach * (law.heave + 0.1) - 1e-12  # the depth band does not shorten the ramp
+    longer = certify_backup(dataclasses.replace(law, ramp=law.ramp * (1 + 1e-6)), s, omega_xy=0.12, omega_z=0.1,
+                            limits=LIMITS, tick=TICK, handover=(0.125, 0.08))
+    assert {c.condition for c in longer.failures} == {"backup_ramp"}
+    plain = design_backup(omega_xy=0.12, omega_z=0.1, limits=LIMITS, tick=TICK, handover=(0.125, 0.08))
+    assert not plain.law.smooth and plain.law.ramp == 0.0
+
+
+def test_the_smooth_law_resists_the_adversary_from_the_hand_over():
+    """The greedy adversary of this file, with the ramp running from the hand-over (s = 0)."""
+    cert = _smooth_design()
+    law, s = cert.law, cert.safe_set
+    angles = np.linspace(0.0, 2 * math.pi, 8, endpoint=False)
+    for heading in (math.pi / 2, 2.5):
+        state = np.array([0.125, 0.0, 0.08, heading])
+        worst = worst_z = 0.0
+        for k in range(1000):
+            v = law(state, np.zeros(3), k * TICK)
+            wz = 0.1 if state[2] >= 0 else -0.1
+            nxt = [_tick(state, v, np.array([0.12 * math.cos(a), 0.12 * math.sin(a), wz]), TICK) for a in angles]
+            state = max(nxt, key=lambda x: _lyapunov(x, s, law.unstable))
+            worst, worst_z = max(worst, _lyapunov(state, s, law.unstable)), max(worst_z, abs(state[2]))
+        assert worst <= s.level and worst_z <= s.depth
+
+
+def test_the_smooth_design_uses_the_continuous_yaw_law_and_round_trips():
+    """χ_u = 0.8 χ_c with χ_c = acos √(ω̄_xy/u_b) (by hand below); ``backup_unstable`` replaces ``backup_ridge``;
+    the stored law carries ``yaw_law`` and ``unstable`` and reads back."""
+    cert = _smooth_design()
+    law = cert.law
+    assert law.yaw_law == "continuous"
+    assert law.unstable == pytest.approx(0.8 * math.acos(math.sqrt(0.12 / law.surge)), rel=1e-12)
+    names = {c.condition for c in cert.conditions}
+    assert "backup_unstable" in names and "backup_ridge" not in names
+    stored = cert.to_dict()
+    assert stored["law"]["yaw_law"] == "continuous" and stored["law"]["unstable"] == law.unstable
+    assert BackupCertificate.from_dict(stored) == cert
+    assert "continuous yaw law" in "\n".join(cert.summary_lines())
+    stored["law"]["yaw_law"] = "spiral"
+    with pytest.raises(ConfigError, match=r"certificate\.backup\.law\.yaw_law"):
+        BackupCertificate.from_dict(stored)

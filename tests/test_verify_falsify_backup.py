@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import functools
 import math
 
 import numpy as np
@@ -66,3 +67,56 @@ def test_bad_arguments_are_refused(kwargs, match):
     args = {"omega_xy": 0.12, "omega_z": 0.1, "tick": 0.01, **kwargs}
     with pytest.raises(ConfigError, match=match):
         falsify_backup(PLAN, **args)
+
+
+# ---- the smooth law (issue 22) -----------------------------------------------------------------
+
+@functools.lru_cache(maxsize=None)
+def _smooth_plan(omega_xy: float, yaw_rate_error: float) -> BackupPlan:
+    from verify.backup import design_backup
+    cert = design_backup(omega_xy=omega_xy, omega_z=0.1, limits=(0.4, 0.3, 0.5), tick=0.01, handover=(0.125, 0.08),
+                         smooth=True, yaw_rate_error=yaw_rate_error)
+    assert cert.certified
+    return BackupPlan(cert.law, cert.safe_set, handover=(0.125, 0.08))
+
+
+@pytest.mark.parametrize("omega_xy, yaw_rate_error", [(0.12, 0.0), (0.2, 0.05)])
+def test_the_certified_smooth_set_survives_the_search(omega_xy, yaw_rate_error):
+    """Greedy and evolution from hand-over starts, the ramp running from s = 0, the adversary choosing the yaw
+    error."""
+    plan = _smooth_plan(omega_xy, yaw_rate_error)
+    result = falsify_backup(plan, omega_xy=omega_xy, omega_z=0.1, tick=0.01, budget=5, seconds=4.0, seed=2,
+                            yaw_rate_error=yaw_rate_error)
+    assert plan.law.yaw_law == "continuous"  # the smooth design's yaw law has no jump abeam
+    assert result.check(), result.summary()
+    assert result.worst.level_ratio > 0.3  # the attack is not idle: V is pushed from <= 0.125 + β towards c
+
+
+def test_a_ramp_longer_than_the_window_is_refused_and_the_adversary_exits():
+    """A ramp of 100 s (``backup_ramp`` allows about 1.2 s): the certificate refuses it, and the current carries the
+    weak law's vehicle out of the set before the ramp ends."""
+    import dataclasses
+
+    from verify.backup import certify_backup
+    plan = _smooth_plan(0.12, 0.0)
+    slow = BackupPlan(dataclasses.replace(plan.law, ramp=100.0), plan.safe_set, handover=plan.handover)
+    cert = certify_backup(slow.law, slow.safe_set, omega_xy=0.12, omega_z=0.1, limits=(0.4, 0.3, 0.5), tick=0.01,
+                          handover=plan.handover)
+    assert {c.condition for c in cert.failures} == {"backup_ramp"}
+    result = falsify_backup(slow, omega_xy=0.12, omega_z=0.1, tick=0.01, budget=1, seconds=8.0, seed=0)
+    assert result.found and result.worst.left
+
+
+def test_a_bad_yaw_rate_error_is_refused():
+    with pytest.raises(ConfigError, match="yaw_rate_error"):
+        falsify_backup(PLAN, omega_xy=0.12, omega_z=0.1, tick=0.01, yaw_rate_error=-0.1)
+
+
+def test_the_continuous_law_s_lyapunov_function_by_hand():
+    # at (1, 0) heading π + χ_u the axis is at the unstable angle: a = 1, V = 1 + β; heading π: V = 1;
+    # heading π/2 (abeam): a = (1 − cos(π (π/2)/(π − χ_u)))/2
+    law = StationKeeping(0.4, 0.5, 0.5, 0.3, 0.1, yaw_law="continuous", unstable=0.6)
+    assert backup_lyapunov(np.array([1.0, 0.0, 0.0, math.pi + 0.6]), np.zeros(3), 0.4, law) == pytest.approx(1.4)
+    assert backup_lyapunov(np.array([1.0, 0.0, 0.0, math.pi]), np.zeros(3), 0.4, law) == pytest.approx(1.0)
+    abeam = 1.0 + 0.4 * 0.5 * (1 - math.cos(math.pi * (math.pi / 2) / (math.pi - 0.6)))
+    assert backup_lyapunov(np.array([1.0, 0.0, 0.0, math.pi / 2]), np.zeros(3), 0.4, law) == pytest.approx(abeam)

@@ -4,7 +4,9 @@ from __future__ import annotations
 
 from tubekit.scenario import paper_scenario
 from verify import certify
-from verify.report import certificate_text, tiers_line
+import pytest
+
+from verify.report import certificate_text, compare, tiers_line, tried_lines
 
 
 def test_certified_text(pc_cert):
@@ -30,7 +32,7 @@ def test_uncertified_text_names_every_failure(paper_cert):
     assert text.count("[FAIL]") == n
     for f in paper_cert.failures:
         line = next(ln for ln in text.splitlines() if f"] {f.condition}:" in ln)
-        assert line.startswith("  [FAIL]") and f"{f.lhs:.6g} vs {f.rhs:.6g}" in line
+        assert line.startswith("  [FAIL]") and compare(f.lhs, f.rhs) in line
         assert f.detail in line
 
 
@@ -61,3 +63,32 @@ def test_the_tiers_and_the_backup_are_printed(pc_cert, paper_cert):
 def test_a_certificate_without_the_safe_tier_names_its_failures():
     c = certify(paper_scenario().with_changes(sensing_range=0.6))
     assert tiers_line(c).startswith("safe: not certified (safe_only.sensing")
+
+
+@pytest.mark.parametrize("lhs, rhs, text", [
+    (0.9999996, 1.0, "0.9999996 < 1"),          # strict tube condition: never "1 vs 1"
+    (1.0, 1.0, "1 = 1"),
+    (-0.293, 0.0, "-0.293 < 0"),                # the direction is printed
+    (0.4, 0.496991, "0.4 < 0.496991"),
+    (6.0, 1.44993, "6 > 1.44993"),
+    (1.0 + 2.0 ** -52, 1.0, "1.0000000000000002 > 1"),
+    (None, 1.0, "n/a vs 1"),
+    (float("inf"), 1.0, "inf vs 1"),
+])
+def test_compare_prints_the_relation(lhs, rhs, text):
+    """Issue 24 item 9: a condition prints its two numbers with their relation, distinct when they differ."""
+    assert compare(lhs, rhs) == text
+
+
+def test_uncertified_text_does_not_speak_of_certified_designs(paper_cert):
+    text = paper_cert.summary()
+    assert not any(t.certified for t in paper_cert.tried)
+    assert "among the certified ones tried" not in text
+    assert "none tried certified" in text
+
+
+def test_tried_lines_give_every_design_s_failures(paper_cert):
+    lines = tried_lines(paper_cert)
+    assert lines[0] == f"Designs tried ({len(paper_cert.tried)}):" and len(lines) == 1 + len(paper_cert.tried)
+    for trial, line in zip(paper_cert.tried, lines[1:]):
+        assert all(name in line for name in trial.failed) and f"{len(trial.failed)} failed" in line

@@ -6,6 +6,7 @@ the field to fix, before certification, simulation or any file is written:
 * geometry of the start: clear of every obstacle inflated by the vehicle
   radius r̄, inside the workspace box, and at e_d(0) >= ε (e_o is undefined at
   e_d = 0 and the certified region starts at ε);
+* the target path: p_d(t) inside the workspace box over the run (:func:`check_target`);
 * size: the per-tick log of a run (:func:`log_bytes`) fits
   :data:`MEMORY_BUDGET_BYTES`;
 * horizon and limits: N <= :data:`MAX_HORIZON_STEPS`, and the farthest
@@ -30,11 +31,11 @@ import numpy as np
 from tubekit.model.errors import error_coordinates
 from tubekit.exceptions import ConfigError
 from tubekit.scenario import ControllerSettings, Scenario, paper_scenario
-from tubekit.validation import duration_seconds
+from tubekit.validation import duration_seconds, period_count
 
-__all__ = ["check_run_inputs", "check_start", "check_log_size", "check_horizon_and_limits", "log_bytes",
-           "require_one_period", "horizon_reach", "workspace_fits", "workspace_rule",
-           "MEMORY_BUDGET_BYTES", "LOG_BYTES_PER_TICK", "RUNS_PER_STUDY", "MAX_HORIZON_STEPS"]
+__all__ = ["check_run_inputs", "check_start", "check_target", "TARGET_SAMPLES", "check_log_size",
+           "check_horizon_and_limits", "log_bytes", "require_one_period", "horizon_reach", "workspace_fits",
+           "workspace_rule", "MEMORY_BUDGET_BYTES", "LOG_BYTES_PER_TICK", "RUNS_PER_STUDY", "MAX_HORIZON_STEPS"]
 
 #: Memory a study may spend on its per-tick logs (bytes): 2 GiB.
 MEMORY_BUDGET_BYTES = 2 * 1024 ** 3
@@ -43,6 +44,8 @@ MEMORY_BUDGET_BYTES = 2 * 1024 ** 3
 LOG_BYTES_PER_TICK = 1024
 #: Runs held in memory together by a study (tube and baseline).
 RUNS_PER_STUDY = 2
+#: Instants at which :func:`check_target` samples the target path.
+TARGET_SAMPLES = 4001
 #: Largest FHOCP horizon N accepted (the convex subproblem grows linearly in N; beyond this
 #: one build takes minutes and the horizon dwarfs any workspace).
 MAX_HORIZON_STEPS = 500
@@ -102,12 +105,34 @@ def check_start(scenario: Scenario) -> None:
                           f"e_d(0) = {e_d0:.4g} m")
 
 
+def check_target(scenario: Scenario) -> None:
+    """The target path p_d(t), t in [0, duration], stays inside the workspace box.
+
+    Checked on :data:`TARGET_SAMPLES` evenly spaced instants: a refusal is certain (a sampled
+    target lies outside); an excursion shorter than one sample spacing may pass (verify's
+    ``target_in_workspace`` condition bounds every instant).
+    """
+    if scenario.workspace is None:
+        return
+    t = np.linspace(0.0, scenario.duration, TARGET_SAMPLES)
+    p = np.asarray(scenario.trajectory.position(t), dtype=float).reshape(-1, 3)
+    lower, upper = (np.asarray(side, dtype=float) for side in scenario.workspace)
+    out = np.maximum(lower - p, p - upper).max(axis=1)
+    k = int(np.argmax(out))
+    if not out[k] <= 0.0:
+        raise ConfigError("trajectory", f"a target path p_d(t) inside the workspace {[lower.tolist(), upper.tolist()]}"
+                          f" m for t in [0, duration = {scenario.duration:g} s]",
+                          scenario.trajectory.kind, f"p_d({t[k]:.4g} s) = [{', '.join(f'{x:.4g}' for x in p[k])}] m "
+                          f"is {out[k]:.4g} m outside it")
+
+
 def require_one_period(field: str, duration: float, dt: float) -> None:
     """Raise ``ConfigError(field, ...)`` unless ``duration`` (s) holds at least one FHOCP period ``dt`` (s).
 
-    The loop runs ``round(duration / dt)`` periods; a duration that rounds to none is refused.
+    The loop runs ``round(duration / dt)`` periods; a duration that rounds to none, or to more than
+    :data:`tubekit.validation.MAX_PERIODS`, is refused (the count is checked before it is made an int).
     """
-    if not round(duration / dt) >= 1:
+    if not round(period_count(field, duration, dt)) >= 1:
         raise ConfigError(field, f"at least one FHOCP period ({dt:g} s)", duration)
 
 
@@ -169,3 +194,4 @@ def check_run_inputs(scenario: Scenario, duration: float | None = None) -> None:
     check_log_size(scenario, duration)
     check_horizon_and_limits(scenario)
     check_start(scenario)
+    check_target(scenario)

@@ -12,7 +12,9 @@ The fields (:func:`design_fields`, a flat dict of dotted names, numbers as float
 ``vehicle_radius``, ``sensing_range``, ``workspace``, ``duration`` (the target must stay in
 the workspace over the run, ``target_in_workspace``),
 ``controller.{dt, horizon_steps, ancillary_rate_hz}``, ``plant.*`` (``plant.kind`` only
-on the kinematic plant). A run shorter than the certified duration is covered
+on the kinematic plant; on the dynamic plant every vehicle parameter, intervals included, but not
+``plant.truth``: the coefficients of the plant as simulated may be any point of the box the
+certificate covers). A run shorter than the certified duration is covered
 (:func:`require_matching` accepts it). The backup law and its safe set are derived from
 these (ω̄, V, the ancillary rate, the margins), so they need no field of their own. Not in
 the key, because the theorem does not read them: the name, the current's and the sway's
@@ -33,7 +35,7 @@ from tubekit.exceptions import ConfigError
 __all__ = ["THEOREM_VERSION", "design_fields", "design_key", "first_difference", "require_matching"]
 
 #: Version of the theorem a certificate states; a certificate of another version is not this design.
-THEOREM_VERSION = "sampled-data-tube+backup/3"
+THEOREM_VERSION = "sampled-data-tube+backup+velocity-loop/4"
 
 _SCENARIO_KEYS = ("limits", "trajectory", "epsilon", "region", "obstacles", "vehicle_radius", "sensing_range",
                   "workspace", "duration")
@@ -94,8 +96,8 @@ def design_fields(scenario: Any, law: str, sigma: float) -> dict[str, Any]:
     plant = d.get("plant", {"kind": "kinematic"})
     if plant.get("kind", "kinematic") == "kinematic":
         out["plant.kind"] = "kinematic"
-    else:
-        _flatten("plant", plant, out)
+    else:  # the plant as simulated (``truth``) is any point of the coefficient box the theorem covers
+        _flatten("plant", {k: v for k, v in plant.items() if k != "truth"}, out)
     return out
 
 

@@ -27,7 +27,8 @@ import numpy as np
 from tubekit.exceptions import ConfigError, ShapeError
 from tubekit.model.kinematics import InputLimits, SwayModel
 from tubekit.model.trajectory import Circle, Trajectory, trajectory_from_dict
-from tubekit.validation import StrChoice, as_vector, choice, positive, replace_fields
+from tubekit.validation import (StrChoice, as_vector, choice, gain, period_count, positive, replace_fields, speed_bound,
+                                text, ticks_per_period)
 from tubekit.model.vehicles import PlantSettings
 
 __all__ = [
@@ -124,6 +125,8 @@ class Disturbance:
         object.__setattr__(self, "period", positive("disturbance.period", self.period))
         object.__setattr__(self, "constant",
                            tuple(float(c) for c in as_vector("disturbance.constant", self.constant, 3)))
+        speed_bound("disturbance.amplitude", max(math.hypot(*amp[::2]), amp[1]), list(self.amplitude))
+        speed_bound("disturbance.constant", math.hypot(*self.constant), list(self.constant))
 
     @property
     def current_bound(self) -> float:
@@ -183,7 +186,7 @@ class ControllerSettings:
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "dt", positive("controller.dt", self.dt))
-        if not isinstance(self.horizon_steps, int) or self.horizon_steps < 1:
+        if not isinstance(self.horizon_steps, int) or isinstance(self.horizon_steps, bool) or self.horizon_steps < 1:
             raise ConfigError("controller.horizon_steps", "an integer >= 1", self.horizon_steps)
         for name in ("Q", "R", "P"):
             vec = as_vector(f"controller.{name}", getattr(self, name), 3)
@@ -192,16 +195,13 @@ class ControllerSettings:
                                   getattr(self, name))
             object.__setattr__(self, name, tuple(float(x) for x in vec))
         from tubekit.model.ancillary import LAWS  # the registry: built-in laws plus registered ones
-        if self.law not in LAWS:
+        if not isinstance(self.law, str) or self.law not in LAWS:
             raise ConfigError("controller.law", f"one of {tuple(LAWS)}", self.law)
         if self.sigma is not None:
-            object.__setattr__(self, "sigma", positive("controller.sigma", self.sigma))
+            object.__setattr__(self, "sigma", gain("controller.sigma", self.sigma))
         object.__setattr__(self, "ancillary_rate_hz",
                            positive("controller.ancillary_rate_hz", self.ancillary_rate_hz))
-        ratio = self.ancillary_rate_hz * self.dt
-        if abs(ratio - round(ratio)) > 1e-9 or round(ratio) < 1:
-            raise ConfigError("controller.ancillary_rate_hz", "a positive multiple of 1/dt",
-                              self.ancillary_rate_hz)
+        ticks_per_period("controller.ancillary_rate_hz", self.ancillary_rate_hz, "controller.dt", self.dt)
         object.__setattr__(self, "terminal_level", positive("controller.terminal_level", self.terminal_level))
         object.__setattr__(self, "fhocp_mode", choice("controller.fhocp_mode", FhocpMode, self.fhocp_mode))
         object.__setattr__(self, "terminal_mode", choice("controller.terminal_mode", TerminalMode,
@@ -294,6 +294,7 @@ class Scenario:
     plant: PlantSettings = field(default_factory=PlantSettings)
 
     def __post_init__(self) -> None:
+        text("name", self.name)
         object.__setattr__(self, "vehicle_radius", positive("vehicle_radius", self.vehicle_radius))
         object.__setattr__(self, "sensing_range", positive("sensing_range", self.sensing_range))
         if self.sensing_range <= self.vehicle_radius:
@@ -323,7 +324,8 @@ class Scenario:
             hi = as_vector("workspace[1]", self.workspace[1], 3)
             if np.any(hi <= lo):
                 raise ConfigError("workspace", "lower < upper on every axis", self.workspace)
-            object.__setattr__(self, "workspace", (tuple(lo), tuple(hi)))
+            object.__setattr__(self, "workspace", (tuple(float(x) for x in lo), tuple(float(x) for x in hi)))
+        period_count("duration", self.duration, self.controller.dt)
 
     @property
     def steps(self) -> int:
@@ -366,6 +368,8 @@ class Scenario:
                            if v is not None and not (k == "fhocp_backend" and v == "scp")},
             "region": {k: (str(v) if isinstance(v, str) else v) for k, v in asdict(self.region).items()},
         }
+        if self.limits.rate is not None:  # only when set: a scenario without it keeps its dict
+            d["limits"]["rate"] = list(self.limits.rate)
         if self.workspace is not None:
             d["workspace"] = [list(self.workspace[0]), list(self.workspace[1])]
         if self.plant != PlantSettings():  # the default kinematic plant leaves the dict as before
@@ -424,7 +428,7 @@ def scenario_from_dict(d: dict) -> Scenario:
     base = paper_scenario()
     kw: dict[str, Any] = {}
     if "name" in d:
-        kw["name"] = str(d["name"])
+        kw["name"] = text("name", d["name"])
     if "trajectory" in d:
         kw["trajectory"] = trajectory_from_dict(d["trajectory"])
     if "obstacles" in d:
@@ -439,9 +443,10 @@ def scenario_from_dict(d: dict) -> Scenario:
                 built.append(Obstacle(o["center"], o["radius"]))
         kw["obstacles"] = tuple(built)
     if "limits" in d:
-        lim = _table(d, "limits", InputLimits, {"u_max", "w_max", "r_max"})
+        lim = _table(d, "limits", InputLimits, {"u_max", "w_max", "r_max", "rate"})
         b = base.limits
-        kw["limits"] = InputLimits(lim.get("u_max", b.u_max), lim.get("w_max", b.w_max), lim.get("r_max", b.r_max))
+        kw["limits"] = InputLimits(lim.get("u_max", b.u_max), lim.get("w_max", b.w_max), lim.get("r_max", b.r_max),
+                                   lim.get("rate", b.rate))
     for key in ("vehicle_radius", "sensing_range", "epsilon", "duration"):
         if key in d:
             kw[key] = d[key]

@@ -136,6 +136,10 @@ class Tightening:
         Which tier of promise the certificate gives, e.g. ``{"safe": True, "tracking": False}``.
         A safe-only tightening (tracking False) has σ = 0, ``v_max`` = V, a zero tube and margins
         whose e-columns are zero (not enforced: only the position constraints are checked).
+    velocity_loop : (3,) floats or None
+        Dynamic plant: the certificate's derived bound on the velocity loop's error
+        |u_b − u|, |w_b − w|, |r_b − r| (m/s, m/s, rad/s), checked in every run (promise
+        ``velocity_loop``); None otherwise.
     """
 
     v_max: np.ndarray
@@ -157,10 +161,16 @@ class Tightening:
     design_fields: dict | None = None
     backup: BackupPlan | None = None
     tiers: dict | None = None
+    velocity_loop: tuple[float, float, float] | None = None
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "region", RegionBounds.of(self.region))
         object.__setattr__(self, "disturbance", DisturbanceBound.of(self.disturbance))
+        if self.velocity_loop is not None:
+            loop = _numbers("tightening.velocity_loop", self.velocity_loop, 3)
+            if min(loop) < 0.0:
+                raise ConfigError("tightening.velocity_loop", "three numbers >= 0 (m/s, m/s, rad/s)", loop)
+            object.__setattr__(self, "velocity_loop", tuple(loop))
 
     @property
     def terminal_backup(self) -> BackupPlan | None:

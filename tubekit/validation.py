@@ -17,10 +17,21 @@ import numpy as np
 
 from tubekit.exceptions import ConfigError, ShapeError
 
-__all__ = ["as_vector", "positive", "nonnegative", "finite", "interval", "positive_triple", "nonnegative_triple",
-           "StrChoice", "choice", "duration_seconds", "replace_fields"]
+__all__ = ["as_vector", "is_number", "bounded_int", "positive", "nonnegative", "finite", "interval", "positive_triple",
+           "nonnegative_triple", "StrChoice", "choice", "duration_seconds", "replace_fields", "text", "period_count",
+           "ticks_per_period", "speed_bound", "MAX_PERIODS", "MAX_TICKS_PER_PERIOD", "MAX_SPEED",
+           "gain", "MAX_GAIN"]
 
 _E = TypeVar("_E", bound="StrChoice")
+
+#: Most periods a run may have (duration / dt); beyond, counts overflow memory and time.
+MAX_PERIODS = 1e9
+#: Most ticks of a fast law per period (rate x dt).
+MAX_TICKS_PER_PERIOD = 1e6
+#: Largest speed accepted anywhere (m/s, a current): beyond, no bound derived from it is worth using.
+MAX_SPEED = 1e6
+#: Largest ancillary gain sigma accepted (1/s): beyond, sigma x tick overflows every bound of the tube.
+MAX_GAIN = 1e6
 
 
 class StrChoice(str, enum.Enum):
@@ -52,23 +63,86 @@ def choice(field: str, kind: type[_E], value: Any) -> _E:
 
 def duration_seconds(field: str, value: Any) -> float:
     """``value`` as a finite number of seconds > 0 (booleans rejected), else :class:`ConfigError`."""
-    if isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, float, np.integer, np.floating)) \
-            or not math.isfinite(value) or value <= 0:
+    try:
+        seconds = finite(field, value)
+    except ConfigError:
+        raise ConfigError(field, "a number of seconds > 0", value) from None
+    if seconds <= 0:
         raise ConfigError(field, "a number of seconds > 0", value)
-    return float(value)
+    return seconds
+
+
+def is_number(value: Any) -> bool:
+    """Whether ``value`` is a real number: an int or float (numpy's too); never a bool, a string or None."""
+    return isinstance(value, (int, float, np.integer, np.floating)) and not isinstance(value, (bool, np.bool_))
 
 
 def finite(field: str, value: Any) -> float:
-    """Return ``value`` as a finite float or raise :class:`ConfigError` (booleans are not numbers)."""
-    if isinstance(value, (bool, np.bool_)):
+    """Return ``value`` as a finite float or raise :class:`ConfigError`.
+
+    Types are strict: a string (``"100"``), a boolean or None is not a number.
+    """
+    if not is_number(value):
         raise ConfigError(field, "a finite number", value)
     try:
         x = float(value)
-    except (TypeError, ValueError):
+    except OverflowError:  # an int beyond the float range
         raise ConfigError(field, "a finite number", value) from None
     if not math.isfinite(x):
         raise ConfigError(field, "a finite number", value)
     return x
+
+
+def bounded_int(field: str, value: Any, lo: int, hi: int) -> int:
+    """``value`` as an int in [lo, hi] (a bool or a float is not an int), else :class:`ConfigError`."""
+    if not isinstance(value, (int, np.integer)) or isinstance(value, (bool, np.bool_)) or not lo <= value <= hi:
+        raise ConfigError(field, f"an integer in [{lo}, {hi}]", value)
+    return int(value)
+
+
+def text(field: str, value: Any) -> str:
+    """``value`` if it is a string, else :class:`ConfigError`."""
+    if not isinstance(value, str):
+        raise ConfigError(field, "a string", value)
+    return value
+
+
+def period_count(field: str, duration: float, dt: float) -> float:
+    """``duration / dt`` (periods), refused past :data:`MAX_PERIODS` before any count is made an int."""
+    periods = duration / dt
+    if not periods <= MAX_PERIODS:
+        raise ConfigError(field, f"at most {MAX_PERIODS:g} FHOCP periods of {dt:g} s ({MAX_PERIODS * dt:.6g} s)",
+                          duration)
+    return periods
+
+
+def ticks_per_period(rate_field: str, rate: float, dt_field: str, dt: float) -> int:
+    """Ticks of a ``rate`` (Hz) law per period ``dt`` (s): a whole number in [1, :data:`MAX_TICKS_PER_PERIOD`].
+
+    A period shorter than one tick names ``dt_field``; too many ticks, or not a whole number, ``rate_field``.
+    """
+    ratio = rate * dt
+    if ratio < 1 - 1e-9:
+        raise ConfigError(dt_field, f"at least one tick 1/{rate_field.rsplit('.', 1)[-1]} = {1 / rate:g} s", dt)
+    if ratio > MAX_TICKS_PER_PERIOD:
+        raise ConfigError(rate_field, f"at most {MAX_TICKS_PER_PERIOD:g} ticks per period (rate x dt)", rate)
+    if abs(ratio - round(ratio)) > 1e-9:
+        raise ConfigError(rate_field, "a positive multiple of 1/dt", rate)
+    return round(ratio)
+
+
+def gain(field: str, value: Any) -> float:
+    """An ancillary gain sigma (1/s): a number in (0, :data:`MAX_GAIN`], else :class:`ConfigError`."""
+    sigma = positive(field, value)
+    if sigma > MAX_GAIN:
+        raise ConfigError(field, f"a gain in (0, {MAX_GAIN:g}] 1/s", value)
+    return sigma
+
+
+def speed_bound(field: str, magnitude: float, value: Any) -> None:
+    """Refuse a speed ``magnitude`` (m/s) beyond :data:`MAX_SPEED` (``value``: what the user gave)."""
+    if not magnitude <= MAX_SPEED:
+        raise ConfigError(field, f"a speed of magnitude <= {MAX_SPEED:g} m/s", value)
 
 
 def positive(field: str, value: Any) -> float:
@@ -125,11 +199,13 @@ def nonnegative_triple(field: str, value: Any) -> tuple[float, float, float]:
 
 def as_vector(name: str, value: Any, size: int) -> np.ndarray:
     """Return ``value`` as a finite float vector of length ``size``."""
-    if isinstance(value, (list, tuple)) and any(isinstance(v, (bool, np.bool_)) for v in value):
+    if isinstance(value, (list, tuple)) and not all(is_number(v) for v in value):
+        raise ConfigError(name, f"{size} numbers", value)
+    if isinstance(value, np.ndarray) and value.dtype.kind not in "iuf":
         raise ConfigError(name, f"{size} numbers", value)
     try:
         arr = np.asarray(value, dtype=float)
-    except (TypeError, ValueError):
+    except (TypeError, ValueError, OverflowError):
         raise ConfigError(name, f"{size} numbers", value) from None
     if arr.shape != (size,):
         raise ShapeError(name, f"({size},)", arr.shape)

@@ -81,8 +81,9 @@ print("\npremises, checked in every run:", *cert.premises, sep="\n  - ")
 # of the run must respect ω̄ — `tubekit.loop.promises.check_promises(run)` measures both on each run.
 #
 # ## Step 2: choose σ yourself
-# `controller.sigma = None` lets `certify` try σ ∈ {0, f/32, …, f} and keep the largest that
-# certifies. Setting it fixes σ: the certificate then judges that one value. Nested settings are
+# `controller.sigma = None` lets `certify` try σ ∈ {0, f/32, …, f} and keep, among those that
+# certify, the one with the most slack in V̄ and Ē (`cert.sigma.source` says so; `cert.sigma.tried` lists
+# each candidate and its verdict). Setting it fixes σ: the certificate then judges that one value. Nested settings are
 # frozen dataclasses: `dataclasses.replace` makes a modified copy, `Scenario.with_changes` puts it back.
 
 # %%
@@ -163,18 +164,23 @@ def diag_inverse(J):
 
 mine = AncillaryLaw("diag-inverse", diag_inverse, "kappa = -sigma diag(1/J00, 1, 1/J22) rho",
                     symbolic_gain=lambda J: sp.diag(1 / J[0, 0], 1, 1 / J[2, 2]))
-law_certs = {name: verify.certify(currents, law) for name, law in
-             (("corrected", "corrected"), ("diag-inverse", mine), ("paper", "paper"))}
+laws = (("corrected", "corrected"), ("diag-inverse", mine), ("paper", "paper"))
+law_certs = {name: verify.certify(currents, law) for name, law in laws}          # sigma chosen by certify
+common = with_sigma(currents, 3.125)                                            # one sigma for all three
+at_common = {name: verify.certify(common, law) for name, law in laws}
 K_entries, G_entries = verify.gains.gain_entries("diag-inverse", -1)        # registered by certify
 print("diag-inverse, toward the target: G = J K =")
 sp.pprint(sp.Matrix(3, 3, G_entries))
 for name, c in law_certs.items():
-    g = c.gains
-    print(f"\n{name:>12}: {'CERTIFIED' if c.certified else 'not certified'} at sigma = {c.sigma.value:g}; "
-          f"G diagonal in [{', '.join(f'{lo:.3g}..{hi:.3g}' for lo, hi in zip(g.g_lo, g.g_hi))}], "
+    g, fixed = c.gains, at_common[name]
+    largest = max((t.sigma for t in c.sigma.tried if t.certified), default=None)
+    print(f"\n{name:>12}: {'CERTIFIED' if c.certified else 'not certified'} at sigma = {c.sigma.value:g} (chosen); "
+          f"largest certified sigma tried = {largest if largest is None else f'{largest:g}'}")
+    print(f"{'':>14}G diagonal in [{', '.join(f'{lo:.3g}..{hi:.3g}' for lo, hi in zip(g.g_lo, g.g_hi))}], "
           f"sup|G_od| = {g.g_off[2][0]:.3g}, sup|K| rows = {np.round(np.sum(g.k_abs, axis=1), 3)}")
-    print(f"{'':>14}tube rho = {np.round(c.tube.rho, 4)}, kappa_bar = {np.round(c.kappa_bar, 4)}")
-    for f in c.failures:
+    print(f"{'':>14}at sigma = 3.125: {'CERTIFIED' if fixed.certified else 'not certified'}, "
+          f"tube rho = {np.round(fixed.tube.rho, 4)}, kappa_bar = {np.round(fixed.kappa_bar, 4)}")
+    for f in fixed.failures:
         print(f"{'':>14}FAIL {f.condition}: {num(f.lhs)} vs {num(f.rhs)}")
 
 # %% [markdown]
@@ -184,13 +190,19 @@ for name, c in law_certs.items():
 #   row of K carries the coupling term, so the yaw input it reserves (κ̄_r) grows fastest with σ.
 # * **diag-inverse** (ours): the same diagonal G_jj = 1, plus an off-diagonal G_od = −e_o/e_d (up to
 #   e_o_max/ε = 1 here) that couples the e_d deviation into e_o. Its K has smaller rows (it does
-#   not fight the coupling), so each unit of σ costs less yaw input — and here it certifies at a
-#   *larger* σ than the corrected law. Exact inversion is not automatically the best gain.
-# * **paper** (K = I): G = J, whose diagonal is c ∈ [−1, −0.87] toward the target: the feedback
-#   pushes ρ the wrong way and each tick *grows* it by 1 + σh|c|. That is Remark 1's failure, and
-#   it rules out Lemma 1's invariant tube. Under the reset, though, ρ restarts at 0 every period,
-#   so a small σ only widens the tube (its ρ̄_o is the widest of the three) and the design can
-#   still certify. The certificate judges the loop that runs, not the paper's argument.
+#   not fight the coupling), so each unit of σ costs less yaw input (compare κ̄_r at σ = 3.125), which
+#   is what lets a larger σ certify: read "largest certified sigma tried" for each law. Exact inversion
+#   is not automatically the best gain.
+# * **paper** (K = I): G = J, whose diagonal is c ∈ [−1, −0.87] toward the target: on e_d and e_o the
+#   feedback pushes ρ the wrong way and each tick *grows* it by 1 + σh|c| (e_z, where J is 1, still
+#   contracts). That is Remark 1's failure, and it rules out Lemma 1's invariant tube for every σ > 0.
+#   Under the reset, though, ρ restarts at 0 every period, so a small σ only *widens* the tube (at
+#   σ = 3.125 compare its ρ̄_d and ρ̄_o with the corrected law's) and the design can still certify.
+#
+# Left to choose, `certify` takes σ = 0 for all three (no feedback at all: most slack), and at σ = 0 the
+# three laws are the same loop with the same tube; they differ only once σ > 0. The certificate judges
+# the loop that runs, not the paper's argument: Remark 1's failure means feedback with the paper's law
+# cannot shrink the deviation, not that the reset loop using it is unsafe.
 #
 # ## Step 5: re-check a certificate from its JSON
 # `cert.to_dict()` is strict JSON (what `tubekit certify FILE --json cert.json` writes). It holds

@@ -4,17 +4,18 @@ The law (:class:`tubekit.model.backup.StationKeeping`) is held at the ancillary 
 the horizontal distance to the anchor, χ the axis angle (``tubekit.model.backup.axis_angle``) and
 ω the total disturbance (current and sway, ‖ω_xy‖ <= ω̄_xy, |ω_z| <= ω̄_z), along the plant
 
-    ḋ = −u cos φ + ω_r,        χ̇ = r + (u sin φ − ω_t) / d,        u = u_b cos φ',  r = −k sat(χ'/χ_0),
+    ḋ = −u cos φ + ω_r,   χ̇ = r + ε_r + (u sin φ − ω_t) / d,   u = u_b cos φ',  r = −k sat(χ'/χ_0),
 
-where φ', χ' are the angles at the last tick. The candidate safe set is
+where φ', χ' are the angles at the last tick and |ε_r| <= E_r (``yaw_rate_error``: the velocity loop's
+yaw-rate error on the dynamic plant, 0 on the kinematic one). The candidate safe set is
 
     S = {V = d + β (1 − cos χ) <= c,  |z − z*| <= Z}.
 
 **Theorem** (first exit). On the level set V = c, d >= c − β; within a tick d changes by at most
-h (u_b + ω̄_xy) and χ by at most Δ = h (k + (u_b + ω̄_xy)/d_tick), d_tick = c − β − h (u_b + ω̄_xy) > 0.
+h (u_b + ω̄_xy) and χ by at most Δ = h (k + E_r + (u_b + ω̄_xy)/d_tick), d_tick = c − β − h (u_b + ω̄_xy) > 0.
 If, for every χ ∈ [0, π/2] and every χ' within Δ of χ, the supremum over ‖ω_xy‖ <= ω̄_xy of V̇,
 
-    −u_b cos χ' cos χ + ω̄_xy √(1 + (g'/d)²) + g' (−k sat(χ'/χ_0) + u_b cos χ' sin χ / d),   g' = β sin χ,
+    −u_b cos χ' cos χ + ω̄_xy √(1 + (g'/d)²) + g' (−k sat(χ'/χ_0) + E_r + u_b cos χ' sin χ / d),   g' = β sin χ,
 
 is negative (:func:`planar_rate_bound`, Arb bisection over χ; the case χ < 0 is the mirror image),
 and the axis angle cannot cross ±π/2 within a tick (condition ``ridge``), then a trajectory that
@@ -23,10 +24,23 @@ held heave command is −w_b sign(z − z*) (``z_0 + h (w_b + ω̄_z) <= Z``) an
 Every input of the law lies in V, so the sway bound γ̄ inside ω̄_xy (derived over V) applies.
 A state whose horizontal distance to the anchor is at most c − β (any heading) and whose depth
 error is at most Z lies in S: that is the hand-over condition.
+
+**Fades and ramp** (``StationKeeping.surge_fade`` d_0, ``yaw_fade`` d_1, ``ramp`` t_r). The argument above
+only uses the law at tick starts with d >= d_tick (``backup_fade``: d_0, d_1 <= d_tick, so the fades are
+1 there) and after the ramp: from the hand-over (d <= h_xy, |z − z*| <= h_z) V = c needs d >= c − β, at
+least (c − β − h_xy)/(u_b + ω̄_xy) seconds later, and |z − z*| = Z at least (Z − h_z)/(w_b + ω̄_z)
+seconds later; ``backup_ramp`` asks t_r + h below both, so every tick start that matters has s >= t_r.
+The command's rate is bounded in :mod:`verify.backup_rate`.
+
+**Continuous yaw law** (``StationKeeping.yaw_law == "continuous"``): the level set is V = d + β a(χ)
+(:func:`tubekit.model.backup.axis_shape`), the rate bound is :func:`verify.backup_continuous.continuous_rate_bound`
+over the whole axis circle, and the condition ``backup_ridge`` is replaced by ``backup_unstable``
+(0 < χ_u < χ_c); every other condition is the same.
 """
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from dataclasses import asdict, dataclass
 
@@ -39,9 +53,11 @@ from tubekit.validation import nonnegative, positive
 from verify.design import Condition
 from verify.intervals import enclose, lower, upper
 from verify.parts import block, bound, integer, item, number, numbers
+from verify.backup_continuous import continuous_rate_bound, continuous_rate_sampled, cone_angle, unstable_condition
+from verify.backup_rate import backup_command_rate, backup_tick_change
 
-__all__ = ["BackupCertificate", "planar_rate_bound", "certify_backup", "design_backup",
-           "BACKUP_MAX_BOXES"]
+__all__ = ["BackupCertificate", "planar_rate_bound", "certify_backup", "design_backup", "ramp_window",
+           "backup_command_rate", "backup_tick_change", "BACKUP_MAX_BOXES", "UNSTABLE_FRACTION"]
 
 #: Bisection budget of :func:`planar_rate_bound` (intervals of χ examined): a work unit, not seconds.
 BACKUP_MAX_BOXES = 4096
@@ -62,6 +78,7 @@ class BackupCertificate:
     boxes: int
     conditions: tuple[Condition, ...]
     handover: tuple[float, float] = (0.0, 0.0)
+    yaw_rate_error: float = 0.0
 
     @property
     def certified(self) -> bool:
@@ -75,16 +92,22 @@ class BackupCertificate:
 
     def to_dict(self) -> dict:
         """Plain JSON-able data (floats, strings, booleans)."""
-        return {"law": asdict(self.law), "safe_set": asdict(self.safe_set), "omega_xy": self.omega_xy,
-                "omega_z": self.omega_z, "tick": self.tick, "rate_bound": self.rate_bound,
-                "rate_sampled": self.rate_sampled, "boxes": self.boxes, "certified": self.certified,
-                "handover": list(self.handover), "conditions": [c.to_dict() for c in self.conditions]}
+        law = {k: v for k, v in asdict(self.law).items()
+               if not (k in _SMOOTH_KEYS and v == 0.0) and not (k == "yaw_law" and v == "ridge")}
+        out = {"law": law, "safe_set": asdict(self.safe_set), "omega_xy": self.omega_xy,
+               "omega_z": self.omega_z, "tick": self.tick, "rate_bound": self.rate_bound,
+               "rate_sampled": self.rate_sampled, "boxes": self.boxes, "certified": self.certified,
+               "handover": list(self.handover), "conditions": [c.to_dict() for c in self.conditions]}
+        if self.yaw_rate_error:  # issue 22's keys appear only when on: older certificates keep their JSON
+            out["yaw_rate_error"] = self.yaw_rate_error
+        return out
 
     @classmethod
     def from_dict(cls, d: dict, where: str = "certificate.backup") -> "BackupCertificate":
         """Inverse of :meth:`to_dict` (``certified`` is recomputed; ConfigError naming the key)."""
-        law_ = _typed(StationKeeping, block(d, "law", where), f"{where}.law",
-                      ("surge", "yaw_rate", "yaw_band", "heave", "heave_band"))
+        raw = block(d, "law", where)
+        law_ = _typed(StationKeeping, raw, f"{where}.law", ("surge", "yaw_rate", "yaw_band", "heave", "heave_band"),
+                      _SMOOTH_KEYS, {"yaw_law": raw["yaw_law"]} if "yaw_law" in raw else {})
         safe_ = _typed(SafeSet, block(d, "safe_set", where), f"{where}.safe_set", ("level", "shape", "depth"))
         conds = item(d, "conditions", where)
         if not isinstance(conds, list):
@@ -94,7 +117,8 @@ class BackupCertificate:
                    rate_bound=bound(d, "rate_bound", where), rate_sampled=number(d, "rate_sampled", where),
                    boxes=integer(d, "boxes", where),
                    conditions=tuple(Condition.from_dict(c, f"{where}.conditions[{i}]") for i, c in enumerate(conds)),
-                   handover=numbers(d, "handover", where, 2))
+                   handover=numbers(d, "handover", where, 2),
+                   yaw_rate_error=number(d, "yaw_rate_error", where) if "yaw_rate_error" in d else 0.0)
 
     def summary_lines(self) -> list[str]:
         """Human-readable lines for a certificate's text."""
@@ -106,13 +130,28 @@ class BackupCertificate:
                 f"  law: u_b {law.surge:g} m/s, k {law.yaw_rate:g} rad/s, w_b {law.heave:g} m/s; against "
                 f"ω̄_xy {self.omega_xy:.4g} m/s, ω̄_z {self.omega_z:.4g} m/s",
                 f"  sup V̇ on the level set <= {self.rate_bound:.4g} m/s (sampled {self.rate_sampled:.4g}, "
-                f"{self.boxes} intervals)"]
+                f"{self.boxes} intervals)"] + self._smooth_lines()
+
+    def _smooth_lines(self) -> list[str]:
+        law = self.law
+        if not (law.surge_fade or law.yaw_fade or law.ramp or self.yaw_rate_error):
+            return []
+        yaw = ([f"  continuous yaw law: unstable axis angle χ_u {law.unstable:.4g} rad, "
+                f"band χ_0 {law.yaw_band:.4g} rad"]
+               if law.yaw_law == "continuous" else [])
+        return [f"  fades d_0 {law.surge_fade:.4g} m, d_1 {law.yaw_fade:.4g} m, ramp t_r {law.ramp:.4g} s; "
+                f"yaw-rate error E_r {self.yaw_rate_error:.4g} rad/s"] + yaw
 
 
-def _typed(cls: type, d: dict, where: str, keys: tuple[str, ...]):
-    """``cls(**numbers)`` from ``d``, a ConfigError naming ``where.key`` when a value is refused."""
+#: Optional keys of a stored law (issue 22; 0 = off, so older certificates read unchanged).
+_SMOOTH_KEYS = ("surge_fade", "yaw_fade", "ramp", "unstable")
+
+
+def _typed(cls: type, d: dict, where: str, keys: tuple[str, ...], optional: tuple[str, ...] = (),
+           extra: dict | None = None):
+    """``cls(**numbers, **extra)`` from ``d``, a ConfigError naming ``where.key`` when a value is refused."""
     try:
-        return cls(**{k: number(d, k, where) for k in keys})
+        return cls(**{k: number(d, k, where) for k in keys + tuple(k for k in optional if k in d)}, **(extra or {}))
     except ConfigError as exc:
         if exc.field.startswith(where):
             raise
@@ -124,12 +163,13 @@ def _tick_distance(law: StationKeeping, safe: SafeSet, omega_xy: float, tick: fl
     return lower(arb(safe.level) - arb(safe.shape) - arb(tick) * (arb(law.surge) + arb(omega_xy)))
 
 
-def _angle_step(law: StationKeeping, omega_xy: float, tick: float, d_tick: float) -> float:
-    """Δ (rad), a float >= h (k + (u_b + ω̄_xy) / d_tick): how far χ moves within one tick."""
-    return upper(arb(tick) * (arb(law.yaw_rate) + (arb(law.surge) + arb(omega_xy)) / arb(d_tick)))
+def _angle_step(law: StationKeeping, omega_xy: float, tick: float, d_tick: float, yaw_err: float = 0.0) -> float:
+    """Δ (rad), a float >= h (k + E_r + (u_b + ω̄_xy) / d_tick): how far χ moves within one tick."""
+    return upper(arb(tick) * (arb(law.yaw_rate) + arb(yaw_err) + (arb(law.surge) + arb(omega_xy)) / arb(d_tick)))
 
 
-def _rate_upper(law: StationKeeping, safe: SafeSet, omega_xy: float, delta: float, a: float, b: float) -> float:
+def _rate_upper(law: StationKeeping, safe: SafeSet, omega_xy: float, delta: float, a: float, b: float,
+                yaw_err: float = 0.0) -> float:
     """An upper bound (m/s) of V̇ over χ ∈ [a, b] on the level set, every held χ' and every ω."""
     x = enclose(a, b)
     beta, c, ub = arb(safe.shape), arb(safe.level), arb(law.surge)
@@ -140,36 +180,41 @@ def _rate_upper(law: StationKeeping, safe: SafeSet, omega_xy: float, delta: floa
     r_up = -arb(law.yaw_rate) * arb(ratio_low)
     held_cos = held.cos()
     rate = (-ub * held_cos * x.cos() + arb(omega_xy) * (1 + (g_prime / d) ** 2).sqrt()
-            + g_prime * (r_up + ub * held_cos * x.sin() / d))
+            + g_prime * (r_up + arb(yaw_err) + ub * held_cos * x.sin() / d))
     return upper(rate)
 
 
-def _rate_sampled(law: StationKeeping, safe: SafeSet, omega_xy: float, n: int = 721) -> float:
+def _rate_sampled(law: StationKeeping, safe: SafeSet, omega_xy: float, n: int = 721, yaw_err: float = 0.0) -> float:
     """The largest V̇ (m/s) at sampled χ with the input of the same instant (no hold) and the worst ω."""
+    if law.yaw_law == "continuous":
+        return continuous_rate_sampled(law, safe, omega_xy, 2 * n - 1, yaw_err)
     chi = np.linspace(0.0, math.pi / 2, n)
     gp = safe.shape * np.sin(chi)
     d = safe.level - safe.shape * (1 - np.cos(chi))
     r = -law.yaw_rate * np.clip(chi / law.yaw_band, -1.0, 1.0)
     u = law.surge * np.cos(chi)
-    rate = -u * np.cos(chi) + omega_xy * np.sqrt(1 + (gp / d) ** 2) + gp * (r + u * np.sin(chi) / d)
+    rate = -u * np.cos(chi) + omega_xy * np.sqrt(1 + (gp / d) ** 2) + gp * (r + yaw_err + u * np.sin(chi) / d)
     return float(rate.max())
 
 
 def planar_rate_bound(law: StationKeeping, safe: SafeSet, omega_xy: float, tick: float,
-                      max_boxes: int = BACKUP_MAX_BOXES) -> tuple[float, int]:
+                      max_boxes: int = BACKUP_MAX_BOXES, yaw_rate_error: float = 0.0) -> tuple[float, int]:
     """(bound, intervals): a certified upper bound (m/s) of V̇ on the level set V = c, by bisection in χ.
 
     Bisection stops on an interval once its bound is negative; the bound returned is the largest
-    over the final cover of [0, π/2] (``inf`` when c − β cannot absorb a tick's motion).
+    over the final cover of [0, π/2] (``inf`` when c − β cannot absorb a tick's motion). The yaw
+    rate error E_r (rad/s) widens χ̇ (the law's fades and ramp are 1 on the level set: ``backup_fade``).
     """
     d_tick = _tick_distance(law, safe, omega_xy, tick)
     if not d_tick > 0.0:
         return math.inf, 0
-    delta = _angle_step(law, omega_xy, tick, d_tick)
+    delta = _angle_step(law, omega_xy, tick, d_tick, yaw_rate_error)
+    if law.yaw_law == "continuous":
+        return continuous_rate_bound(law, safe, omega_xy, delta, max_boxes, yaw_rate_error)
     pending, done, used = [(0.0, _HALF_PI_UP)], [], 0
     while pending:
         a, b = pending.pop()
-        bound = _rate_upper(law, safe, omega_xy, delta, a, b)
+        bound = _rate_upper(law, safe, omega_xy, delta, a, b, yaw_rate_error)
         used += 1
         if bound < 0.0 or used + len(pending) >= max_boxes or b - a < 1e-9:
             done.append(bound)
@@ -179,20 +224,56 @@ def planar_rate_bound(law: StationKeeping, safe: SafeSet, omega_xy: float, tick:
     return max(done), used
 
 
+def _reach_time(law: StationKeeping, safe: SafeSet, omega_xy: float, omega_z: float,
+                handover: tuple[float, float]) -> float:
+    """A float <= min((c − β − h_xy)/(u_b + ω̄_xy), (Z − h_z)/(w_b + ω̄_z)) (s): no exit of S before it."""
+    planar = (arb(safe.level) - arb(safe.shape) - arb(handover[0])) / (arb(law.surge) + arb(omega_xy))
+    depth = (arb(safe.depth) - arb(handover[1])) / (arb(law.heave) + arb(omega_z))
+    return min(lower(planar), lower(depth))
+
+
+def ramp_window(law: StationKeeping, safe: SafeSet, *, omega_xy: float, omega_z: float, tick: float,
+                handover: tuple[float, float]) -> float:
+    """A float t (s) with t + h <= min((c − β − h_xy)/(u_b + ω̄_xy), (Z − h_z)/(w_b + ω̄_z)), within a
+    relative 1e-9 of the largest: the longest ramp t_r that ``backup_ramp`` admits (negative when none does)."""
+    t = lower(arb(_reach_time(law, safe, omega_xy, omega_z, handover)) - arb(tick))
+    return t * (1 - 1e-9) if t > 0 else t
+
+
+def _smooth_conditions(law: StationKeeping, safe: SafeSet, dist: tuple[float, float], tick: float,
+                       handover: tuple[float, float], d_tick: float) -> tuple[Condition, ...]:
+    """``backup_fade`` (when a fade is on) and ``backup_ramp`` (when the ramp is on), with both numbers."""
+    out = []
+    if law.surge_fade > 0.0 or law.yaw_fade > 0.0:
+        fade = max(law.surge_fade, law.yaw_fade)
+        out.append(Condition("backup_fade", "d_0, d_1 <= d_tick = c − β − h (u_b + ω̄_xy)", fade, d_tick,
+                             fade <= d_tick, "the law is unfaded at every tick start near V = c"))
+    if law.ramp > 0.0:
+        need = upper(arb(law.ramp) + arb(tick))
+        window = _reach_time(law, safe, dist[0], dist[1], handover)
+        out.append(Condition("backup_ramp", "t_r + h <= (c − β − h_xy)/(u_b + ω̄_xy) and t_r + h <= "
+                             "(Z − h_z)/(w_b + ω̄_z)", need, window, need <= window,
+                             "the ramp ends before V = c or |z − z*| = Z can be reached"))
+    return tuple(out)
+
+
 def _conditions(law: StationKeeping, safe: SafeSet, dist: tuple[float, float], limits: tuple[float, float, float],
-                tick: float, handover: tuple[float, float], rate: float) -> tuple[Condition, ...]:
+                tick: float, handover: tuple[float, float], rate: float, yaw_err: float) -> tuple[Condition, ...]:
     """Every inequality of the theorem, with both numbers."""
     wxy, wz = dist
     d_tick = _tick_distance(law, safe, wxy, tick)
-    delta = _angle_step(law, wxy, tick, d_tick) if d_tick > 0 else math.inf
-    ridge = upper((arb(law.surge) * arb(min(1.0, 2 * delta)) + arb(wxy)) / arb(d_tick)) if d_tick > 0 else math.inf
+    delta = _angle_step(law, wxy, tick, d_tick, yaw_err) if d_tick > 0 else math.inf
+    ridge = (upper((arb(law.surge) * arb(min(1.0, 2 * delta)) + arb(wxy)) / arb(d_tick) + arb(yaw_err))
+             if d_tick > 0 else math.inf)
     hold_z = upper(arb(law.heave_band) + arb(tick) * (arb(law.heave) + arb(wz)))
+    ridge_text = "(u_b sin 2Δ + ω̄_xy) / d_tick" + (" + E_r" if yaw_err > 0 else "") + " < k and χ_0 <= π/2 − 2Δ"
     cond = Condition
     return (
         cond("backup_inputs", "u_b <= u_max, w_b <= w_max, k <= r_max", max(law.surge / limits[0],
              law.heave / limits[1], law.yaw_rate / limits[2]), 1.0, law.within(*limits), "largest ratio"),
         cond("backup_tick", "c − β − h (u_b + ω̄_xy) > 0", d_tick, 0.0, d_tick > 0.0),
-        cond("backup_ridge", "(u_b sin 2Δ + ω̄_xy) / d_tick < k and χ_0 <= π/2 − 2Δ", ridge, law.yaw_rate,
+        unstable_condition(law, wxy) if law.yaw_law == "continuous" else
+        cond("backup_ridge", ridge_text, ridge, law.yaw_rate,
              ridge < law.yaw_rate and law.yaw_band <= math.pi / 2 - 2 * delta),
         cond("backup_level_set", "sup V̇ on V = c < 0", rate, 0.0, rate < 0.0),
         cond("backup_heave", "ω̄_z < w_b", wz, law.heave, wz < law.heave),
@@ -201,12 +282,12 @@ def _conditions(law: StationKeeping, safe: SafeSet, dist: tuple[float, float], l
              handover[0] <= safe.handover_radius),
         cond("backup_handover_depth", "hand-over depth error <= Z", handover[1], safe.depth,
              handover[1] <= safe.depth),
-    )
+    ) + _smooth_conditions(law, safe, dist, tick, handover, d_tick)
 
 
 def certify_backup(law: StationKeeping, safe: SafeSet, *, omega_xy: float, omega_z: float,
                    limits: tuple[float, float, float], tick: float, handover: tuple[float, float] = (0.0, 0.0),
-                   max_boxes: int = BACKUP_MAX_BOXES) -> BackupCertificate:
+                   max_boxes: int = BACKUP_MAX_BOXES, yaw_rate_error: float = 0.0) -> BackupCertificate:
     """Prove (or refute, naming the failed inequalities) that ``safe`` is invariant under ``law``.
 
     Parameters
@@ -214,23 +295,26 @@ def certify_backup(law: StationKeeping, safe: SafeSet, *, omega_xy: float, omega
     law, safe : StationKeeping, SafeSet
         The backup law and its candidate safe set.
     omega_xy, omega_z : float
-        Certified disturbance bounds (m/s), current and sway together.
+        Certified disturbance bounds (m/s), current and sway together (and the loop's E_u, E_w).
     limits : (float, float, float)
         V: u_max, w_max (m/s), r_max (rad/s).
     tick : float
         Hold of the law (s): 1 / ancillary rate.
     handover : (float, float)
         Largest horizontal distance and depth error (m) from the anchor when the backup takes over.
+    yaw_rate_error : float
+        E_r (rad/s): ψ̇ = r + ε_r with |ε_r| <= E_r (the velocity loop's yaw error; 0 = exact).
     """
     if not isinstance(law, StationKeeping) or not isinstance(safe, SafeSet):
         raise ConfigError("backup", "a StationKeeping law and a SafeSet", (type(law).__name__, type(safe).__name__))
     wxy, wz, h = nonnegative("omega_xy", omega_xy), nonnegative("omega_z", omega_z), positive("tick", tick)
+    e_r = nonnegative("yaw_rate_error", yaw_rate_error)
     handover = (nonnegative("handover[0]", handover[0]), nonnegative("handover[1]", handover[1]))
-    rate, boxes = planar_rate_bound(law, safe, wxy, h, max_boxes)
-    conditions = _conditions(law, safe, (wxy, wz), tuple(float(x) for x in limits), h, handover, rate)
+    rate, boxes = planar_rate_bound(law, safe, wxy, h, max_boxes, e_r)
+    conditions = _conditions(law, safe, (wxy, wz), tuple(float(x) for x in limits), h, handover, rate, e_r)
     return BackupCertificate(law=law, safe_set=safe, omega_xy=wxy, omega_z=wz, tick=h, rate_bound=rate,
-                             rate_sampled=_rate_sampled(law, safe, wxy), boxes=boxes, conditions=conditions,
-                             handover=handover)
+                             rate_sampled=_rate_sampled(law, safe, wxy, yaw_err=e_r), boxes=boxes,
+                             conditions=conditions, handover=handover, yaw_rate_error=e_r)
 
 
 def _candidates(limits: tuple[float, float, float], omega_xy: float) -> list[tuple[float, float]]:
@@ -238,47 +322,112 @@ def _candidates(limits: tuple[float, float, float], omega_xy: float) -> list[tup
     return [(f * limits[0], limits[2]) for f in (0.5, 0.625, 0.75, 0.875, 1.0) if f * limits[0] > omega_xy]
 
 
+#: Yaw bands χ_0 (rad) the smooth design tries, widest first (a wide band keeps the yaw command's rate low).
+SMOOTH_YAW_BANDS = (math.pi / 4, math.pi / 8, 0.05)
+#: Bisection budget of each candidate of the smooth design (a refuted candidate costs its whole budget).
+SMOOTH_SEARCH_BOXES = 1024
+#: The smooth design's unstable axis angle χ_u as a fraction of the cone angle χ_c = acos √(ω̄_xy/u_b).
+UNSTABLE_FRACTION = 0.8
+
+
 def design_backup(*, omega_xy: float, omega_z: float, limits: tuple[float, float, float], tick: float,
-                  handover: tuple[float, float] = (0.0, 0.0), max_boxes: int = BACKUP_MAX_BOXES) -> BackupCertificate:
-    """The certified station-keeping design with the smallest safe radius on a fixed grid (deterministic).
+                  handover: tuple[float, float] = (0.0, 0.0), max_boxes: int = BACKUP_MAX_BOXES,
+                  yaw_rate_error: float = 0.0, smooth: bool = False, min_level: float = 0.2) -> BackupCertificate:
+    """The certified station-keeping design with the smallest safe radius >= ``min_level`` (m) on a fixed grid
+    (deterministic; a larger ``min_level`` gives wider fades and a longer ramp: a gentler command).
 
     The grid (surge fractions, shapes β, levels c) is searched with the float rate of
     :func:`_rate_sampled` as a filter; each candidate that passes is then proved by
     :func:`certify_backup`. Returns the last refuted candidate when none is certified.
+
+    ``smooth=True`` (issue 22) designs the rate-bounded law: for each candidate (c, β) the fades are
+    d_0 = d_1 = d_tick (the largest ``backup_fade`` admits: the gentlest fade), the depth band is
+    Z = max(Z_0, h_z + T_xy (w_b + ω̄_z)) with T_xy = (c − β − h_xy)/(u_b + ω̄_xy) (so the heave
+    channel never shortens the ramp), the heave band z_0 = Z − h (w_b + ω̄_z) (the widest
+    ``backup_depth_hold`` admits), the ramp t_r = :func:`ramp_window` (the longest ``backup_ramp``
+    admits); yaw bands χ_0 are tried widest first (:data:`SMOOTH_YAW_BANDS`), the first that certifies
+    is returned. Wider fades, bands and ramps all lower :func:`backup_command_rate`. The smooth design's
+    yaw law is the continuous one (no jump abeam) with χ_u = :data:`UNSTABLE_FRACTION` · χ_c for each u_b;
+    each candidate gets at most :data:`SMOOTH_SEARCH_BOXES` intervals.
     """
     wxy, wz, h = nonnegative("omega_xy", omega_xy), nonnegative("omega_z", omega_z), positive("tick", tick)
+    e_r = nonnegative("yaw_rate_error", yaw_rate_error)
+    last: BackupCertificate | None = None
+    for band in (SMOOTH_YAW_BANDS if smooth else (0.05,)):
+        found, last = _search(wxy, wz, tuple(float(x) for x in limits), h, handover, max_boxes, e_r, band, smooth,
+                              positive("min_level", min_level))
+        if found:
+            return last
+    return last
+
+
+def _search(wxy: float, wz: float, limits: tuple[float, float, float], h: float, handover: tuple[float, float],
+            max_boxes: int, e_r: float, yaw_band: float, smooth: bool,
+            min_level: float = 0.2) -> tuple[bool, BackupCertificate]:
+    """(certified?, the smallest certified design at ``yaw_band``, else the last refuted one)."""
     heave = limits[1]
     band = max(1e-3, 0.5 * handover[1])
     depth = max(handover[1], band + h * (heave + wz)) * (1 + 1e-9)
     best: BackupCertificate | None = None
     last: BackupCertificate | None = None
     for surge, yaw in _candidates(limits, wxy):
-        law = StationKeeping(surge=surge, yaw_rate=yaw, yaw_band=0.05, heave=heave, heave_band=band)
-        for level in np.round(np.arange(0.2, 6.0001, 0.05), 6):
+        law = StationKeeping(surge=surge, yaw_rate=yaw, yaw_band=yaw_band, heave=heave, heave_band=band,
+                             **_yaw_law(surge, wxy, smooth))
+        for level in np.round(np.arange(max(0.2, min_level), max(6.0, min_level) + 1e-4, 0.05), 6):
             if best is not None and level >= best.safe_set.level:
                 break
-            shape = _best_shape(law, float(level), wxy, handover[0])
+            shape = _best_shape(law, float(level), wxy, handover[0], e_r)
             if shape is None:
                 continue
-            last = certify_backup(law, SafeSet(level=float(level), shape=shape, depth=depth), omega_xy=wxy,
-                                  omega_z=wz, limits=limits, tick=h, handover=handover, max_boxes=max_boxes)
+            safe = SafeSet(level=float(level), shape=shape, depth=depth)
+            trial, safe = _smoothed(law, safe, wxy, wz, h, handover) if smooth else (law, safe)
+            last = certify_backup(trial, safe, omega_xy=wxy, omega_z=wz, limits=limits, tick=h, handover=handover,
+                                  max_boxes=min(max_boxes, SMOOTH_SEARCH_BOXES) if smooth else max_boxes,
+                                  yaw_rate_error=e_r)
             if last.certified:
                 best = last
                 break
     if best is not None:
-        return best
+        return True, best
     if last is None:
-        law = StationKeeping(surge=limits[0], yaw_rate=limits[2], yaw_band=0.05, heave=heave, heave_band=band)
+        law = StationKeeping(surge=limits[0], yaw_rate=limits[2], yaw_band=yaw_band, heave=heave, heave_band=band,
+                             **_yaw_law(limits[0], wxy, smooth))
         last = certify_backup(law, SafeSet(level=6.0, shape=1.0, depth=depth), omega_xy=wxy, omega_z=wz,
-                              limits=limits, tick=h, handover=handover, max_boxes=max_boxes)
-    return last
+                              limits=limits, tick=h, handover=handover, yaw_rate_error=e_r,
+                              max_boxes=min(max_boxes, SMOOTH_SEARCH_BOXES) if smooth else max_boxes)
+    return False, last
 
 
-def _best_shape(law: StationKeeping, level: float, omega_xy: float, handover: float) -> float | None:
+def _yaw_law(surge: float, wxy: float, smooth: bool) -> dict:
+    """The yaw law's keywords: the continuous law with χ_u = UNSTABLE_FRACTION · χ_c when ``smooth`` (without a
+    cone, ω̄_xy >= u_b, χ_u = UNSTABLE_FRACTION · π/2: the refuted fallback then names ``backup_unstable``)."""
+    if not smooth:
+        return {}
+    cone = cone_angle(surge, wxy)
+    return {"yaw_law": "continuous", "unstable": UNSTABLE_FRACTION * (cone if cone > 0.0 else math.pi / 2)}
+
+
+def _smoothed(law: StationKeeping, safe: SafeSet, wxy: float, wz: float, h: float,
+              handover: tuple[float, float]) -> tuple[StationKeeping, SafeSet]:
+    """The smooth design's fades, depth band, heave band and ramp for (c, β) (see :func:`design_backup`)."""
+    d_tick = _tick_distance(law, safe, wxy, h)
+    if not d_tick > 0.0:
+        return law, safe
+    t_xy = (arb(safe.level) - arb(safe.shape) - arb(handover[0])) / (arb(law.surge) + arb(wxy))
+    depth = max(safe.depth, upper(arb(handover[1]) + t_xy * (arb(law.heave) + arb(wz))))
+    safe = SafeSet(level=safe.level, shape=safe.shape, depth=depth)
+    band = max(law.heave_band, lower(arb(depth) - arb(h) * (arb(law.heave) + arb(wz))) * (1 - 1e-9))
+    ramp = ramp_window(law, safe, omega_xy=wxy, omega_z=wz, tick=h, handover=handover)
+    law = dataclasses.replace(law, surge_fade=d_tick, yaw_fade=d_tick, heave_band=band, ramp=max(0.0, ramp))
+    return law, safe
+
+
+def _best_shape(law: StationKeeping, level: float, omega_xy: float, handover: float,
+                yaw_err: float = 0.0) -> float | None:
     """The shape β on a grid with the most negative sampled level-set rate at ``level``, or None."""
     best, value = None, 0.0
     for shape in np.round(np.arange(0.05, level - handover, 0.05), 6):
-        rate = _rate_sampled(law, SafeSet(level=level, shape=float(shape), depth=1.0), omega_xy)
+        rate = _rate_sampled(law, SafeSet(level=level, shape=float(shape), depth=1.0), omega_xy, yaw_err=yaw_err)
         if rate < value:
             best, value = float(shape), rate
     return best

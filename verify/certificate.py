@@ -30,7 +30,7 @@ import importlib.util
 import math
 import time
 from dataclasses import dataclass, field
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -42,12 +42,18 @@ from tubekit.scenario import Scenario
 from tubekit.tightening import Tightening
 
 from verify.backup import BackupCertificate
-from verify.design import Condition, Design, DisturbanceBounds, disturbance_bounds
+from verify.design import Condition, Design, DisturbanceBounds, choose_design, disturbance_bounds
 from verify.gains import GainBounds, gain_bounds
 from verify.parts import EBar, SigmaChoice, SigmaTrial
 from verify.region import Region
 from verify.sampled import HorizonMargins, PeriodTube
 from verify.tiers import backup_of, key_sigma, safe_only_design, tier_conditions, tracking_design
+
+if TYPE_CHECKING:  # the dynamic plant's modules load only when a dynamic scenario is certified
+    from verify.velocity_loop import LoopBound
+
+#: Why σ = 0 on the dynamic plant (:mod:`verify.dynamic`).
+DYNAMIC_SIGMA_SOURCE = "dynamic plant: sigma = 0 (kappa = 0, so the velocity loop sees only bounded command jumps)"
 
 __all__ = ["Condition", "Certificate", "NotCertifiedError", "certify", "sigma_candidates", "choose_design",
            "certificate_fields", "paper_route_of", "ASSUMPTIONS", "PREMISES", "THEOREM"]
@@ -120,6 +126,11 @@ class Certificate:
         The backup law, its safe set and the proof (``backup_*`` conditions).
     safe_design : Design or None
         The safe tier's design at σ = 0 when the chosen (tracking) design does not certify, else None.
+    velocity_loop : LoopBound or None
+        Dynamic plant: the velocity loop's derived error bound (:mod:`verify.velocity_loop`), else None.
+    plant_conditions : tuple of Condition
+        Dynamic plant: the loop's conditions and the fixed point's (:func:`verify.dynamic.solve_dynamic`);
+        both tiers depend on them.
     """
 
     scenario_name: str
@@ -141,18 +152,21 @@ class Certificate:
     paper_route: Any = None
     backup: BackupCertificate | None = None
     safe_design: Design | None = None
+    velocity_loop: "LoopBound | None" = None
+    plant_conditions: tuple[Condition, ...] = ()
 
     # ------------------------------------------------------------------ status
     @property
     def conditions(self) -> tuple[Condition, ...]:
         """Every checked inequality: the chosen design's, the safe-only design's (``safe_only.*``), the backup's."""
         extra = self.safe_design.conditions if self.safe_design is not None else ()
-        return self.design.conditions + extra + (self.backup.conditions if self.backup is not None else ())
+        return (self.design.conditions + extra + (self.backup.conditions if self.backup is not None else ())
+                + self.plant_conditions)
 
     @property
     def tier_conditions(self) -> dict[str, tuple[Condition, ...]]:
         """For each tier (``safe``, ``tracking``) the conditions it depends on (``verify.tiers.tier_conditions``)."""
-        return tier_conditions(self.design, self.safe_design, self.backup)
+        return tier_conditions(self.design, self.safe_design, self.backup, self.plant_conditions)
 
     @property
     def tiers(self) -> dict[str, bool]:
@@ -162,7 +176,7 @@ class Certificate:
     @property
     def key_sigma(self) -> float:
         """σ (1/s) of the tightening handed out, the one :attr:`design_fields` holds (0 for a safe-only one)."""
-        return key_sigma(self.design, self.safe_design, self.backup)
+        return key_sigma(self.design, self.safe_design, self.backup, self.plant_conditions)
 
     @property
     def tier_failures(self) -> dict[str, tuple[str, ...]]:
@@ -295,23 +309,10 @@ def sigma_candidates(scenario: Scenario) -> tuple[tuple[float, ...], str]:
     ctrl = scenario.controller
     if ctrl.sigma is not None:
         return (float(ctrl.sigma),), "controller.sigma"
+    if _is_dynamic(scenario):
+        return (0.0,), DYNAMIC_SIGMA_SOURCE
     f = float(ctrl.ancillary_rate_hz)
     return (0.0,) + tuple(f / 2 ** k for k in range(5, -1, -1)), "largest slack among the certified ones tried"
-
-
-def choose_design(designs: list[Design]) -> Design:
-    """The certified σ with the largest normalised slack of V̄ and Ē (ties: the larger σ); when none certifies,
-    the design with a finite tube, the fewest failures and the largest slack (deterministic).
-
-    Slack, not the strongest feedback: under the reset a larger σ shrinks the per-period tube but asks for
-    input and turns the heading, which the replayed plan's margins must absorb; the slack is what keeps
-    plans acceptable (the recursive-feasibility premise). Measured on 24 sampled campaign runs of
-    paper_currents: premises held in 24/24 (largest slack) against 20/24 (largest certified σ).
-    """
-    certified = [d for d in designs if d.certified]
-    if certified:
-        return max(certified, key=lambda d: (d.score, d.sigma))
-    return min(designs, key=lambda d: (not d.tube.certified, len(d.failures), -d.score, d.sigma))
 
 
 def _resolve_law(scenario: Scenario, law: str | AncillaryLaw | None) -> str:
@@ -328,14 +329,27 @@ def _is_dynamic(scenario: Scenario) -> bool:
 
 
 def _dynamic_assumptions(scenario: Scenario, dist: DisturbanceBounds) -> tuple[str, ...]:
-    """What the certificate assumes of the dynamic plant (each checked in every run by tubekit.loop.promises)."""
-    du, dw, dr = scenario.plant.tracking_bound
-    return (f"Dynamic plant: the velocity loop tracks the command within |u_b - u| <= {du:g} m/s, "
-            f"|w_b - w| <= {dw:g} m/s, |r_b - r| <= {dr:g} rad/s (plant.tracking_bound: assumed, not derived; "
-            "checked in every run as the promise velocity_loop). Surge and heave errors enter omega, the yaw "
-            "error the heading bound of the tube.",
-            f"Dynamic plant: the hull's sway stays within gamma_bar = {dist.gamma:.4g} m/s, the ISS bound of the "
-            "sway dynamics over the body velocities the loop allows (verify.design.hull_sway_bound).")
+    """What the certificate takes from the dynamic plant's model (docs/plant.md)."""
+    return ("Dynamic plant: the 4-DOF model of docs/plant.md (surge, sway, heave, yaw; no roll or pitch; the "
+            "current's own acceleration neglected in the relative-velocity dynamics) with every hydrodynamic "
+            "coefficient anywhere in its interval; the controller's feedforward uses the midpoints. The velocity "
+            "loop's error and the hull's sway are derived from it (verify.velocity_loop, "
+            f"gamma_bar = {dist.gamma:.4g} m/s), not assumed.",
+            "Dynamic plant: the run starts trimmed (body velocities equal to the first command, thrust equal to "
+            "the feedforward).")
+
+
+def _solve(scenario: Scenario, region: Region, gains: GainBounds, sigmas: tuple[float, ...]):
+    """(dist, designs, best, safe, backup, loop, plant conditions): kinematic directly, dynamic by the fixed point."""
+    if _is_dynamic(scenario):
+        from verify.dynamic import solve_dynamic
+        sol = solve_dynamic(scenario, region, gains, sigmas)
+        return sol.dist, list(sol.designs), sol.best, sol.safe, sol.backup, sol.loop, sol.conditions
+    dist = disturbance_bounds(scenario)
+    designs = [tracking_design(scenario, region, gains, s, dist) for s in sigmas]
+    best = choose_design(designs)
+    safe = None if best.certified else safe_only_design(scenario, region, gains, dist)
+    return dist, designs, best, safe, backup_of(scenario, dist, (safe or best).margins), None, ()
 
 
 def certify(scenario: Scenario, law: str | AncillaryLaw | None = None, *, region: Region | None = None,
@@ -368,12 +382,8 @@ def certify(scenario: Scenario, law: str | AncillaryLaw | None = None, *, region
     elif not isinstance(region, Region):
         raise ConfigError("region", "a verify.Region", type(region).__name__)
     gains = gain_bounds(law, region, max_boxes=max_boxes)
-    dist = disturbance_bounds(scenario)
     sigmas, source = sigma_candidates(scenario)
-    designs = [tracking_design(scenario, region, gains, s, dist) for s in sigmas]
-    best = choose_design(designs)
-    safe = None if best.certified else safe_only_design(scenario, region, gains, dist)
-    backup = backup_of(scenario, dist, (safe or best).margins)
+    dist, designs, best, safe, backup, loop, plant_conds = _solve(scenario, region, gains, sigmas)
     tried = tuple(SigmaTrial(sigma=d.sigma, certified=d.certified, score=d.score if math.isfinite(d.score) else None,
                              failed=tuple(c.condition for c in d.failures)) for d in designs)
     ctrl = scenario.controller
@@ -383,8 +393,10 @@ def certify(scenario: Scenario, law: str | AncillaryLaw | None = None, *, region
                        elapsed_s=round(time.perf_counter() - t0, 3), horizon_steps=ctrl.horizon_steps, dt=ctrl.dt,
                        limits=tuple(float(x) for x in scenario.limits.vector),
                        scenario_data=to_jsonable(scenario.to_dict()), assumptions=assumptions,
-                       design_fields=certificate_fields(scenario, law, key_sigma(best, safe, backup), region),
-                       paper_route=paper_route_of(scenario, law, region), backup=backup, safe_design=safe)
+                       design_fields=certificate_fields(scenario, law, key_sigma(best, safe, backup, plant_conds),
+                                                        region),
+                       paper_route=paper_route_of(scenario, law, region), backup=backup, safe_design=safe,
+                       velocity_loop=loop, plant_conditions=plant_conds)
 
 
 def certificate_fields(scenario: Scenario, law: str, sigma: float, region: Region) -> dict:

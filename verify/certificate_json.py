@@ -68,6 +68,8 @@ def certificate_to_dict(cert: Any) -> dict:
         "backup": None if cert.backup is None else cert.backup.to_dict(),
         "safe_design": None if cert.safe_design is None else design_to_dict(cert.safe_design),
         "tiers": tiers_to_dict(cert),
+        "velocity_loop": None if cert.velocity_loop is None else cert.velocity_loop.to_dict(),
+        "plant_conditions": [c.to_dict() for c in cert.plant_conditions],
     })
     if cert.paper_route is not None:
         out["paper_route"] = to_jsonable(cert.paper_route.to_dict())
@@ -107,10 +109,26 @@ def _conditions(d: dict, where: str = "certificate") -> tuple[Condition, ...]:
     return tuple(Condition.from_dict(c, f"{where}.conditions[{i}]") for i, c in enumerate(conds))
 
 
+def _plant_conditions(d: dict) -> tuple[Condition, ...]:
+    """The dynamic plant's conditions (``plant_conditions``; absent in a kinematic certificate's dict: none)."""
+    if item(d, "plant_conditions", "certificate") is None:
+        return ()
+    return _conditions({"conditions": d["plant_conditions"]}, "certificate.plant_conditions")
+
+
+def _velocity_loop(d: dict) -> Any:
+    if item(d, "velocity_loop", "certificate") is None:
+        return None
+    from verify.velocity_loop import LoopBound
+    return LoopBound.from_dict(block(d, "velocity_loop", "certificate"))
+
+
 def _design_conditions(d: dict) -> tuple[Condition, ...]:
-    """The chosen design's conditions: the stored list without the safe-only (``safe_only.*``) and backup
-    (``backup*``) ones, which their own blocks hold."""
-    return tuple(c for c in _conditions(d) if not c.condition.startswith((SAFE_PREFIX, "backup")))
+    """The chosen design's conditions: the stored list without the safe-only (``safe_only.*``), backup
+    (``backup*``) and dynamic plant ones, which their own blocks hold."""
+    plant = {c.condition for c in _plant_conditions(d)}
+    return tuple(c for c in _conditions(d) if not c.condition.startswith((SAFE_PREFIX, "backup"))
+                 and c.condition not in plant)
 
 
 def _design(d: dict, sigma: SigmaChoice) -> Design:
@@ -161,4 +179,5 @@ def certificate_from_dict(cls: type, d: Any) -> Any:
         backup=None if item(d, "backup", "certificate") is None else BackupCertificate.from_dict(
             block(d, "backup", "certificate")),
         safe_design=None if item(d, "safe_design", "certificate") is None else design_from_dict(
-            block(d, "safe_design", "certificate")))
+            block(d, "safe_design", "certificate")),
+        velocity_loop=_velocity_loop(d), plant_conditions=_plant_conditions(d))

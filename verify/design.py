@@ -36,7 +36,7 @@ from verify.region import Region
 from verify.sampled import HorizonMargins, PeriodTube, TubeProblem, horizon_margins, one_period_tube
 
 __all__ = ["Condition", "Design", "DisturbanceBounds", "disturbance_bounds", "hull_sway_bound", "tube_problem",
-           "evaluate_design", "arc_rates", "sway_condition", "input_tightening", "state_conditions"]
+           "evaluate_design", "arc_rates", "sway_condition", "input_tightening", "state_conditions", "choose_design"]
 
 
 @dataclass(frozen=True)
@@ -102,13 +102,24 @@ def hull_sway_bound(params: VehicleParams, u_bar: float, r_bar: float) -> arb:
     |v| > v*, the positive root of |Y_vv| v² + b v − F = 0; |v| >= v* whenever
     |q| >= q* = m22 v* + |m24| r̄. So |q| <= q* (q(0) = m24 r(0)) and
     |v| <= (q* + |m24| r̄) / m22 = v* + 2 |m24| r̄ / m22. Infinite when nothing damps sway.
+
+    A vehicle with coefficient intervals (``params.interval``) gets the bound for every point
+    of its box: v* = 2F / (b + √(b² + 4 a F)) grows with F and falls with a = |Y_vv| and b, so
+    it is evaluated at the worst ends (largest F, smallest a and b, each from Arb balls of
+    the intervals) and the mass ratio 2|m24| r̄ / m22 over the balls of m, x_g and the added masses.
     """
-    p = params
-    m11, m22, _, _, m24, _ = (arb(x) for x in p.mass_entries)
+    from verify.loop_model import field_ball  # a leaf module: no cycle
+
+    def ball(name: str) -> arb:
+        return field_ball(params, name)
+
+    m = ball("m")
+    m11, m22, m24 = m - ball("X_udot"), m - ball("Y_vdot"), m * ball("x_g") - ball("Y_rdot")
     ub, rb = arb(u_bar), arb(r_bar)
-    force = abs(arb(p.Y_ur_lift) - m11) * ub * rb + abs(arb(p.Y_rr)) * rb * rb
-    a, b = abs(arb(p.Y_vv)), -arb(p.Y_v) - abs(arb(p.Y_uv)) * ub
-    if p.Y_vv < 0:
+    force = arb(upper(abs(ball("Y_ur_lift") - m11) * ub * rb + abs(ball("Y_rr")) * rb * rb))
+    a = arb(lower(abs(ball("Y_vv"))))
+    b = arb(lower(-ball("Y_v") - abs(ball("Y_uv")) * ub))
+    if a > 0:
         v_star = (-b + (b * b + 4 * a * force).sqrt()) / (2 * a)
     elif b > 0:
         v_star = force / b
@@ -117,21 +128,26 @@ def hull_sway_bound(params: VehicleParams, u_bar: float, r_bar: float) -> arb:
     return v_star + 2 * abs(m24) * rb / m22
 
 
-def disturbance_bounds(scenario: Scenario) -> DisturbanceBounds:
+def disturbance_bounds(scenario: Scenario, loop_error: tuple[float, float, float] | None = None) -> DisturbanceBounds:
     """ω̄_xy = max(a_x, a_y) + ‖c_xy‖ + γ̄, ω̄_z = a_z + |c_z|, γ̄ = gain ū r̄ + amplitude (over V).
 
     On the dynamic plant (``[plant] kind = "dynamic"``) ω = δ + R(ψ)(u_b − u, v_b) in the
-    plane and δ_z + w_b − w in heave, so with the assumed velocity-loop bound
-    (Δu, Δw, Δr) = ``plant.tracking_bound``: γ̄ = :func:`hull_sway_bound` over
-    |u_b| <= ū + Δu, |r_b| <= r̄ + Δr, ω̄_xy = max(a_x, a_y) + ‖c_xy‖ + ‖(Δu, γ̄)‖,
-    ω̄_z = a_z + |c_z| + Δw. The sway table is unused there (declared = γ̄).
+    plane and δ_z + w_b − w in heave, so with the velocity loop's error bound
+    ``loop_error`` = (E_u, E_w, E_r) (m/s, m/s, rad/s; derived by :mod:`verify.velocity_loop`,
+    composed by :func:`verify.dynamic.solve_dynamic`): γ̄ = :func:`hull_sway_bound` over
+    |u_b| <= ū + E_u, |r_b| <= r̄ + E_r and the vehicle's coefficient box,
+    ω̄_xy = max(a_x, a_y) + ‖c_xy‖ + ‖(E_u, γ̄)‖, ω̄_z = a_z + |c_z| + E_w, and the yaw-rate
+    error E_r. The sway table is unused there (declared = γ̄).
     """
     d, lim = scenario.disturbance, scenario.limits
     a, c = d.amplitude, d.constant
     cxy = (arb(c[0]) ** 2 + arb(c[1]) ** 2).sqrt()
     wz = arb(a[2]) + abs(arb(c[2]))
     if scenario.plant.dynamic:
-        du, dw, dr = (arb(x) for x in scenario.plant.tracking_bound)
+        if loop_error is None:
+            raise ValueError("disturbance_bounds on the dynamic plant needs the velocity loop's error bound "
+                             "(verify.dynamic.solve_dynamic composes them)")
+        du, dw, dr = (arb(x) for x in loop_error)
         gamma = hull_sway_bound(scenario.plant.params, upper(arb(lim.u_max) + du), upper(arb(lim.r_max) + dr))
         wxy = arb(max(a[0], a[1])) + cxy + (du * du + gamma * gamma).sqrt()
         return DisturbanceBounds(omega_xy=upper(wxy), omega_z=upper(wz + dw), gamma=upper(gamma),
@@ -292,3 +308,18 @@ def evaluate_design(scenario: Scenario, region: Region, gains: GainBounds, sigma
     conds += state_conditions(scenario, region, p, m, v_bar)
     return Design(sigma=sigma, problem=p, tube=tube, margins=m, v_bar=tuple(v_bar), conditions=tuple(conds),
                   score=_score(p, region, m, v_bar), rates=arc_rates(p))
+
+
+def choose_design(designs: list[Design]) -> Design:
+    """The certified σ with the largest normalised slack of V̄ and Ē (ties: the larger σ); when none certifies,
+    the design with a finite tube, the fewest failures and the largest slack (deterministic).
+
+    Slack, not the strongest feedback: under the reset a larger σ shrinks the per-period tube but asks for
+    input and turns the heading, which the replayed plan's margins must absorb; the slack is what keeps
+    plans acceptable (the recursive-feasibility premise). Measured on 24 sampled campaign runs of
+    paper_currents: premises held in 24/24 (largest slack) against 20/24 (largest certified σ).
+    """
+    certified = [d for d in designs if d.certified]
+    if certified:
+        return max(certified, key=lambda d: (d.score, d.sigma))
+    return min(designs, key=lambda d: (not d.tube.certified, len(d.failures), -d.score, d.sigma))

@@ -214,6 +214,9 @@ def _check_inputs(scenario: Scenario, eps: float | None, speeds) -> tuple[float,
     """Validated epsilon (m) and speed grid (m/s); the default grid spans (0, u_max) plus the scenario's speed."""
     if not isinstance(scenario, Scenario):
         raise ConfigError("scenario", "a tubekit.scenario.Scenario", type(scenario).__name__)
+    if scenario.plant.dynamic:
+        raise ConfigError("plant.kind", "\"kinematic\" (the envelope sweeps the kinematic theorem; a dynamic "
+                          "scenario's bounds come from its vehicle: use tubekit certify)", scenario.plant.kind)
     eps = scenario.epsilon if eps is None else positive("eps", eps)
     if eps >= scenario.region.e_d_max:
         raise ConfigError("eps", f"a number < region.e_d_max = {scenario.region.e_d_max}", eps)

@@ -86,7 +86,9 @@ def _common(cert) -> dict:
                 disturbance=DisturbanceBound(omega_xy=cert.disturbance.omega_xy, omega_z=cert.disturbance.omega_z,
                                              sway=cert.disturbance.gamma),
                 law=cert.law, design_key=cert.design_key, design_fields=dict(cert.design_fields),
-                backup=_backup_plan(cert), tiers=dict(cert.tiers))
+                backup=_backup_plan(cert), tiers=dict(cert.tiers),
+                velocity_loop=None if cert.velocity_loop is None or not cert.velocity_loop.certified
+                else tuple(cert.velocity_loop.error))
 
 
 def _safe_only(cert) -> Tightening:

@@ -217,6 +217,20 @@ def _verdicts(raw: dict, cert: Any, design: Any, derived: tuple, scenario: Scena
               "the chosen sigma among those tried, its verdict not stronger than derived")
 
 
+def _plant_bounds(cert: Any, scenario: Any, region: Any, sigma: float, led: Ledger) -> tuple[Any, tuple]:
+    """Dynamic plant: the loop bound's fixed point re-derived (:func:`verify.dynamic.solve_dynamic`); the stored
+    bound must be at least the derived one. Returns the derived ω̄ and the plant's conditions."""
+    from verify.dynamic import solve_dynamic
+    sol = solve_dynamic(scenario, region, cert.gains, (sigma,))
+    stored = cert.velocity_loop
+    if stored is None:
+        led.check("velocity_loop", False, None, "a velocity_loop block", "a dynamic certificate carries its loop bound")
+    else:
+        led.each("at_least", "velocity_loop.error", list(stored.error), list(sol.loop.error))
+        led.at_least("velocity_loop.sway", stored.sway, sol.loop.sway)
+    return sol.dist, sol.conditions
+
+
 def rederive(raw: dict, cert: Any, led: Ledger, gain_boxes: int) -> None:
     """Every re-check after the checksum (module doc), appended to ``led`` in order."""
     from verify.design import disturbance_bounds, tube_problem
@@ -233,19 +247,20 @@ def rederive(raw: dict, cert: Any, led: Ledger, gain_boxes: int) -> None:
     except ConfigError as exc:
         raise ConfigError(f"certificate.design_fields.region_override ({exc.field})", exc.expected,
                           exc.received) from None
-    dist = disturbance_bounds(scenario)
     sigma = cert.design.sigma
+    dist, plant = _plant_bounds(cert, scenario, region, sigma, led) if scenario.plant.dynamic else (
+        disturbance_bounds(scenario), ())
     design = tracking_design(scenario, region, cert.gains, sigma, dist)
     tiers = derive_tiers(cert, scenario, region, dist, design)
     safe, backup = tiers.safe, tiers.backup
-    _key(raw, cert, scenario, region, led, key_sigma(design, safe, backup))
+    _key(raw, cert, scenario, region, led, key_sigma(design, safe, backup, plant))
     _inputs(raw, cert, scenario, region, dist, led)
     _gains(cert, region, gain_boxes, led)
     _problem(cert, tube_problem(scenario, region, cert.gains, sigma, dist), led)
     _tube(raw, cert, design, led)
     _e_bar(raw, region, design, led)
-    check_tiers(raw, cert, design, tiers, led)
-    derived = tier_conditions(design, safe, backup)
+    check_tiers(raw, cert, design, tiers, led, plant)
+    derived = tier_conditions(design, safe, backup, plant)
     backup_part = derived["tracking"][len(design.conditions):]
     every = design.conditions + (safe.conditions if safe is not None else ()) + backup_part
     _verdicts(raw, cert, design, every, scenario, led)

@@ -77,11 +77,13 @@ def _safe_design(cert: Any, safe: Design | None, led: Any) -> None:
     led.each("at_least", "safe_design.arc_rates", list(stored.rates), list(safe.rates))
 
 
-def check_tiers(raw: dict, cert: Any, design: Design, tiers: DerivedTiers, led: Any) -> dict[str, bool]:
-    """Record the backup, safe-design and tier checks; return the derived tiers."""
+def check_tiers(raw: dict, cert: Any, design: Design, tiers: DerivedTiers, led: Any,
+                plant: tuple = ()) -> dict[str, bool]:
+    """Record the backup, safe-design and tier checks; return the derived tiers (``plant``: the dynamic
+    plant's derived conditions, :func:`verify.dynamic.solve_dynamic`)."""
     _backup(raw, cert, tiers, led)
     _safe_design(cert, tiers.safe, led)
-    derived = tiers_of(design, tiers.safe, tiers.backup)
+    derived = tiers_of(design, tiers.safe, tiers.backup, plant)
     stored = raw.get("tiers") if isinstance(raw.get("tiers"), dict) else {}
     for k, v in derived.items():
         claim = stored.get(k)

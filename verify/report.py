@@ -5,7 +5,7 @@ from __future__ import annotations
 import math
 from typing import Any
 
-__all__ = ["certificate_text", "tiers_line"]
+__all__ = ["certificate_text", "tiers_line", "compare", "tried_lines"]
 
 
 def _f(x: Any, d: int = 4) -> str:
@@ -19,10 +19,41 @@ def _vec(xs: Any, d: int = 4) -> str:
     return "[" + ", ".join(_f(x, d) for x in xs) + "]"
 
 
+def compare(lhs: Any, rhs: Any) -> str:
+    """``lhs OP rhs`` with OP the relation of the two numbers (<, = or >), shown with enough digits
+    (6 to 17 significant) that two different numbers never print alike (``0.9999996 < 1``, not ``1 vs 1``)."""
+    if lhs is None or rhs is None or not (math.isfinite(float(lhs)) and math.isfinite(float(rhs))):
+        return f"{_f(lhs, 6)} vs {_f(rhs, 6)}"
+    a, b = float(lhs), float(rhs)
+    op = "<" if a < b else ">" if a > b else "="
+    for digits in range(6, 18):
+        left, right = _f(a, digits), _f(b, digits)
+        if (left != right) == (a != b):
+            break
+    return f"{left} {op} {right}"
+
+
+def _sigma_source(cert) -> str:
+    """Why this sigma: the certificate's rule, or, when no sigma tried certified, what the shown design is."""
+    if cert.certified or any(trial.certified for trial in cert.tried):
+        return cert.sigma_source
+    return "none tried certified: shown is the design with a finite tube, the fewest failed conditions and the " \
+           "largest slack"
+
+
+def tried_lines(cert) -> list[str]:
+    """Every sigma tried, its verdict and its failed conditions (``tubekit certify -v``)."""
+    out = [f"Designs tried ({len(cert.tried)}):"]
+    for trial in cert.tried:
+        verdict = "certified" if trial.certified else f"{len(trial.failed)} failed: {', '.join(trial.failed)}"
+        out.append(f"  sigma = {_f(trial.sigma)} 1/s: {verdict}; slack score {_f(trial.score)}")
+    return out
+
+
 def _tube_lines(cert) -> list[str]:
     d = cert.design
     t = d.tube
-    out = [f"sigma = {_f(d.sigma)} 1/s ({cert.sigma_source}); tried: "
+    out = [f"sigma = {_f(d.sigma)} 1/s ({_sigma_source(cert)}); tried: "
            + ", ".join(f"{_f(x.sigma)}{'*' if x.certified else ''}" for x in cert.tried)
            + "  (* = certified)"]
     if not t.certified:
@@ -82,11 +113,13 @@ def certificate_text(cert) -> str:
              f"Disturbance: ||omega_xy|| <= {_f(dist.omega_xy)} m/s, |omega_z| <= {_f(dist.omega_z)} m/s "
              f"(sway gamma_bar = {_f(dist.gamma)} m/s from the sway model over V; declared {_f(dist.declared_sway)})"]
     lines += _tube_lines(cert)
+    if getattr(cert, "velocity_loop", None) is not None:  # dynamic plant: the derived loop bound
+        lines += cert.velocity_loop.summary_lines()
     lines += _tier_lines(cert)
     lines.append("Conditions:")
     for c in cert.conditions:
         tag = {True: "ok  ", False: "FAIL", None: "n/a "}[c.ok]
-        lines.append(f"  [{tag}] {c.condition}: {c.inequality}: {_f(c.lhs, 6)} vs {_f(c.rhs, 6)}"
+        lines.append(f"  [{tag}] {c.condition}: {c.inequality}: {compare(c.lhs, c.rhs)}"
                      + (f"  ({c.detail})" if c.detail and c.ok is not True else ""))
     lines.append("Premises (checked in every run; a premise failure is reported as such, never as a broken promise):")
     lines.extend(f"  - {p}" for p in cert.premises)

@@ -135,10 +135,12 @@ def backup_of(scenario: Scenario, dist: DisturbanceBounds, margins: HorizonMargi
     tick = 1.0 / float(scenario.controller.ancillary_rate_hz)
     hand = _handover(margins)
     bc = design_backup(omega_xy=dist.omega_xy, omega_z=dist.omega_z, limits=limits, tick=tick,
-                       handover=hand if math.isfinite(hand[0]) else (0.0, 0.0))
+                       handover=hand if math.isfinite(hand[0]) else (0.0, 0.0),
+                       yaw_rate_error=dist.yaw_rate_error, smooth=scenario.plant.kind == "dynamic")
     if not math.isfinite(hand[0]):
         bc = certify_backup(bc.law, bc.safe_set, omega_xy=dist.omega_xy, omega_z=dist.omega_z, limits=limits,
-                            tick=tick, handover=(np.finfo(float).max, np.finfo(float).max))
+                            tick=tick, handover=(np.finfo(float).max, np.finfo(float).max),
+                            yaw_rate_error=dist.yaw_rate_error)
     return _with_initial(scenario, bc)
 
 
@@ -150,7 +152,7 @@ def recertify_backup(scenario: Scenario, law: StationKeeping, safe: SafeSet, dis
     bc = certify_backup(law, safe, omega_xy=dist.omega_xy, omega_z=dist.omega_z,
                         limits=tuple(float(x) for x in scenario.limits.vector),
                         tick=1.0 / float(scenario.controller.ancillary_rate_hz),
-                        handover=hand if math.isfinite(hand[0]) else (big, big))
+                        handover=hand if math.isfinite(hand[0]) else (big, big), yaw_rate_error=dist.yaw_rate_error)
     return _with_initial(scenario, bc)
 
 
@@ -158,25 +160,30 @@ def _with_initial(scenario: Scenario, bc: BackupCertificate) -> BackupCertificat
     return dataclasses.replace(bc, conditions=bc.conditions + (initial_backup(scenario, bc.law, bc.safe_set),))
 
 
-def tier_conditions(design: Design, safe_design: Design | None,
-                    backup: BackupCertificate | None) -> dict[str, tuple[Condition, ...]]:
+def tier_conditions(design: Design, safe_design: Design | None, backup: BackupCertificate | None,
+                    plant: tuple[Condition, ...] = ()) -> dict[str, tuple[Condition, ...]]:
     """The conditions each tier depends on (module doc); ``safe_design`` replaces the tracking design's
     safe conditions when given. A missing backup leaves both tiers uncertified (an empty backup part is
-    represented by a failed ``backup`` condition)."""
+    represented by a failed ``backup`` condition). ``plant``: the dynamic plant's conditions
+    (:func:`verify.dynamic.solve_dynamic`), which both tiers depend on (ω̄ holds only with the loop's bound)."""
     bk = backup.conditions if backup is not None else (
         Condition("backup", "a certified backup law", None, None, False, "no backup"),)
     safe_src = safe_design.conditions if safe_design is not None else tuple(
         c for c in design.conditions if is_safe_condition(c.condition))
-    return {"safe": tuple(safe_src) + tuple(bk), "tracking": tuple(design.conditions) + tuple(bk)}
+    return {"safe": tuple(safe_src) + tuple(bk) + tuple(plant),
+            "tracking": tuple(design.conditions) + tuple(bk) + tuple(plant)}
 
 
-def tiers_of(design: Design, safe_design: Design | None, backup: BackupCertificate | None) -> dict[str, bool]:
+def tiers_of(design: Design, safe_design: Design | None, backup: BackupCertificate | None,
+             plant: tuple[Condition, ...] = ()) -> dict[str, bool]:
     """``{"safe": bool, "tracking": bool}``: every condition of the tier holds."""
-    return {k: all(c.ok is True for c in v) for k, v in tier_conditions(design, safe_design, backup).items()}
+    return {k: all(c.ok is True for c in v) for k, v in tier_conditions(design, safe_design, backup, plant).items()}
 
 
-def key_sigma(design: Design, safe_design: Design | None, backup: BackupCertificate | None) -> float:
+def key_sigma(design: Design, safe_design: Design | None, backup: BackupCertificate | None,
+              plant: tuple[Condition, ...] = ()) -> float:
     """The σ (1/s) of the tightening a certificate hands out, which its design key holds: 0 for the
     safe-only design, else the chosen design's."""
-    safe_only = safe_design is not None and tiers_of(design, safe_design, backup) == {"safe": True, "tracking": False}
+    safe_only = safe_design is not None and tiers_of(design, safe_design, backup, plant) == {
+        "safe": True, "tracking": False}
     return 0.0 if safe_only else float(design.sigma)

@@ -1,10 +1,13 @@
 """``tubekit campaign``: many closed-loop runs on a dask.distributed cluster — reproducible, resumable.
 
 Pipeline (client side): validate the spec (:mod:`tubekit.app.campaign_spec`) and plan every run →
-certify once per distinct certificate input (:func:`verify.certify`, on the client) → open a
-:class:`distributed.Client` (a LocalCluster of N worker processes on 127.0.0.1, or ``--scheduler``)
-→ submit the unfinished runs (``retries``) → store each finished run as ``DIR/runs/run_KKKKKK.json``
-the moment it completes → assemble ``DIR/runs.parquet`` atomically → ``summary.json`` → figures.
+load the certificates stored in ``DIR/certificates/`` (:func:`tubekit.app.certified.read_cached`: checksum,
+design key, scenario) → open a :class:`distributed.Client` (a LocalCluster of N worker processes on
+127.0.0.1, or ``--scheduler``) → submit one certification task per missing certificate input
+(:func:`tubekit.app.certified.issue_certificate`, keyed by :func:`tubekit.app.certified.input_key`) and
+the unfinished runs, each depending on its certificate's task (``retries``) → store each certificate as
+``DIR/certificates/<key>.json`` and each finished run as ``DIR/runs/run_KKKKKK.json`` the moment it
+completes → assemble ``DIR/runs.parquet`` atomically → ``summary.json`` (with the throughput) → figures.
 
 Worker side (:func:`simulate_task`): the run's scenario under the shipped tightening (each simulation is
 :func:`tubekit.loop.pipeline.certified_run`; the verdict travels in ``Tightening.certified``), plus
@@ -21,8 +24,10 @@ import json
 import logging
 import os
 import sys
+import threading
 import time
-from dataclasses import dataclass
+from concurrent.futures import ThreadPoolExecutor
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any, Callable, Iterator
 
@@ -32,31 +37,32 @@ from tubekit.exceptions import ConfigError, TubekitError
 from tubekit.jsonable import write_json
 from tubekit.scenario import Scenario
 from tubekit.tightening import Tightening
-from tubekit.app.campaign_spec import CampaignSpec, RunPlan, certificate_key, spec_from_stored
+from tubekit.app.campaign_spec import CampaignSpec, RunPlan, spec_from_stored
+from tubekit.app.exit_codes import children_ignore_interrupts
 from tubekit.app.output import check_output_dir
+from tubekit.app.campaign_summary import (FIGURES, METRIC_COLUMNS, import_plotting, summarise, summary_line,
+                                          write_figures)
 
-__all__ = ["RunTask", "simulate_task", "certify_plans", "open_client", "run_campaign", "read_rows", "replay_run",
+__all__ = ["RunTask", "simulate_task", "certify_plans", "cached_certificates", "CERTIFICATES", "open_client",
+           "run_campaign", "read_rows", "replay_run",
            "replay_into", "ReplayResult", "summarise", "summary_line", "write_figures", "METRIC_COLUMNS", "FIGURES"]
 
 LOGGER = logging.getLogger("tubekit.campaign")
-#: Per-run metric columns of ``runs.parquet`` (after run, seed and the sampled values).
-METRIC_COLUMNS = ("certified", "safe_tier", "tracking_tier", "max_rho_ratio", "min_clearance", "min_e_d",
-                  "tracking_rmse", "saturated_steps", "replaced_steps", "backup_s", "backup_engagements",
-                  "violated", "safety_broken", "premises_held", "broken", "worst_sequence", "error", "wall_s")
-#: Figures written under ``DIR/figures/``.
-FIGURES = ("ecdf.png", "worst_runs.png")
 #: Retries of a run whose worker raised or died (dask ``retries``).
 RETRIES = 3
+#: Folder of a campaign directory holding its certificates, one ``<input key>.json`` each.
+CERTIFICATES = "certificates"
 
 
 @dataclass(frozen=True)
 class RunTask:
-    """Everything a worker needs for one run (pickled to the worker); ``tightening.certified`` is the verdict."""
+    """Everything a worker needs for one run (pickled to the worker); ``tightening.certified`` is the verdict
+    (None: the tightening of the certificate task the run depends on, see :func:`simulate_task`)."""
 
     run: int
     seed: int
     scenario: Scenario
-    tightening: Tightening
+    tightening: Tightening | None
     sequences: int
 
 
@@ -103,8 +109,14 @@ def _tiers_of(tightening: Tightening) -> dict[str, bool]:
     return {"safe_tier": bool(given.get("safe")), "tracking_tier": bool(given.get("tracking"))}
 
 
-def simulate_task(task: RunTask) -> dict[str, Any]:
-    """Run ``task`` and return its row (without the sampled values); ``wall_s`` is the only timing."""
+def simulate_task(task: RunTask, issued: Any = None) -> dict[str, Any]:
+    """Run ``task`` and return its row (without the sampled values); ``wall_s`` is the only timing.
+
+    ``issued`` (a :class:`tubekit.app.certified.IssuedCertificate`, the result of the certificate task the
+    run depends on) gives the tightening when ``task.tightening`` is None.
+    """
+    if issued is not None:
+        task = replace(task, tightening=issued.tightening)
     started = time.perf_counter()
     try:
         sims = _simulate_all(task)
@@ -139,16 +151,28 @@ def _row_of(task: RunTask, sims: list[Any], started: float) -> dict[str, Any]:
 # ---- certificates and the cluster (client side) ---------------------------------------------------------
 
 def certify_plans(plans: list[RunPlan]) -> dict[str, Tightening]:
-    """One certification per distinct certificate input of ``plans`` (keyed by :func:`certificate_key`):
-    its best-effort tightening, ``certified`` set when the certificate certified it."""
-    from tubekit.app.certified import certify_design
+    """One certification per distinct certificate input of ``plans``, in this process (keyed by
+    :func:`tubekit.app.certified.input_key`): its best-effort tightening, ``certified`` set when certified."""
+    from tubekit.app.certified import certify_design, input_key
 
     certs: dict[str, Tightening] = {}
     for plan in plans:
-        key = certificate_key(plan.scenario)
+        key = input_key(plan.scenario)
         if key not in certs:
             certs[key] = certify_design(plan.scenario).tightening
     return certs
+
+
+def cached_certificates(out: Path, scenarios: dict[str, Scenario]) -> dict[str, Tightening]:
+    """The certificates of ``scenarios`` (by input key) stored in ``out/certificates``, each loaded through
+    :func:`tubekit.app.certified.read_cached` (a file that fails a check is refused: ConfigError)."""
+    from tubekit.app.certified import read_cached
+
+    folder = out / CERTIFICATES
+    if not folder.is_dir():
+        return {}
+    found = {key: read_cached(folder, scenario) for key, scenario in scenarios.items()}
+    return {key: design.tightening for key, design in found.items() if design is not None}
 
 
 @contextlib.contextmanager
@@ -167,9 +191,10 @@ def open_client(workers: int, scheduler: str | None) -> Iterator[Any]:
         with client:
             yield client
         return
-    with LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, host="127.0.0.1",
-                      scheduler_port=0, dashboard_address="127.0.0.1:0", silence_logs=logging.ERROR) as cluster, \
-            Client(cluster) as client:
+    with children_ignore_interrupts():  # Ctrl-C: the client stops the workers, no worker traceback (exit 130)
+        cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, host="127.0.0.1",
+                               scheduler_port=0, dashboard_address="127.0.0.1:0", silence_logs=logging.ERROR)
+    with cluster, Client(cluster) as client:
         yield client
 
 
@@ -240,134 +265,39 @@ def _write_parquet(out: Path, rows: list[dict[str, Any]]) -> Path:
     return target
 
 
-# ---- summary and figures --------------------------------------------------------------------------------
-
-def _quantiles(rows: list[dict], key: str) -> dict[str, float | None]:
-    x = np.array([r[key] for r in rows if r.get(key) is not None], dtype=float)
-    x = x[np.isfinite(x)]
-    if not x.size:
-        return {"min": None, "p05": None, "median": None, "p95": None, "max": None}
-    q = np.quantile(x, [0.0, 0.05, 0.5, 0.95, 1.0])
-    return dict(zip(("min", "p05", "median", "p95", "max"), (float(v) for v in q)))
-
-
-def _worst(rows: list[dict], count: int = 10) -> list[dict]:
-    ranked = sorted((r for r in rows if r.get("max_rho_ratio") is not None), key=lambda r: -r["max_rho_ratio"])
-    keep = ("run", "seed", "certified", "max_rho_ratio", "min_clearance", "violated", "broken", "worst_sequence")
-    values = [k for k in (ranked[0] if ranked else {}) if k not in keep and k not in METRIC_COLUMNS]
-    return [{**{k: r[k] for k in keep}, "values": {k: r[k] for k in values}} for r in ranked[:count]]
-
-
-def _tier_summary(rows: list[dict], seconds_per_run: float) -> dict[str, Any]:
-    """Safety (must be 0), the backup's activity and the tracking tier over the runs (issue 21); a row's
-    ``backup_s`` is its worst simulation's, so ``share_of_simulated_time`` is per run's duration."""
-    safe = [r for r in rows if r.get("safe_tier")]
-    tracking = [r for r in rows if r.get("tracking_tier")]
-    engaged = [r for r in rows if (r.get("backup_s") or 0) > 0]
-    simulated = seconds_per_run * len(rows)
-    return {
-        "safe_tier_runs": len(safe), "tracking_tier_runs": len(tracking),
-        "safety_broken": sum(bool(r.get("safety_broken")) for r in rows),
-        "safety_broken_safe_tier": sum(bool(r.get("safety_broken")) for r in safe),
-        "tracking_broken_tracking_tier": sum(bool(r["broken"]) and r["broken"] != r.get("safety_broken")
-                                             for r in tracking),
-        "backup": {"runs_engaged": len(engaged), "fraction_engaged": len(engaged) / len(rows) if rows else None,
-                   "seconds_total": float(sum(r["backup_s"] for r in engaged)),
-                   "share_of_simulated_time": (float(sum(r["backup_s"] for r in engaged)) / simulated
-                                               if simulated else None),
-                   "seconds_per_engaged_run": _quantiles(engaged, "backup_s"),
-                   "engagements_per_engaged_run": _quantiles(engaged, "backup_engagements")},
-        "runs_with_replaced_steps": sum((r.get("replaced_steps") or 0) > 0 for r in rows),
-    }
-
-
-def summarise(rows: list[dict], spec: CampaignSpec, certs: dict[str, Tightening], facts: dict) -> dict[str, Any]:
-    """``summary.json``: the largest max_rho_ratio beside the certified radius (1 in the tube's box norm), counts."""
-    certified = [r for r in rows if r["certified"]]
-    tubes = np.array([t.tube for t in certs.values() if t.certified], dtype=float).reshape(-1, 3)
-    largest = _worst(rows, 1)
-    largest_cert = _worst(certified, 1)
-    return {
-        "runs": len(rows), "planned_runs": spec.runs, "seed": spec.seed, "duration_s": spec.duration,
-        "scenario": spec.scenario_source, "falsify_sequences": spec.falsify_sequences,
-        "certified_runs": len(certified), "distinct_certificates": len(certs),
-        "certified_certificates": int(sum(bool(t.certified) for t in certs.values())),
-        "certificate_radius": 1.0,
-        "certificate_tube_box": {"min": tubes.min(axis=0).tolist() if tubes.size else None,
-                                 "max": tubes.max(axis=0).tolist() if tubes.size else None},
-        "largest_max_rho_ratio": largest[0] if largest else None,
-        "largest_max_rho_ratio_certified": largest_cert[0] if largest_cert else None,
-        "violations": sum(bool(r["violated"]) for r in rows),
-        "violations_certified": sum(bool(r["violated"]) for r in certified),  # of a given tier, its premises held
-        "premise_failures": sum(not r["premises_held"] for r in rows),
-        "errors": sum(bool(r["error"]) for r in rows),
-        **_tier_summary(rows, spec.duration),
-        "metrics": {k: _quantiles(rows, k) for k in ("max_rho_ratio", "min_clearance", "min_e_d", "tracking_rmse",
-                                                     "saturated_steps", "replaced_steps", "backup_s", "wall_s")},
-        "worst_runs": _worst(rows),
-        **facts,
-    }
-
-
-def summary_line(summary: dict, out: str | Path) -> str:
-    """The result line of ``tubekit campaign``: runs, the largest max_rho_ratio beside the radius, violations."""
-    top = summary["largest_max_rho_ratio"] or {}
-    return (f"{summary['runs']} runs ({summary['computed_runs']} computed), {summary['certified_runs']} certified; "
-            f"largest max_rho_ratio {top.get('max_rho_ratio')} (run {top.get('run')}, seed {top.get('seed')}) vs "
-            f"certified radius 1; violations {summary['violations']} ({summary['violations_certified']} of a "
-            f"certified run with its premises held); safety promises broken {summary['safety_broken_safe_tier']} "
-            f"(of {summary['safe_tier_runs']} runs with the safe tier); backup engaged in "
-            f"{summary['backup']['runs_engaged']} runs, {summary['backup']['seconds_total']:.4g} s in all; wrote {out}")
-
-
-def write_figures(out: Path, rows: list[dict], epsilon: float) -> list[Path]:
-    """``figures/ecdf.png`` (one ECDF per metric, its bound dashed) and ``figures/worst_runs.png``."""
-    from matplotlib.figure import Figure
-
-    folder = out / "figures"
-    folder.mkdir(exist_ok=True)
-    panels = (("max_rho_ratio", 1.0, "certified radius"), ("min_clearance", 0.0, "contact"),
-              ("min_e_d", epsilon, "epsilon"), ("tracking_rmse", None, ""), ("saturated_steps", None, ""),
-              ("replaced_steps", None, ""), ("backup_s", None, ""), ("wall_s", None, ""))
-    fig = Figure(figsize=(14, 6.5), layout="constrained")
-    for ax, (key, bound, label) in zip(fig.subplots(2, 4).ravel(), panels):
-        x = np.sort([float(r[key]) for r in rows if r.get(key) is not None and np.isfinite(float(r[key]))])
-        ax.step(np.r_[x[:1], x], np.arange(x.size + 1) / max(x.size, 1), where="post", color="C0")
-        if bound is not None:
-            ax.axvline(bound, color="C3", ls="--", label=label)
-            ax.legend(loc="lower right", fontsize=8)
-        ax.set(xlabel=key, ylabel="fraction of runs <= x", title=f"{key} ({x.size} runs)")
-        ax.grid(alpha=0.3)
-    paths = [folder / FIGURES[0]]
-    fig.savefig(paths[0], dpi=100)
-    worst = _worst(rows, 15)[::-1]
-    fig = Figure(figsize=(8, 0.35 * len(worst) + 1.5), layout="constrained")
-    ax = fig.subplots()
-    ax.barh(range(len(worst)), [w["max_rho_ratio"] for w in worst],
-            color=["C3" if w["violated"] else "C0" for w in worst])
-    ax.set_yticks(range(len(worst)), [f"run {w['run']}  seed {w['seed']}" for w in worst], fontsize=7)
-    ax.axvline(1.0, color="C3", ls="--", label="certified radius")
-    ax.set(xlabel="max_rho_ratio (tube deviation / certified radius)", title="worst runs (replay: tubekit "
-           "simulate --from-campaign DIR --run K)")
-    ax.legend(loc="lower right", fontsize=8)
-    paths.append(folder / FIGURES[1])
-    fig.savefig(paths[1], dpi=100)
-    return paths
-
-
 # ---- the pipeline ---------------------------------------------------------------------------------------
 
+def _submit(client: Any, tasks: list[RunTask], keys: dict[int, str], missing: dict[str, Scenario],
+            name: str) -> tuple[list[Any], list[Any]]:
+    """One certificate task per ``missing`` input key (first), then the runs, each depending on its own."""
+    from tubekit.app.certified import issue_certificate
+
+    certs = {key: client.submit(issue_certificate, scenario, key=f"tubekit-{name}-cert-{key[:16]}",
+                                retries=RETRIES, pure=False, priority=1) for key, scenario in missing.items()}
+    runs = [client.submit(simulate_task, task, certs.get(keys[task.run]), key=f"tubekit-{name}-run-{task.run}",
+                          retries=RETRIES, pure=False) for task in tasks]
+    return list(certs.values()), runs
+
+
 def _execute(client: Any, tasks: list[RunTask], plans: dict[int, RunPlan], out: Path, key: str,
-             progress: bool) -> None:
-    """Submit ``tasks``; store each row the moment its run completes."""
+             progress: bool, missing: dict[str, Scenario], certs: dict[str, Tightening]) -> None:
+    """Certify ``missing`` and run ``tasks`` on the workers; store each certificate (into ``certs`` and
+    ``out/certificates``) and each row the moment it completes."""
     from distributed import as_completed
     from tqdm.auto import tqdm
 
-    futures = [client.submit(simulate_task, task, key=f"tubekit-{key}-run-{task.run}", retries=RETRIES,
-                             pure=False) for task in tasks]
+    from tubekit.app.certified import IssuedCertificate, input_key, write_cached
+
+    keys = {task.run: input_key(task.scenario) for task in tasks}
+    cert_futures, futures = _submit(client, tasks, keys, missing, key)
+    threading.Thread(target=import_plotting, name="tubekit-import-plotting", daemon=True).start()
     with tqdm(total=len(futures), unit="run", disable=not (progress and sys.stderr.isatty())) as bar:
-        for future in as_completed(futures):
+        for future in as_completed(cert_futures + futures):
             row = future.result()
+            if isinstance(row, IssuedCertificate):
+                write_cached(out / CERTIFICATES, row)
+                certs[row.key] = row.tightening
+                continue
             row = {"run": row["run"], "seed": row["seed"], **_flat_values(plans[row["run"]].values),
                    **{k: row[k] for k in METRIC_COLUMNS}}
             write_json(_run_file(out, row["run"]), row)
@@ -398,23 +328,39 @@ def run_campaign(spec: CampaignSpec, out: str | Path, *, workers: int = 2, sched
     check_output_dir(out)
     _check_campaign_dir(out, spec)
     plans = {k: spec.plan(k) for k in range(spec.runs)}  # every sample is validated before anything is written
-    certs = certify_plans(list(plans.values()))
-    done = _finished(out) if (out / "campaign.json").exists() else set()
-    todo = [RunTask(k, p.seed, p.scenario, certs[certificate_key(p.scenario)], spec.falsify_sequences)
+    from tubekit.app.certified import input_key
+
+    scenarios = {input_key(p.scenario): p.scenario for p in reversed(plans.values())}  # the first run's scenario
+    resumed = (out / "campaign.json").exists()
+    certs = cached_certificates(out, scenarios) if resumed else {}
+    missing = {key: scenario for key, scenario in scenarios.items() if key not in certs}
+    done = _finished(out) if resumed else set()
+    todo = [RunTask(k, p.seed, p.scenario, certs.get(input_key(p.scenario)), spec.falsify_sequences)
             for k, p in plans.items() if k not in done]
-    LOGGER.info("campaign: %d runs (%d already finished), %d distinct certificates, %s", spec.runs,
-                spec.runs - len(todo), len(certs), scheduler or f"LocalCluster of {workers} workers")
+    LOGGER.info("campaign: %d runs (%d already finished), %d distinct certificates (%d stored), %s", spec.runs,
+                spec.runs - len(todo), len(scenarios), len(certs), scheduler or f"LocalCluster of {workers} workers")
     nworkers = 0
-    with open_client(workers, scheduler) if todo else contextlib.nullcontext() as client:
-        _prepare_dir(out, spec)  # after the scheduler answered: a bad --scheduler writes nothing
-        if todo:
-            _execute(client, todo, plans, out, spec.fingerprint[:12], progress)
-            nworkers = len(client.scheduler_info().get("workers", {}))
+    with ThreadPoolExecutor(1, thread_name_prefix="tubekit-campaign-finish") as pool:
+        with open_client(workers, scheduler) if todo or missing else contextlib.nullcontext() as client:
+            _prepare_dir(out, spec)  # after the scheduler answered: a bad --scheduler writes nothing
+            if client is not None:
+                _execute(client, todo, plans, out, spec.fingerprint[:12], progress, missing, certs)
+                nworkers = len(client.scheduler_info().get("workers", {}))
+            facts = {"workers": nworkers, "scheduler": scheduler or "LocalCluster"}
+            finishing = pool.submit(_finish, out, spec, certs, todo, started, facts)  # while the cluster stops
+        return finishing.result()
+
+
+def _finish(out: Path, spec: CampaignSpec, certs: dict[str, Tightening], todo: list[RunTask], started: float,
+            facts: dict[str, Any]) -> dict[str, Any]:
+    """``runs.parquet``, ``summary.json`` (with this invocation's throughput) and the figures; the summary."""
     rows = [r for r in read_rows(out) if r["run"] < spec.runs]
+    computed = {task.run for task in todo}
     _write_parquet(out, rows)
-    facts = {"computed_runs": len(todo), "skipped_runs": spec.runs - len(todo), "workers": nworkers,
-             "scheduler": scheduler or "LocalCluster", "campaign_wall_s": time.perf_counter() - started,
-             "runs_wall_s": float(sum(r["wall_s"] for r in rows))}
+    facts = {"computed_runs": len(todo), "skipped_runs": spec.runs - len(todo), **facts,
+             "campaign_wall_s": time.perf_counter() - started,
+             "runs_wall_s": float(sum(r["wall_s"] for r in rows)),
+             "computed_runs_wall_s": float(sum(r["wall_s"] for r in rows if r["run"] in computed))}
     summary = summarise(rows, spec, certs, facts)
     write_json(out / "summary.json", summary)
     write_figures(out, rows, float(spec.base["epsilon"]))
@@ -432,7 +378,12 @@ def replay_run(campaign_dir: str | Path, run: int) -> tuple[dict, dict | None, A
     if isinstance(run, bool) or not isinstance(run, int) or not 0 <= run < spec.runs:
         raise ConfigError("--run", f"a run number in [0, {spec.runs - 1}]", run)
     plan = spec.plan(run)
-    cert = certify_plans([plan])[certificate_key(plan.scenario)]
+    from tubekit.app.certified import input_key
+
+    key = input_key(plan.scenario)
+    cert = cached_certificates(folder, {key: plan.scenario}).get(key)  # the campaign's own, through the checks
+    if cert is None:
+        cert = certify_plans([plan])[key]
     task = RunTask(run, plan.seed, plan.scenario, cert, spec.falsify_sequences)
     started = time.perf_counter()
     sims = _simulate_all(task)

@@ -15,6 +15,12 @@ A spec names a base scenario, how many runs, one seed and what to sample::
     [falsify]                          # optional
     sequences = 2                      # random piecewise-constant disturbances per run
 
+``plant.truth`` takes ``{ box = true }``: every coefficient the scenario's vehicle gives as an interval
+is drawn uniformly inside it (the plant as simulated; the certificate covers the whole box, so every
+run shares it)::
+
+    "plant.truth" = { box = true }
+
 ``obstacles`` takes a third kind, a cluster drawn afresh for every run (:func:`draw_cluster`)::
 
     "obstacles" = { cluster = { count = [3, 7], radius = [0.15, 0.4], gap = [0.01, 0.3],
@@ -50,7 +56,7 @@ __all__ = ["Distribution", "CampaignSpec", "RunPlan", "load_spec", "spec_from_di
 #: Top-level keys of a spec.
 SPEC_KEYS = ("scenario", "runs", "seed", "duration", "sample", "falsify")
 #: Scenario keys ``verify.certify`` does not read (a test keeps this true): samples of these share a certificate.
-NOT_CERTIFICATE_INPUTS = ("name", "duration", "disturbance.period")
+NOT_CERTIFICATE_INPUTS = ("name", "duration", "disturbance.period", "plant.truth")
 #: Upper bound on ``runs`` (a typo guard; 10^6 run files is already a lot).
 MAX_RUNS = 1_000_000
 #: Keys of an ``obstacles = { cluster = {...} }`` entry (``margin`` optional, m).
@@ -75,6 +81,8 @@ class Distribution:
         """One value: a float, a list of floats (vector uniform), one of ``options`` or a cluster's obstacles."""
         if self.kind == "cluster":
             return draw_cluster(dict(self.options), rng)
+        if self.kind == "box":  # one value per interval coefficient, in the order of ``options``
+            return {name: float(rng.uniform(lo, hi)) for name, lo, hi in self.options}
         if self.kind == "choice":
             return self.options[int(rng.integers(len(self.options)))]
         value = rng.uniform(np.asarray(self.low, dtype=float), np.asarray(self.high, dtype=float))
@@ -84,6 +92,8 @@ class Distribution:
         """The TOML form: ``{uniform = [lo, hi]}`` or ``{choice = [...]}``."""
         if self.kind == "cluster":
             return {"cluster": {k: v for k, v in self.options if k != "vehicle_radius"}}
+        if self.kind == "box":
+            return {"box": True}
         return {"choice": list(self.options)} if self.kind == "choice" else {"uniform": [self.low, self.high]}
 
 
@@ -260,6 +270,8 @@ def _distribution(key: str, entry: Any, base: dict) -> Distribution:
     field = f"sample.{key}"
     if key == "obstacles" and isinstance(entry, dict) and list(entry) == ["cluster"]:
         return _cluster(f"{field}.cluster", entry["cluster"], base)
+    if key == "plant.truth":
+        return _coefficient_box(field, entry, base)
     if not isinstance(entry, dict) or len(entry) != 1 or next(iter(entry)) not in ("uniform", "choice"):
         raise ConfigError(field, "{ uniform = [lo, hi] } or { choice = [...] }"
                           + (" or { cluster = {...} }" if key == "obstacles" else ""), entry)
@@ -270,6 +282,19 @@ def _distribution(key: str, entry: Any, base: dict) -> Distribution:
     if not isinstance(options, list) or not options:
         raise ConfigError(f"{field}.choice", "a non-empty list of values", options)
     return Distribution("choice", options=tuple(options))
+
+
+def _coefficient_box(field: str, entry: Any, base: dict) -> Distribution:
+    """``{ box = true }``: the base vehicle's interval coefficients, each drawn uniformly in its interval."""
+    if entry != {"box": True}:
+        raise ConfigError(field, "{ box = true } (every interval coefficient of the vehicle drawn in its interval)",
+                          entry)
+    params = scenario_from_dict(base).plant.params
+    names = tuple(getattr(params, "interval_fields", ()))
+    if not names:
+        raise ConfigError(field, "a vehicle with at least one coefficient given as an interval [lo, hi]",
+                          base.get("plant", {}).get("vehicle"))
+    return Distribution("box", options=tuple((n, *params.interval(n)) for n in names))
 
 
 def _integer(field: str, value: Any, low: int, high: int | None = None) -> int:

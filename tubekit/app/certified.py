@@ -5,21 +5,34 @@ already computed) and returns a :class:`CertifiedDesign`: the certificate and th
 run uses, its best-effort one when not certified. Whether the design is certified is stored
 once, in :attr:`Tightening.certified <tubekit.tightening.Tightening.certified>`;
 :class:`CertifiedDesign` only reads it. The runs themselves are :func:`tubekit.loop.pipeline.certified_run`.
+
+Campaigns certify on their workers (:func:`issue_certificate`) and keep each certificate by its
+input key (:func:`input_key`, the SHA-256 of what :func:`verify.certify` reads: the design key's fields
+plus the start, which the ``initial`` conditions read and the design key leaves out). A stored
+certificate is used only through :func:`load_certificate`: checksum, design key, the scenario it was
+issued for, then :func:`tubekit.design_key.require_matching` against the run's scenario.
 """
 
 from __future__ import annotations
 
+import hashlib
+import json
 import logging
 import time
 from dataclasses import dataclass
+from pathlib import Path
 from typing import Any
 
 import verify
 
+from tubekit.design_key import design_key, require_matching
+from tubekit.exceptions import ConfigError
+from tubekit.jsonable import to_jsonable, write_json
 from tubekit.scenario import Scenario
 from tubekit.tightening import Tightening
 
-__all__ = ["CertifiedDesign", "certify_design"]
+__all__ = ["CertifiedDesign", "certify_design", "IssuedCertificate", "input_key", "issue_certificate",
+           "load_certificate", "read_cached", "write_cached"]
 
 LOGGER = logging.getLogger(__name__)
 
@@ -58,3 +71,92 @@ def certify_design(scenario: Scenario, certificate: Any = None) -> CertifiedDesi
                 "certified" if design.certified else "NOT certified (best-effort tightening used)",
                 design.certify_s, tightening.sigma, tightening.rho_tilde)
     return design
+
+
+@dataclass(frozen=True)
+class IssuedCertificate:
+    """A certificate computed for one input key: its JSON dict (checksummed) and the tightening runs use."""
+
+    key: str
+    data: dict
+    tightening: Tightening
+
+
+def _input_text(data: dict) -> str:
+    """Canonical JSON of a scenario dict without the keys certify does not read
+    (:data:`tubekit.app.campaign_spec.NOT_CERTIFICATE_INPUTS`)."""
+    from tubekit.app.campaign_spec import NOT_CERTIFICATE_INPUTS
+
+    data = json.loads(json.dumps(to_jsonable(data)))
+    for dotted in NOT_CERTIFICATE_INPUTS:
+        *parents, leaf = dotted.split(".")
+        table = data
+        for part in parents:
+            table = table.get(part, {})
+        table.pop(leaf, None)
+    return json.dumps(data, sort_keys=True, separators=(",", ":"))
+
+
+def input_key(scenario: Scenario) -> str:
+    """SHA-256 (hex) of what :func:`verify.certify` reads of ``scenario``: equal keys share one certificate."""
+    return hashlib.sha256(_input_text(scenario.to_dict()).encode("utf-8")).hexdigest()
+
+
+def issue_certificate(scenario: Scenario) -> IssuedCertificate:
+    """Certify ``scenario`` (a campaign worker's task): its key, certificate dict and best-effort tightening."""
+    design = certify_design(scenario)
+    return IssuedCertificate(input_key(scenario), design.certificate.to_dict(), design.tightening)
+
+
+def load_certificate(data: Any, scenario: Scenario, where: str = "certificate") -> CertifiedDesign:
+    """A stored certificate dict for ``scenario``, through the checks any given certificate passes.
+
+    Raises
+    ------
+    ConfigError
+        ``<where>.checksum`` (edited after issue), ``<where>.<key>`` (incomplete), ``<where>.design_key``
+        (the key is not that of its fields), ``<where>.scenario_data`` (issued for another scenario or
+        start), ``design_key.<field>`` (:func:`tubekit.design_key.require_matching`).
+    """
+    from verify.certificate import Certificate
+    from verify.certificate_json import checksum_of
+
+    started = time.perf_counter()
+    if not isinstance(data, dict):
+        raise ConfigError(where, "a certificate JSON object", type(data).__name__)
+    if data.get("checksum") != checksum_of(data):
+        raise ConfigError(f"{where}.checksum", f"the SHA-256 of the content ({checksum_of(data)[:16]}...)",
+                          data.get("checksum"), "the certificate was edited after issue")
+    certificate = Certificate.from_dict(data)
+    if design_key(certificate.design_fields) != data.get("design_key"):
+        raise ConfigError(f"{where}.design_key", "the key of its design_fields", data.get("design_key"))
+    stored = data.get("scenario_data")
+    if not isinstance(stored, dict) or _input_text(stored) != _input_text(scenario.to_dict()):
+        raise ConfigError(f"{where}.scenario_data", f"the certificate input of scenario {scenario.name!r} "
+                          f"(key {input_key(scenario)[:16]}...)", "another scenario or start",
+                          "it was issued for another design")
+    tightening: Tightening = certificate.best_effort_tightening()
+    require_matching(scenario, tightening)
+    return CertifiedDesign(certificate, tightening, time.perf_counter() - started)
+
+
+def _cache_file(folder: Path, key: str) -> Path:
+    return folder / f"{key}.json"
+
+
+def read_cached(folder: str | Path, scenario: Scenario) -> CertifiedDesign | None:
+    """The certificate of ``scenario`` stored in ``folder`` (None when absent), through :func:`load_certificate`."""
+    path = _cache_file(Path(folder), input_key(scenario))
+    if not path.exists():
+        return None
+    try:
+        data = json.loads(path.read_text(encoding="utf-8"))
+    except (OSError, UnicodeDecodeError, ValueError) as exc:
+        raise ConfigError(str(path), "a certificate JSON file", str(exc), "delete it to certify again") from None
+    return load_certificate(data, scenario, where=str(path))
+
+
+def write_cached(folder: str | Path, issued: IssuedCertificate) -> Path:
+    """Store ``issued`` as ``folder/<key>.json`` (atomic)."""
+    Path(folder).mkdir(parents=True, exist_ok=True)
+    return write_json(_cache_file(Path(folder), issued.key), issued.data)

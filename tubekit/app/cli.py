@@ -12,10 +12,20 @@ Exit codes (:mod:`tubekit.app.exit_codes`, one table by error type): 0 success /
 (one message, no traceback), 3 not certified / counterexample found, 4 a certified promise
 broken in a run (simulate, reproduce, campaign), 130 interrupted (Ctrl-C).
 
-Every command takes ``-v`` (debug diagnostics) and ``-q`` (warnings and errors
-only): diagnostics go through :mod:`logging` to stderr; results are printed on
-stdout. Every file-system error (an unreadable or binary CONFIG, an ``--out``
-naming a file or an unwritable place) is one line naming the option, exit 2.
+Every command takes ``-v`` (debug diagnostics; ``certify -v`` also prints every sigma tried with
+its failed conditions) and ``-q`` (warnings and errors only; ``certify -q`` prints no summary
+either): diagnostics go through :mod:`logging` to stderr; results are printed on stdout. Every
+file-system error (an unreadable or binary CONFIG, an ``--out`` naming a file or an unwritable
+place, an ``--out`` another run holds) is one line naming the option, exit 2; a full disk is the
+machine's fault, not the input's: one line with the path, exit 1.
+
+One meaning per option across subcommands: ``--law NAME`` is a registered ancillary law (built in:
+paper, corrected), checked the same way everywhere; ``--duration S`` is the simulated time of each
+closed-loop run in seconds (reproduce, simulate; falsify with ``--closed-loop``); ``--quick`` is a
+faster, coarser smoke test (reproduce, simulate: ``--duration`` = :data:`tubekit.app.QUICK_S`;
+envelope: fewer speeds and bisection steps). ``falsify`` exits 0 only when a certified scenario
+resists the search: 3 when a counterexample is found or when the scenario is not certified (its
+best-effort tube promises nothing; the output says so).
 """
 
 from __future__ import annotations
@@ -65,13 +75,21 @@ SUBCOMMANDS: dict[str, Subcommand] = {
 }
 
 
-def _verbosity_options() -> argparse.ArgumentParser:
-    """``-v`` / ``-q``, shared by every subcommand (a parent parser)."""
+#: ``-v`` / ``-q`` help where a subcommand does more than the logging level.
+VERBOSITY_HELP: dict[str, tuple[str, str]] = {
+    "certify": ("debug diagnostics on stderr, and every sigma tried with its failed conditions on stdout",
+                "warnings and errors only on stderr, and no summary on stdout"),
+}
+
+
+def _verbosity_options(command: str) -> argparse.ArgumentParser:
+    """``-v`` / ``-q`` of one subcommand (a parent parser), with that subcommand's help."""
+    verbose, quiet = VERBOSITY_HELP.get(command, ("debug diagnostics on stderr",
+                                                  "warnings and errors only on stderr (results still on stdout)"))
     parent = argparse.ArgumentParser(add_help=False)
     group = parent.add_mutually_exclusive_group()
-    group.add_argument("-v", "--verbose", action="store_true", help="debug diagnostics on stderr")
-    group.add_argument("-q", "--quiet", action="store_true",
-                       help="warnings and errors only on stderr (certify: no summary either)")
+    group.add_argument("-v", "--verbose", action="store_true", help=verbose)
+    group.add_argument("-q", "--quiet", action="store_true", help=quiet)
     return parent
 
 
@@ -102,9 +120,9 @@ def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(prog="tubekit", description="Robust tube-based NMPC for underactuated AUVs.")
     parser.add_argument("--version", action="version", version=f"tubekit {__version__}")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND")
-    verbosity = _verbosity_options()
     for name, command in SUBCOMMANDS.items():
-        subparser = sub.add_parser(name, help=command.help, description=command.help, parents=[verbosity])
+        subparser = sub.add_parser(name, help=command.help, description=command.help,
+                                   parents=[_verbosity_options(name)])
         try:
             command.configure(subparser)
         except ImportError as exc:

@@ -7,33 +7,40 @@ Each is a ``configure_*(parser)`` adding its options and a ``run_*(args) -> exit
 from __future__ import annotations
 
 import argparse
+import importlib.util
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from tubekit.exceptions import ConfigError
-from tubekit.scenario import load_scenario, paper_scenario
-from tubekit.app.exit_codes import EXIT_FAILURE, EXIT_OK, EXIT_PROMISE_BROKEN
+from tubekit.checks import check_run_inputs
+from tubekit.exceptions import ConfigError, NotAvailableError
+from tubekit.scenario import Scenario, load_scenario, paper_scenario
+from tubekit.validation import bounded_int
+from tubekit.app.commands_verify import add_law_option, checked_law
+from tubekit.app.exit_codes import EXIT_FAILURE, EXIT_OK, EXIT_PROMISE_BROKEN, extra_hint
+from tubekit.app.output import OutputLock, check_output_dir
 
 if TYPE_CHECKING:  # the study (and with it verify and matplotlib) is imported when a command runs
     from tubekit.app.study import StudyResult
 
 __all__ = ["configure_reproduce", "run_reproduce", "configure_simulate", "run_simulate", "configure_campaign",
-           "run_campaign", "study_exit", "echo"]
+           "run_campaign", "study_exit", "echo", "require_campaign_extra", "CAMPAIGN_MODULES", "MAX_WORKERS"]
+
+#: Largest ``campaign --workers`` (local processes).
+MAX_WORKERS = 256
 
 
 def study_options(parser: argparse.ArgumentParser, default_out: str | None) -> None:
     from tubekit.app import QUICK_S as QUICK_DURATION_S
 
     parser.add_argument("--out", metavar="DIR", default=default_out,
-                        help="output directory" + (f" (default: {default_out})" if default_out else
-                                                   " (default: results/<scenario name>)"))
+                        help="output directory, locked while the run writes it" + (
+                            f" (default: {default_out})" if default_out else " (default: results/<scenario name>)"))
     length = parser.add_mutually_exclusive_group()
     length.add_argument("--duration", type=float, metavar="S", default=None,
-                        help="simulated time in seconds (default: the scenario's)")
+                        help="simulated time of each closed-loop run in seconds (default: the scenario's)")
     length.add_argument("--quick", action="store_true",
-                        help=f"shorthand for --duration {QUICK_DURATION_S:g} (smoke test)")
-    parser.add_argument("--law", choices=("paper", "corrected"), default=None,
-                        help="ancillary law (default: the scenario's controller.law)")
+                        help=f"a faster, shorter run (smoke test): --duration {QUICK_DURATION_S:g}")
+    add_law_option(parser)
     parser.add_argument("--no-progress", action="store_true", help="no progress bar")
     parser.add_argument("--animate", action="store_true",
                         help="also write top_view.gif (and top_view.mp4 where ffmpeg exists)")
@@ -54,36 +61,59 @@ def configure_simulate(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--run", metavar="K", type=int, default=None, help="the run of --from-campaign to replay")
 
 
+def _study_scenario(scenario: Scenario, args: argparse.Namespace) -> Scenario:
+    """The scenario with ``--duration`` / ``--quick`` / ``--law`` applied and every pre-run check passed."""
+    from tubekit.app.study import apply_overrides
+
+    law = None if args.law is None else checked_law(args.law, scenario)
+    scenario = apply_overrides(scenario, duration=args.duration, quick=args.quick, law=law)
+    check_run_inputs(scenario)
+    return scenario
+
+
+def _locked_study(scenario: Scenario, out: Path, args: argparse.Namespace, **options) -> int:
+    """The study into ``out`` under its lock (:class:`~tubekit.app.output.OutputLock`), checked first."""
+    from tubekit.app.study import run_study
+
+    check_output_dir(out)
+    with OutputLock(out):
+        result = run_study(scenario, out, progress=not args.no_progress, animate=args.animate, echo=echo, **options)
+    return study_exit(result)
+
+
 def run_reproduce(args: argparse.Namespace) -> int:
     """Section VI of the paper, tube against baseline, with the acceptance criteria."""
-    from tubekit.app.study import apply_overrides, run_study
-
-    scenario = apply_overrides(paper_scenario(), duration=args.duration, quick=args.quick, law=args.law)
-    out = Path(args.out or "results/reproduce")
-    result = run_study(scenario, out, progress=not args.no_progress, with_acceptance=True, animate=args.animate,
-                       dynamic=True, echo=echo)
-    return study_exit(result)
+    scenario = _study_scenario(paper_scenario(), args)
+    return _locked_study(scenario, Path(args.out or "results/reproduce"), args, with_acceptance=True, dynamic=True)
 
 
 def run_simulate(args: argparse.Namespace) -> int:
     """The same study on a scenario from TOML; or, with ``--from-campaign DIR --run K``, a campaign run replayed."""
-    from tubekit.app.study import apply_overrides, output_dir_name, run_study
+    from tubekit.app.study import output_dir_name
 
     if args.from_campaign is not None or args.run is not None:
-        from tubekit.app.campaign import replay_into
-
-        if args.from_campaign is None or args.run is None or args.config is not None:
-            raise ConfigError("--from-campaign", "--from-campaign DIR together with --run K (and no CONFIG)",
-                              args.from_campaign)
-        replay = replay_into(args.from_campaign, args.run, args.out, echo=echo)
-        return EXIT_PROMISE_BROKEN if replay.broken else EXIT_OK if replay.identical else EXIT_FAILURE
+        return _replay(args)
     if args.config is None:
         raise ConfigError("CONFIG", "a scenario TOML file (or --from-campaign DIR --run K)", None)
-    scenario = apply_overrides(load_scenario(args.config), duration=args.duration, quick=args.quick, law=args.law)
+    scenario = _study_scenario(load_scenario(args.config), args)
     out = Path(args.out) if args.out else Path("results") / output_dir_name(scenario.name)
-    result = run_study(scenario, out, progress=not args.no_progress, with_acceptance=False, animate=args.animate,
-                       echo=echo)
-    return study_exit(result)
+    return _locked_study(scenario, out, args, with_acceptance=False)
+
+
+def _replay(args: argparse.Namespace) -> int:
+    """``simulate --from-campaign DIR --run K``: 0 identical, 4 a certified promise broken, 1 not identical."""
+    from tubekit.app.campaign import replay_into
+
+    if args.from_campaign is None or args.run is None or args.config is not None:
+        raise ConfigError("--from-campaign", "--from-campaign DIR together with --run K (and no CONFIG)",
+                          args.from_campaign)
+    if args.out is None:
+        replay = replay_into(args.from_campaign, args.run, args.out, echo=echo)
+    else:
+        check_output_dir(Path(args.out))
+        with OutputLock(Path(args.out)):
+            replay = replay_into(args.from_campaign, args.run, args.out, echo=echo)
+    return EXIT_PROMISE_BROKEN if replay.broken else EXIT_OK if replay.identical else EXIT_FAILURE
 
 
 def echo(message: str) -> None:
@@ -98,23 +128,44 @@ def study_exit(result: StudyResult) -> int:
 
 # ---- campaign -------------------------------------------------------------------------------------------
 
-def configure_campaign(parser: argparse.ArgumentParser) -> None:
-    from tubekit.app.campaign_spec import require_dependencies
+#: Modules of the ``campaign`` extra of pyproject.toml.
+CAMPAIGN_MODULES = ("distributed", "pyarrow")
 
-    require_dependencies()
+
+def configure_campaign(parser: argparse.ArgumentParser) -> None:
+    """The campaign's options: always listed, whether or not the ``campaign`` extra is installed."""
     parser.add_argument("spec", metavar="SPEC", help="campaign TOML (schema: docs/campaign.md)")
-    parser.add_argument("--out", metavar="DIR", required=True, help="campaign directory (a rerun resumes it)")
-    parser.add_argument("--workers", type=int, default=2, metavar="N", help="local worker processes (default 2)")
+    parser.add_argument("--out", metavar="DIR", required=True,
+                        help="campaign directory (a rerun resumes it; locked while a campaign writes it)")
+    parser.add_argument("--workers", type=int, default=2, metavar="N",
+                        help=f"local worker processes, 1 to {MAX_WORKERS} (default 2)")
     parser.add_argument("--scheduler", metavar="ADDRESS", help="an existing dask scheduler, tcp://HOST:PORT")
     parser.add_argument("--no-progress", action="store_true", help="no progress bar")
+    missing = [m for m in CAMPAIGN_MODULES if importlib.util.find_spec(m) is None]
+    if missing:
+        parser.epilog = f"Needs the campaign extra ({', '.join(missing)} missing): {extra_hint('campaign')}"
+
+
+def require_campaign_extra() -> None:
+    """Raise :class:`NotAvailableError` naming the ``campaign`` extra when dask or pyarrow is missing (exit 1)."""
+    missing = [m for m in CAMPAIGN_MODULES if importlib.util.find_spec(m) is None]
+    if missing:
+        raise NotAvailableError(f"{' and '.join(missing)} not installed (the campaign extra). "
+                                f"{extra_hint('campaign')}")
 
 
 def run_campaign(args: argparse.Namespace) -> int:
     """Monte Carlo closed-loop runs on dask; 0 done, 4 when a certified run broke a promise."""
+    require_campaign_extra()
     from tubekit.app.campaign import run_campaign, summary_line
     from tubekit.app.campaign_spec import load_spec
 
-    summary = run_campaign(load_spec(args.spec), args.out, workers=args.workers, scheduler=args.scheduler,
-                           progress=not args.no_progress)
+    bounded_int("--workers", args.workers, 1, MAX_WORKERS)
+    spec = load_spec(args.spec)
+    out = Path(args.out)
+    check_output_dir(out)
+    with OutputLock(out):
+        summary = run_campaign(spec, args.out, workers=args.workers, scheduler=args.scheduler,
+                               progress=not args.no_progress)
     echo(summary_line(summary, args.out))
     return EXIT_PROMISE_BROKEN if summary["violations_certified"] else EXIT_OK

@@ -9,51 +9,85 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
+from tubekit.checks import check_log_size, check_run_inputs, require_one_period
 from tubekit.exceptions import ConfigError
 from tubekit.scenario import Scenario, load_scenario, paper_scenario
-from tubekit.validation import positive
+from tubekit.validation import bounded_int, duration_seconds, gain, positive
 from tubekit.app.exit_codes import EXIT_NOT_CERTIFIED, EXIT_OK
-from tubekit.app.output import check_file_target, emit_json, write_json_creating_dirs
+from tubekit.app.output import check_figure_target, check_file_target, emit_json, write_json_creating_dirs
 
 __all__ = ["configure_audit", "run_audit", "configure_certify", "run_certify", "configure_envelope", "run_envelope",
-           "configure_recheck", "run_recheck", "configure_falsify", "run_falsify"]
+           "configure_recheck", "run_recheck", "configure_falsify", "run_falsify", "add_law_option", "checked_law",
+           "load_checked", "MAX_SAMPLES", "MAX_SEED", "MAX_BOXES", "MAX_BUDGET", "FALSIFY_DURATION_S"]
+
+#: Largest ``audit --samples`` (points per term).
+MAX_SAMPLES = 10 ** 6
+#: Largest ``--seed`` (the seeds are 32-bit).
+MAX_SEED = 2 ** 32 - 1
+#: Largest ``certify --max-boxes`` (boxes per gain entry).
+MAX_BOXES = 10 ** 7
+#: Largest ``falsify --budget`` (starts or simulations).
+MAX_BUDGET = 10 ** 6
+#: ``falsify --closed-loop``: simulated time of each run when ``--duration`` is not given (s).
+FALSIFY_DURATION_S = 3.0
+
+
+def add_law_option(parser: argparse.ArgumentParser) -> None:
+    """``--law NAME``: the one definition of every subcommand that takes it."""
+    parser.add_argument("--law", default=None, metavar="NAME",
+                        help="ancillary law, a registered name (built in: 'paper', 'corrected'; "
+                             "default: the scenario's controller.law)")
+
+
+def checked_law(law: str | None, scenario: Scenario) -> str:
+    """The ``--law`` option, else the scenario's; an unknown name is a :class:`ConfigError` naming ``--law``."""
+    from tubekit.model.ancillary import LAWS
+
+    name = law if law is not None else scenario.controller.law
+    if name not in LAWS:
+        raise ConfigError("--law" if law is not None else "controller.law", f"one of {tuple(LAWS)}", name)
+    return name
+
+
+def load_checked(config: str | None, duration: float | None = None) -> Scenario:
+    """The scenario of CONFIG (default: the paper's) after every pre-run check of
+    :func:`tubekit.checks.check_run_inputs`, the same for every command."""
+    scenario = paper_scenario() if config is None else load_scenario(config)
+    check_run_inputs(scenario, duration)
+    return scenario
 
 
 def _verify_options(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("config", nargs="?", metavar="CONFIG", default=None,
                         help="scenario TOML (default: the paper's Section VI scenario)")
-    parser.add_argument("--law", default=None, metavar="NAME",
-                        help="ancillary law: 'paper' or 'corrected' (default: the scenario's controller.law)")
+    add_law_option(parser)
     parser.add_argument("--json", default=None, metavar="FILE", help="write the result as JSON ('-' = stdout)")
 
 
-def _scenario(config: str | None) -> Scenario:
-    return paper_scenario() if config is None else load_scenario(config)
-
-
-def _law(args: argparse.Namespace, scenario: Scenario) -> str:
-    """The ``--law`` option, else the scenario's; unknown names raise :class:`ConfigError`."""
-    from tubekit.model.ancillary import get_law
-
-    law = args.law if args.law is not None else scenario.controller.law
-    get_law(law)
-    return law
+def _json_target(path: str | None) -> None:
+    """``--json FILE`` (or ``-``): a file in an existing, writable directory."""
+    if path in (None, "-"):
+        return
+    if not Path(path).parent.exists():
+        raise ConfigError("--json", "a file in an existing directory", path)
+    check_file_target("--json", path)
 
 
 # ---- audit ----------------------------------------------------------------------------------------------
 
 def configure_audit(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--json", metavar="FILE", help="write the audit as JSON to FILE")
-    parser.add_argument("--samples", type=int, default=2000, help="random points per term (default 2000)")
-    parser.add_argument("--seed", type=int, default=0, help="RNG seed (default 0)")
+    parser.add_argument("--samples", type=int, default=2000,
+                        help=f"random points per term, 10 to {MAX_SAMPLES} (default 2000)")
+    parser.add_argument("--seed", type=int, default=0, help=f"RNG seed, 0 to {MAX_SEED} (default 0)")
 
 
 def run_audit(args: argparse.Namespace) -> int:
     """Run the audit, print the table, optionally write JSON."""
     from tubekit.paper.audit import audit
 
-    if args.samples < 10:
-        raise ConfigError("--samples", "an integer >= 10", args.samples)
+    bounded_int("--samples", args.samples, 10, MAX_SAMPLES)
+    bounded_int("--seed", args.seed, 0, MAX_SEED)
     if args.json:
         check_file_target("--json", args.json)
     report = audit(samples=args.samples, seed=args.seed)
@@ -70,36 +104,39 @@ def configure_certify(parser: argparse.ArgumentParser) -> None:
     _verify_options(parser)
     parser.add_argument("--max-boxes", type=int, default=4000, metavar="N",
                         help="branch-and-bound budget per gain entry, in boxes (a work unit: the verdict does not "
-                             "depend on machine load; default 4000)")
+                             f"depend on machine load; 1 to {MAX_BOXES}, default 4000)")
     parser.add_argument("--search-region", action="store_true",
                         help="certify on a fixed grid of (region.e_o_max, region.e_d_max) and report every "
                              "verdict; exit 0 if any certifies (the best is printed), else 3")
 
 
 def run_certify(args: argparse.Namespace) -> int:
-    """Certify; print the summary; 0 certified, 3 not certified (``--search-region``: any point of the grid)."""
-    from verify import certify
+    """Certify; print the summary; 0 certified, 3 not certified (``--search-region``: any point of the grid).
 
-    scenario = _scenario(args.config)
-    law = _law(args, scenario)
-    if args.json not in (None, "-"):
-        if not Path(args.json).parent.exists():
-            raise ConfigError("--json", "a file in an existing directory", args.json)
-        check_file_target("--json", args.json)
+    ``-q`` prints no summary; ``-v`` adds every sigma tried with its failed conditions.
+    """
+    from verify import certify
+    from verify.report import tried_lines
+
+    scenario = load_checked(args.config)
+    law = checked_law(args.law, scenario)
+    _json_target(args.json)
+    bounded_int("--max-boxes", args.max_boxes, 1, MAX_BOXES)
+    show = not args.quiet and args.json != "-"
     if args.search_region:
         from verify.region_search import search_region
 
         found = search_region(scenario, law)
-        if not args.quiet and args.json != "-":
+        if show:
             print(found.summary())
         if args.json is not None:
             emit_json(args.json, found.to_dict())
         return EXIT_OK if found.best is not None else EXIT_NOT_CERTIFIED
-    if args.max_boxes < 1:
-        raise ConfigError("--max-boxes", "an integer >= 1", args.max_boxes)
     cert = certify(scenario, law, max_boxes=args.max_boxes)
-    if not args.quiet and args.json != "-":
+    if show:
         print(cert.summary())
+        if args.verbose:
+            print("\n".join(tried_lines(cert)))
     if args.json is not None:
         emit_json(args.json, cert.to_dict())
     return EXIT_OK if cert.certified else EXIT_NOT_CERTIFIED
@@ -107,8 +144,10 @@ def run_certify(args: argparse.Namespace) -> int:
 
 def configure_envelope(parser: argparse.ArgumentParser) -> None:
     _verify_options(parser)
-    parser.add_argument("--plot", default=None, metavar="FILE", help="save the envelope plot (PNG/PDF/SVG)")
-    parser.add_argument("--quick", action="store_true", help="fewer speeds and bisection steps (faster)")
+    parser.add_argument("--plot", default=None, metavar="FILE",
+                        help="save the envelope plot; the suffix picks the format (.png, .pdf, .svg, ...)")
+    parser.add_argument("--quick", action="store_true",
+                        help="a faster, coarser run (smoke test): fewer speeds and bisection steps")
     parser.add_argument("--eps", type=float, default=None, metavar="E",
                         help="epsilon = min e_d in m for both frontiers (default: the scenario's)")
 
@@ -119,15 +158,14 @@ def run_envelope(args: argparse.Namespace) -> int:
 
     from tubekit.app.plots import plot_envelope
 
-    scenario = _scenario(args.config)
-    law = _law(args, scenario)
-    if args.plot is not None and not Path(args.plot).parent.exists():
-        raise ConfigError("--plot", "a file in an existing directory", args.plot)
+    scenario = load_checked(args.config)
+    law = checked_law(args.law, scenario)
     if args.plot is not None:
-        check_file_target("--plot", args.plot)
-    if args.json not in (None, "-"):
-        check_file_target("--json", args.json)
+        check_figure_target("--plot", args.plot)
+    _json_target(args.json)
     eps = None if args.eps is None else positive("--eps", args.eps)
+    if eps is not None and eps >= scenario.region.e_d_max:
+        raise ConfigError("--eps", f"a number < region.e_d_max = {scenario.region.e_d_max:g} m", args.eps)
     result = envelope(scenario, law, eps=eps, quick=args.quick)
     if args.json != "-":
         print(result.summary())
@@ -171,35 +209,63 @@ def run_recheck(args: argparse.Namespace) -> int:
 def configure_falsify(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("config", nargs="?", metavar="CONFIG",
                         help="scenario TOML (default: the paper's Section VI scenario)")
-    parser.add_argument("--law", choices=("paper", "corrected"), help="ancillary law (default: the scenario's)")
-    parser.add_argument("--budget", type=int, default=None,
-                        help="one-period starts searched by hypothesis (default 500), or with --closed-loop "
-                             "simulations (default 20)")
-    parser.add_argument("--seed", type=int, default=0, help="search seed (default 0)")
+    add_law_option(parser)
+    parser.add_argument("--budget", type=int, default=None, metavar="N",
+                        help=f"one-period starts searched by hypothesis (default 500), or with --closed-loop "
+                             f"simulations (default 20); at most {MAX_BUDGET}")
+    parser.add_argument("--seed", type=int, default=0, help=f"search seed, 0 to {MAX_SEED} (default 0)")
     parser.add_argument("--sigma", type=float, help="override the ancillary gain sigma (1/s; one-period search)")
     parser.add_argument("--closed-loop", action="store_true",
                         help="attack whole runs of the loop with disturbance sequences (greedy + evolution)")
-    parser.add_argument("--duration", type=float, default=3.0, help="seconds per closed-loop run (default 3)")
+    parser.add_argument("--duration", type=float, default=None, metavar="S",
+                        help=f"simulated time of each closed-loop run in seconds (with --closed-loop; "
+                             f"default {FALSIFY_DURATION_S:g})")
     parser.add_argument("--json", metavar="FILE", help="write the result as JSON")
 
 
-def run_falsify(args: argparse.Namespace) -> int:
-    """3 when a counterexample is found (ratio > 1 or a promise broken), 0 when none within the budget."""
-    from verify.falsify.one_period import falsify, falsify_closed_loop
-
-    scenario = _scenario(args.config)
+def _falsify_inputs(args: argparse.Namespace) -> tuple[Scenario, int, float]:
+    """The checked scenario, budget and closed-loop duration (s) of ``falsify``; every error names its option."""
+    if args.duration is not None and not args.closed_loop:
+        raise ConfigError("--duration", "--duration only with --closed-loop (it is each run's length)",
+                          args.duration)
+    if args.sigma is not None and args.closed_loop:
+        raise ConfigError("--sigma", "--sigma only with the one-period search (not with --closed-loop)",
+                          args.sigma)
+    duration = FALSIFY_DURATION_S if args.duration is None else duration_seconds("--duration", args.duration)
+    scenario = load_checked(args.config)
+    if args.closed_loop:
+        require_one_period("--duration", duration, scenario.controller.dt)
+        check_log_size(scenario, duration)
+    checked_law(args.law, scenario)
     if args.sigma is not None:
-        positive("--sigma", args.sigma)
-    positive("--duration", args.duration)
+        gain("--sigma", args.sigma)
+    budget = (20 if args.closed_loop else 500) if args.budget is None else args.budget
+    bounded_int("--budget", budget, 1, MAX_BUDGET)
+    bounded_int("--seed", args.seed, 0, MAX_SEED)
     if args.json:
         check_file_target("--json", args.json)
+    return scenario, budget, duration
+
+
+def run_falsify(args: argparse.Namespace) -> int:
+    """3 when a counterexample is found or the scenario is not certified, 0 when a certified scenario resists.
+
+    On a scenario that is not certified the search attacks the best-effort tube (no promise); the
+    output says so in its last line, and the exit code is 3 whatever the search found.
+    """
+    from verify.falsify.one_period import falsify, falsify_closed_loop
+
+    scenario, budget, duration = _falsify_inputs(args)
     if args.closed_loop:
-        budget = 20 if args.budget is None else args.budget
-        result = falsify_closed_loop(scenario, args.law, budget=budget, seed=args.seed, duration=args.duration)
+        result = falsify_closed_loop(scenario, args.law, budget=budget, seed=args.seed, duration=duration)
+        certified = bool(result.certified)
     else:
-        budget = 500 if args.budget is None else args.budget
         result = falsify(scenario, args.law, budget=budget, seed=args.seed, sigma=args.sigma)
+        certified = bool(result.space.certified)
     print(result.summary())
+    if not certified:
+        print("NOT CERTIFIED: the scenario is not certified, so this search tested its best-effort tube, which "
+              "promises nothing (exit 3 whatever it found; `tubekit certify -v` lists what fails)")
     if args.json:
         write_json_creating_dirs(args.json, result.to_dict())
-    return EXIT_NOT_CERTIFIED if result.found else EXIT_OK
+    return EXIT_NOT_CERTIFIED if result.found or not certified else EXIT_OK

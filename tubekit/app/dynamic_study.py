@@ -26,16 +26,28 @@ from tubekit.app.certified import certify_design
 from tubekit.app.plots import backup_stretches, shade_backup, title_lines
 from tubekit.app.tiers import report_title, tier_report
 
-__all__ = ["run_dynamic", "comparison_figure", "DYNAMIC_FILES"]
+__all__ = ["run_dynamic", "comparison_figure", "DYNAMIC_FILES", "DYNAMIC_VEHICLE", "DYNAMIC_RATE"]
 
 #: Files the dynamic part writes.
 DYNAMIC_FILES: tuple[str, ...] = ("dynamic_trajectory.csv", "dynamic_certificate.txt", "dynamic_vs_kinematic.png")
 
 
+#: The vehicle of ``reproduce``'s dynamic run: actuated in surge, heave and yaw at any speed, as the paper
+#: assumes (REMUS 100's rudder and stern planes give nothing at u = 0: ``docs/plant.md``).
+DYNAMIC_VEHICLE = "bluerov2_heavy"
+#: The plans' rate limit of that run (m/s², m/s², rad/s²), well inside what its thrusters deliver against
+#: drag at the corner of V (``rate_authority`` in its certificate).
+DYNAMIC_RATE = (0.3, 0.3, 1.0)
+
+
 def _dynamic_scenario(scenario: Scenario) -> Scenario:
+    """``scenario`` on the 4-DOF plant: unchanged when it is dynamic already; else the BlueROV2 Heavy with
+    rate-limited plans (:data:`DYNAMIC_VEHICLE`, :data:`DYNAMIC_RATE`)."""
     if scenario.plant.kind == "dynamic":
         return scenario
-    return scenario.with_changes(plant=replace(scenario.plant, kind="dynamic"))
+    limits = scenario.limits if scenario.limits.rate is not None else replace(scenario.limits, rate=DYNAMIC_RATE)
+    return scenario.with_changes(plant=replace(scenario.plant, kind="dynamic", vehicle=DYNAMIC_VEHICLE),
+                                 limits=limits)
 
 
 def comparison_figure(scenario: Scenario, kinematic: SimulationResult, dynamic: SimulationResult,
@@ -47,7 +59,7 @@ def comparison_figure(scenario: Scenario, kinematic: SimulationResult, dynamic: 
     """
     fig = Figure(figsize=(12, 8.5), layout="constrained")
     ax = fig.subplots(2, 2)
-    runs = (("kinematic plant", kinematic, "tab:blue"), ("dynamic plant (REMUS 100)", dynamic, "tab:purple"))
+    runs = (("kinematic plant", kinematic, "tab:blue"), (f"dynamic plant ({scenario.plant.vehicle})", dynamic, "tab:purple"))
     for label, run, colour in runs:
         ax[0, 0].plot(run.states[:, 0], run.states[:, 1], color=colour, lw=1.2, label=label)
         ax[0, 1].plot(run.t, run.errors[:, 0], color=colour, lw=1.2, label=label)
@@ -63,11 +75,13 @@ def comparison_figure(scenario: Scenario, kinematic: SimulationResult, dynamic: 
     for s in (gamma, -gamma):
         ax[1, 0].axhline(s, color="tab:red", ls="--", lw=1.0, label="±γ̄ (certificate)" if s > 0 else None)
     ax[1, 0].set(xlabel="t (s)", ylabel="m/s", title="sway against its bound")
-    limits = np.asarray(scenario.plant.params.thrust_limits, dtype=float)
+    truth = scenario.plant.truth_params  # the plant as simulated; fins: limits ∝ u² (docs/plant.md)
+    limits = np.array([truth.thrust_limits_at(u) for u in dynamic.body[:, 0]]) if dynamic.body is not None else None
     if dynamic.thrust is not None:
         for k, (name, colour) in enumerate((("X / X_max", "tab:blue"), ("Z / Z_max", "tab:orange"),
                                              ("N / N_max", "tab:green"))):
-            ax[1, 1].plot(dynamic.t, dynamic.thrust[:, k] / limits[k], color=colour, lw=0.9, label=name)
+            ratio = np.divide(dynamic.thrust[:, k], limits[:, k], out=np.zeros(len(limits)), where=limits[:, k] > 0)
+            ax[1, 1].plot(dynamic.t, ratio, color=colour, lw=0.9, label=name)
     ax[1, 1].axhline(1.0, color="tab:red", ls="--", lw=1.0, label="limit")
     ax[1, 1].axhline(-1.0, color="tab:red", ls="--", lw=1.0)
     ax[1, 1].set(xlabel="t (s)", ylabel="thrust / limit", title="thrust against its limits")
@@ -87,7 +101,8 @@ def run_dynamic(scenario: Scenario, staging: Path, kinematic: SimulationResult,
     """Certify and run the dynamic plant; write its files into ``staging``; return the run and its metrics.
 
     The metrics are the run's (``run.metrics``) plus ``failures`` (the certificate's failed
-    conditions), ``vehicle``, ``tracking_bound`` and ``tiers_report`` (:func:`tubekit.app.tiers.tier_report`).
+    conditions), ``vehicle``, ``velocity_loop`` (the certificate's derived loop bound, None when not
+    certified) and ``tiers_report`` (:func:`tubekit.app.tiers.tier_report`).
     """
     scd = _dynamic_scenario(scenario)
     design = certify_design(scd)
@@ -95,8 +110,9 @@ def run_dynamic(scenario: Scenario, staging: Path, kinematic: SimulationResult,
     dyn = certified_run(scd, design.tightening, progress=progress, label="dynamic")
     dyn.run.write_csv(staging / "dynamic_trajectory.csv")
     metrics = dyn.to_dict()
+    loop = design.tightening.velocity_loop
     metrics.update(failures=[f.condition for f in design.certificate.failures], vehicle=scd.plant.vehicle,
-                   tracking_bound=list(scd.plant.tracking_bound))
+                   velocity_loop=None if loop is None else list(loop))
     metrics["tiers_report"] = tier_report(design.certificate, metrics)
     gamma = float(design.tightening.disturbance.sway)
     figure = comparison_figure(scd, kinematic, dyn.run, gamma, tiers=report_title(metrics["tiers_report"]))

@@ -4,9 +4,11 @@
 code   meaning
 =====  ==========================================================================================
 0      success / certified
-1      internal error (:class:`SolverError`, any other :class:`TubekitError`) or an optional
-       backend not available (:class:`NotAvailableError`, ``ImportError``; with the install hint)
-2      bad input (:class:`ConfigError`, :class:`ShapeError`, a file-system error naming the file)
+1      internal error (:class:`SolverError`, any other :class:`TubekitError`), an optional
+       backend not available (:class:`NotAvailableError`, ``ImportError``; with the install hint),
+       or the machine failing a write (:data:`ENVIRONMENT_ERRNOS`: a full disk, a quota, an I/O
+       error; the line gives the path) -- the input was fine, so it is not exit 2
+2      bad input (:class:`ConfigError`, :class:`ShapeError`, any other file-system error naming the file)
 3      not certified (:class:`verify.certificate.NotCertifiedError`) or a counterexample found
 4      a certified promise broken in a run (``simulate``, ``reproduce``, ``campaign``)
 130    interrupted (``KeyboardInterrupt``)
@@ -18,13 +20,18 @@ Codes 0, 3 and 4 are also outcomes a command returns (a verdict, not an error);
 
 from __future__ import annotations
 
+import contextlib
+import errno
+import signal
 import sys
-from typing import Callable
+import threading
+from typing import Callable, Iterator
 
 from tubekit.exceptions import ConfigError, NotAvailableError, ShapeError, SolverError, TubekitError
 
 __all__ = ["EXIT_OK", "EXIT_FAILURE", "EXIT_BAD_INPUT", "EXIT_NOT_CERTIFIED", "EXIT_PROMISE_BROKEN",
-           "EXIT_INTERRUPTED", "INSTALL_HINT", "error_table", "handle_error"]
+           "EXIT_INTERRUPTED", "INSTALL_HINT", "ENVIRONMENT_ERRNOS", "is_environment_error", "MachineError",
+           "children_ignore_interrupts", "extra_hint", "error_table", "handle_error"]
 
 EXIT_OK = 0
 EXIT_FAILURE = 1
@@ -35,11 +42,51 @@ EXIT_NOT_CERTIFIED = 3
 EXIT_PROMISE_BROKEN = 4
 #: Interrupted (Ctrl-C); an interrupted study leaves ``--out`` as it was.
 EXIT_INTERRUPTED = 130
-#: What to do when an optional backend is missing.
-INSTALL_HINT = "Try: pip install -e . (it installs every dependency of the commands)."
+#: What to do when an optional backend is missing (the extras are in pyproject.toml).
+INSTALL_HINT = ('Try: pip install -e ".[campaign]" (dask) or ".[bench]" (CasADi/IPOPT): the plain install '
+                'leaves the optional extras out.')
+#: OS errors of the machine, not of the input: a full disk, a quota, an I/O error, out of memory (exit 1).
+ENVIRONMENT_ERRNOS = frozenset({errno.ENOSPC, errno.EDQUOT, errno.EIO, errno.ENOMEM})
+
+
+def is_environment_error(exc: BaseException) -> bool:
+    """Whether ``exc`` is an OS error of the machine (:data:`ENVIRONMENT_ERRNOS`), not of the input."""
+    return isinstance(exc, OSError) and exc.errno in ENVIRONMENT_ERRNOS
+
+
+class _MachineErrorType(type):
+    def __instancecheck__(cls, obj: object) -> bool:
+        return isinstance(obj, BaseException) and is_environment_error(obj)
+
+
+class MachineError(OSError, metaclass=_MachineErrorType):
+    """The table's row for OS errors of the machine: ``isinstance(e, MachineError)`` is
+    :func:`is_environment_error` (never raised itself)."""
+
+
+def extra_hint(extra: str) -> str:
+    """The install line of one optional extra of pyproject.toml, e.g. ``pip install -e ".[campaign]"``."""
+    return f'Try: pip install -e ".[{extra}]"'
+
 
 #: How an error is reported: ``message(exc) -> the text after "tubekit COMMAND: "``.
 Message = Callable[[BaseException], str]
+
+
+@contextlib.contextmanager
+def children_ignore_interrupts() -> Iterator[None]:
+    """Processes started inside the block ignore SIGINT (Ctrl-C): they inherit SIG_IGN, under which Python
+    and asyncio install no KeyboardInterrupt handler. The parent alone turns Ctrl-C into exit 130 and
+    stops them (a dask LocalCluster's workers: no worker traceback). A Ctrl-C inside the block itself is
+    dropped. Off the main thread (where signals cannot be set) the block changes nothing."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    previous = signal.signal(signal.SIGINT, signal.SIG_IGN)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGINT, previous)
 
 
 def _first_line(exc: BaseException) -> str:
@@ -50,6 +97,18 @@ def _first_line(exc: BaseException) -> str:
 def _os_error(exc: BaseException) -> str:
     name = getattr(exc, "filename", None) or "a file"
     return f"error: {name}: {getattr(exc, 'strerror', None) or exc}"
+
+
+def _not_available(exc: BaseException) -> str:
+    text = _first_line(exc)
+    return f"not available: {text}" + ("" if "pip install" in text else f". {INSTALL_HINT}")
+
+
+def _environment_error(exc: BaseException) -> str:
+    name = getattr(exc, "filename", None) or "(path unknown)"
+    return (f"cannot write {name}: {getattr(exc, 'strerror', None) or exc} (a problem of the machine, not of the "
+            "input; nothing was replaced)")
+
 
 
 def _not_certified_error() -> type[BaseException] | None:
@@ -69,9 +128,10 @@ def error_table() -> tuple[tuple[type[BaseException], int, Message], ...]:
         (ConfigError, EXIT_BAD_INPUT, lambda e: f"error: {_first_line(e)}"),
         (ShapeError, EXIT_BAD_INPUT, lambda e: f"error: {_first_line(e)}"),
         (SolverError, EXIT_FAILURE, lambda e: f"solver failed: {_first_line(e)}"),
-        (NotAvailableError, EXIT_FAILURE, lambda e: f"not available: {_first_line(e)}. {INSTALL_HINT}"),
-        (ImportError, EXIT_FAILURE, lambda e: f"not available: {_first_line(e)}. {INSTALL_HINT}"),
+        (NotAvailableError, EXIT_FAILURE, _not_available),
+        (ImportError, EXIT_FAILURE, _not_available),
         (BrokenPipeError, EXIT_OK, lambda e: ""),
+        (MachineError, EXIT_FAILURE, _environment_error),
         (OSError, EXIT_BAD_INPUT, _os_error),
         (TubekitError, EXIT_FAILURE, lambda e: f"internal error: {type(e).__name__}: {_first_line(e)}"),
     ]

@@ -1,4 +1,4 @@
-"""Figures: a run (paper Figs. 2-4, ‖ρ‖ against ρ̃, a 3-D view, clearance) and a design envelope.
+"""Figures of a run: paper Figs. 2-4, the per-axis deviation against the tube box, a 3-D view, clearance.
 
 Uses matplotlib's object API (:class:`matplotlib.figure.Figure`, Agg canvas):
 no pyplot state, no window, never ``show()``. Every function takes logged
@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import textwrap
 from pathlib import Path
-from typing import TYPE_CHECKING, Mapping, Sequence
+from typing import Mapping, Sequence
 
 import numpy as np
 from matplotlib.collections import PatchCollection
@@ -18,13 +18,12 @@ from matplotlib.patches import Circle as CirclePatch
 from matplotlib.ticker import MaxNLocator
 
 from tubekit.exceptions import ConfigError
-from tubekit.loop.metrics import clearance, rho_period_peaks
+from tubekit.loop.metrics import clearance
 from tubekit.loop.result import SimulationResult
 from tubekit.scenario import Scenario
 from tubekit.tightening import Tightening
-
-if TYPE_CHECKING:  # verify is imported for its type only; plotting needs no certificate code
-    from verify.envelope import EnvelopeResult
+from tubekit.app.plots_obstacle import draw_obstacle_side_view
+from tubekit.app.plots_envelope import envelope_figure, plot_envelope  # re-exported: their old home
 
 __all__ = [
     "Run",
@@ -200,8 +199,16 @@ def fit_canvas(fig: Figure, ax, legend_in: float = 2.9, longest_in: float = 6.2)
     ax.set_aspect("equal", adjustable="datalim")
 
 
+def _scene_extent(ax) -> tuple[float, float]:
+    """Width and height (m) of the data drawn on ``ax`` (its autoscaled limits)."""
+    ax.autoscale_view()
+    (x0, x1), (y0, y1) = ax.get_xlim(), ax.get_ylim()
+    return max(x1 - x0, 1e-6), max(y1 - y0, 1e-6)
+
+
 def top_view(scenario: Scenario, runs: Sequence[Run], *, tightening: Tightening | None = None) -> Figure:
-    """Fig. 2: paths with time ticks, the position tube around the nominal, sensing range at intervals.
+    """Fig. 2: paths with time ticks, the position tube around the nominal, sensing range at intervals; beside
+    it the legend (small) and a side view at the nearest obstacle (passes over it, mm overlaps, zoomed).
 
     Parameters
     ----------
@@ -211,14 +218,15 @@ def top_view(scenario: Scenario, runs: Sequence[Run], *, tightening: Tightening 
         Its ``obstacle_margin`` (m) is the half-width of the position tube drawn
         around the first run's nominal path (none when 0 or absent).
     """
-    fig = Figure(figsize=(9.0, 6.2), layout="constrained")
-    ax = fig.add_subplot()
+    fig = Figure(layout="constrained")
+    grid = fig.add_gridspec(2, 2, width_ratios=(2.5, 1.25), height_ratios=(1.0, 1.1))
+    ax = fig.add_subplot(grid[:, 0])
     t_end = _t_end(scenario, runs)
     draw_scene_xy(ax, scenario, t_end)
     half = _position_tube(tightening)
     if runs and half > 0:
         certified = bool(getattr(tightening, "certified", False))
-        _draw_tube_band(ax, runs[0][1], half, rf"position tube: $\hat p$ $\pm$ obstacle margin {half:.3g} m "
+        _draw_tube_band(ax, runs[0][1], half, rf"position tube: $\hat p$ $\pm$ {half:.3g} m "
                                               f"({'certified' if certified else 'best effort, NOT certified'})")
     _draw_path_with_time(ax, scenario, runs, _tick_interval(t_end))
     if runs and "backup_active" in runs[0][1]:
@@ -228,8 +236,18 @@ def top_view(scenario: Scenario, runs: Sequence[Run], *, tightening: Tightening 
             ax.plot(np.asarray(c["x"])[on], np.asarray(c["y"])[on], ".", color="0.35", ms=2.5, zorder=4,
                     label=f"{runs[0][0]}: backup law active")
     ax.set_title(f"Top view ({scenario.name})")
-    fit_canvas(fig, ax)
-    ax.legend(**_LEGEND_OUTSIDE)
+    dx, dy = _scene_extent(ax)
+    height = 6.0
+    fig.set_size_inches(min(max(height * dx / dy, 3.0), 9.0) + 3.6, height + 0.4)
+    ax.set_aspect("equal", adjustable="datalim")
+    side = fig.add_subplot(grid[1, 1])
+    draw_obstacle_side_view(side, scenario, runs, [run_style(i) for i in range(len(runs))])
+    legend_ax = fig.add_subplot(grid[0, 1])
+    legend_ax.set_axis_off()
+    handles, labels = ax.get_legend_handles_labels()
+    more = side.get_legend_handles_labels()
+    legend_ax.legend(handles + more[0], labels + more[1], loc="upper left", fontsize=6.5, frameon=False,
+                     borderaxespad=0.0, handlelength=1.6)
     return fig
 
 
@@ -307,23 +325,48 @@ def inputs_figure(scenario: Scenario, runs: Sequence[Run], *, tightening: Tighte
     return fig
 
 
-def rho_figure(runs: Sequence[Run], rho_tilde: float | None, certified: bool) -> Figure:
-    """‖ρ(t)‖ = ‖e − ê‖ (peak of each sampling period) against the tube radius ρ̃."""
-    fig = Figure(figsize=(7.5, 3.8), layout="constrained")
-    ax = fig.add_subplot()
-    for i, (label, c) in enumerate(runs):
-        tt, peak = rho_period_peaks(c)
-        ax.plot(tt, peak, label=rf"$\max\|\rho\|$ per period, {label}", **run_style(i))
-    if rho_tilde is not None and np.isfinite(rho_tilde) and rho_tilde > 0:
-        lab = (rf"$\tilde\rho$ = {rho_tilde:.3g} (certified)" if certified
-               else rf"$\tilde\rho$ = {rho_tilde:.3g} (best effort, NOT certified)")
-        ax.axhline(rho_tilde, color="tab:red", ls="--" if certified else ":", lw=1.2, label=lab)
-    shade_backup(ax, backup_stretches(runs[0][1]) if runs else [])
-    ax.set_xlabel("t (s)")
-    ax.set_ylabel(r"$\|\rho\| = \|e - \hat e\|$")
-    ax.set_title("Deviation from the nominal (ρ resets to 0 at every FHOCP sample)")
-    ax.grid(alpha=0.3)
-    ax.legend(fontsize=8)
+def _period_peaks(columns: Mapping[str, np.ndarray], values: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Per sampling period: its end time (s) and the max of ``values`` over its ticks (the pre-reset peak)."""
+    step = np.asarray(columns["step"])
+    m = int(np.sum(step == step[0]))
+    n = (len(values) - 1) // m if m else 0
+    t = np.asarray(columns["t"], dtype=float)
+    if m < 1 or n < 1 or n * m + 1 != len(values):
+        return t, values
+    with np.errstate(all="ignore"):
+        return t[m::m][:n], np.nanmax(values[1:n * m + 1].reshape(n, m), axis=1)
+
+
+def rho_figure(runs: Sequence[Run], tube: Sequence[float] | None, certified: bool) -> Figure:
+    """Per axis, |e_j − ê_j| / tube_j (peak of each sampling period) of the first run against 1, the box the
+    ``tube`` promise checks (max_j of these ratios ≤ 1, while a plan is followed); |e_j − ê_j| itself when
+    there is no tube (``tube`` None or not positive). Ticks under the backup law are left out (grey)."""
+    fig = Figure(figsize=(8.0, 5.4), layout="constrained")
+    axes = fig.subplots(3, 1, sharex=True)
+    box = None if tube is None else np.asarray(tube, dtype=float)
+    ratio = box is not None and bool(np.all(box > 0))
+    names = (("rho_d", "e_d", "m"), ("rho_z", "e_z", "m"), ("rho_o", "e_o", "-"))
+    worst = []
+    if runs:
+        label, c = runs[0]
+        following = np.asarray(c.get("backup_active", np.zeros(len(c["t"]))), dtype=float) < 0.5
+        for j, (ax, (key, name, unit)) in enumerate(zip(axes, names)):
+            dev = np.where(following, np.abs(np.asarray(c[key], dtype=float)), np.nan)
+            tt, peak = _period_peaks(c, dev / box[j] if ratio else dev)
+            ax.plot(tt, peak, label=f"{label}, max per period", **run_style(0))
+            worst.append(float(np.nanmax(peak)) if np.any(np.isfinite(peak)) else float("nan"))
+            ax.set_ylabel(rf"$|\rho_{{{name[2:]}}}|$ / tube" if ratio else rf"$|\rho_{{{name[2:]}}}|$ ({unit})")
+            ax.grid(alpha=0.3)
+            if ratio:
+                ax.axhline(1.0, color="tab:red", ls="--" if certified else ":", lw=1.2,
+                           label=f"tube box ({name}: {box[j]:.4g} {unit}), {'certified' if certified else 'NOT certified'}")
+                ax.set_ylim(0.0, 1.4)  # the legend sits above the box line, clear of the data
+            shade_backup(ax, backup_stretches(c), label=j == 0)
+            ax.legend(fontsize=7, loc="upper center", ncol=3, frameon=False)
+    head = "|e_j - e_hat_j| / tube_j per axis" if ratio else "|e_j - e_hat_j| per axis (no tube: nothing promised)"
+    top = f"; largest {np.nanmax(worst):.6g} (promise: <= 1)" if ratio and worst else ""
+    fig.suptitle(f"Deviation from the nominal, {head}{top}\n(it restarts at 0 at every FHOCP sample)", fontsize=10)
+    axes[-1].set_xlabel("t (s)")
     return fig
 
 
@@ -402,14 +445,16 @@ def plot_all(out_dir: str | Path, scenario: Scenario, runs: Sequence[Run], *,
              tightening: Tightening | None = None, tiers: str | None = None) -> list[Path]:
     """Write every figure of :data:`FIGURE_FILES` into ``out_dir``; returns the paths.
 
-    ``tightening`` (optional) adds the position tube to the top view and the bounds of V̄ to the inputs;
+    ``tightening`` (optional) adds the position tube to the top view, the bounds of V̄ to the inputs and the
+    per-axis tube box to ``rho.png`` (``rho_tilde`` is accepted for callers of the older figure and unused);
     ``tiers`` (optional, :func:`tier_title`) is added as a title line to every figure. The first run's
     backup-active stretches are shaded on every time axis and marked on the top view.
     """
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     figs = (top_view(scenario, runs, tightening=tightening), errors_figure(scenario, runs),
-            inputs_figure(scenario, runs, tightening=tightening), rho_figure(runs, rho_tilde, certified),
+            inputs_figure(scenario, runs, tightening=tightening),
+            rho_figure(runs, None if tightening is None else tightening.tube, certified),
             view_3d(scenario, runs), clearance_figure(scenario, runs))
     paths = []
     for name, fig in zip(FIGURE_FILES, figs):
@@ -420,58 +465,3 @@ def plot_all(out_dir: str | Path, scenario: Scenario, runs: Sequence[Run], *,
         fig.savefig(p, dpi=dpi)
         paths.append(p)
     return paths
-
-
-def envelope_figure(result: EnvelopeResult) -> Figure:
-    """omega_bar_xy against target speed at one epsilon: the certified frontier (region under it shaded)
-    beside the physical-necessity frontier min(u_max - s, r_max epsilon), with the reference operating
-    points (:data:`verify.envelope.REFERENCE_POINTS`) marked: green inside the certified region, red outside,
-    white when the point's epsilon is not this envelope's."""
-    from verify.envelope import REFERENCE_POINTS  # data only: verify imports no plotting library
-
-    u_max, r_max = result.limits[0], result.limits[2]
-    fig = Figure(figsize=(7.6, 5.4), layout="constrained")
-    ax = fig.add_subplot()
-    s_fine = np.linspace(0.0, u_max, 400)
-    need = np.minimum(u_max - s_fine, r_max * result.epsilon)
-    ax.plot(s_fine, need, "--", color="k", lw=1.6, zorder=4,
-            label=f"necessary: min(u_max - s, r_max eps) = min({u_max:g} - s, {r_max * result.epsilon:.3g})")
-    ax.fill_between(s_fine, need, 0.5, color="0.85", label="physically impossible")
-    cert = np.nan_to_num(result.certified_omega, nan=0.0)
-    ax.fill_between(result.speeds, 0.0, cert, color="tab:green", alpha=0.3, label="certified")
-    ax.plot(result.speeds, result.certified_omega, "o-", color="tab:green", ms=4, lw=1.4,
-            label="certified frontier (bisection)")
-    ax.axhline(result.gamma + result.current_offset, color="tab:gray", ls=":", lw=1,
-               label=f"sway gamma_bar = {result.gamma:.3g} m/s (no current)")
-    for (name, speed, omega, eps), marker in zip(REFERENCE_POINTS, ("*", "D")):
-        same_eps = abs(eps - result.epsilon) < 1e-9
-        inside = omega <= np.interp(speed, result.speeds, cert)
-        colour = ("tab:green" if inside else "tab:red") if same_eps else "white"
-        verdict = ("inside" if inside else "outside") if same_eps else "other eps: not judged here"
-        ax.plot([speed], [omega], marker, ms=13 if marker == "*" else 8, mec="k", color=colour,
-                label=f"{name}: {speed:g} m/s, {omega:g} m/s at eps {eps:g} m ({verdict})")
-    rmin, rmed = result.ratio_min, result.ratio_median
-    ratio = "no feasible speed" if rmin is None else f"certified / necessary: min {rmin:.4f}, median {rmed:.4f}"
-    ax.set_title(f"{result.scenario_name}, law '{result.law}', eps = {result.epsilon:g} m\n{ratio}", fontsize=10)
-    ax.set_xlim(0.0, u_max)
-    ax.set_ylim(0.0, max(0.3, 1.15 * float(np.max(need))))
-    ax.set_xlabel("horizontal target speed s [m/s]")
-    ax.set_ylabel("omega_bar_xy = current amplitude + sway bound [m/s]")
-    ax.grid(alpha=0.3)
-    ax.legend(fontsize=8, loc="upper right")
-    return fig
-
-
-def plot_envelope(result: EnvelopeResult, path: str | Path) -> Path:
-    """Save :func:`envelope_figure` to ``path`` (PNG/PDF/SVG by extension, 120 dpi); returns the path.
-
-    Raises
-    ------
-    ConfigError
-        When the directory of ``path`` does not exist (field ``--plot``).
-    """
-    path = Path(path)
-    if not path.parent.exists():
-        raise ConfigError("--plot", "a file in an existing directory", str(path))
-    envelope_figure(result).savefig(path, dpi=120)
-    return path

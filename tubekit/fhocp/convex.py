@@ -21,7 +21,11 @@
   footprint's sphere (the same normal as the node's obstacle row), the workspace box shrunk
   by the footprint, and the sensed region as second-order cones (constant data: the frame's
   origin is the measured position); none of it is built without a backup;
-* a box trust region on the input step, intersected with the input box.
+* a box trust region on the input step, intersected with the input box;
+* with a rate limit (``nlp.rate_jump``), the rate rows of :mod:`tubekit.fhocp.rows` (hard): the
+  node-to-node steps and the terminal rest with constant J, the first node against the Parameter
+  ``vlast`` with the Parameter bound ``jb`` (J, or a non-binding 2 V-bar when no v_last is given);
+* with a rate penalty (``nlp.rate_penalty`` > 0), its quadratic in the objective (``vlast`` again).
 
 The problem is built once; :meth:`ConvexSubproblem.linearise` writes every parameter
 into one vector, which the fast path (:class:`tubekit.fhocp.fastpath.CompiledConeProgram`)
@@ -118,6 +122,7 @@ class ConvexSubproblem:
         self._layout()
         self.linearise(neutral_state, rollout(neutral_state, np.zeros((N, 3)), nlp.dt), np.zeros((N, 3)),
                        neutral_reference, np.zeros((0, 4)), trust_radius)
+        self.write_last_command(np.zeros(3), False)
         self.push_parameters()
 
     # ------------------------------------------------------------- building
@@ -135,6 +140,10 @@ class ConvexSubproblem:
         v["e_o"] = cp.Variable(N, name="e_o")
         slack = {n: cp.Variable(N, name=f"slack_{n}") for n in _SLACKS}
         cons = self._model_rows(par, v, slack)
+        if self.nlp.rate_jump is not None or self.nlp.rate_penalty > 0:
+            par("vlast", 3)
+        if self.nlp.rate_jump is not None:
+            cons += self._rate_rows(par, v)
         for j in range(self.max_obstacles):
             ox, oy, oz, ro = par(f"ox{j}", N), par(f"oy{j}", N), par(f"oz{j}", N), par(f"ro{j}", N)
             cons.append(cp.multiply(ox, v["x"]) + cp.multiply(oy, v["y"]) + cp.multiply(oz, v["z"])
@@ -175,6 +184,20 @@ class ConvexSubproblem:
             cp.multiply(nx, x) + cp.multiply(ny, y) + slack["e_d_min"] >= red,
             cp.multiply(nx, x) + cp.multiply(ny, y) - slack["box"] <= rdx,
         ]
+
+    def _rate_rows(self, par: _Par, v: dict) -> list:
+        """|v_{k+1} - v_k| <= J, |v_0 - vlast| <= jb and (terminal rest) |v_{N-1}| <= J, per component."""
+        nlp, N = self.nlp, self.nlp.n
+        vlast, jb = self._params["vlast"], par("jb", 3)
+        cons = []
+        for c, name in enumerate(("u", "w", "r")):
+            var, jump = v[name], float(nlp.rate_jump[c])
+            if N > 1:
+                cons += [var[1:] - var[:-1] <= jump, var[:-1] - var[1:] <= jump]
+            cons += [var[0] - vlast[c] <= jb[c], vlast[c] - var[0] <= jb[c]]
+            if nlp.terminal_rest:
+                cons += [var[N - 1] <= jump, -var[N - 1] <= jump]
+        return cons
 
     def _box_rows(self, par: _Par, v: dict, slack: dict) -> list:
         """|e_o| <= e_o_max, |e_z| <= e_z_max with the z walls, the nearer x/y walls, slacks >= 0."""
@@ -251,6 +274,11 @@ class ConvexSubproblem:
                                  + cp.sum(slack["box"])))
         if sig_t is not None:
             cost = cost + nlp.terminal_penalty * sig_t
+        if nlp.rate_penalty > 0:
+            vlast = self._params["vlast"]
+            for c, var in enumerate((u, w, r)):
+                steps = cp.sum_squares(var[1:] - var[:-1]) if N > 1 else 0
+                cost = cost + nlp.rate_penalty * nlp.r[c] * (steps + cp.square(var[0] - vlast[c]))
         return cost
 
     def _layout(self) -> None:
@@ -276,6 +304,7 @@ class ConvexSubproblem:
                   "walls": ["wsx", "wbx", "wsy", "wby"] if nlp.workspace is not None else [],
                   "c0": ["c0"],
                   "obsT": [f"rt{j}" for j in range(M)] if nlp.backup_terminal is not None else [],
+                  "vlast": ["vlast"] if "vlast" in self._cols else [], "jb": ["jb"] if "jb" in self._cols else [],
                   "wallT": ["wT"] if nlp.backup_terminal is not None and nlp.workspace is not None else []}
         self._gidx = {g: np.concatenate([self._cols[n] for n in names]) if names else np.zeros(0, dtype=int)
                       for g, names in groups.items()}
@@ -396,6 +425,15 @@ class ConvexSubproblem:
         if self.nlp.backup_terminal is not None:  # the last node's half-space with the footprint's sphere
             self.param_vector[self._gidx["obsT"]] = ob[:, 3, -1] + np.where(
                 np.arange(self.max_obstacles) < k, self.nlp.backup_terminal.sphere - self.nlp.clearance, 0.0)
+
+    def write_last_command(self, v_last: np.ndarray, first_row: bool) -> None:
+        """Write ``vlast`` (the rate rows' and the rate penalty's v_last, (3,)) and the bound ``jb`` of
+        row (b): J when ``first_row``, else 2 V-bar (never binding); no-op without those rows."""
+        gidx, nlp = self._gidx, self.nlp
+        if gidx["vlast"].size:
+            self.param_vector[gidx["vlast"]] = v_last
+        if gidx["jb"].size:
+            self.param_vector[gidx["jb"]] = nlp.rate_jump if first_row else 2.0 * nlp.v_max
 
     def _write_input_bounds(self, v: np.ndarray, radius: float) -> None:
         """The input box V-bar intersected with the trust region |v_new - v| <= radius V-bar."""

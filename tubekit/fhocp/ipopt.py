@@ -28,7 +28,9 @@ from tubekit.tightening import Tightening
 from tubekit.validation import as_vector, finite
 from tubekit.fhocp.nlp import FhocpNlp, rollout, select_obstacles
 from tubekit.model.kinematics import SINC_SERIES_THRESHOLD
+from tubekit.fhocp.options import DEFAULT_RATE_PENALTY
 from tubekit.fhocp.result import FhocpResult, Status, shifted_plan, status_from
+from tubekit.fhocp.rows import rate_project
 
 __all__ = ["IpoptFHOCP", "import_casadi", "IPOPT_STATUS", "SQP_OPTIONS", "NLP_SOLVERS"]
 
@@ -135,15 +137,19 @@ class IpoptFHOCP:
         Also pass the previous multipliers and IPOPT's warm-start options.
     ipopt_options : dict, optional
         Extra ``ipopt.*`` options (keys without the prefix).
+    rate_penalty : float
+        lambda (s) of the rate penalty, as :class:`~tubekit.fhocp.options.ScpOptions` (same default).
     nlp_solver : {"ipopt", "sqpmethod"}
         CasADi plugin. ``"sqpmethod"`` uses :data:`SQP_OPTIONS` updated by ``ipopt_options`` (keys as
-        CasADi's sqpmethod takes them); its warm start passes the previous multipliers.
+        CasADi's sqpmethod takes them); its warm start passes the previous multipliers. Its QP
+        solver (qrqp, eigen-clip) fails on the node-to-node coupling of the rate penalty: use it
+        with ``rate_penalty=0`` (a failed QP is a fallback, never an exception).
     """
 
     def __init__(self, scenario: Scenario, tightening: Tightening, *, max_obstacles: int = 4,
                  terminal: str = "soft", penalty: float = 1e3, terminal_penalty: float | None = None,
                  warm_start_duals: bool = False, ipopt_options: dict | None = None,
-                 nlp_solver: str = "ipopt") -> None:
+                 nlp_solver: str = "ipopt", rate_penalty: float = DEFAULT_RATE_PENALTY) -> None:
         ca = import_casadi()
         if nlp_solver not in NLP_SOLVERS:
             raise ConfigError("nlp_solver", f"one of {NLP_SOLVERS}", nlp_solver)
@@ -153,7 +159,7 @@ class IpoptFHOCP:
             raise ConfigError("max_obstacles", "an integer >= 0", max_obstacles)
         self.scenario = scenario
         self.nlp = FhocpNlp.from_scenario(scenario, tightening, terminal=terminal, penalty=penalty,
-                                          terminal_penalty=terminal_penalty)
+                                          terminal_penalty=terminal_penalty, rate_penalty=rate_penalty)
         self.max_obstacles = max_obstacles
         self.warm_start_duals = bool(warm_start_duals)
         self._build(ca, ipopt_options or {})
@@ -161,6 +167,8 @@ class IpoptFHOCP:
         self._plan_inputs: np.ndarray | None = None
         self._lam_x: np.ndarray | None = None
         self._lam_g: np.ndarray | None = None
+        self._last = np.concatenate([np.zeros(3), 2.0 * self.nlp.v_max])  # v_last and row (b)'s bound
+        self._anchor, self._first_row = np.zeros(3), False
         self.build_time_s = time.perf_counter() - t0
 
     # ------------------------------------------------------------ building
@@ -173,7 +181,8 @@ class IpoptFHOCP:
         sym = {"V": ca.SX.sym("v", 3, N), "S": ca.SX.sym("s", 4, N),       # S: s_1..s_N
                "sig": ca.SX.sym("sig", 4, N),                              # e_d_min, obstacle, e_o, box
                "sig_t": ca.SX.sym("sig_t", n_t), "sig_b": ca.SX.sym("sig_b", n_b), "s0": ca.SX.sym("s0", 4),
-               "ref": ca.SX.sym("ref", 3, N + 1), "obs": ca.SX.sym("obs", 5, M)}  # cx, cy, cz, radius, active
+               "ref": ca.SX.sym("ref", 3, N + 1), "obs": ca.SX.sym("obs", 5, M),  # cx, cy, cz, radius, active
+               "last": ca.SX.sym("last", 6)}  # v_last, bound of rate row (b)
         states = [sym["s0"]] + [sym["S"][:, k] for k in range(N)]
         rows = _Rows()
         cost = self._shooting(ca, sym, states, rows)
@@ -181,8 +190,9 @@ class IpoptFHOCP:
         cost = self._terminal(ca, sym, states[N], rows, cost)
         if n_b:
             cost = self._backup_rows(ca, sym, states[N], rows, cost)
+        cost = self._rate_rows(ca, sym, rows, cost)
         x = ca.vertcat(ca.vec(sym["V"]), ca.vec(sym["S"]), ca.vec(sym["sig"]), sym["sig_t"], sym["sig_b"])
-        p = ca.vertcat(sym["s0"], ca.vec(sym["ref"]), ca.vec(sym["obs"]))
+        p = ca.vertcat(sym["s0"], ca.vec(sym["ref"]), ca.vec(sym["obs"]), sym["last"])
         self._solver = ca.nlpsol(f"fhocp_{self.nlp_solver}", self.nlp_solver,
                                  {"x": x, "p": p, "f": cost, "g": ca.vertcat(*rows.g)}, self._options(extra))
         nx = x.shape[0]
@@ -267,6 +277,26 @@ class IpoptFHOCP:
         rows.nonpositive([(reach2 - b * b) / (2.0 * b) + shortfall - sig_b])
         return cost + nlp.penalty * sig_b
 
+    def _rate_rows(self, ca: Any, sym: dict, rows: _Rows, cost: Any) -> Any:
+        """The rate rows and the rate penalty (:mod:`tubekit.fhocp.rows`); returns the full cost."""
+        nlp, V, last = self.nlp, sym["V"], sym["last"]
+        N = nlp.n
+        if nlp.rate_penalty > 0:
+            for c in range(3):
+                d0 = V[c, 0] - last[c]
+                steps = sum((V[c, k + 1] - V[c, k]) ** 2 for k in range(N - 1))
+                cost += nlp.rate_penalty * nlp.r[c] * (d0 * d0 + steps)
+        if nlp.rate_jump is None:
+            return cost
+        for c in range(3):
+            jump = float(nlp.rate_jump[c])
+            for k in range(N - 1):
+                rows.nonpositive([V[c, k + 1] - V[c, k] - jump, V[c, k] - V[c, k + 1] - jump])
+            rows.nonpositive([V[c, 0] - last[c] - last[3 + c], last[c] - V[c, 0] - last[3 + c]])
+            if nlp.terminal_rest:
+                rows.nonpositive([V[c, N - 1] - jump, -V[c, N - 1] - jump])
+        return cost
+
     def _options(self, extra: dict) -> dict:
         """CasADi/IPOPT options: quiet, tol 1e-8, optional dual warm start, then ``extra``."""
         if self.nlp_solver == "sqpmethod":
@@ -285,7 +315,7 @@ class IpoptFHOCP:
         self._plan_t = self._plan_inputs = self._lam_x = self._lam_g = None
 
     def solve(self, t: float, state: np.ndarray, obstacles: Sequence[Obstacle] | np.ndarray = (),
-              initial_inputs: np.ndarray | None = None) -> FhocpResult:
+              initial_inputs: np.ndarray | None = None, *, v_last: np.ndarray | None = None) -> FhocpResult:
         """Solve the NLP at ``t`` from ``state``; warm-started from the shifted previous solution.
 
         Parameters
@@ -298,6 +328,8 @@ class IpoptFHOCP:
             Detected obstacles (same selection rule as the SCP).
         initial_inputs : array (N, 3), optional
             Initial guess for the inputs (overrides the warm start).
+        v_last : array (3,), optional
+            The command before the plan (rate row (b) and the rate penalty, as :meth:`FHOCP.solve`).
 
         Returns
         -------
@@ -318,7 +350,14 @@ class IpoptFHOCP:
             guess = np.asarray(initial_inputs, dtype=float)
         if guess.shape != (N, 3):
             raise ConfigError("initial_inputs", f"an array of shape ({N}, 3)", guess.shape)
+        last = None if v_last is None else np.clip(as_vector("v_last", v_last, 3), -nlp.v_max, nlp.v_max)
         guess = np.clip(guess, -nlp.v_max, nlp.v_max)
+        if nlp.rate_jump is not None:
+            guess = rate_project(guess, nlp.rate_jump, nlp.v_max, last, nlp.terminal_rest)
+        anchor = guess[0].copy() if last is None else last
+        bound = nlp.rate_jump if last is not None and nlp.rate_jump is not None else 2.0 * nlp.v_max
+        self._last = np.concatenate([anchor, bound])
+        self._anchor, self._first_row = anchor, last is not None
         args = {"x0": self._initial_point(s0, guess, ref, obs), "p": self._parameters(s0, ref, obs),
                 "lbx": self._lbx, "ubx": self._ubx, "lbg": self._lbg, "ubg": self._ubg}
         if self.warm_start_duals and self._lam_x is not None and initial_inputs is None:
@@ -327,7 +366,10 @@ class IpoptFHOCP:
         ts = time.perf_counter()
         sol = self._solver(**args)
         solver_time = time.perf_counter() - ts
-        stats = self._solver.stats()
+        try:
+            stats = self._solver.stats()
+        except RuntimeError:  # sqpmethod whose QP failed outright has no readable stats: a failed solve
+            stats = {}
         raw = str(stats.get("return_status", "unknown"))
         v = np.asarray(sol["x"]).ravel()[:3 * N].reshape(N, 3)
         status = status_from(IPOPT_STATUS, raw)
@@ -338,8 +380,10 @@ class IpoptFHOCP:
             self._lam_x = np.asarray(sol["lam_x"]).ravel()
             self._lam_g = np.asarray(sol["lam_g"]).ravel()
         v = np.clip(v, -nlp.v_max, nlp.v_max)
+        if nlp.rate_jump is not None:
+            v = rate_project(v, nlp.rate_jump, nlp.v_max, last, nlp.terminal_rest)
         s = rollout(s0, v, nlp.dt)
-        ev = nlp.evaluate(s, v, ref, obs)
+        ev = nlp.evaluate(s, v, ref, obs, anchor, last is not None)
         self._plan_t, self._plan_inputs = t, v.copy()
         return FhocpResult(status=Status.FALLBACK if fallback else status, states=s, inputs=v, cost=ev.cost,
                            iterations=int(stats.get("iter_count", 0)),
@@ -352,7 +396,7 @@ class IpoptFHOCP:
         """x0: the guess, its rollout, and the slacks at their optimal values for that plan."""
         nlp = self.nlp
         s_guess = rollout(s0, guess, nlp.dt)
-        ev = nlp.evaluate(s_guess, guess, ref, obs)
+        ev = nlp.evaluate(s_guess, guess, ref, obs, self._anchor, self._first_row)
         ps = ev.per_step
         return np.concatenate([guess.ravel(), s_guess[1:].ravel(),
                                np.stack([ps["e_d_min"], ps["obstacle"], ps["e_o"], ps["box"]], axis=1).ravel(),
@@ -367,4 +411,4 @@ class IpoptFHOCP:
         if len(obs):
             obs_p[:len(obs), :4] = obs
             obs_p[:len(obs), 4] = 1.0
-        return np.concatenate([s0, ref.ravel(), obs_p.ravel()])
+        return np.concatenate([s0, ref.ravel(), obs_p.ravel(), self._last])

@@ -49,6 +49,10 @@ the sphere of radius hypot(R_f, H_f) contains the footprint's cylinder, so a pla
 rows meets :func:`tubekit.loop.terminal.terminal_condition`'s obstacle part, which
 ``tubekit.loop.plan_check`` then checks exactly.
 
+With a rate limit the inputs also meet the rate rows of :mod:`tubekit.fhocp.rows` (hard, like the
+input box; family ``rate``); the cost adds the rate penalty lambda sum_c R_c (sum_k (v_k,c -
+v_{k-1},c)^2 + (v_0,c - v_last,c)^2) (lambda = ``rate_penalty``, s; 0 leaves the cost as above).
+
 Q, R, P are diagonal (the scenario's 3-vectors). The slacks are exact
 (l1) penalties: whenever the hard-constrained problem is feasible and
 ``mu`` exceeds its multipliers the two have the same minimisers; the
@@ -65,6 +69,7 @@ from typing import Sequence
 import numpy as np
 
 from tubekit.exceptions import ConfigError, ShapeError
+from tubekit.fhocp.rows import RATE_MARGIN, BackupTerminal, rate_penalty_cost, rate_violation
 from tubekit.model.errors import error_coordinates
 from tubekit.model.kinematics import dsinc, sinc, unicycle_step
 from tubekit.scenario import Obstacle, Scenario, TerminalMode
@@ -256,53 +261,6 @@ class NlpEvaluation:
 
 
 @dataclass(frozen=True)
-class BackupTerminal:
-    """The backup's terminal condition as the FHOCP carries it at the last node (module doc).
-
-    Attributes
-    ----------
-    sphere : float
-        hypot(R_f, H_f) (m): added to each obstacle radius at p_N (no obstacle margin: p_N is the
-        plan's exact nominal end, the point the exact check reads).
-    footprint : (float, float)
-        (R_f, H_f) (m): the workspace box shrunk by it holds p_N.
-    safe : (float, float)
-        (c, Z) (m): the safe set's radius and depth, for the sensed-region row.
-    sensed_bound : float
-        R_bar - vehicle radius (m).
-    """
-
-    sphere: float
-    footprint: tuple[float, float]
-    safe: tuple[float, float]
-    sensed_bound: float
-
-    @classmethod
-    def of(cls, scenario: Scenario, tightening: Tightening) -> "BackupTerminal | None":
-        """The terminal rows of ``tightening.terminal_backup`` on ``scenario`` (None without a certified backup)."""
-        backup = tightening.terminal_backup
-        if backup is None:
-            return None
-        r_f, h_f = backup.footprint(scenario.vehicle_radius)
-        return cls(sphere=math.hypot(r_f, h_f), footprint=(r_f, h_f),
-                   safe=(backup.safe_set.radius, backup.safe_set.depth),
-                   sensed_bound=scenario.sensing_range - scenario.vehicle_radius)
-
-    def violation(self, p0: np.ndarray, pn: np.ndarray, obstacles: np.ndarray,
-                  workspace: np.ndarray | None) -> float:
-        """Largest violation (m, >= 0) of the rows at the end position ``pn`` sensed from ``p0``."""
-        worst = 0.0
-        if len(obstacles):
-            dist = np.linalg.norm(obstacles[:, :3] - pn[None, :], axis=1)
-            worst = max(worst, float(np.max(obstacles[:, 3] + self.sphere - dist)))
-        if workspace is not None:
-            pad = np.array([self.footprint[0], self.footprint[0], self.footprint[1]])
-            worst = max(worst, float(np.max(workspace[0] + pad - pn)), float(np.max(pn - workspace[1] + pad)))
-        spread = math.hypot(math.hypot(pn[0] - p0[0], pn[1] - p0[1]) + self.safe[0], abs(pn[2] - p0[2]) + self.safe[1])
-        return max(worst, spread - self.sensed_bound)
-
-
-@dataclass(frozen=True)
 class FhocpNlp:
     """The discretised FHOCP (see the module docstring) with all its constants.
 
@@ -335,6 +293,12 @@ class FhocpNlp:
     backup_terminal : BackupTerminal or None
         The backup's terminal rows at the last node (None: none, the problem of a tightening
         without a backup).
+    rate_jump : array (3,) or None
+        The imposed J (1 - RATE_MARGIN) of the rate rows (None: no rate limit).
+    terminal_rest : bool
+        Impose |v_{N-1}| <= J (with a rate limit and a certified backup).
+    rate_penalty : float
+        lambda (s, >= 0) of the rate penalty.
     """
 
     dt: float
@@ -354,6 +318,9 @@ class FhocpNlp:
     penalty: float = 1e3
     terminal_penalty: float = 50.0
     backup_terminal: BackupTerminal | None = None
+    rate_jump: np.ndarray | None = None
+    terminal_rest: bool = False
+    rate_penalty: float = 0.0
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "dt", positive("dt", self.dt))
@@ -383,17 +350,28 @@ class FhocpNlp:
         w[:, -1] = self.p
         object.__setattr__(self, "_w", w)
         object.__setattr__(self, "_dt_r", self.dt * self.r)
+        if self.rate_jump is not None:
+            jump = as_vector("rate_jump", self.rate_jump, 3)
+            if np.any(jump <= 0):
+                raise ConfigError("rate_jump", "three numbers > 0", self.rate_jump)
+            object.__setattr__(self, "rate_jump", jump)
+        if self.rate_penalty < 0 or not math.isfinite(self.rate_penalty):
+            raise ConfigError("rate_penalty", "a finite number >= 0", self.rate_penalty)
+        object.__setattr__(self, "_rate_w", self.rate_penalty * self.r)
 
     @classmethod
     def from_scenario(cls, scenario: Scenario, tightening: Tightening, *, terminal: TerminalMode | str = "soft",
-                      penalty: float = 1e3, terminal_penalty: float | None = None) -> "FhocpNlp":
-        """The NLP of ``scenario`` (weights, horizon, workspace) with the sets of ``tightening``."""
+                      penalty: float = 1e3, terminal_penalty: float | None = None,
+                      rate_penalty: float = 0.0) -> "FhocpNlp":
+        """The NLP of ``scenario`` (weights, horizon, workspace, rate limit) with the sets of ``tightening``."""
         if not isinstance(scenario, Scenario):
             raise ConfigError("scenario", "a tubekit.Scenario", type(scenario).__name__)
         if not isinstance(tightening, Tightening):
             raise ConfigError("tightening", "a tubekit.Tightening", type(tightening).__name__)
         c = scenario.controller
         ws = None if scenario.workspace is None else np.array(scenario.workspace, dtype=float)
+        jump = scenario.limits.jump(c.dt)
+        backup = BackupTerminal.of(scenario, tightening)
         margin = float(tightening.obstacle_margin)
         if not math.isfinite(margin) or margin < 0:
             raise ConfigError("tightening.obstacle_margin", "a finite number >= 0", margin)
@@ -404,7 +382,8 @@ class FhocpNlp:
                    workspace=ws, terminal=terminal, terminal_level=c.terminal_level,
                    penalty=penalty,
                    terminal_penalty=penalty / 20.0 if terminal_penalty is None else terminal_penalty,
-                   backup_terminal=BackupTerminal.of(scenario, tightening))
+                   backup_terminal=backup, rate_jump=None if jump is None else jump * (1.0 - RATE_MARGIN),
+                   terminal_rest=jump is not None and backup is not None, rate_penalty=rate_penalty)
 
     @property
     def n(self) -> int:
@@ -419,13 +398,14 @@ class FhocpNlp:
         """[e_d, e_z, e_o] (K, 3) of ``states`` (K, 4) w.r.t. ``ref`` (K, 3), e_d floored at 1e-9."""
         return error_coordinates(states, ref, _ED_FLOOR)
 
-    def cost(self, states: np.ndarray, inputs: np.ndarray, ref: np.ndarray) -> float:
-        """Stage + terminal cost (no penalties)."""
+    def cost(self, states: np.ndarray, inputs: np.ndarray, ref: np.ndarray, v_last: np.ndarray | None = None) -> float:
+        """Stage + terminal cost + the rate penalty (no exact penalties)."""
         e = self.errors(states, ref)
-        return float(np.einsum("kc,kc,ck->", e, e, self._w) + np.einsum("kc,kc,c->", inputs, inputs, self._dt_r))
+        return float(np.einsum("kc,kc,ck->", e, e, self._w) + np.einsum("kc,kc,c->", inputs, inputs, self._dt_r)
+                     + (rate_penalty_cost(inputs, self._rate_w, v_last) if self.rate_penalty else 0.0))
 
     def evaluate(self, states: np.ndarray, inputs: np.ndarray, ref: np.ndarray,
-                 obstacles: np.ndarray) -> NlpEvaluation:
+                 obstacles: np.ndarray, v_last: np.ndarray | None = None, first_row: bool = True) -> NlpEvaluation:
         """Cost, merit and nonlinear-constraint violations of a plan.
 
         Parameters
@@ -436,6 +416,8 @@ class FhocpNlp:
             p_d at the samples.
         obstacles : array (M, 4)
             [cx, cy, cz, radius] of the obstacles in the problem.
+        v_last : array (3,), optional
+            The command before the plan (rate penalty; with ``first_row``, the rate row (b)).
         """
         states = np.asarray(states, dtype=float)
         inputs = np.asarray(inputs, dtype=float)
@@ -443,6 +425,8 @@ class FhocpNlp:
         e = error_coordinates(states, ref, _ED_FLOOR)
         e2 = e * e
         cost = float(np.einsum("kc,ck->", e2, self._w) + np.einsum("kc,kc,c->", inputs, inputs, self._dt_r))
+        if self.rate_penalty:
+            cost += rate_penalty_cost(inputs, self._rate_w, v_last)
         # per-step violations, rows: e_d_min, obstacle, e_o, box (k = 1..N)
         viol = np.zeros((4, n))
         e1 = e[1:]
@@ -473,6 +457,11 @@ class FhocpNlp:
             backup = max(0.0, self.backup_terminal.violation(states[0, :3], states[n, :3], obstacles, self.workspace))
             merit += self.penalty * backup
             violations["backup_terminal"] = backup
+        if self.rate_jump is not None:
+            rate = max(rate_violation(inputs, self.rate_jump, v_last if first_row else None,
+                                      self.terminal_rest).values())
+            merit += self.penalty * rate
+            violations["rate"] = rate
         mv = max(violations.values())
         if not (math.isfinite(cost) and math.isfinite(mv) and math.isfinite(merit)):
             cost, merit, mv = math.inf, math.inf, math.inf

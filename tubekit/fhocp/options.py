@@ -1,7 +1,8 @@
 """The SCP solver's options (:class:`ScpOptions`): one frozen, validated value instead of eleven keywords.
 
 ``FHOCP(scenario, tightening, mode, options=ScpOptions(...))``; every field has the
-default the solver always had, and a bad value is a :class:`~tubekit.exceptions.ConfigError`
+default the solver always had (but ``rate_penalty``, new, on by default: ``rate_penalty=0`` gives
+the earlier problem), and a bad value is a :class:`~tubekit.exceptions.ConfigError`
 naming the field when the options are made, before any problem is built.
 """
 
@@ -13,9 +14,13 @@ from typing import Any, Mapping
 
 from tubekit.exceptions import ConfigError
 from tubekit.scenario import TerminalMode
-from tubekit.validation import choice, positive
+from tubekit.validation import choice, nonnegative, positive
 
-__all__ = ["ScpOptions"]
+__all__ = ["ScpOptions", "DEFAULT_RATE_PENALTY"]
+
+#: The rate penalty's default weight lambda (s): damps the real-time SCP's alternating plans (issue 24 item 8),
+#: measured by the ``sign_flips_per_s`` metric of :mod:`tubekit.loop.metrics`.
+DEFAULT_RATE_PENALTY = 10.0
 
 
 def _count(name: str, value: object, minimum: int, expected: str) -> int:
@@ -61,6 +66,10 @@ class ScpOptions:
     clarabel_settings : mapping or None
         Overrides of :data:`tubekit.fhocp.convex.DEFAULT_CLARABEL_SETTINGS` / Clarabel's settings
         (kept read-only).
+    rate_penalty : float
+        lambda (s, >= 0) of the rate penalty lambda sum_c R_c (sum_k (v_k,c - v_{k-1},c)^2 + (v_0,c -
+        v_last,c)^2) in the cost (:mod:`tubekit.fhocp.rows`); default :data:`DEFAULT_RATE_PENALTY`,
+        0 switches it off (the cost of the paper's FHOCP).
     """
 
     max_obstacles: int | None = None
@@ -74,6 +83,7 @@ class ScpOptions:
     extrapolate: bool = True
     fast_path: bool = True
     clarabel_settings: Mapping[str, Any] | None = None
+    rate_penalty: float = DEFAULT_RATE_PENALTY
 
     def __post_init__(self) -> None:
         if self.max_obstacles is not None:
@@ -87,6 +97,7 @@ class ScpOptions:
         _count("cold_start_iterations", self.cold_start_iterations, 1, "an integer >= 1")
         object.__setattr__(self, "tolerance", positive("tolerance", self.tolerance))
         object.__setattr__(self, "trust_radius", positive("trust_radius", self.trust_radius))
+        object.__setattr__(self, "rate_penalty", nonnegative("rate_penalty", self.rate_penalty))
         for name in ("extrapolate", "fast_path"):
             if not isinstance(getattr(self, name), bool):
                 raise ConfigError(name, "True or False", getattr(self, name))

@@ -188,9 +188,14 @@ def shifted_plan(plan_inputs: np.ndarray | None, plan_t: float | None, t: float,
 
 
 class FhocpSolver(Protocol):
-    """What the closed loop needs from a FHOCP solver (e.g. :class:`tubekit.fhocp.FHOCP`)."""
+    """What the closed loop needs from a FHOCP solver (e.g. :class:`tubekit.fhocp.FHOCP`).
 
-    def solve(self, t: float, state: np.ndarray, obstacles: Sequence[Obstacle]) -> FhocpResult:
+    The keyword ``v_last`` (the command applied in the last tick before the plan, (3,) or None) is
+    optional: the loop passes it to a ``solve`` that takes it (the built-in backends do).
+    """
+
+    def solve(self, t: float, state: np.ndarray, obstacles: Sequence[Obstacle], *,
+              v_last: np.ndarray | None = None) -> FhocpResult:
         """Plan from ``state`` [x, y, z, psi] (m, rad) at time ``t`` (s) around the known ``obstacles``."""
         ...
 

@@ -45,6 +45,7 @@ from tubekit.fhocp.fastpath import CompiledConeProgram
 from tubekit.fhocp.nlp import FhocpNlp, NlpEvaluation, rollout, select_obstacles
 from tubekit.fhocp.options import ScpOptions
 from tubekit.fhocp.result import FallbackWarning, FhocpResult, Status, shift_steps, shifted_plan
+from tubekit.fhocp.rows import rate_project
 
 __all__ = ["FHOCP", "MODES", "TAIL_GRID", "obstacle_slots", "search_tail"]
 
@@ -69,32 +70,49 @@ def obstacle_slots(scenario: Scenario) -> int:
     return int(max(1, meet.sum(axis=1).max()))
 
 
+def _grid(half: np.ndarray) -> np.ndarray:
+    """The :data:`TAIL_GRID` points of the box |v| <= ``half`` (3,), shape (K, 3)."""
+    return np.stack(np.meshgrid(*[np.linspace(-b, b, k) for b, k in zip(half, TAIL_GRID)],
+                                indexing="ij"), axis=-1).reshape(-1, 3)
+
+
+def _rate_fit(nlp: FhocpNlp, v: np.ndarray, v_last: np.ndarray | None) -> np.ndarray:
+    """``v`` projected on the rate rows (:func:`rate_project`; unchanged without a rate limit)."""
+    if nlp.rate_jump is None:
+        return v
+    return rate_project(v, nlp.rate_jump, nlp.v_max, v_last, nlp.terminal_rest)
+
+
 def search_tail(nlp: FhocpNlp, s0: np.ndarray, v: np.ndarray, kept: int, ref: np.ndarray,
-                obs: np.ndarray) -> tuple[np.ndarray, np.ndarray, NlpEvaluation]:
+                obs: np.ndarray, v_last: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray, NlpEvaluation]:
     """Keep ``v[:kept]`` and choose each later input on a grid over V-bar, one step at a time.
 
     Each appended input is the grid point (:data:`TAIL_GRID`) whose plan violates the
-    state constraints least (terminal set excluded), ties broken by the merit.
+    state constraints least (terminal set excluded), ties broken by the merit. With a rate
+    limit the grid spans the previous node +- J instead and the plan is projected on the rate
+    rows (:func:`tubekit.fhocp.rows.rate_project`; the rows are not part of the key).
 
     Returns
     -------
     states (N+1, 4), inputs (N, 3), their :class:`NlpEvaluation`
     """
-    v = np.clip(v, -nlp.v_max, nlp.v_max)
-    grid = np.stack(np.meshgrid(*[np.linspace(-b, b, k) for b, k in zip(nlp.v_max, TAIL_GRID)],
-                                indexing="ij"), axis=-1).reshape(-1, 3)
+    v = _rate_fit(nlp, np.clip(v, -nlp.v_max, nlp.v_max), v_last)
+    grid = _grid(nlp.v_max if nlp.rate_jump is None else nlp.rate_jump)
     for j in range(kept, nlp.n):
         best_key, best_u = None, v[j]
-        for cand in grid:
+        prev = v[j - 1] if j else v_last
+        cands = grid if nlp.rate_jump is None or prev is None else np.clip(prev + grid, -nlp.v_max, nlp.v_max)
+        for cand in cands:
             v[j:] = cand
-            ev = nlp.evaluate(rollout(s0, v, nlp.dt), v, ref, obs)
-            viol = max(val for key, val in ev.violations.items() if key != "terminal")
+            ev = nlp.evaluate(rollout(s0, v, nlp.dt), v, ref, obs, v_last)
+            viol = max(val for key, val in ev.violations.items() if key not in ("terminal", "rate"))
             key = (round(viol, 9), ev.merit)
             if best_key is None or key < best_key:
                 best_key, best_u = key, cand.copy()
         v[j:] = best_u
+    v = _rate_fit(nlp, v, v_last)
     s = rollout(s0, v, nlp.dt)
-    return s, v, nlp.evaluate(s, v, ref, obs)
+    return s, v, nlp.evaluate(s, v, ref, obs, v_last)
 
 
 @dataclass
@@ -105,6 +123,8 @@ class _Iterate:
     s: np.ndarray
     ev: NlpEvaluation | None
     radius: float
+    anchor: np.ndarray | None = None   # v_last, else the warm start's first input (rate penalty)
+    first_row: bool = False            # v_last given: rate row (b) imposed
     setup_s: float = 0.0
     solver_s: float = 0.0
     iterations: int = 0
@@ -159,7 +179,7 @@ class FHOCP:
         self.scenario = scenario
         self.tightening = tightening
         self.nlp = FhocpNlp.from_scenario(scenario, tightening, terminal=terminal, penalty=opts.penalty,
-                                          terminal_penalty=opts.terminal_penalty)
+                                          terminal_penalty=opts.terminal_penalty, rate_penalty=opts.rate_penalty)
         self._check_workspace()
         self.tolerance = opts.tolerance
         self.trust_radius = opts.trust_radius
@@ -245,7 +265,8 @@ class FHOCP:
         return kept
 
     # ---------------------------------------------------------------- solve
-    def solve(self, t: float, state: np.ndarray, obstacles: Sequence[Obstacle] | np.ndarray = ()) -> FhocpResult:
+    def solve(self, t: float, state: np.ndarray, obstacles: Sequence[Obstacle] | np.ndarray = (), *,
+              v_last: np.ndarray | None = None) -> FhocpResult:
         """Solve the FHOCP at time ``t`` (s) from the measured ``state`` (4,).
 
         Parameters
@@ -256,6 +277,10 @@ class FHOCP:
             Measured state [x, y, z, psi]; the nominal is reset to it (e_hat(t_k) = e(t_k)).
         obstacles : sequence of Obstacle
             Currently detected obstacles (filtered again by sensing range).
+        v_last : array (3,), optional
+            The command applied in the last tick before this plan starts (m/s, m/s, rad/s): the
+            rate row (b) with a rate limit, and the rate penalty's v_0 term (without it the warm
+            start's first input stands in for the penalty and row (b) is not imposed).
 
         Returns
         -------
@@ -266,21 +291,23 @@ class FHOCP:
         t_start = time.perf_counter()
         t = finite("t", t)
         s0 = as_vector("state", state, 4)
+        last = None if v_last is None else np.clip(as_vector("v_last", v_last, 3), -self.nlp.v_max, self.nlp.v_max)
         obs = self.select_obstacles(s0, obstacles)
         nlp = self.nlp
         ref = nlp.reference(self.scenario.trajectory, t)
         guess, warm = self.warm_start_inputs(t)
-        guess = np.clip(guess, -nlp.v_max, nlp.v_max)
+        guess = _rate_fit(nlp, np.clip(guess, -nlp.v_max, nlp.v_max), last)
         realtime = warm and self.mode is FhocpMode.REALTIME
         cap = 1 if realtime else (self.max_iterations if warm else self.cold_start_iterations)
         s = rollout(s0, guess, nlp.dt)
-        it = _Iterate(v=guess, s=s, ev=None if realtime else nlp.evaluate(s, guess, ref, obs),
-                      radius=self.trust_radius)
+        anchor = guess[0].copy() if last is None else last
+        it = _Iterate(v=guess, s=s, ev=None if realtime else nlp.evaluate(s, guess, ref, obs, anchor, last is not None),
+                      radius=self.trust_radius, anchor=anchor, first_row=last is not None)
         for _ in range(cap):
             if self._iteration(it, s0, ref, obs, realtime):
                 break
         if it.failure and it.accepted == 0:
-            return self._fallback(t, s0, guess, ref, obs, it, t_start)
+            return self._fallback(t, s0, guess, ref, obs, it, t_start, last)
         return self._result(t, ref, obs, it, realtime, t_start)
 
     def _iteration(self, it: _Iterate, s0: np.ndarray, ref: np.ndarray, obs: np.ndarray, realtime: bool) -> bool:
@@ -288,6 +315,7 @@ class FHOCP:
         nlp = self.nlp
         ts = time.perf_counter()
         self.subproblem.linearise(s0, it.s, it.v, ref, obs, it.radius)
+        self.subproblem.write_last_command(it.anchor, it.first_row)
         it.setup_s += time.perf_counter() - ts
         status, v_new, model_obj, stime = self._solve_subproblem()
         it.iterations += 1
@@ -295,7 +323,7 @@ class FHOCP:
         if v_new is None or not np.all(np.isfinite(v_new)):
             it.failure = f"convex subproblem {it.iterations} returned status '{status}'"
             return True
-        v_new = np.clip(v_new, -nlp.v_max, nlp.v_max)
+        v_new = _rate_fit(nlp, np.clip(v_new, -nlp.v_max, nlp.v_max), it.anchor if it.first_row else None)
         s_new = rollout(s0, v_new, nlp.dt)
         if realtime:
             it.v, it.s, it.accepted, it.status = v_new, s_new, 1, status
@@ -306,7 +334,7 @@ class FHOCP:
                     status: Status, ref: np.ndarray, obs: np.ndarray) -> bool:
         """Trust-region step on the exact merit: accept/extrapolate or shrink; True when converged."""
         nlp, tol = self.nlp, self.tolerance
-        ev_new = nlp.evaluate(s_new, v_new, ref, obs)
+        ev_new = nlp.evaluate(s_new, v_new, ref, obs, it.anchor, it.first_row)
         pred = it.ev.merit - model_obj
         actual = it.ev.merit - ev_new.merit
         if pred <= tol * max(1.0, abs(it.ev.merit)):
@@ -321,7 +349,7 @@ class FHOCP:
             it.converged = it.radius <= tol
             return it.converged
         if self.extrapolate and actual >= 0.9 * pred:
-            v_new, s_new, ev_new = self._extrapolate(s0, it.v, v_new, ev_new, ref, obs)
+            v_new, s_new, ev_new = self._extrapolate(s0, it, v_new, ev_new, ref, obs)
             actual = it.ev.merit - ev_new.merit
         it.v, it.s, it.ev = v_new, s_new, ev_new
         it.accepted += 1
@@ -334,7 +362,7 @@ class FHOCP:
         it.converged = step <= tol or actual <= tol * max(1.0, abs(it.ev.merit))
         return it.converged
 
-    def _extrapolate(self, s0: np.ndarray, v: np.ndarray, v_new: np.ndarray, ev_new: NlpEvaluation,
+    def _extrapolate(self, s0: np.ndarray, it: _Iterate, v_new: np.ndarray, ev_new: NlpEvaluation,
                      ref: np.ndarray, obs: np.ndarray) -> tuple[np.ndarray, np.ndarray, NlpEvaluation]:
         """Line search beyond an accurately modelled step: v + 2^j (v_new - v) while the merit falls.
 
@@ -342,15 +370,17 @@ class FHOCP:
         exclusion, e_d >= e_d_min), so where such a constraint is active the model's steps
         are too short (the convex-concave procedure's slow slide along the boundary); a
         step whose prediction was accurate is therefore stretched while the exact merit
-        keeps decreasing. Costs one rollout and one evaluation per trial.
+        keeps decreasing. Costs one rollout and one evaluation per trial. With a rate limit each
+        trial is projected on the rate rows.
         """
-        nlp = self.nlp
+        nlp, v = self.nlp, it.v
         best = (v_new, None, ev_new)
         d = v_new - v
         for j in range(1, 6):
-            cand = np.clip(v + (2.0 ** j) * d, -nlp.v_max, nlp.v_max)
+            cand = _rate_fit(nlp, np.clip(v + (2.0 ** j) * d, -nlp.v_max, nlp.v_max),
+                             it.anchor if it.first_row else None)
             s_c = rollout(s0, cand, nlp.dt)
-            ev_c = nlp.evaluate(s_c, cand, ref, obs)
+            ev_c = nlp.evaluate(s_c, cand, ref, obs, it.anchor, it.first_row)
             if not ev_c.merit < best[2].merit:
                 break
             best = (cand, s_c, ev_c)
@@ -367,7 +397,7 @@ class FHOCP:
             status = Status.OPTIMAL_INACCURATE
         elif not realtime and not it.converged:
             status = Status.ITERATION_LIMIT
-        ev = it.ev if it.ev is not None else self.nlp.evaluate(it.s, it.v, ref, obs)
+        ev = it.ev if it.ev is not None else self.nlp.evaluate(it.s, it.v, ref, obs, it.anchor, it.first_row)
         self._plan_t, self._plan_inputs = t, it.v.copy()
         return FhocpResult(status=status, states=it.s, inputs=it.v, cost=ev.cost, iterations=it.iterations,
                            solve_time_s=time.perf_counter() - t_start, setup_time_s=it.setup_s,
@@ -375,8 +405,8 @@ class FHOCP:
                            violations=ev.violations, solver_time_s=it.solver_s, t=t)
 
     # ------------------------------------------------------------- fallback
-    def shifted_candidate(self, t: float, state: np.ndarray, obstacles: Sequence[Obstacle] | np.ndarray = ()
-                          ) -> tuple[np.ndarray, np.ndarray, NlpEvaluation]:
+    def shifted_candidate(self, t: float, state: np.ndarray, obstacles: Sequence[Obstacle] | np.ndarray = (), *,
+                          v_last: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray, NlpEvaluation]:
         """Tube MPC's candidate at ``t``: the stored plan shifted, its new tail input searched.
 
         The inputs the previous plan still covers are kept; each appended input is
@@ -392,6 +422,8 @@ class FHOCP:
             State the candidate starts from (m, rad).
         obstacles : sequence of Obstacle
             Obstacles to check against (filtered like :meth:`solve`).
+        v_last : array (3,), optional
+            The command before the candidate (rate rows, as :meth:`solve`).
 
         Returns
         -------
@@ -401,13 +433,15 @@ class FHOCP:
         obs = self.select_obstacles(s0, obstacles)
         ref = self.nlp.reference(self.scenario.trajectory, finite("t", t))
         guess, _ = self.warm_start_inputs(t)
-        return search_tail(self.nlp, s0, np.where(np.isfinite(guess), guess, 0.0), self._kept_steps(t), ref, obs)
+        last = None if v_last is None else as_vector("v_last", v_last, 3)
+        return search_tail(self.nlp, s0, np.where(np.isfinite(guess), guess, 0.0), self._kept_steps(t), ref, obs,
+                           last)
 
     def _fallback(self, t: float, s0: np.ndarray, guess: np.ndarray, ref: np.ndarray, obs: np.ndarray,
-                  it: _Iterate, t_start: float) -> FhocpResult:
+                  it: _Iterate, t_start: float, v_last: np.ndarray | None) -> FhocpResult:
         """The shifted previous plan with a searched tail (zeros without one), rolled out from ``s0``, flagged."""
         s, v, ev = search_tail(self.nlp, s0, np.where(np.isfinite(guess), guess, 0.0), self._kept_steps(t),
-                               ref, obs)
+                               ref, obs, v_last)
         msg = f"FHOCP at t={t:.3f} s failed ({it.failure}); returning the shifted previous plan"
         warnings.warn(msg, FallbackWarning, stacklevel=3)
         self._plan_t, self._plan_inputs = t, v.copy()

@@ -40,6 +40,12 @@ plan is accepted again; only a tightening without a backup keeps the zero input
 (J singular) is replaced by zero and counted. Nothing non-finite reaches the
 plant.
 
+Rate limit (``scenario.limits.rate``): every solve gets ``v_last``, the command of the last tick
+before the plan starts (the previous plan's node, the replayed node, or the backup's last command; none
+at t = 0), when the solver's ``solve`` takes that keyword; the exact check then verifies the plan's
+rate rows against it (:func:`tubekit.loop.plan_check.check_rates`, also without margins), so every
+command jump between periods is at most J = rate · dt.
+
 Logging: one row per tick plus a final row at t = duration (inputs NaN there).
 The nominal x̂ logged at a sampling instant is the left limit x̂(t_k⁻), before the
 reset, so ‖ρ‖ = ‖e - ê‖ shows the largest deviation of every interval; the κ
@@ -49,6 +55,7 @@ applied at that tick uses the reset nominal (ρ = 0).
 from __future__ import annotations
 
 import enum
+import inspect
 import logging
 import math
 import sys
@@ -64,7 +71,7 @@ from tubekit.checks import require_one_period
 from tubekit.model.ancillary import AncillaryLaw, get_law
 from tubekit.exceptions import ConfigError, SolverError
 from tubekit.loop.memory import ZERO_INPUT, PlanMemory
-from tubekit.loop.plan_check import PlanCheck, check_plan
+from tubekit.loop.plan_check import PlanCheck, check_plan, check_rates
 from tubekit.model.backup import station_keeping_input
 from tubekit.plant.base import OmegaOverride, PlantModel
 from tubekit.plant.factory import make_plant
@@ -133,6 +140,15 @@ def build_solver(scenario: Scenario, tightening: Tightening, solver_factory: Sol
         return solver_factory(scenario, tightening)
     from tubekit.fhocp.registry import make_solver  # imported lazily: cvxpy loads only when a solver is built
     return make_solver(scenario, tightening)
+
+
+def _takes_v_last(solver: FhocpSolver) -> bool:
+    """True when ``solver.solve`` accepts the keyword ``v_last`` (the built-in backends do)."""
+    try:
+        params = inspect.signature(solver.solve).parameters
+    except (TypeError, ValueError):  # pragma: no cover - a builtin without a signature
+        return False
+    return "v_last" in params or any(p.kind is inspect.Parameter.VAR_KEYWORD for p in params.values())
 
 
 def _silence_fallback_warnings() -> None:
@@ -245,6 +261,8 @@ class _ClosedLoop:
         self.memory = PlanMemory()
         self.log = _Log.allocate(clock)
         self.sign = HEMISPHERE_SIGN[scenario.region.heading]
+        self.v_last: np.ndarray | None = None  # the command of the last tick before the next plan
+        self.passes_v_last = _takes_v_last(solver)
 
     def sense(self, xk: np.ndarray) -> tuple[Obstacle, ...]:
         """Obstacles known after sensing at the position of ``xk``."""
@@ -256,7 +274,10 @@ class _ClosedLoop:
         c0 = time.perf_counter()
         result: FhocpResult | None = None
         try:
-            result = self.solver.solve(tk, xk.copy(), known)
+            if self.passes_v_last:
+                result = self.solver.solve(tk, xk.copy(), known, v_last=self.v_last)
+            else:
+                result = self.solver.solve(tk, xk.copy(), known)
             first = np.asarray(result.first_input, dtype=float).reshape(3)
             usable = bool(np.all(np.isfinite(first)))
         except SolverError:
@@ -297,10 +318,16 @@ class _ClosedLoop:
         The check's ``end`` is the accepted plan's nominal end: the backup's anchor.
         """
         if self.tightening.horizon_arcs == 0:
-            return PlanCheck(True, math.inf, "no margins")
-        check = check_plan(self.scenario, self.tightening, tk, xk, result.inputs, known, self.sign)
+            if self.scenario.limits.rate is None:
+                return PlanCheck(True, math.inf, "no margins")
+            check = check_rates(self.scenario, self.tightening, result.inputs, self.v_last)
+        else:
+            check = check_plan(self.scenario, self.tightening, tk, xk, result.inputs, known, self.sign,
+                               v_last=self.v_last)
         self.log.plan_slack[k] = check.slack
         self.log.rejected[k] = not check.ok
+        if not check.ok:
+            _LOG.debug("period %d: plan rejected by '%s' (slack %.3g)", k, check.where, check.slack)
         return check
 
     def ancillary(self, i: int, xs: np.ndarray, x_hat: np.ndarray) -> np.ndarray:
@@ -325,7 +352,8 @@ class _ClosedLoop:
             xs = np.asarray(x)
             log.states[i] = xs
             if period.anchor is not None:
-                v = station_keeping_input(self.tightening.backup.law, x, period.anchor)
+                self.t_h = clock.t[i0] if j == 0 and not (i0 and log.backup_active[i0 - 1]) else self.t_h  # hand-over
+                v = station_keeping_input(self.tightening.backup.law, x, period.anchor, float(clock.t[i] - self.t_h))
                 log.kappa[i] = 0.0
                 log.v_hat[i] = v
             elif self.sigma > 0.0:
@@ -376,6 +404,7 @@ class _ClosedLoop:
         self.log_period(k, xk, period, nominal_before)
         x, law_s = self.run_ticks(k, x, period)
         self.log.step_ms[i0] = 1e3 * (control_s + law_s)
+        self.v_last = np.array(self.log.v_hat[i0 + m - 1], dtype=float)  # v̂, or the backup's command
         self.log.wall[i0:i0 + m] = time.perf_counter() - wall0
         return x, period.arc[m]
 

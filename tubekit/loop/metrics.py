@@ -26,6 +26,14 @@ centre), so each can be recomputed from the two files. Definitions (units m, s):
   ``sway_bound``: the certificate's γ̄ (null when none was given).
 * ``velocity_error_max``: max over samples of |u_b − u|, |w_b − w|, |r_b − r| (the dynamic plant's
   velocity loop, from the columns ``u_b``, ``w_b``, ``r_b``); null on the kinematic plant.
+* ``sign_flips_per_s``: per input channel {"u", "w", "r"} of the applied input, the sign changes
+  between consecutive logged samples per second of the run (:func:`sign_flips_per_s`), samples with
+  |v_c| below :data:`FLIP_THRESHOLD` × v̄_c ignored (a chattering command flips often; a smooth one
+  a few times per turn).
+* ``command_jump_max``: per channel, the largest change of v̂ (columns ``u_hat``, ``w_hat``, ``r_hat``:
+  the plan's node, or the backup's command) between consecutive ticks (m/s, rad/s); with
+  ``limits.rate`` every jump of a plan's or a replayed node, and the hand-over to and from the
+  backup, is at most J = rate · dt (the backup's own per-tick changes follow its rate bound).
 * ``fhocp_max_violation``: largest nonlinear-constraint violation of the
   nominal plans the FHOCP returned (its ``max_violation``; 0 when every plan
   is feasible for the tightened problem).
@@ -66,6 +74,9 @@ __all__ = [
     "encirclements",
     "obstacle_passes",
     "tracking_rmse",
+    "sign_flips_per_s",
+    "command_jumps",
+    "FLIP_THRESHOLD",
     "intervals_below",
     "percentile_ms",
     "sway_series",
@@ -77,12 +88,16 @@ __all__ = [
     "RUN_KEYS",
 ]
 
+#: Fraction of the channel's limit v̄_c below which a sample's sign is ignored by :func:`sign_flips_per_s`.
+FLIP_THRESHOLD = 0.01
+_CHANNELS = ("u", "w", "r")
+
 #: Keys every metrics dictionary has (the issue's list plus a few more).
 METRIC_KEYS: tuple[str, ...] = (
     "scenario", "duration_s", "steps", "obstacles", "vehicle_radius", "min_clearance", "min_e_d",
     "epsilon", "max_input_ratio", "saturated_steps", "encirclements", "tracking_rmse", "max_rho",
     "rho_bound", "step_ms_median", "step_ms_p95", "wall_s", "sway_max", "sway_bound", "backup_s",
-    "backup_engagements",
+    "backup_engagements", "sign_flips_per_s", "command_jump_max",
 )
 #: Keys :func:`run_metrics` adds to :func:`compute_metrics` (every run has them; the baseline's promises are empty).
 RUN_KEYS: tuple[str, ...] = ("tube", "law", "sigma", "kappa_failures", "checks", "certified", "rho_tilde_used",
@@ -164,6 +179,30 @@ def tracking_rmse(positions: np.ndarray, desired: np.ndarray) -> float:
     """sqrt(mean ‖p − p_d‖²) (m)."""
     d = np.asarray(positions, dtype=float)[:, :3] - np.asarray(desired, dtype=float)[:, :3]
     return float(np.sqrt(np.mean(np.sum(d * d, axis=1))))
+
+
+def sign_flips_per_s(t: np.ndarray, values: np.ndarray, floor: Sequence[float]) -> dict[str, float | None]:
+    """Sign changes per second of each column of ``values`` (n, 3) (keys "u", "w", "r").
+
+    Non-finite samples and samples with |v_c| < ``floor[c]`` are dropped; a flip is a sign change
+    between consecutive kept samples; the count is divided by the logged span t[-1] − t[0] (s).
+    None for a log shorter than one sample step.
+    """
+    t = np.asarray(t, dtype=float)
+    v = np.asarray(values, dtype=float)
+    span = float(t[-1] - t[0]) if len(t) > 1 else 0.0
+    out: dict[str, float | None] = {}
+    for c, name in enumerate(_CHANNELS):
+        x = v[:, c]
+        kept = np.sign(x[np.isfinite(x) & (np.abs(x) >= floor[c])])
+        out[name] = float(np.count_nonzero(kept[1:] != kept[:-1]) / span) if span > 0 else None
+    return out
+
+
+def command_jumps(values: np.ndarray) -> dict[str, float | None]:
+    """Largest |v_c(i+1) − v_c(i)| over consecutive finite samples of ``values`` (n, 3), per channel."""
+    d = np.abs(np.diff(np.asarray(values, dtype=float), axis=0))
+    return {name: _nanmax_or_none(d[:, c]) if len(d) else None for c, name in enumerate(_CHANNELS)}
 
 
 def intervals_below(t: np.ndarray, values: np.ndarray, threshold: float) -> list[dict[str, float]]:
@@ -330,6 +369,11 @@ def compute_metrics(columns: Mapping[str, np.ndarray], scenario: Scenario, *,
     }
     m.update(_sway_metrics(c, scenario, sway_bound))
     m["velocity_error_max"] = _velocity_error_max(c)
+    m["sign_flips_per_s"] = sign_flips_per_s(t, inputs, FLIP_THRESHOLD * np.asarray(lim, dtype=float))
+    if all(k in c for k in ("u_hat", "w_hat", "r_hat")):
+        m["command_jump_max"] = command_jumps(np.column_stack([c["u_hat"], c["w_hat"], c["r_hat"]]))
+    else:
+        m["command_jump_max"] = None
     if extra:
         m.update(extra)
     return m
@@ -366,7 +410,7 @@ def run_metrics(run: RunLog, promises: Sequence[Promise] | None = None) -> dict[
     if not run.tube:
         promises = ()
     elif promises is None:
-        promises = check_promises(run)
+        promises = check_promises(run, uncertified=True)
     m = compute_metrics(run.columns(), run.scenario, rho_bound=float(tight.rho_tilde) if certified else None,
                         sway_bound=float(tight.disturbance.sway) if run.tube else None, extra=run.facts)
     m.update(certified=certified, rho_tilde_used=float(tight.rho_tilde), tiers=tiers_given(tight),

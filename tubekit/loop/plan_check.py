@@ -7,6 +7,10 @@ certificate does not rely on that: a plan is *accepted* only when
 follows), that
 
 * v̂_j is in V̄;
+* with a rate limit (``scenario.limits.rate``, J = rate · dt per component), the rate rows
+  (:func:`check_rates`): |v̂_{j+1} − v̂_j| <= J, |v̂_0 − v_last| <= J (v_last the command applied in the
+  last tick before the plan, when given) and, when the tightening gates plans by a certified backup,
+  the terminal rest |v̂_{n−1}| <= J, each up to the absolute tolerance :data:`RATE_TOLERANCE`;
 * ε + M_d[j] <= e_d <= e_d_max - M_d[j], |e_z| <= e_z_max - M_z[j],
   |e_o| <= e_o_max - M_o[j], and the heading stays in the certified hemisphere;
 * the vehicle ball inflated by M_pos[j] is clear of every known obstacle and
@@ -40,10 +44,14 @@ from tubekit.scenario import Obstacle, Scenario
 from tubekit.loop.terminal import terminal_condition
 from tubekit.tightening import Tightening
 
-__all__ = ["PlanCheck", "check_plan", "plan_arcs", "tracking_checked"]
+__all__ = ["PlanCheck", "check_plan", "check_rates", "rate_slacks", "plan_arcs", "tracking_checked",
+           "RATE_TOLERANCE"]
 
 #: Points per arc of the check (plus the arc's end).
 SAMPLES_PER_ARC = 10
+#: Absolute tolerance (m/s, rad/s) of the rate rows: round-off only; the FHOCP imposes J (1 - 1e-4), so a
+#: plan it returns meets J with room, and the theorem's jump bound is J + RATE_TOLERANCE at most.
+RATE_TOLERANCE = 1e-9
 
 
 @dataclass(frozen=True)
@@ -66,6 +74,40 @@ def plan_arcs(x0: np.ndarray, inputs: np.ndarray, dt: float, samples: int) -> np
         out[j] = nominal_arc(x, v, tau)
         x = out[j, -1]
     return out
+
+
+def rate_slacks(inputs: np.ndarray, jump: np.ndarray, v_last: np.ndarray | None,
+                rest: bool) -> dict[str, float]:
+    """Smallest slack (J − |jump|, >= 0 is fine) of each rate row of ``inputs`` (n, 3): "rate: between
+    nodes", "rate: first node" (with ``v_last``) and "rate: terminal rest" (with ``rest``)."""
+    v = np.asarray(inputs, dtype=float)
+    j = np.asarray(jump, dtype=float)
+    out = {"rate: between nodes": float(np.min(j - np.abs(v[1:] - v[:-1]), initial=math.inf))}
+    if v_last is not None:
+        out["rate: first node"] = float(np.min(j - np.abs(v[0] - np.asarray(v_last, dtype=float))))
+    if rest:
+        out["rate: terminal rest"] = float(np.min(j - np.abs(v[-1])))
+    return out
+
+
+def check_rates(scenario: Scenario, tight: Tightening, inputs: np.ndarray,
+                v_last: np.ndarray | None = None) -> PlanCheck:
+    """The rate rows alone (module doc) on the first ``tight.horizon_arcs`` inputs (all without margins).
+
+    ``ok`` without a rate limit; otherwise ok when every slack is >= −:data:`RATE_TOLERANCE`, and
+    ``where`` names the tightest row.
+    """
+    jump = scenario.limits.jump(scenario.controller.dt)
+    v = np.asarray(inputs, dtype=float)
+    if jump is None:
+        return PlanCheck(True, math.inf, "no rate limit")
+    if v.ndim != 2 or v.shape[1] != 3 or len(v) == 0 or not np.all(np.isfinite(v)):
+        return PlanCheck(False, -math.inf, "plan shape or values")
+    if tight.horizon_arcs:
+        v = v[:tight.horizon_arcs]
+    slacks = rate_slacks(v, jump, v_last, tight.terminal_backup is not None)
+    where, worst = min(slacks.items(), key=lambda kv: kv[1])
+    return PlanCheck(worst >= -RATE_TOLERANCE, worst, where)
 
 
 def _error_slacks(tight: Tightening, e: np.ndarray, cos_rel: np.ndarray, margins: np.ndarray,
@@ -107,8 +149,10 @@ def _terminal_slack(scenario: Scenario, tight: Tightening, x0: np.ndarray, end: 
 
 
 def check_plan(scenario: Scenario, tight: Tightening, t0: float, x0: np.ndarray, inputs: np.ndarray,
-               obstacles: Sequence[Obstacle], sign: int, samples: int = SAMPLES_PER_ARC) -> PlanCheck:
-    """Verify a plan (module doc). ``sign`` is the certified hemisphere (-1 toward, +1 away, 0 both)."""
+               obstacles: Sequence[Obstacle], sign: int, samples: int = SAMPLES_PER_ARC, *,
+               v_last: np.ndarray | None = None) -> PlanCheck:
+    """Verify a plan (module doc). ``sign`` is the certified hemisphere (-1 toward, +1 away, 0 both);
+    ``v_last`` (3,) the command before the plan (rate row (b); None: not checked)."""
     inputs = np.asarray(inputs, dtype=float)
     n = tight.horizon_arcs
     if inputs.ndim != 2 or inputs.shape[1] != 3 or inputs.shape[0] < n or not np.all(np.isfinite(inputs)):
@@ -117,6 +161,9 @@ def check_plan(scenario: Scenario, tight: Tightening, t0: float, x0: np.ndarray,
     over = np.max(np.abs(inputs) - np.asarray(tight.v_max)[None, :])
     if over > 1e-9:
         return PlanCheck(False, -float(over), "input outside V_bar")
+    rates = check_rates(scenario, tight, inputs, v_last)
+    if not rates.ok:
+        return rates
     dt = scenario.controller.dt
     arcs = plan_arcs(x0, inputs, dt, samples)
     times = t0 + dt * (np.arange(n)[:, None] + np.linspace(0.0, 1.0, samples + 1)[None, :])

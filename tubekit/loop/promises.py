@@ -10,8 +10,9 @@ Each :class:`Promise` compares an observed figure with the certificate's bound:
 * ``clearance`` — min vehicle-ball clearance to every obstacle at the ticks, minus the distance the
   vehicle can move in half a tick, >= 0 (so it holds between ticks too); ``workspace`` likewise;
 * ``sway`` — max |v_s| applied <= γ̄ (on the dynamic plant: max |v_b| of the hull, γ̄ its ISS bound);
-* ``velocity_loop`` (dynamic plant only) — the assumption of ``docs/plant.md``: max |u_b - u|,
-  |w_b - w|, |r_b - r| within ``scenario.plant.tracking_bound`` (observed = the largest ratio, <= 1);
+* ``velocity_loop`` (dynamic plant with a certified loop bound) — max |u_b - u|, |w_b - w|, |r_b - r|
+  at the ticks within the certificate's derived bound ``tightening.velocity_loop`` (observed = the
+  largest ratio, <= 1);
 * the premises: ``disturbance`` (‖ω_xy‖ <= ω̄_xy, |ω_z| <= ω̄_z over every evaluation of ω the
   plant's integrator made, between ticks included, and at the logged ticks) and
   ``recursive_feasibility`` (a plan accepted at t = 0, and the replayed candidate never older than
@@ -210,17 +211,18 @@ def _disturbance(run: RunLog) -> list[Promise]:
 
 
 def _velocity_loop(run: RunLog) -> list[Promise]:
-    """The velocity loop's error against its assumed bound (dynamic plant only)."""
+    """The velocity loop's error against the certificate's derived bound (dynamic plant with a loop bound only)."""
     err = run.velocity_error
-    if err is None:
+    loop = getattr(run.tightening, "velocity_loop", None)
+    if err is None or loop is None:
         return []
-    bound = np.asarray(run.scenario.plant.tracking_bound, dtype=float)
+    bound = np.asarray(loop, dtype=float)
     worst = np.nanmax(np.abs(err[:-1]), axis=0) if len(err) > 1 else np.zeros(3)
     ratio = float(np.max(np.where(bound > 0, worst / np.where(bound > 0, bound, 1.0),
                                   np.where(worst > 0, np.inf, 0.0))))
     return [_at_most("velocity_loop", ratio, 1.0,
-                     f"assumption: max |u_b - u|, |w_b - w|, |r_b - r| = {np.round(worst, 6).tolist()} vs "
-                     f"plant.tracking_bound = {bound.tolist()} (observed = largest ratio)")]
+                     f"max |u_b - u|, |w_b - w|, |r_b - r| = {np.round(worst, 6).tolist()} vs the certificate's "
+                     f"derived bound {np.round(bound, 6).tolist()} (observed = largest ratio)")]
 
 
 def _feasibility(run: RunLog) -> Promise:
@@ -269,18 +271,32 @@ def _annotate(promise: Promise, tightening: Tightening, given: dict[str, bool]) 
                    given=given.get(tier, True) if tier != "premise" else True)
 
 
-def check_promises(run: RunLog) -> list[Promise]:
+def check_promises(run: RunLog, *, uncertified: bool = False) -> list[Promise]:
     """Every promise of the module doc measured on ``run`` (a tube run with a certificate's Tightening).
+
+    Parameters
+    ----------
+    run : RunLog
+        A tube run (``tubekit.simulate(scenario, certificate)``).
+    uncertified : bool
+        Also measure a run under a best-effort tightening (no certificate): the figures a
+        certificate would promise, which promise nothing (a tube-less design measures ``inf``).
 
     Raises
     ------
     ConfigError
-        ``run`` is a run without a certificate (the baseline: no tube, nothing promised).
+        ``run`` is a run without a certificate: the baseline (no tube, nothing promised), or,
+        unless ``uncertified``, a tube run under a tightening no certificate gave.
     """
     if not run.tube:
         raise ConfigError("run", "a tube run with a certificate's Tightening (tubekit.simulate(scenario, "
                           "certificate))", "a run without a certificate (the baseline)",
                           "the baseline is promised nothing")
+    if not uncertified and not run.tightening.certified:
+        tube = [float(x) for x in np.asarray(run.tightening.tube, dtype=float)]
+        raise ConfigError("run.tightening", "a certified tightening (tubekit.simulate(scenario, certificate) with "
+                          "certificate.certified)", f"a best-effort tightening, tube = {tube}",
+                          "nothing is promised; check_promises(run, uncertified=True) measures the figures anyway")
     raw = [_tube(run), *_region(run), _inputs(run), *_geometry(run), *_disturbance(run), *_velocity_loop(run),
            _feasibility(run)]
     given = tiers_given(run.tightening)

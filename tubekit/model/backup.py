@@ -10,6 +10,29 @@ the vehicle from p* and φ = ψ − θ − π the angle between the heading and 
   line of sight, whichever end points at p*;
 * heave w = −w_b sat((z − z*) / z_0).
 
+Optionally (issue 22, every one 0 = off) each channel is faded near the anchor and ramped from the
+hand-over: with s the time since the hand-over (s),
+
+* u = u_b f cos φ, f = min(1, d/d_0, s/t_r);  r = −k sat(χ/χ_0) g, g = min(1, d/d_1, s/t_r);
+* w = −w_b sat((z − z*)/z_0) min(1, s/t_r),
+
+d_0 = ``surge_fade``, d_1 = ``yaw_fade`` (m), t_r = ``ramp`` (s); a zero fade or ramp drops its term.
+The command then starts at 0 at the hand-over and, away from the ridge χ = ±π/2 (everywhere with the
+continuous yaw law below), is Lipschitz along every trajectory (:func:`verify.backup.backup_command_rate`).
+
+**Continuous yaw** (``yaw_law="continuous"``, issue 22). The yaw law above jumps from −k to +k where the
+hull crosses abeam (the ridge χ = ±π/2). The continuous law replaces sat(χ/χ_0) by ρ(φ), π-periodic
+and Lipschitz with constant 1/χ_0, with a stable zero at χ = 0 and an unstable zero at χ = χ_u
+(``unstable``, 0 < χ_u < π/2): with x = φ mod π ∈ [0, π),
+
+* ρ = min(1, x/χ_0, (χ_u − x)/χ_0) on [0, χ_u] (turn back onto the line of sight),
+* ρ = −min(1, (x − χ_u)/χ_0, (π − x)/χ_0) on [χ_u, π) (turn the long way round, through abeam).
+
+Its safe set uses a(χ) of :func:`axis_shape` in place of 1 − cos χ (both have minimum 0, maximum 1):
+a rises on [0, χ_p], χ_p = :data:`SHAPE_PLATEAU` χ_u (``StationKeeping.plateau``), is 1 on [χ_p, χ_u]
+(where the line of sight's turn can outpace the small ρ, the radial speed alone must decrease V) and
+falls on [χ_u, π).
+
 Every input stays in V when u_b <= ū, w_b <= w̄ and k <= r̄, so the law never saturates.
 :func:`verify.backup.certify_backup` proves that the set
 S = {d + β(1 − cos χ) <= c, |z − z*| <= Z} is invariant under the law held at the ancillary rate
@@ -26,7 +49,13 @@ import numpy as np
 from tubekit.exceptions import ConfigError
 from tubekit.validation import nonnegative, positive
 
-__all__ = ["StationKeeping", "SafeSet", "BackupPlan", "line_of_sight_angle", "axis_angle", "station_keeping_input"]
+__all__ = ["StationKeeping", "SafeSet", "BackupPlan", "line_of_sight_angle", "axis_angle", "station_keeping_input",
+           "yaw_shape", "axis_shape", "YAW_LAWS", "SHAPE_PLATEAU"]
+
+#: The yaw laws: "ridge" (r = −k sat(χ/χ_0), the default) and "continuous" (r = −k ρ(φ)).
+YAW_LAWS = ("ridge", "continuous")
+#: χ_p / χ_u: where the continuous law's a(χ) reaches its plateau 1 below the unstable angle.
+SHAPE_PLATEAU = 0.75
 
 
 def _sat(x: float) -> float:
@@ -68,6 +97,16 @@ class StationKeeping:
         w_b, the largest heave speed (m/s).
     heave_band : float
         z_0, the depth error (m) below which the heave speed is proportional.
+    surge_fade : float
+        d_0 (m): the surge is scaled by d/d_0 within d_0 of the anchor (0: no fade).
+    yaw_fade : float
+        d_1 (m): the yaw rate is scaled by d/d_1 within d_1 of the anchor (0: no fade).
+    ramp : float
+        t_r (s): every channel is scaled by s/t_r for the first t_r seconds after the hand-over (0: none).
+    yaw_law : str
+        "ridge" (default: r = −k sat(χ/χ_0)) or "continuous" (r = −k ρ(φ), module doc).
+    unstable : float
+        χ_u (rad), the continuous law's unstable axis angle, in (0, π/2); 0 with the ridge law.
     """
 
     surge: float
@@ -75,32 +114,97 @@ class StationKeeping:
     yaw_band: float
     heave: float
     heave_band: float
+    surge_fade: float = 0.0
+    yaw_fade: float = 0.0
+    ramp: float = 0.0
+    yaw_law: str = "ridge"
+    unstable: float = 0.0
 
     def __post_init__(self) -> None:
         for name in ("surge", "yaw_rate", "yaw_band", "heave", "heave_band"):
             object.__setattr__(self, name, positive(f"backup.{name}", getattr(self, name)))
+        for name in ("surge_fade", "yaw_fade", "ramp"):
+            object.__setattr__(self, name, nonnegative(f"backup.{name}", getattr(self, name)))
         if self.yaw_band > math.pi / 2:
             raise ConfigError("backup.yaw_band", "an angle in (0, pi/2] rad", self.yaw_band)
+        if self.yaw_law not in YAW_LAWS:
+            raise ConfigError("backup.yaw_law", f"one of {YAW_LAWS}", self.yaw_law)
+        object.__setattr__(self, "unstable", nonnegative("backup.unstable", self.unstable))
+        if self.yaw_law == "continuous" and not 0.0 < self.unstable < math.pi / 2:
+            raise ConfigError("backup.unstable", "an angle χ_u in (0, pi/2) rad (the continuous law)", self.unstable)
+        if self.yaw_law == "ridge" and self.unstable != 0.0:
+            raise ConfigError("backup.unstable", "0 with the ridge yaw law", self.unstable)
+
+    @property
+    def smooth(self) -> bool:
+        """True when both fades and the ramp are on (the command is rate-bounded; with the ridge law only
+        away from the ridge)."""
+        return self.surge_fade > 0.0 and self.yaw_fade > 0.0 and self.ramp > 0.0
+
+    @property
+    def plateau(self) -> float:
+        """χ_p = SHAPE_PLATEAU χ_u (rad): a(χ) = 1 on [χ_p, χ_u] (the continuous law; 0 with the ridge law)."""
+        return self.unstable * SHAPE_PLATEAU
 
     def within(self, u_max: float, w_max: float, r_max: float) -> bool:
         """True when every input of the law lies in V = {|u| <= u_max, |w| <= w_max, |r| <= r_max}."""
         return self.surge <= u_max and self.heave <= w_max and self.yaw_rate <= r_max
 
-    def __call__(self, state: np.ndarray, anchor: np.ndarray) -> np.ndarray:
-        """v = (u, w, r) (m/s, m/s, rad/s) at ``state`` [x, y, z, ψ] about ``anchor`` [x*, y*, z*] (m)."""
-        return np.array(station_keeping_input(self, tuple(map(float, state)), tuple(map(float, anchor))))
+    def __call__(self, state: np.ndarray, anchor: np.ndarray, elapsed: float = math.inf) -> np.ndarray:
+        """v = (u, w, r) (m/s, m/s, rad/s) at ``state`` [x, y, z, ψ] about ``anchor`` [x*, y*, z*] (m),
+        ``elapsed`` seconds after the hand-over."""
+        return np.array(station_keeping_input(self, tuple(map(float, state)), tuple(map(float, anchor)), elapsed))
+
+
+def _fade(value: float, scale: float) -> float:
+    """min(1, value / scale), 1 when ``scale`` is 0 (the term is off)."""
+    return 1.0 if scale <= 0.0 or value >= scale else max(0.0, value / scale)
 
 
 def station_keeping_input(law: StationKeeping, state: tuple[float, float, float, float],
-                          anchor: tuple[float, float, float]) -> tuple[float, float, float]:
-    """The law on float tuples (the closed loop's inner loop): (u, w, r) in m/s, m/s, rad/s."""
+                          anchor: tuple[float, float, float],
+                          elapsed: float = math.inf) -> tuple[float, float, float]:
+    """The law on float tuples (the closed loop's inner loop): (u, w, r) in m/s, m/s, rad/s.
+
+    ``elapsed`` is the time s (s) since the backup took over; the default (∞) is the law after its ramp.
+    """
     x, y, z, psi = state
     phi = line_of_sight_angle(x, y, psi, anchor[0], anchor[1])
     chi = axis_angle(phi)
-    u = law.surge * math.cos(phi)
-    r = -law.yaw_rate * _sat(chi / law.yaw_band)
-    w = -law.heave * _sat((z - anchor[2]) / law.heave_band)
+    ramp = _fade(elapsed, law.ramp)
+    d = math.hypot(x - anchor[0], y - anchor[1]) if law.surge_fade > 0.0 or law.yaw_fade > 0.0 else math.inf
+    u = law.surge * min(_fade(d, law.surge_fade), ramp) * math.cos(phi)
+    turn = yaw_shape(law, phi) if law.yaw_law == "continuous" else _sat(chi / law.yaw_band)
+    r = -law.yaw_rate * turn * min(_fade(d, law.yaw_fade), ramp)
+    w = -law.heave * _sat((z - anchor[2]) / law.heave_band) * ramp
     return u, w, r
+
+
+def yaw_shape(law: StationKeeping, phi: float) -> float:
+    """ρ(φ) of the continuous yaw law (module doc): π-periodic in φ (rad), in [−1, 1], Lipschitz 1/χ_0."""
+    x = math.fmod(phi, math.pi)
+    x = x + math.pi if x < 0.0 else x
+    band, cut = law.yaw_band, law.unstable
+    if x <= cut:
+        return min(1.0, x / band, (cut - x) / band)
+    return -min(1.0, (x - cut) / band, (math.pi - x) / band)
+
+
+def axis_shape(law: StationKeeping, phi: float) -> float:
+    """a(χ) of the safe set V = d + β a(χ) (dimensionless, in [0, 1]) at the line-of-sight angle φ (rad).
+
+    Ridge law: 1 − cos χ. Continuous law: with x = φ mod π and χ_p = ``law.plateau``,
+    (1 − cos(π min(x, χ_p)/χ_p))/2 on [0, χ_u] and (1 − cos(π (π − x)/(π − χ_u)))/2 on [χ_u, π):
+    minimum 0 at χ = 0, maximum 1 on [χ_p, χ_u], C¹.
+    """
+    if law.yaw_law != "continuous":
+        return 1.0 - math.cos(axis_angle(phi))
+    x = math.fmod(phi, math.pi)
+    x = x + math.pi if x < 0.0 else x
+    cut = law.unstable
+    top = law.plateau
+    arg = math.pi * min(x, top) / top if x <= cut else math.pi * (math.pi - x) / (math.pi - cut)
+    return 0.5 * (1.0 - math.cos(arg))
 
 
 @dataclass(frozen=True)

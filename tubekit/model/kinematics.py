@@ -12,6 +12,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from tubekit.exceptions import ConfigError
 from tubekit.validation import nonnegative, positive
 
 __all__ = [
@@ -26,6 +27,18 @@ __all__ = [
 ]
 
 
+def _rate_triple(value: object) -> tuple[float, float, float]:
+    """``limits.rate`` as three positive finite floats; strings and booleans refused (ConfigError)."""
+    if isinstance(value, (str, bytes)) or not isinstance(value, (list, tuple, np.ndarray)) or len(value) != 3:
+        raise ConfigError("limits.rate", "three numbers > 0 [rho_u, rho_w, rho_r] (m/s^2, m/s^2, rad/s^2)", value)
+    out = []
+    for i, x in enumerate(value):
+        if isinstance(x, (str, bytes, bool, np.bool_)) or not isinstance(x, (int, float, np.integer, np.floating)):
+            raise ConfigError(f"limits.rate[{i}]", "a number > 0", x)
+        out.append(positive(f"limits.rate[{i}]", x))
+    return (out[0], out[1], out[2])
+
+
 @dataclass(frozen=True)
 class InputLimits:
     """Box input set V = {|u| <= u_max, |w| <= w_max, |r| <= r_max}.
@@ -36,15 +49,26 @@ class InputLimits:
         Surge and heave speed limits (m/s).
     r_max : float
         Yaw-rate limit (rad/s).
+    rate : (float, float, float) or None
+        Command-rate limit [rho_u, rho_w, rho_r] (m/s^2, m/s^2, rad/s^2): every plan changes
+        its command by at most J = rate * controller.dt per period (``tubekit.fhocp.rows``);
+        None (default): no rate limit.
     """
 
     u_max: float
     w_max: float
     r_max: float
+    rate: tuple[float, float, float] | None = None
 
     def __post_init__(self) -> None:
         for name in ("u_max", "w_max", "r_max"):
             object.__setattr__(self, name, positive(f"limits.{name}", getattr(self, name)))
+        if self.rate is not None:
+            object.__setattr__(self, "rate", _rate_triple(self.rate))
+
+    def jump(self, dt: float) -> np.ndarray | None:
+        """J = rate * ``dt`` (3,): the largest command change per period (None without a rate limit)."""
+        return None if self.rate is None else np.asarray(self.rate, dtype=float) * float(dt)
 
     @property
     def vector(self) -> np.ndarray:

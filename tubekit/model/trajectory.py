@@ -15,7 +15,8 @@ import numpy as np
 from tubekit.exceptions import ConfigError
 from tubekit.validation import as_vector, finite, positive
 
-__all__ = ["Trajectory", "Circle", "Helix", "Line", "Waypoints", "trajectory_from_dict"]
+__all__ = ["Trajectory", "Circle", "Helix", "Line", "Waypoints", "trajectory_from_dict", "toml_keys", "KINDS",
+           "TOML_NAMES"]
 
 
 class Trajectory(ABC):
@@ -71,7 +72,7 @@ class Circle(Trajectory):
     def __post_init__(self) -> None:
         object.__setattr__(self, "radius", positive("trajectory.radius", self.radius))
         object.__setattr__(self, "rate", finite("trajectory.rate", self.rate))
-        object.__setattr__(self, "center", tuple(as_vector("trajectory.center", self.center, 3)))
+        object.__setattr__(self, "center", tuple(float(x) for x in as_vector("trajectory.center", self.center, 3)))
         object.__setattr__(self, "phase", finite("trajectory.phase", self.phase))
 
     def position(self, t):
@@ -137,7 +138,7 @@ class Line(Trajectory):
     start : array (3,)
         Position at t = 0 (m).
     direction_velocity : array (3,)
-        Constant velocity (m/s).
+        Constant velocity (m/s); its TOML/JSON key is ``velocity``.
     """
 
     start: tuple[float, float, float] = (0.0, 0.0, 0.0)
@@ -145,9 +146,9 @@ class Line(Trajectory):
     kind: str = field(default="line", init=False)
 
     def __post_init__(self) -> None:
-        object.__setattr__(self, "start", tuple(as_vector("trajectory.start", self.start, 3)))
+        object.__setattr__(self, "start", tuple(float(x) for x in as_vector("trajectory.start", self.start, 3)))
         object.__setattr__(self, "direction_velocity",
-                           tuple(as_vector("trajectory.velocity", self.direction_velocity, 3)))
+                           tuple(float(x) for x in as_vector("trajectory.velocity", self.direction_velocity, 3)))
 
     def position(self, t):
         t = np.asarray(t, dtype=float)[..., None]
@@ -188,7 +189,7 @@ class Waypoints(Trajectory):
         lengths = np.linalg.norm(np.diff(pts, axis=0), axis=1)
         if np.any(lengths <= 0):
             raise ConfigError("trajectory.points", "consecutive points that differ", self.points)
-        object.__setattr__(self, "points", tuple(map(tuple, pts)))
+        object.__setattr__(self, "points", tuple(tuple(float(x) for x in p) for p in pts))
         object.__setattr__(self, "speed", positive("trajectory.speed", self.speed))
 
     def _segments(self):
@@ -234,32 +235,39 @@ class Waypoints(Trajectory):
         return {"kind": "waypoints", "points": [list(p) for p in self.points], "speed": self.speed}
 
 
+#: The classes by TOML ``kind``.
+KINDS: dict[str, type[Trajectory]] = {"circle": Circle, "helix": Helix, "line": Line, "waypoints": Waypoints}
+#: A field whose TOML/JSON key differs from its Python name, by kind: {TOML key: field name}.
+TOML_NAMES: dict[str, dict[str, str]] = {"line": {"velocity": "direction_velocity"}}
+#: Top-level scenario keys a user may write after the [trajectory] header by mistake (for the hint).
+_TOP_LEVEL_KEYS = ("name", "duration", "epsilon", "vehicle_radius", "sensing_range", "initial_state", "workspace")
+
+
+def toml_keys(kind: str) -> list[str]:
+    """The documented TOML keys of a trajectory ``kind`` (``kind`` itself aside), sorted."""
+    renamed = {name: key for key, name in TOML_NAMES.get(kind, {}).items()}
+    return sorted(renamed.get(f.name, f.name) for f in fields(KINDS[kind]) if f.init)
+
+
 def trajectory_from_dict(d: dict) -> Trajectory:
-    """Build a trajectory from a TOML/JSON table with a ``kind`` key."""
+    """Build a trajectory from a TOML/JSON table with a ``kind`` key and the keys of its ``to_dict``.
+
+    Raises
+    ------
+    ConfigError
+        An unknown kind, an unknown key (the error lists the documented keys of that kind) or a bad value.
+    """
     if not isinstance(d, dict):
         raise ConfigError("trajectory", "a table with a 'kind' key", d)
     d = dict(d)
     kind = d.pop("kind", None)
-    if kind == "line" and "velocity" in d:
-        d["direction_velocity"] = d.pop("velocity")
-    classes = {"circle": Circle, "helix": Helix, "line": Line, "waypoints": Waypoints}
-    if kind in classes:
-        allowed = sorted(f.name for f in fields(classes[kind]) if f.init)
-        for key in sorted(d):
-            if key not in allowed:
-                raise ConfigError(f"trajectory.{key}", f"one of the keys {allowed} of a {kind} trajectory", key,
-                                  "a top-level key written after the [trajectory] header belongs above the "
-                                  "first table")
-    try:
-        if kind == "circle":
-            return Circle(**d)
-        if kind == "helix":
-            return Helix(**d)
-        if kind == "line":
-            return Line(**d)
-        if kind == "waypoints":
-            return Waypoints(**d)
-    except TypeError as exc:
-        raise ConfigError("trajectory", f"only the keys of a {kind} trajectory", sorted(d),
-                          str(exc)) from None
-    raise ConfigError("trajectory.kind", "one of 'circle', 'helix', 'line', 'waypoints'", kind)
+    if not isinstance(kind, str) or kind not in KINDS:
+        raise ConfigError("trajectory.kind", f"one of {tuple(KINDS)}", kind)
+    allowed = toml_keys(kind)
+    for key in sorted(d):
+        if key not in allowed:
+            hint = ("a top-level key written after the [trajectory] header belongs above the first table"
+                    if key in _TOP_LEVEL_KEYS else "")
+            raise ConfigError(f"trajectory.{key}", f"one of the keys {allowed} of a {kind} trajectory", key, hint)
+    names = TOML_NAMES.get(kind, {})
+    return KINDS[kind](**{names.get(key, key): value for key, value in d.items()})

@@ -14,13 +14,17 @@ Kinematics: ṗ_xy = R(ψ)(u, v) + δ_xy(t), ż = w + δ_z(t), ψ̇ = r, with th
 scenario's current δ (:class:`tubekit.plant.kinematic.Plant`); the current's acceleration
 is neglected in the relative-velocity dynamics (documented in ``docs/plant.md``).
 
-Thrust: τ̇ = (sat(τ_cmd) − τ) / T_thr (first-order thrusters, saturation at
-X_max, Z_max, N_max). The low-level velocity loop turns the kinematic command
-v = v̂ + κ = (u_c, w_c, r_c) into τ_cmd: model feedforward n(ν) = C(ν)ν + D(ν)ν
-(feedback linearisation, the sway row eliminated from the yaw row) plus PI on
+Thrust: τ̇ = (sat(τ_cmd) − τ) / T_thr (first-order actuators on every channel,
+saturation at the limits of the vehicle at its current surge speed,
+:meth:`~tubekit.model.vehicle_params.VehicleParams.thrust_limits_at`: constant for
+thrusters, ∝ u² for REMUS' stern planes and rudder). The low-level velocity loop turns
+the kinematic command v = v̂ + κ = (u_c, w_c, r_c) into τ_cmd: model feedforward
+n̂(ν) = Ĉ(ν)ν + D̂(ν)ν of the NOMINAL vehicle (the midpoints of the coefficient box;
+feedback linearisation, the sway row eliminated from the yaw row) plus PI on
 e = (u_c − u, w_c − w, r_c − r) with k_p = ω_b, k_i = ω_b²/4 and conditional
-integration while saturated. Positions, ν, τ and the integrators are integrated
-together by classical RK4 at the closed loop's fixed step.
+integration while saturated. The vehicle itself moves with the TRUTH (a point of the
+box, ``[plant.truth]``). Positions, ν, τ and the integrators are integrated together by
+classical RK4 at the closed loop's fixed step.
 """
 
 from __future__ import annotations
@@ -74,7 +78,7 @@ class DynamicPlant:
     Same interface as :class:`tubekit.plant.kinematic.Plant` for the closed loop
     (:meth:`step_tuple` on the pose [x, y, z, ψ]); the body velocities, thrusts
     and integrators are internal state, initialised on the first step to the
-    trimmed start ν = (u_c, 0, w_c, r_c), τ = sat(n(ν)) (the vehicle already
+    trimmed start ν = (u_c, 0, w_c, r_c), τ = sat(n̂(ν)) (the vehicle already
     moving at the first command, as the kinematic plant assumes). Each call of
     :meth:`step_tuple` (one tick) logs ν and τ at its start (:meth:`history`).
 
@@ -85,19 +89,28 @@ class DynamicPlant:
     override : callable, optional
         ``override(t) -> current`` (3,) m/s replacing the scenario's current.
     params : VehicleParams, optional
-        Vehicle (default ``scenario.plant.params``).
+        The vehicle as simulated, a point (default ``scenario.plant.truth_params``).
+
+    Attributes
+    ----------
+    params : VehicleParams
+        The plant as simulated (a point of the coefficient box).
+    model : VehicleParams
+        The controller's model: ``scenario.plant.params.nominal`` (feedforward and PI gains).
     """
 
     def __init__(self, scenario: Scenario, override: OmegaOverride | None = None,
                  params: VehicleParams | None = None) -> None:
-        self.params = params if params is not None else scenario.plant.params
+        if params is not None and not params.is_point:
+            raise ValueError(f"DynamicPlant(params=...) needs a point vehicle; {list(params.interval_fields)} "
+                             "are intervals: pass .nominal or .sample(rng)")
+        self.params = params if params is not None else scenario.plant.truth_params
+        self.model = scenario.plant.params.nominal
         self.override = override
         self._current_model = Plant(scenario.disturbance)
-        p = self.params
-        self._mass = p.mass_entries
-        self._limits = p.thrust_limits
-        self._kp, self._ki = p.loop_bandwidth, 0.25 * p.loop_bandwidth ** 2
-        self._tau_inv = 1.0 / p.thruster_time_constant
+        self._mass = self.model.mass_entries
+        self._kp, self._ki = self.model.loop_bandwidth, 0.25 * self.model.loop_bandwidth ** 2
+        self._tau_inv = 1.0 / self.params.thruster_time_constant
         self.state: tuple[float, ...] | None = None  # (u, v, w, r, X, Z, N, I_u, I_w, I_r)
         self._log: list[tuple[float, ...]] = []
         self._peak = [0.0, 0.0]  # largest ||omega_xy||, |omega_z| over every evaluation (m/s)
@@ -112,13 +125,16 @@ class DynamicPlant:
 
     def thrust_command(self, nu: Sequence[float], command: Sequence[float],
                        integral: Sequence[float]) -> tuple[tuple[float, float, float], tuple[bool, bool, bool]]:
-        """τ_cmd (saturated) and which channels saturate: feedforward n(ν) + M (k_p e + k_i ∫e)."""
+        """τ_cmd (saturated at the truth's limits at surge ``nu[0]``) and which channels saturate.
+
+        Feedforward n̂(ν) + M̂ (k_p e + k_i ∫e) of the nominal model.
+        """
         m11, m22, m33, m44, m24, m42 = self._mass
-        n1, n2, n3, n4 = body_forces(self.params, nu)
+        n1, n2, n3, n4 = body_forces(self.model, nu)
         e = (command[0] - nu[0], command[1] - nu[2], command[2] - nu[3])
         a = [self._kp * ei + self._ki * ii for ei, ii in zip(e, integral)]
         raw = (n1 + m11 * a[0], n3 + m33 * a[1], n4 - m42 * n2 / m22 + (m44 - m42 * m24 / m22) * a[2])
-        sat = tuple(min(max(c, -lim), lim) for c, lim in zip(raw, self._limits))
+        sat = tuple(min(max(c, -lim), lim) for c, lim in zip(raw, self.params.thrust_limits_at(nu[0])))
         return sat, tuple(s != c for s, c in zip(sat, raw))
 
     def _rhs(self, t: float, y: Sequence[float], command: Sequence[float]) -> tuple[float, ...]:

@@ -1,6 +1,7 @@
 """Falsifiers of the backup law (issue 21): disturbance sequences against station keeping.
 
 :func:`verify.backup.certify_backup` proves that S = {V = d + β(1 − cos χ) <= c, |z − z*| <= Z}
+(with the continuous yaw law, V = d + β a(χ), a of :func:`tubekit.model.backup.axis_shape`)
 is invariant under the station-keeping law held at the ancillary tick, for every current with
 ‖ω_xy‖ <= ω̄_xy, |ω_z| <= ω̄_z, from every hand-over state (d <= handover radius, any heading).
 This module attacks that claim by simulation, independently of the Arb proof:
@@ -13,7 +14,8 @@ This module attacks that claim by simulation, independently of the Arb proof:
   optimised by a seeded (1 + λ) evolution strategy on the largest V / c.
 
 The plant is the kinematic model the proof covers (x' = u cos ψ + ω_x, y' = u sin ψ + ω_y,
-z' = w + ω_z, ψ' = r), RK4 over each tick with the law's input held. The budget counts
+z' = w + ω_z, ψ' = r + ε_r, |ε_r| <= E_r the yaw-rate error), RK4 over each tick with the law's input
+held; the law sees the time since the hand-over (its ramp starts at the start of each run). The budget counts
 simulations, never seconds; the search is deterministic for a seed. The closed-loop attack on
 runs in which the backup engages is :func:`verify.falsify.backup_loop.falsify_backup_loop`.
 """
@@ -27,7 +29,8 @@ from typing import Callable
 import numpy as np
 
 from tubekit.exceptions import ConfigError
-from tubekit.model.backup import BackupPlan, axis_angle, line_of_sight_angle, station_keeping_input
+from tubekit.model.backup import (BackupPlan, StationKeeping, axis_angle, axis_shape, line_of_sight_angle,
+                                  station_keeping_input)
 from tubekit.plant.kinematic import rk4_tuple
 from verify.falsify.outcome import SearchOutcome
 
@@ -41,15 +44,18 @@ _LAMBDA, _STEP = 4, 0.2
 #: RK4 sub-steps per tick.
 _SUBSTEPS = 4
 
-#: ``disturbance(t, state, v) -> ω`` (m/s) for one tick.
+#: ``disturbance(t, state, v) -> (ω_x, ω_y, ω_z, ε_r)`` (m/s, rad/s) for one tick.
 Adversary = Callable[[float, np.ndarray, tuple[float, float, float]], np.ndarray]
 
 
-def backup_lyapunov(state: np.ndarray, anchor: np.ndarray, shape: float) -> float:
-    """V = d + β(1 − cos χ) (m) of ``state`` [x, y, z, ψ] about ``anchor`` [x*, y*, z*] with β = ``shape``."""
+def backup_lyapunov(state: np.ndarray, anchor: np.ndarray, shape: float, law: StationKeeping | None = None) -> float:
+    """V = d + β a(χ) (m) of ``state`` [x, y, z, ψ] about ``anchor`` [x*, y*, z*] with β = ``shape``:
+    a = 1 − cos χ, or the continuous law's a(χ) when ``law`` has ``yaw_law="continuous"``."""
     d = math.hypot(state[0] - anchor[0], state[1] - anchor[1])
     phi = line_of_sight_angle(float(state[0]), float(state[1]), float(state[3]), float(anchor[0]), float(anchor[1]))
-    return d + shape * (1.0 - math.cos(axis_angle(phi)))
+    if law is None:
+        return d + shape * (1.0 - math.cos(axis_angle(phi)))
+    return d + shape * axis_shape(law, phi)
 
 
 def handover_start(plan: BackupPlan, unit: np.ndarray) -> np.ndarray:
@@ -67,12 +73,14 @@ def handover_start(plan: BackupPlan, unit: np.ndarray) -> np.ndarray:
 
 
 def _rk4_tick(state: np.ndarray, v: tuple[float, float, float], omega: np.ndarray, tick: float) -> np.ndarray:
-    """The kinematic plant ẋ = f(x) v + ω over one tick, ``v`` and ``omega`` held: the plant's own RK4
+    """The kinematic plant ẋ = f(x) v + ω over one tick, ``v`` and ``omega`` held (a fourth entry of
+    ``omega``, when present, is the yaw-rate error ε_r): the plant's own RK4
     (:func:`tubekit.plant.kinematic.rk4_tuple`, :data:`_SUBSTEPS` steps)."""
-    w1, w2, w3 = (float(c) for c in omega)
+    w1, w2, w3 = (float(c) for c in omega[:3])
+    w4 = float(omega[3]) if len(omega) > 3 else 0.0
 
     def rhs(t: float, x: tuple, vv: tuple) -> tuple[float, float, float, float]:
-        return (vv[0] * math.cos(x[3]) + w1, vv[0] * math.sin(x[3]) + w2, vv[1] + w3, vv[2])
+        return (vv[0] * math.cos(x[3]) + w1, vv[0] * math.sin(x[3]) + w2, vv[1] + w3, vv[2] + w4)
 
     return np.array(rk4_tuple(rhs, 0.0, tuple(map(float, state)), v, tick / _SUBSTEPS, _SUBSTEPS))
 
@@ -83,34 +91,40 @@ def simulate_backup(plan: BackupPlan, start: np.ndarray, adversary: Adversary, *
     law, safe = plan.law, plan.safe_set
     state = np.asarray(start, dtype=float)
     anchor = np.zeros(3)
-    level = backup_lyapunov(state, anchor, safe.shape)
+    level = backup_lyapunov(state, anchor, safe.shape, law)
     depth = abs(state[2])
     for k in range(int(round(seconds / tick))):
-        v = station_keeping_input(law, tuple(map(float, state)), (0.0, 0.0, 0.0))
+        v = station_keeping_input(law, tuple(map(float, state)), (0.0, 0.0, 0.0), k * tick)
         state = _rk4_tick(state, v, adversary(k * tick, state, v), tick)
-        level = max(level, backup_lyapunov(state, anchor, safe.shape))
+        level = max(level, backup_lyapunov(state, anchor, safe.shape, law))
         depth = max(depth, abs(state[2]))
     return level / safe.level, depth / safe.depth
 
 
-def _greedy(plan: BackupPlan, omega_xy: float, omega_z: float, tick: float, directions: int) -> Adversary:
-    """Each tick, the current on ‖ω_xy‖ = ω̄_xy (of ``directions``) that ends the tick at the largest V."""
+def _greedy(plan: BackupPlan, omega_xy: float, omega_z: float, tick: float, directions: int,
+            yaw_error: float = 0.0) -> Adversary:
+    """Each tick, the current on ‖ω_xy‖ = ω̄_xy (of ``directions``), and the yaw error ε_r ∈ {−E_r, 0, E_r}
+    (0 alone when E_r = 0), that ends the tick at the largest V."""
     angles = np.linspace(0.0, 2 * math.pi, directions, endpoint=False)
+    errors = (-yaw_error, 0.0, yaw_error) if yaw_error > 0 else (0.0,)
     shape = plan.safe_set.shape
 
     def omega(t: float, state: np.ndarray, v: tuple[float, float, float]) -> np.ndarray:
         wz = omega_z if state[2] >= 0 else -omega_z
-        options = [np.array([omega_xy * math.cos(a), omega_xy * math.sin(a), wz]) for a in angles]
-        return max(options, key=lambda w: backup_lyapunov(_rk4_tick(state, v, w, tick), np.zeros(3), shape))
+        options = [np.array([omega_xy * math.cos(a), omega_xy * math.sin(a), wz, e]) for a in angles
+                   for e in errors]
+        return max(options, key=lambda w: backup_lyapunov(_rk4_tick(state, v, w, tick), np.zeros(3), shape, plan.law))
     return omega
 
 
-def _piecewise(omega_xy: float, omega_z: float, piece: float, units: np.ndarray) -> Adversary:
-    """One ω per ``piece`` seconds from ``units`` (pieces, 3) in [0, 1]: direction, magnitude, heave."""
+def _piecewise(omega_xy: float, omega_z: float, piece: float, units: np.ndarray, yaw_error: float = 0.0) -> Adversary:
+    """One ω per ``piece`` seconds from ``units`` (pieces, 3 or 4) in [0, 1]: direction, magnitude, heave
+    and, with a fourth column, the yaw-rate error ε_r = E_r (2 u − 1)."""
     table = []
     for u in np.clip(units, 0.0, 1.0):
         a, mag = 2 * math.pi * u[0], omega_xy * min(1.0, 2.0 * u[1])
-        table.append(np.array([mag * math.cos(a), mag * math.sin(a), omega_z * (2.0 * u[2] - 1.0)]))
+        eps = yaw_error * (2.0 * u[3] - 1.0) if len(u) > 3 else 0.0
+        table.append(np.array([mag * math.cos(a), mag * math.sin(a), omega_z * (2.0 * u[2] - 1.0), eps]))
 
     def omega(t: float, state: np.ndarray, v: tuple[float, float, float]) -> np.ndarray:
         return table[min(int(t / piece + 1e-9), len(table) - 1)]
@@ -177,7 +191,8 @@ def _validate(budget: int, seconds: float, piece: float, tick: float) -> None:
 
 
 def falsify_backup(plan: BackupPlan, *, omega_xy: float, omega_z: float, tick: float, budget: int = 12,
-                   seconds: float = 20.0, piece: float = 1.0, seed: int = 0, directions: int = 8) -> BackupAttack:
+                   seconds: float = 20.0, piece: float = 1.0, seed: int = 0, directions: int = 8,
+                   yaw_rate_error: float = 0.0) -> BackupAttack:
     """Search hand-over starts and currents within (ω̄_xy, ω̄_z) for a run that leaves the safe set.
 
     Parameters
@@ -197,11 +212,16 @@ def falsify_backup(plan: BackupPlan, *, omega_xy: float, omega_z: float, tick: f
         Seed; the search is deterministic for a seed.
     directions : int
         Current directions the greedy adversary compares each tick.
+    yaw_rate_error : float
+        E_r (rad/s): the adversary also chooses ψ̇ − r in [−E_r, E_r] (0: the kinematic plant's exact yaw).
     """
     _validate(budget, seconds, piece, tick)
+    if not isinstance(yaw_rate_error, (int, float)) or not math.isfinite(yaw_rate_error) or yaw_rate_error < 0:
+        raise ConfigError("yaw_rate_error", "a finite number >= 0 (rad/s)", yaw_rate_error)
+    cols = 4 if yaw_rate_error > 0 else 3
     rng = np.random.default_rng(seed)
     runs: list[BackupRun] = []
-    greedy = _greedy(plan, omega_xy, omega_z, tick, directions)
+    greedy = _greedy(plan, omega_xy, omega_z, tick, directions, yaw_rate_error)
     for _ in range(max(1, budget // 4)):
         start = handover_start(plan, rng.uniform(0, 1, BACKUP_START_DIM))
         runs.append(BackupRun("greedy", tuple(map(float, start)),
@@ -210,13 +230,14 @@ def falsify_backup(plan: BackupPlan, *, omega_xy: float, omega_z: float, tick: f
 
     def evaluate(genome: np.ndarray) -> BackupRun:
         start = handover_start(plan, genome[:BACKUP_START_DIM])
-        adversary = _piecewise(omega_xy, omega_z, piece, genome[BACKUP_START_DIM:].reshape(pieces, 3))
+        adversary = _piecewise(omega_xy, omega_z, piece, genome[BACKUP_START_DIM:].reshape(pieces, cols),
+                               yaw_rate_error)
         return BackupRun("evolution", tuple(map(float, start)),
                          *simulate_backup(plan, start, adversary, tick=tick, seconds=seconds))
 
     if len(runs) < budget:
-        parent = rng.uniform(0, 1, BACKUP_START_DIM + 3 * pieces)
-        parent[BACKUP_START_DIM + 1::3] = 1.0  # every piece on the circle ‖ω_xy‖ = ω̄_xy
+        parent = rng.uniform(0, 1, BACKUP_START_DIM + cols * pieces)
+        parent[BACKUP_START_DIM + 1::cols] = 1.0  # every piece on the circle ‖ω_xy‖ = ω̄_xy
         best = evaluate(parent)
         runs.append(best)
         while len(runs) < budget:

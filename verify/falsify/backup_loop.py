@@ -58,8 +58,8 @@ def backup_figures(sim: CertifiedRun) -> tuple[float, float]:
     anchors = getattr(run, "backup_anchor", None)
     if backup is None or anchors is None or not np.any(active):
         return seconds, math.nan
-    level = max(backup_lyapunov(run.states[k], np.asarray(anchors[k], dtype=float), backup.safe_set.shape)
-                for k in np.flatnonzero(active))
+    level = max(backup_lyapunov(run.states[k], np.asarray(anchors[k], dtype=float), backup.safe_set.shape,
+                                backup.law) for k in np.flatnonzero(active))
     return seconds, level / backup.safe_set.level
 
 

@@ -1,0 +1,96 @@
+"""verify.dynamic: the dynamic plant's loop bound composed with ω̄, the tube and the backup."""
+
+from __future__ import annotations
+
+import json
+import math
+
+import pytest
+
+from tubekit.scenario import load_scenario, scenario_from_dict
+from verify.certificate import Certificate, certify
+from verify.dynamic import PLAN_CHECK_TOLERANCE, plan_jumps
+from verify.recheck import recheck
+
+PAPER_CURRENTS = "verify/scenarios/paper_currents.toml"
+
+
+def _dynamic(vehicle: str = "bluerov2_heavy", rate: list | None = None, **changes) -> object:
+    d = load_scenario(PAPER_CURRENTS).to_dict()
+    d["plant"] = {"kind": "dynamic", "vehicle": vehicle}
+    if rate is not None:
+        d["limits"]["rate"] = rate
+    d["duration"] = 20.0
+    d.update(changes)
+    return scenario_from_dict(d)
+
+
+def _failed(cert: Certificate) -> set[str]:
+    return {c.condition for c in cert.failures}
+
+
+def test_plan_jumps_are_the_rate_times_the_period_or_twice_v():
+    """J = ρ δ (+ the plan check's 1e-9) with δ = 0.1 s; without a rate limit any two commands of V: 2V."""
+    assert plan_jumps(_dynamic(rate=[0.1, 0.2, 0.4])) == pytest.approx((0.01, 0.02, 0.04), rel=1e-6)
+    assert all(j >= x + 1e-9 for j, x in zip(plan_jumps(_dynamic(rate=[0.1, 0.2, 0.4])), (0.01, 0.02, 0.04)))
+    assert plan_jumps(_dynamic()) == pytest.approx((0.8, 0.6, 1.0))  # V = (0.4, 0.3, 0.5)
+
+
+def test_the_tolerance_is_the_plan_checks():
+    from tubekit.loop.plan_check import RATE_TOLERANCE
+    assert PLAN_CHECK_TOLERANCE == RATE_TOLERANCE
+
+
+def test_a_dynamic_scenario_without_a_rate_limit_is_refused_by_name():
+    cert = certify(_dynamic())
+    assert "limits_rate" in _failed(cert)
+    assert cert.tiers == {"safe": False, "tracking": False}
+    assert cert.velocity_loop is not None and cert.sigma.value == 0.0
+
+
+def test_remus_fins_cannot_turn_or_heave_at_low_speed():
+    """REMUS 100's rudder and stern planes give ∝ u²: nothing at u = 0, which V contains."""
+    cert = certify(_dynamic("remus100", rate=[0.1, 0.1, 0.2]))
+    failed = _failed(cert)
+    assert {"loop_saturation[Z]", "loop_saturation[N]"} <= failed
+    text = next(c for c in cert.plant_conditions if c.condition == "loop_saturation[N]")
+    assert text.rhs == 0.0                                   # the smallest yaw moment over |u| <= u_max
+    assert not cert.tiers["safe"]
+
+
+def test_a_kinematic_certificate_has_no_loop_part():
+    cert = certify(load_scenario(PAPER_CURRENTS))
+    assert cert.velocity_loop is None and cert.plant_conditions == ()
+    assert not any(c.condition.startswith(("loop_", "rate_authority")) for c in cert.conditions)
+
+
+def test_sigma_other_than_zero_fails_on_the_dynamic_plant():
+    d = _dynamic(rate=[0.1, 0.1, 0.2]).to_dict()
+    d["controller"]["sigma"] = 3.125
+    cert = certify(scenario_from_dict(d))
+    assert "loop_kappa" in _failed(cert)
+
+
+def test_a_dynamic_certificate_round_trips_and_rechecks():
+    cert = certify(_dynamic(rate=[0.1, 0.1, 0.2]))
+    data = json.loads(json.dumps(cert.to_dict(), allow_nan=False))
+    again = Certificate.from_dict(data)
+    assert again.plant_conditions == cert.plant_conditions
+    assert again.velocity_loop == cert.velocity_loop
+    assert recheck(data).ok
+
+
+def test_an_edited_loop_bound_is_caught_by_recheck():
+    """A stored loop bound smaller than derived is a disagreement naming the field."""
+    cert = certify(_dynamic(rate=[0.1, 0.1, 0.2]))
+    data = json.loads(json.dumps(cert.to_dict(), allow_nan=False))
+    loop = data["velocity_loop"]
+    if not all(isinstance(x, float) and math.isfinite(x) for x in loop["error"]):
+        loop["error"] = [0.0, 0.0, 0.0]
+    else:
+        loop["error"] = [x / 2 for x in loop["error"]]
+    from verify.certificate_json import checksum_of
+    data["checksum"] = checksum_of(data)
+    result = recheck(data)
+    assert not result.ok
+    assert any(c["name"].startswith("velocity_loop") and not c["ok"] for c in result.checks)

@@ -1,0 +1,138 @@
+"""Rows the FHOCP adds to the plain NLP: the backup's terminal rows (:class:`BackupTerminal`), the
+command-rate rows (issue 22, design (1)) and the rate penalty (issue 24 item 8).
+
+With J = ``scenario.limits.rate`` * dt (per component, m/s, m/s, rad/s) every plan v_0..v_{N-1} meets
+
+* (a) |v_{k+1} - v_k| <= J between consecutive nodes;
+* (b) |v_0 - v_last| <= J, v_last the command applied in the last tick before the plan starts;
+* (c) |v_{N-1}| <= J (terminal rest) when the tightening gates plans by a certified backup.
+
+The FHOCP imposes them with J (1 - :data:`RATE_MARGIN`) (room for the solver's tolerance);
+:func:`rate_project` removes what the solver's tolerance leaves over; the exact plan check
+(:func:`tubekit.loop.plan_check.check_rates`) reads J itself. The rate penalty (weight lambda, s)
+is :func:`rate_penalty_cost`.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from tubekit.scenario import Scenario
+from tubekit.tightening import Tightening
+
+__all__ = ["RATE_MARGIN", "rate_violation", "rate_project", "rate_penalty_cost", "BackupTerminal"]
+
+#: The FHOCP imposes J (1 - RATE_MARGIN): room for the solver's tolerance below the J the exact check reads.
+RATE_MARGIN = 1e-4
+
+
+def rate_violation(inputs: np.ndarray, jump: np.ndarray, v_last: np.ndarray | None = None,
+                   rest: bool = False) -> dict[str, float]:
+    """Largest violation (>= 0, input units) of each rate row of ``inputs`` (N, 3) against ``jump`` J (3,).
+
+    Keys ``"between nodes"`` (|v_{k+1} - v_k| <= J), ``"first node"`` (|v_0 - v_last| <= J; only with
+    ``v_last``) and ``"terminal rest"`` (|v_{N-1}| <= J; only with ``rest``).
+    """
+    v = np.asarray(inputs, dtype=float)
+    j = np.asarray(jump, dtype=float)
+    steps = (np.abs(v[1:] - v[:-1]) - j).max() if len(v) > 1 else 0.0
+    out = {"between nodes": max(0.0, float(steps))}
+    if v_last is not None:
+        out["first node"] = max(0.0, float((np.abs(v[0] - v_last) - j).max()))
+    if rest:
+        out["terminal rest"] = max(0.0, float((np.abs(v[-1]) - j).max()))
+    return out
+
+
+def rate_project(inputs: np.ndarray, jump: np.ndarray, v_max: np.ndarray, v_last: np.ndarray | None = None,
+                 rest: bool = False) -> np.ndarray:
+    """``inputs`` (N, 3) made to meet the rate rows (forward clamp), inside the box ``v_max``.
+
+    Node k is clipped to [v_{k-1} - J, v_{k-1} + J] (v_{-1} = ``v_last``; none without it), to the box
+    and, with ``rest``, to |v_k| <= (N - k) J, which keeps the terminal rest reachable; when the rest
+    bound and the step bound do not meet (v_last too far from rest) the step bound wins. A plan
+    that already meets every row comes back unchanged. Returns a new array.
+    """
+    v = np.array(inputs, dtype=float)
+    if max(rate_violation(v, jump, v_last, rest).values()) <= 0.0 and (np.abs(v) <= v_max).all():
+        return v
+    n = v.shape[0]
+    rows = v.tolist()  # plain floats: N x 3 scalars clamp faster than numpy calls per node
+    js, vm = [float(x) for x in jump], [float(x) for x in v_max]
+    prev = None if v_last is None else [float(x) for x in v_last]
+    for k in range(n):
+        for c in range(3):
+            lo, hi = -vm[c], vm[c]
+            if prev is not None:
+                lo, hi = max(lo, prev[c] - js[c]), min(hi, prev[c] + js[c])
+            if rest:
+                reach = (n - k) * js[c]
+                if max(lo, -reach) <= min(hi, reach):
+                    lo, hi = max(lo, -reach), min(hi, reach)
+            rows[k][c] = min(max(rows[k][c], lo), hi)
+        prev = rows[k]
+    return np.array(rows, dtype=float)
+
+
+def rate_penalty_cost(inputs: np.ndarray, weight: np.ndarray, v_last: np.ndarray | None = None) -> float:
+    """sum_c weight_c (sum_k (v_k,c - v_{k-1},c)^2 + (v_0,c - v_last,c)^2) (the last term only with ``v_last``).
+
+    ``weight`` (3,) is lambda R (the rate penalty times the input weights).
+    """
+    v = np.asarray(inputs, dtype=float)
+    d = np.diff(v, axis=0)
+    total = float(np.einsum("kc,kc,c->", d, d, weight))
+    if v_last is not None:
+        d0 = v[0] - np.asarray(v_last, dtype=float)
+        total += float(np.einsum("c,c,c->", d0, d0, weight))
+    return total
+
+
+@dataclass(frozen=True)
+class BackupTerminal:
+    """The backup's terminal condition as the FHOCP carries it at the last node (module doc).
+
+    Attributes
+    ----------
+    sphere : float
+        hypot(R_f, H_f) (m): added to each obstacle radius at p_N (no obstacle margin: p_N is the
+        plan's exact nominal end, the point the exact check reads).
+    footprint : (float, float)
+        (R_f, H_f) (m): the workspace box shrunk by it holds p_N.
+    safe : (float, float)
+        (c, Z) (m): the safe set's radius and depth, for the sensed-region row.
+    sensed_bound : float
+        R_bar - vehicle radius (m).
+    """
+
+    sphere: float
+    footprint: tuple[float, float]
+    safe: tuple[float, float]
+    sensed_bound: float
+
+    @classmethod
+    def of(cls, scenario: Scenario, tightening: Tightening) -> "BackupTerminal | None":
+        """The terminal rows of ``tightening.terminal_backup`` on ``scenario`` (None without a certified backup)."""
+        backup = tightening.terminal_backup
+        if backup is None:
+            return None
+        r_f, h_f = backup.footprint(scenario.vehicle_radius)
+        return cls(sphere=math.hypot(r_f, h_f), footprint=(r_f, h_f),
+                   safe=(backup.safe_set.radius, backup.safe_set.depth),
+                   sensed_bound=scenario.sensing_range - scenario.vehicle_radius)
+
+    def violation(self, p0: np.ndarray, pn: np.ndarray, obstacles: np.ndarray,
+                  workspace: np.ndarray | None) -> float:
+        """Largest violation (m, >= 0) of the rows at the end position ``pn`` sensed from ``p0``."""
+        worst = 0.0
+        if len(obstacles):
+            dist = np.linalg.norm(obstacles[:, :3] - pn[None, :], axis=1)
+            worst = max(worst, float(np.max(obstacles[:, 3] + self.sphere - dist)))
+        if workspace is not None:
+            pad = np.array([self.footprint[0], self.footprint[0], self.footprint[1]])
+            worst = max(worst, float(np.max(workspace[0] + pad - pn)), float(np.max(pn - workspace[1] + pad)))
+        spread = math.hypot(math.hypot(pn[0] - p0[0], pn[1] - p0[1]) + self.safe[0], abs(pn[2] - p0[2]) + self.safe[1])
+        return max(worst, spread - self.sensed_bound)

@@ -1,0 +1,170 @@
+"""The continuous yaw law's level-set proof, in Arb (issue 22).
+
+The law (:class:`tubekit.model.backup.StationKeeping` with ``yaw_law="continuous"``) turns with
+r = −k ρ(φ) G, ρ π-periodic, Lipschitz 1/χ_0, with a stable zero at χ = 0 and an unstable zero at
+χ_u ∈ (0, χ_c), χ_c = acos √(ω̄_xy/u_b): inside the cone |χ| < χ_c surge alone closes in. Since ρ has the
+same sign on both sides of abeam, the command is continuous: no ridge.
+
+Lift the axis angle to x ∈ [0, π] (x = φ mod π; x and x − π are the same axis). Held over a tick,
+φ' = φ + δ with |δ| <= Δ, and every product of two π-antiperiodic functions of φ, φ' is π-periodic, so
+
+    ḋ = −u_b cos x' cos x + ω_r,   ẋ = −k ρ(x') + ε_r + (u_b cos x' sin x − ω_t) / d,   x' ∈ [x − Δ, x + Δ]
+
+(fades and ramp are 1 at the tick starts that matter: ``backup_fade``, ``backup_ramp``). With
+V = d + β a(x), a of :func:`tubekit.model.backup.axis_shape` (0 at x = 0 and π, 1 on [χ_p, χ_u], a' of
+the sign of ρ or 0), the supremum over ‖ω_xy‖ <= ω̄_xy and |ε_r| <= E_r of V̇ on V = c is
+
+    −u_b cos x' cos x + ω̄_xy √(1 + (β a'/d)²) + β a' (−k ρ(x') + u_b cos x' sin x / d) + β |a'| E_r,
+
+with d = c − β a(x) on the level set. :func:`continuous_rate_bound` bounds it over x ∈ [0, π] (the whole
+circle: no mirror symmetry) by Arb bisection. On the plateau [χ_p, χ_u] (a' = 0), near χ_u and near 0,
+V̇ is ḋ < 0 because cos² χ_u > ω̄_xy/u_b (``backup_unstable``); elsewhere β a' ẋ < 0 dominates. The
+ridge condition of the ridge law disappears.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from flint import arb
+
+from tubekit.model.backup import SafeSet, StationKeeping
+from verify.design import Condition
+from verify.intervals import enclose, lower, upper
+
+__all__ = ["continuous_rate_bound", "continuous_rate_sampled", "unstable_condition", "cone_angle",
+           "shape_enclosure", "yaw_shape_enclosure"]
+
+_PI_UP = math.nextafter(math.pi, math.inf)
+
+
+def cone_angle(surge: float, omega_xy: float) -> float:
+    """χ_c = acos √(ω̄_xy/u_b) (rad), a float <= the true value: inside |χ| < χ_c surge alone closes in."""
+    if omega_xy >= surge:
+        return 0.0
+    return max(0.0, lower((arb(omega_xy) / arb(surge)).sqrt().acos()))
+
+
+def unstable_condition(law: StationKeeping, omega_xy: float) -> Condition:
+    """``backup_unstable``: u_b cos² χ_u > ω̄_xy (0 < χ_u < χ_c), so the radial speed is negative at χ_u."""
+    closing = lower(arb(law.surge) * arb(law.unstable).cos() ** 2)
+    return Condition("backup_unstable", "ω̄_xy < u_b cos² χ_u (0 < χ_u < χ_c)", omega_xy, closing,
+                     omega_xy < closing, f"χ_u {law.unstable:.4g} rad, χ_c {cone_angle(law.surge, omega_xy):.4g} rad")
+
+
+def _pieces(lo: float, hi: float, cut: arb) -> list[tuple[arb, int]]:
+    """Split [lo, hi] ⊂ [−π, 2π] (rad) into balls on one arc each, shifted by a multiple of π into [0, π]:
+    (ball, arc), arc 0 = [0, χ_u] (ρ >= 0), arc 1 = [χ_u, π] (ρ <= 0)."""
+    pi = arb.pi()
+    out = []
+    for shift in (-1, 0, 1):
+        for arc, start, stop in ((0, arb(0), cut), (1, cut, pi)):
+            a, b = max(lo, lower(start + shift * pi)), min(hi, upper(stop + shift * pi))
+            if a <= b:
+                out.append((enclose(a, b) - shift * pi, arc))
+    return out
+
+
+def _arc_clip(x: arb, arc: int, cut: arb) -> arb:
+    """``x`` intersected with its arc (the shift by π may push it out by a rounding)."""
+    lo, hi = (arb(0), cut) if arc == 0 else (cut, arb.pi())
+    return enclose(max(lower(x), lower(lo)), max(min(upper(x), upper(hi)), max(lower(x), lower(lo))))
+
+
+def yaw_shape_enclosure(law: StationKeeping, lo: float, hi: float) -> arb:
+    """An arb containing ρ(x) for every x ∈ [lo, hi] (rad, lifted axis angle; any real interval in [−π, 2π])."""
+    band, cut = arb(law.yaw_band), arb(law.unstable)
+    low, high = math.inf, -math.inf
+    for x, arc in _pieces(lo, hi, cut):
+        x = _arc_clip(x, arc, cut)
+        ends = (x / band, (cut - x) / band) if arc == 0 else ((x - cut) / band, (arb.pi() - x) / band)
+        small = min(1.0, lower(ends[0]), lower(ends[1]))  # min of increasing / decreasing pieces
+        large = min(1.0, upper(ends[0]), upper(ends[1]))
+        small, large = max(small, 0.0), max(large, 0.0)
+        if arc == 1:
+            small, large = -large, -small
+        low, high = min(low, small), max(high, large)
+    return enclose(low, high)
+
+
+def shape_enclosure(law: StationKeeping, lo: float, hi: float) -> tuple[arb, arb]:
+    """Arbs containing a(x) and a'(x) for every x ∈ [lo, hi] ⊂ [−π, 2π] (the lifted axis angle, rad)."""
+    cut, pi, top = arb(law.unstable), arb.pi(), law.plateau
+    parts = []
+    for x, arc in _pieces(lo, hi, cut):
+        x = _arc_clip(x, arc, cut)
+        if arc == 1:
+            scale = pi / (pi - cut)
+            arg = scale * (pi - x)
+            parts.append(((1 - arg.cos()) / 2, -scale / 2 * arg.sin()))
+            continue
+        low, high = lower(x), upper(x)  # a = (1 − cos(π min(x, χ_p)/χ_p))/2 on [0, χ_u]
+        scale = pi / arb(top)
+        arg = scale * enclose(min(low, top), min(high, top))
+        slope = scale / 2 * arg.sin() if low < top else arb(0)
+        if high >= top:
+            slope = enclose(min(0.0, lower(slope)), max(0.0, upper(slope)))
+        parts.append(((1 - arg.cos()) / 2, slope))
+    a = enclose(min(lower(p[0]) for p in parts), max(upper(p[0]) for p in parts))
+    da = enclose(min(lower(p[1]) for p in parts), max(upper(p[1]) for p in parts))
+    return enclose(max(0.0, lower(a)), min(1.0, upper(a))), da
+
+
+def _rate_upper(law: StationKeeping, safe: SafeSet, omega_xy: float, delta: float, a: float, b: float,
+                yaw_err: float) -> float:
+    """An upper bound (m/s) of V̇ over x ∈ [a, b] on the level set, every held x' within Δ and every ω."""
+    x = enclose(a, b)
+    beta, ub = arb(safe.shape), arb(law.surge)
+    shape, slope = shape_enclosure(law, a, b)
+    d = arb(safe.level) - beta * shape
+    g = beta * slope
+    held = enclose(a - delta, b + delta)
+    held_cos = held.cos()
+    rho = yaw_shape_enclosure(law, a - delta, b + delta)
+    rate = (-ub * held_cos * x.cos() + arb(omega_xy) * (1 + (g / d) ** 2).sqrt()
+            + g * (-arb(law.yaw_rate) * rho + ub * held_cos * x.sin() / d) + abs(g) * arb(yaw_err))
+    return upper(rate)
+
+
+def continuous_rate_bound(law: StationKeeping, safe: SafeSet, omega_xy: float, delta: float, max_boxes: int,
+                          yaw_rate_error: float = 0.0) -> tuple[float, int]:
+    """(bound, intervals): an upper bound (m/s) of V̇ on V = c over the lifted circle x ∈ [0, π], by bisection.
+
+    ``delta`` is the tick drift Δ (rad) of the axis angle; an interval is split until its bound is
+    negative or the budget ``max_boxes`` is spent (then the bound returned is the largest in the cover).
+    """
+    pending, done, used = [(0.0, _PI_UP)], [], 0
+    while pending:
+        a, b = pending.pop()
+        bound = _rate_upper(law, safe, omega_xy, delta, a, b, yaw_rate_error)
+        used += 1
+        if bound < 0.0 or used + len(pending) >= max_boxes or b - a < 1e-9:
+            done.append(bound)
+            continue
+        mid = 0.5 * (a + b)
+        pending += [(mid, b), (a, mid)]
+    return max(done), used
+
+
+def _profiles(law: StationKeeping, x: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(a, a', ρ) at lifted angles ``x`` ∈ [0, π] (rad), in floats (the design's filter)."""
+    cut, band, top = law.unstable, law.yaw_band, law.plateau
+    first = x <= cut
+    s0, s1 = math.pi / top, math.pi / (math.pi - cut)
+    arg = np.where(first, s0 * np.minimum(x, top), s1 * (math.pi - x))
+    slope = np.where(first, 0.5 * s0 * np.sin(arg), -0.5 * s1 * np.sin(arg))
+    rho = np.where(first, np.minimum(1.0, np.minimum(x, cut - x) / band),
+                   -np.minimum(1.0, np.minimum(x - cut, math.pi - x) / band))
+    return 0.5 * (1.0 - np.cos(arg)), slope, rho
+
+
+def continuous_rate_sampled(law: StationKeeping, safe: SafeSet, omega_xy: float, n: int = 1441,
+                            yaw_err: float = 0.0) -> float:
+    """The largest V̇ (m/s) at sampled x ∈ [0, π] with the input of the same instant (no hold) and the worst ω."""
+    x = np.linspace(0.0, math.pi, n)
+    a, slope, rho = _profiles(law, x)
+    d, g = safe.level - safe.shape * a, safe.shape * slope
+    rate = (-law.surge * np.cos(x) ** 2 + omega_xy * np.sqrt(1 + (g / d) ** 2)
+            + g * (-law.yaw_rate * rho + law.surge * np.cos(x) * np.sin(x) / d) + np.abs(g) * yaw_err)
+    return float(rate.max())

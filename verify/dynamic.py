@@ -1,0 +1,179 @@
+"""The dynamic plant inside the theorem: the velocity loop's bound and the backup's command rate, composed.
+
+On the dynamic plant the kinematic command v is tracked by a velocity loop (``docs/plant.md``). Its error
+E = (E_u, E_w, E_r) (:func:`verify.velocity_loop.velocity_loop_bound`) depends on how far the command
+jumps; the command jumps
+
+* at period boundaries by at most J = ρ δ (the plans' rate limit ``limits.rate``, imposed by the FHOCP and
+  checked by the plan check: between nodes, against the last applied command, and the terminal rest that
+  makes the hand-over to the backup continuous up to J), and
+* at every tick during the backup by at most :func:`verify.backup.backup_tick_change` (the backup law's
+  command rate × h, :func:`verify.backup.backup_command_rate`, finite because the law is faded near its
+  anchor, ramped after the hand-over and, with the continuous yaw law, free of the ridge's jump).
+
+E in turn enters ω̄ (:func:`verify.design.disturbance_bounds`), the tube, the hand-over margins and the
+backup's proof, which fix the backup's command rate. :func:`solve_dynamic` closes this loop as a checked
+fixed point: it *assumes* a bound E_a, derives everything from it, computes E from the resulting jump
+bounds, and certifies only when E <= E_a component-wise (condition ``loop_consistent``). Every step is
+monotone in E_a, so the derived statements hold with E_a in place of E (first exit: the loop error is
+continuous between jumps and the L1 bound covers the jumps).
+
+On the dynamic plant the ancillary feedback is off (σ = 0, κ ≡ 0): κ changes at every tick by an amount
+the loop bound would have to absorb; a scenario asking for σ > 0 fails ``loop_kappa``.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+from flint import arb
+
+from tubekit.scenario import Scenario
+
+from verify.backup import BackupCertificate, backup_tick_change
+from verify.design import Condition, Design, DisturbanceBounds, choose_design, disturbance_bounds
+from verify.gains import GainBounds
+from verify.intervals import upper
+from verify.region import Region
+from verify.tiers import backup_of, safe_only_design, tracking_design
+from verify.velocity_loop import LoopBound, actuator_authority, velocity_loop_bound
+
+__all__ = ["DynamicSolution", "solve_dynamic", "plan_jumps", "FIXED_POINT_ROUNDS", "PLAN_CHECK_TOLERANCE"]
+
+#: Absolute tolerance of the plan check's rate rows (``tubekit.loop.plan_check.RATE_TOLERANCE``; verify may not
+#: import the loop, a test keeps the two equal): an accepted plan jumps by at most ρ δ + this.
+PLAN_CHECK_TOLERANCE = 1e-9
+#: Rounds of the fixed point E_a -> E (a work unit: the verdict is the same on any machine).
+FIXED_POINT_ROUNDS = 6
+#: Growth of the assumed bound over the derived one between rounds.
+_INFLATE = 1.25
+
+
+@dataclass(frozen=True)
+class DynamicSolution:
+    """The composed bounds of a dynamic scenario.
+
+    Attributes
+    ----------
+    loop : LoopBound
+        The velocity loop's bound computed from the jump bounds of the last round.
+    assumed : (3,) floats
+        E_a (m/s, m/s, rad/s): the bound ω̄, the tube and the backup were derived with.
+    dist : DisturbanceBounds
+        ω̄ with E_a.
+    designs, best, safe, backup
+        As :func:`verify.certificate.certify` computes them, with ``dist``.
+    conditions : tuple of Condition
+        The loop's conditions, ``loop_consistent``, ``rate_authority[*]``, ``loop_kappa``.
+    rounds : int
+        Fixed-point rounds used.
+    """
+
+    loop: LoopBound
+    assumed: tuple[float, float, float]
+    dist: DisturbanceBounds
+    designs: tuple[Design, ...]
+    best: Design
+    safe: Design | None
+    backup: BackupCertificate
+    conditions: tuple[Condition, ...]
+    rounds: int
+
+
+def plan_jumps(scenario: Scenario) -> tuple[float, float, float]:
+    """J = ρ δ + the plan check's tolerance per channel (m/s, m/s, rad/s): the largest command change an accepted
+    plan makes per period (between nodes, against the last command, into the terminal rest); 2V without a rate
+    limit (any two commands in V)."""
+    lim, dt = scenario.limits, float(scenario.controller.dt)
+    rate = getattr(lim, "rate", None)
+    if rate is None:
+        return tuple(2.0 * float(x) for x in lim.vector)
+    return tuple(upper(arb(r) * arb(dt) + arb(PLAN_CHECK_TOLERANCE)) for r in rate)
+
+
+def _rate_conditions(scenario: Scenario, v_max: tuple[float, float, float]) -> list[Condition]:
+    """``limits_rate`` (a rate limit is set) and ``rate_authority[c]``: ρ_c <= the acceleration the actuators
+    deliver against drag at the corner of V, over the coefficient box."""
+    rate = getattr(scenario.limits, "rate", None)
+    if rate is None:
+        return [Condition("limits_rate", "limits.rate set (the plans' command jumps bounded by rho delta)", None,
+                          None, False, "without a rate limit a plan may jump by 2V between periods; the loop "
+                          "error after such a jump is of the order of V")]
+    auth = actuator_authority(scenario.plant.params, v_max)
+    return [Condition(f"rate_authority[{ax}]", f"rho_{ax} <= the acceleration the actuators deliver against drag "
+                      "at the corner of V (every coefficient in its interval)", float(r), float(a), bool(r <= a),
+                      "a plan's rate limit must be one the vehicle can follow")
+            for ax, r, a in zip("uwr", rate, auth)]
+
+
+def _kappa_condition(sigma: float) -> Condition:
+    return Condition("loop_kappa", "sigma = 0 on the dynamic plant (no ancillary feedback)", float(sigma), 0.0,
+                     sigma == 0.0, "kappa changes at every tick by an amount no rate limit bounds; the velocity "
+                     "loop's bound covers the plans' jumps and the backup's rate only")
+
+
+def _tiers_at(scenario: Scenario, region: Region, gains: GainBounds, sigmas: tuple[float, ...],
+              assumed: tuple[float, float, float]):
+    dist = disturbance_bounds(scenario, loop_error=assumed)
+    designs = tuple(tracking_design(scenario, region, gains, s, dist) for s in sigmas)
+    best = choose_design(list(designs))
+    safe = None if best.certified else safe_only_design(scenario, region, gains, dist)
+    backup = backup_of(scenario, dist, (safe or best).margins)
+    return dist, designs, best, safe, backup
+
+
+def _loop_at(scenario: Scenario, backup: BackupCertificate, dist: DisturbanceBounds,
+             assumed: tuple[float, float, float]) -> LoopBound:
+    """The loop bound for the jump bounds that ``assumed`` implies (plans: J; backup: its rate × h)."""
+    v_max = tuple(float(x) for x in scenario.limits.vector)
+    tick = 1.0 / float(scenario.controller.ancillary_rate_hz)
+    per_tick = backup_tick_change(backup.law, backup.safe_set, omega_xy=dist.omega_xy, omega_z=dist.omega_z,
+                                  limits=v_max, loop_error=assumed, tick=tick)
+    per_period = tuple(max(j, t) for j, t in zip(plan_jumps(scenario), per_tick))
+    return velocity_loop_bound(scenario.plant.params, v_max=v_max, tick=tick, period=float(scenario.controller.dt),
+                               jump_tick=per_tick, jump_period=per_period)
+
+
+def _consistent(loop: LoopBound, assumed: tuple[float, float, float]) -> Condition:
+    ratio = max((e / a if a > 0 else (math.inf if e > 0 else 0.0)) for e, a in zip(loop.error, assumed))
+    ok = bool(loop.certified and ratio < 1.0)
+    return Condition("loop_consistent", "E derived from the jump bounds < E assumed by omega_bar, the tube and the "
+                     "backup (largest ratio over u, w, r)", ratio if math.isfinite(ratio) else None, 1.0, ok,
+                     f"E = {[round(x, 6) for x in loop.error]}, assumed {[round(x, 6) for x in assumed]}")
+
+
+def solve_dynamic(scenario: Scenario, region: Region, gains: GainBounds,
+                  sigmas: tuple[float, ...]) -> DynamicSolution:
+    """The checked fixed point E_a -> (ω̄, tube, backup) -> jumps -> E (module doc).
+
+    Parameters
+    ----------
+    scenario : Scenario
+        A scenario on the dynamic plant.
+    region, gains : Region, GainBounds
+        As :func:`verify.certificate.certify` computes them.
+    sigmas : tuple of float
+        σ values to try (1/s); the dynamic plant requires 0.
+    """
+    v_max = tuple(float(x) for x in scenario.limits.vector)
+    tick = 1.0 / float(scenario.controller.ancillary_rate_hz)
+    first = velocity_loop_bound(scenario.plant.params, v_max=v_max, tick=tick,
+                                period=float(scenario.controller.dt), jump_tick=(0.0, 0.0, 0.0),
+                                jump_period=plan_jumps(scenario))
+    assumed = tuple(_INFLATE * e if math.isfinite(e) else math.inf for e in first.error)
+    rounds, loop = 0, first
+    while rounds < FIXED_POINT_ROUNDS and all(math.isfinite(a) for a in assumed):
+        rounds += 1
+        dist, designs, best, safe, backup = _tiers_at(scenario, region, gains, sigmas, assumed)
+        loop = _loop_at(scenario, backup, dist, assumed)
+        if not loop.certified or all(e < a for e, a in zip(loop.error, assumed)):
+            break
+        assumed = tuple(max(a, _INFLATE * e) for a, e in zip(assumed, loop.error))
+    if rounds == 0:  # the plans' jumps alone already break the loop: report with a finite stand-in
+        assumed = tuple(e if math.isfinite(e) else float(x) for e, x in zip(first.error, v_max))
+        dist, designs, best, safe, backup = _tiers_at(scenario, region, gains, sigmas, assumed)
+    conds = (*loop.conditions, _consistent(loop, assumed), *_rate_conditions(scenario, v_max),
+             _kappa_condition(best.sigma))
+    return DynamicSolution(loop=loop, assumed=assumed, dist=dist, designs=designs, best=best, safe=safe,
+                           backup=backup, conditions=conds, rounds=rounds)

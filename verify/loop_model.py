@@ -1,0 +1,165 @@
+"""The vehicle of the velocity loop in Arb: coefficient box, forces n(ν), their gradient, the channels.
+
+The plant is M ν̇ + n(ν; θ) = τ with n(ν) = C(ν)ν + D(ν)ν (``tubekit.plant.dynamic.body_forces``;
+``verify`` may not import the plant, so :func:`arb_body_forces` mirrors it in Arb). The true
+coefficients θ lie anywhere in the vehicle's box Θ (:func:`hull_balls`: one ball per coefficient,
+mass entries from the balls of m, I_zz, x_g and the added masses); the controller's feedforward
+uses the nominal vehicle (:func:`nominal_balls`, exact points). n is *linear* in the generalised
+coefficients (m11, m22, m24, X_u, X_u|u|, ...): so n(ν; θ̂) − n(ν; θ) = n(ν; θ̂ − θ), which
+:func:`channel_mismatch` evaluates with the difference balls, free of the dependency problem.
+
+Channels c ∈ (u, w, r): m_u = m11, n_u = n1; m_w = m33, n_w = n3; yaw with the sway row eliminated
+(m22 v̇ + m24 ṙ + n2 = 0): m_r = m44 − m24 m42 / m22, n_r = n4 − (m42 / m22) n2.
+"""
+
+from __future__ import annotations
+
+from typing import Any, Mapping, Sequence
+
+from flint import arb
+
+from tubekit.exceptions import ConfigError
+from verify.intervals import enclose, point, upper
+
+__all__ = ["COEFFICIENTS", "MASS_FIELDS", "field_ball", "nominal_params", "hull_balls", "nominal_balls",
+           "arb_body_forces", "body_force_gradient", "channel_forces", "channel_gradient", "channel_masses",
+           "channel_mismatch", "channel_mismatch_gradient", "velocity_box", "thrust_floor", "point_time_constant"]
+
+#: Hydrodynamic coefficients of n(ν) (``tubekit.model.vehicles.VehicleParams`` field names).
+COEFFICIENTS = ("X_u", "X_uu", "Y_v", "Y_vv", "Y_rr", "Y_uv", "Y_ur_lift", "Z_w", "Z_ww", "Z_uw",
+                "N_r", "N_rr", "N_vv", "N_uv_lift", "N_ur_lift")
+#: Fields of the mass matrix.
+MASS_FIELDS = ("m", "I_zz", "x_g", "X_udot", "Y_vdot", "Z_wdot", "N_rdot", "Y_rdot", "N_vdot")
+_ROUND = 2.0 ** -50   # relative: covers the float rounding of a point vehicle's mass entries
+
+
+def field_ball(params: Any, name: str) -> arb:
+    """The ball of field ``name``: ``params.interval(name)`` when the vehicle has intervals, else its point."""
+    interval = getattr(params, "interval", None)
+    if callable(interval):
+        lo, hi = interval(name)
+        return enclose(lo, hi)
+    return point(getattr(params, name))
+
+
+def nominal_params(params: Any) -> Any:
+    """The controller's point vehicle: ``params.nominal`` (midpoints) when present, else ``params``."""
+    return getattr(params, "nominal", params)
+
+
+def _mass_balls(f: Mapping[str, arb]) -> dict[str, arb]:
+    """m11, m22, m33, m44, m24, m42 from the field balls, widened by the float rounding of a point set."""
+    m, xg = f["m"], f["x_g"]
+    raw = {"m11": m - f["X_udot"], "m22": m - f["Y_vdot"], "m33": m - f["Z_wdot"], "m44": f["I_zz"] - f["N_rdot"],
+           "m24": m * xg - f["Y_rdot"], "m42": m * xg - f["N_vdot"]}
+    return {k: v + arb(0, upper(abs(v)) * _ROUND) for k, v in raw.items()}
+
+
+def hull_balls(params: Any) -> dict[str, arb]:
+    """Balls of every coefficient and mass entry over the vehicle's box Θ (the true plant)."""
+    f = {name: field_ball(params, name) for name in COEFFICIENTS + MASS_FIELDS}
+    return {**{k: f[k] for k in COEFFICIENTS}, **_mass_balls(f)}
+
+
+def nominal_balls(params: Any) -> dict[str, arb]:
+    """Exact points of the nominal vehicle (the feedforward n̂, m̂ the plant's controller uses)."""
+    nom = nominal_params(params)
+    out = {k: point(getattr(nom, k)) for k in COEFFICIENTS}
+    out.update(zip(("m11", "m22", "m33", "m44", "m24", "m42"), (point(x) for x in nom.mass_entries)))
+    return out
+
+
+def _abs(x: arb) -> arb:
+    """|x| as the ball [min |x|, max |x|] (Arb's ``abs`` keeps the radius, so |[−a, a]| would reach below 0)."""
+    return arb(x.abs_lower()).union(arb(x.abs_upper()))
+
+
+def arb_body_forces(c: Mapping[str, arb], nu: Sequence[arb]) -> tuple[arb, arb, arb, arb]:
+    """n(ν) = C(ν)ν + D(ν)ν (N, N, N, N m) in Arb: the mirror of ``tubekit.plant.dynamic.body_forces``.
+
+    ``c`` maps the coefficient names and m11, m22, m24 to balls; ``nu`` = (u, v, w, r) balls.
+    """
+    u, v, w, r = (arb(x) for x in nu)
+    au, av, aw, ar = _abs(u), _abs(v), _abs(w), _abs(r)
+    q = c["m22"] * v + c["m24"] * r
+    d1 = -(c["X_u"] + c["X_uu"] * au) * u
+    d2 = -(c["Y_v"] + c["Y_vv"] * av) * v - c["Y_rr"] * r * ar - c["Y_uv"] * u * v - c["Y_ur_lift"] * u * r
+    d3 = -(c["Z_w"] + c["Z_ww"] * aw) * w - c["Z_uw"] * u * w
+    d4 = -(c["N_r"] + c["N_rr"] * ar) * r - c["N_vv"] * v * av - c["N_uv_lift"] * u * v - c["N_ur_lift"] * u * r
+    return -q * r + d1, c["m11"] * u * r + d2, d3, q * u - c["m11"] * u * v + d4
+
+
+def body_force_gradient(c: Mapping[str, arb], nu: Sequence[arb]) -> tuple[tuple[arb, ...], ...]:
+    """∂n_i/∂ν_j (rows n1..n4, columns u, v, w, r), by hand from :func:`arb_body_forces` (d(x|x|)/dx = 2|x|)."""
+    u, v, w, r = (arb(x) for x in nu)
+    au, av, aw, ar = _abs(u), _abs(v), _abs(w), _abs(r)
+    m11, m22, m24, zero = c["m11"], c["m22"], c["m24"], arb(0)
+    g1 = (-c["X_u"] - 2 * c["X_uu"] * au, -m22 * r, zero, -m22 * v - 2 * m24 * r)
+    g2 = (m11 * r - c["Y_uv"] * v - c["Y_ur_lift"] * r, -c["Y_v"] - 2 * c["Y_vv"] * av - c["Y_uv"] * u, zero,
+          m11 * u - 2 * c["Y_rr"] * ar - c["Y_ur_lift"] * u)
+    g3 = (-c["Z_uw"] * w, zero, -c["Z_w"] - 2 * c["Z_ww"] * aw - c["Z_uw"] * u, zero)
+    g4 = ((m22 - m11 - c["N_uv_lift"]) * v + (m24 - c["N_ur_lift"]) * r,
+          (m22 - m11 - c["N_uv_lift"]) * u - 2 * c["N_vv"] * av, zero,
+          (m24 - c["N_ur_lift"]) * u - c["N_r"] - 2 * c["N_rr"] * ar)
+    return g1, g2, g3, g4
+
+
+def channel_forces(c: Mapping[str, arb], nu: Sequence[arb]) -> tuple[arb, arb, arb]:
+    """(n_u, n_w, n_r) = (n1, n3, n4 − (m42/m22) n2) (N, N, N m)."""
+    n1, n2, n3, n4 = arb_body_forces(c, nu)
+    return n1, n3, n4 - c["m42"] / c["m22"] * n2
+
+
+def channel_gradient(c: Mapping[str, arb], nu: Sequence[arb]) -> tuple[tuple[arb, ...], ...]:
+    """∂(n_u, n_w, n_r)/∂(u, v, w, r)."""
+    g1, g2, g3, g4 = body_force_gradient(c, nu)
+    k = c["m42"] / c["m22"]
+    return g1, g3, tuple(a - k * b for a, b in zip(g4, g2))
+
+
+def channel_masses(c: Mapping[str, arb]) -> tuple[arb, arb, arb]:
+    """(m_u, m_w, m_r) = (m11, m33, m44 − m24 m42 / m22) (kg, kg, kg m²)."""
+    return c["m11"], c["m33"], c["m44"] - c["m24"] * c["m42"] / c["m22"]
+
+
+def channel_mismatch(nominal: Mapping[str, arb], hull: Mapping[str, arb], nu: Sequence[arb]) -> tuple[arb, ...]:
+    """d_c = n̂_c(ν) − n_c(ν; θ) over ν and θ ∈ Θ, by linearity: n(ν; θ̂) − n(ν; θ) = n(ν; θ̂ − θ).
+
+    Yaw: n̂_r − n_r = Δn4 − k̂ Δn2 − (k̂ − k) n2(ν; θ), k = m42/m22.
+    """
+    delta = {key: nominal[key] - hull[key] for key in nominal}
+    d1, d2, d3, d4 = arb_body_forces(delta, nu)
+    k_hat, k = nominal["m42"] / nominal["m22"], hull["m42"] / hull["m22"]
+    n2 = arb_body_forces(hull, nu)[1]
+    return d1, d3, d4 - k_hat * d2 - (k_hat - k) * n2
+
+
+def channel_mismatch_gradient(nominal: Mapping[str, arb], hull: Mapping[str, arb],
+                              nu: Sequence[arb]) -> tuple[tuple[arb, ...], ...]:
+    """∂d_c/∂(u, v, w, r) of :func:`channel_mismatch`, by the same linearity (the gradient is linear in θ too)."""
+    delta = {key: nominal[key] - hull[key] for key in nominal}
+    g1, g2, g3, g4 = body_force_gradient(delta, nu)
+    k_hat, k = nominal["m42"] / nominal["m22"], hull["m42"] / hull["m22"]
+    t2 = body_force_gradient(hull, nu)[1]
+    return g1, g3, tuple(a - k_hat * b - (k_hat - k) * t for a, b, t in zip(g4, g2, t2))
+
+
+def velocity_box(u: float, v: float, w: float, r: float) -> tuple[arb, arb, arb, arb]:
+    """Balls [−u, u], [−v, v], [−w, w], [−r, r] of the body velocities (m/s, rad/s)."""
+    return tuple(enclose(-x, x) for x in (u, v, w, r))
+
+
+def thrust_floor(params: Any, u_abs_max: float) -> tuple[float, float, float]:
+    """Smallest (X, Z, N) limit over |u| <= ``u_abs_max`` and Θ: ``params.thrust_limit_floor`` or the limits."""
+    floor = getattr(params, "thrust_limit_floor", None)
+    limits = floor(u_abs_max) if callable(floor) else params.thrust_limits
+    return tuple(float(x) for x in limits)
+
+
+def point_time_constant(params: Any) -> float:
+    """T_thr (s); a thruster lag given as an interval is refused (the loop's matrix A needs a point)."""
+    ball = field_ball(params, "thruster_time_constant")
+    if ball.rad() != 0:
+        raise ConfigError("plant.vehicle.thruster_time_constant", "a number (the velocity-loop bound needs a "
+                          "point thruster time constant)", ball.str())
+    return float(nominal_params(params).thruster_time_constant)

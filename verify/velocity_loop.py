@@ -1,0 +1,351 @@
+"""The velocity loop's error bound E = (E_u, E_w, E_r), derived in Arb from the vehicle (issue 22).
+
+**Model.** Per channel c ∈ (u, w, r), y = u, w or r: m_c ẏ = τ − n_c(ν; θ) with θ anywhere in the
+coefficient box Θ (yaw with the sway row eliminated, :mod:`verify.loop_model`); the actuator
+τ̇ = (sat(τ_cmd) − τ)/T_thr; the controller τ_cmd = n̂_c(ν) + m̂_c a, a = k_p e + k_i I, e = y* − y,
+İ = e, k_p = ω_b, k_i = ω_b²/4 (nominal n̂, m̂: ``tubekit.plant.dynamic``). Without saturation put
+z = (τ − τ_cmd)/m̂_c, s = a + z = (τ − n̂_c)/m̂_c and W = ẏ − s = (1 − 1/μ) ẏ + d/m̂_c (the
+acceleration the model mismatch adds; μ = m̂_c/m_c, d = n̂_c − n_c). With Ĩ = I + W/k_i and a
+constant drag slope λ_c, x = (Ĩ, e, z) obeys (:func:`loop_matrix`)
+
+    ẋ = A x + (1/k_i, 0, 0) Ẇ + (0, 0, −1) w_n,      w_n = ṅ̂_c/m̂_c − λ_c ẏ,
+    A = [[0, 1, 0], [−k_i, −k_p, −1], [k_i (k_p − λ_c), k_p² − k_i − λ_c k_p, k_p − 1/T_thr − λ_c]],
+
+and e = (0, 1, 0) x, z = (0, 0, 1) x, ẏ = (k_i, k_p, 1) x, a = (k_i, k_p, 0) x − W; Ẇ = (μ − 1) ṡ + ḋ/m_c
+with ṡ = −z/T_thr − λ_c ẏ − w_n. A command jump J adds J (0, 1, −k_p) to x (τ is continuous). The
+trimmed start (e = I = z = 0) gives x(0) = (W(0)/k_i, 0, 0), |W(0)| <= sup|d|/m_c.
+:func:`verify.loop_response.impulse_sums` bounds every output by the sums of its sampled
+response: jumps (J_tick at every tick, J_period − J_tick more at period boundaries, worst phase),
+the inputs Ẇ and w_n (L1), and the free response from x(0) (peak).
+
+**Theorem (first exit).** Let (E, Â, Ẑ, Ŷ) be assumed bounds of (|e|, |a|, |z|, |ẏ|) per channel.
+While they hold on [0, t): ν lies in the box |y_c| <= V_c + E_c, |v| <= γ̄ (hull ISS bound,
+:func:`verify.design.hull_sway_bound`); no channel saturates (``loop_saturation``), so the model
+above holds; the inputs obey the bounds of :func:`input_bounds`; so :func:`computed_bounds`
+bounds (|e|, |a|, |z|, |ẏ|) on [0, t] (a jump at t included). If every computed bound is strictly
+below the assumed one (``loop_fixed_point``), let t* be the first time an assumed bound is reached:
+at t* the computed bounds still hold, so the state is strictly inside, and it stays inside a
+little after t* (the signals are right-continuous, jumps isolated): a contradiction. So
+|u_b − u_c| <= E_u, |w_b − w_c| <= E_w, |r_b − r_c| <= E_r and |v_b| <= γ̄ for all time.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Any, Sequence
+
+from flint import arb, ctx
+
+from tubekit.exceptions import ConfigError
+from tubekit.validation import finite, nonnegative, positive
+from verify.design import Condition, hull_sway_bound
+from verify.intervals import lower, upper
+from verify.loop_bound import LoopBound
+from verify.loop_model import (arb_body_forces, channel_forces, channel_gradient, channel_masses, channel_mismatch,
+                               channel_mismatch_gradient, hull_balls, nominal_balls, nominal_params,
+                               point_time_constant, thrust_floor, velocity_box)
+from verify.loop_response import RESPONSE_PREC, ResponseSums, impulse_sums
+
+__all__ = ["LoopBound", "velocity_loop_bound", "actuator_authority", "loop_matrix", "computed_bounds",
+           "input_bounds", "Inputs", "rate_authority_conditions", "LOOP_MAX_ITERATIONS", "LOOP_INFLATION"]
+
+#: Default bound on the fixed-point iterations (a count, not seconds).
+LOOP_MAX_ITERATIONS = 60
+#: Each iteration assumes (1 + LOOP_INFLATION) x the bounds it computed.
+LOOP_INFLATION = 0.05
+_CHANNELS = "uwr"
+#: Index in ν = (u, v, w, r) of each channel's own speed.
+_OWN = (0, 2, 3)
+_FORCES = "XZN"
+_ACTUATOR = {"X": "the surge thrust", "Z": "the heave force (stern planes on a finned vehicle)",
+             "N": "the yaw moment (the rudder on a finned vehicle)"}
+
+
+def loop_matrix(k_p: float, k_i: float, time_constant: float, slope: float = 0.0) -> list[list[arb]]:
+    """A (1/s) of the module doc for gains k_p (1/s), k_i (1/s²), the actuator lag T_thr (s) and λ_c (1/s).
+
+    With λ_c = ``slope`` the z row loses λ_c (k_i, k_p, 1): the part λ_c ẏ of w_n moved into A.
+    """
+    with ctx.workprec(RESPONSE_PREC):
+        kp, ki, t, lam = arb(k_p), arb(k_i), arb(time_constant), arb(slope)
+        zero = arb(0)
+        return [[zero, arb(1), zero], [-ki, -kp, arb(-1)],
+                [kp * ki - lam * ki, kp * kp - ki - lam * kp, kp - 1 / t - lam]]
+
+
+@dataclass(frozen=True)
+class Inputs:
+    """Bounds of the model's inputs per channel, given the assumed bounds (see the module doc).
+
+    Attributes
+    ----------
+    start : (3,) floats
+        sup|d_c|/m_c >= |W(0)| (m/s², m/s², rad/s²).
+    rate : (3,) floats
+        sup|Ẇ| (m/s³, m/s³, rad/s³).
+    drag : (3,) floats
+        sup|w_n| = sup|ṅ̂_c/m̂_c − λ_c ẏ| (same units).
+    mismatch : (3,) floats
+        sup|W| <= sup|1 − 1/μ| Ŷ + sup|d|/m̂ (m/s², m/s², rad/s²): a = (k_i, k_p, 0) x − W.
+    sway : float
+        γ̄ (m/s) over the assumed velocity box.
+    """
+
+    start: tuple[float, float, float]
+    rate: tuple[float, float, float]
+    drag: tuple[float, float, float]
+    mismatch: tuple[float, float, float]
+    sway: float
+
+
+class _Loop:
+    """The vehicle's fixed data for the fixed point: balls, gains, slopes λ_c, the response sums per channel."""
+
+    def __init__(self, params: Any, v_max: Sequence[float], tick: float, ticks: int) -> None:
+        self.params, self.v_max, self.tick = params, tuple(v_max), tick
+        self.nominal, self.hull = nominal_balls(params), hull_balls(params)
+        nom = nominal_params(params)
+        self.k_p, self.k_i = float(nom.loop_bandwidth), 0.25 * float(nom.loop_bandwidth) ** 2
+        self.lag = point_time_constant(params)
+        self.m_hat, self.m_true = channel_masses(self.nominal), channel_masses(self.hull)
+        box, gamma = self.box((0.0, 0.0, 0.0))
+        self.slope = tuple(float(x.mid()) for x in self.slopes(box, gamma)) if math.isfinite(gamma) else (0.0,) * 3
+        kp, ki = arb(self.k_p), arb(self.k_i)
+        self.sums: tuple[ResponseSums, ...] = tuple(impulse_sums(
+            loop_matrix(self.k_p, self.k_i, self.lag, lam), [[0, 1, -kp], [1 / ki, 0, 0], [0, 0, -1]],
+            [[0, 1, 0], [ki, kp, 0], [0, 0, 1], [ki, kp, 1]], tick=tick, ticks_per_period=ticks)
+            for lam in self.slope)
+
+    @property
+    def stable(self) -> bool:
+        """Every channel's sampled loop is stable."""
+        return all(s.stable for s in self.sums)
+
+    def box(self, error: Sequence[float]) -> tuple[tuple[float, float, float], float]:
+        """(ū, w̄, r̄) = V + E and γ̄ over it (m/s, m/s, rad/s; m/s)."""
+        bar = tuple(upper(arb(v) + arb(e)) for v, e in zip(self.v_max, error))
+        return bar, upper(hull_sway_bound(self.params, bar[0], bar[2]))
+
+    def slopes(self, box: Sequence[float], gamma: float) -> list[arb]:
+        """∂n̂_c/∂y_c / m̂_c over the velocity box (1/s): the drag's slope in the channel's own speed."""
+        grads = channel_gradient(self.nominal, velocity_box(box[0], gamma, box[1], box[2]))
+        return [grads[c][_OWN[c]] / self.m_hat[c] for c in range(3)]
+
+
+def _rates(loop: _Loop, nu: Sequence[arb], accel: Sequence[float]) -> tuple[arb, arb, arb, arb]:
+    """Bounds of |u̇|, |v̇|, |ẇ|, |ṙ|: the channels' Ŷ, and the sway row m22 v̇ = −n2 − m24 ṙ over Θ."""
+    h = loop.hull
+    sway = (abs(arb_body_forces(h, nu)[1]) + abs(h["m24"]) * arb(accel[2])) / h["m22"]
+    return arb(accel[0]), arb(upper(sway)), arb(accel[1]), arb(accel[2])
+
+
+def input_bounds(loop: _Loop, error: Sequence[float], z_bound: Sequence[float],
+                 accel: Sequence[float]) -> Inputs:
+    """The model's input bounds over the box |y_c| <= V_c + E_c, |v| <= γ̄ and Θ, given Ẑ and Ŷ = sup|ẏ|.
+
+    ŵ_n = (sup|∂n̂_c/∂y_c − λ_c m̂_c| Ŷ_c + Σ_{j ≠ c} sup|∂n̂_c/∂ν_j| |ν̇_j|)/m̂_c;
+    sup|Ẇ| = sup|μ − 1| (Ẑ/T_thr + |λ_c| Ŷ_c + ŵ_n) + Σ_j sup|∂d_c/∂ν_j| |ν̇_j| / m_c.
+    """
+    box, gamma = loop.box(error)
+    if not math.isfinite(gamma) or not all(math.isfinite(x) for x in (*box, *z_bound, *accel)):
+        inf = (math.inf,) * 3
+        return Inputs(start=inf, rate=inf, drag=inf, mismatch=inf, sway=math.inf)
+    nu = velocity_box(box[0], gamma, box[1], box[2])
+    rates = _rates(loop, nu, accel)
+    grads = channel_gradient(loop.nominal, nu)
+    d, d_grad = channel_mismatch(loop.nominal, loop.hull, nu), channel_mismatch_gradient(loop.nominal, loop.hull, nu)
+    start, rate, drag, mismatch = [], [], [], []
+    for c in range(3):
+        own, lam, y_dot = _OWN[c], arb(loop.slope[c]), arb(accel[c])
+        cross = sum((abs(g) * x for j, (g, x) in enumerate(zip(grads[c], rates)) if j != own), arb(0))
+        w_n = (abs(grads[c][own] - lam * loop.m_hat[c]) * y_dot + cross) / loop.m_hat[c]
+        s_dot = arb(z_bound[c]) / arb(loop.lag) + abs(lam) * y_dot + w_n
+        mu = loop.m_hat[c] / loop.m_true[c]
+        d_dot = sum((abs(g) * x for g, x in zip(d_grad[c], rates)), arb(0)) / loop.m_true[c]
+        start.append(upper(abs(d[c]) / loop.m_true[c]))
+        rate.append(upper(abs(mu - 1) * s_dot + d_dot))
+        drag.append(upper(w_n))
+        mismatch.append(upper(abs(1 - 1 / mu) * y_dot + abs(d[c]) / loop.m_hat[c]))
+    return Inputs(start=tuple(start), rate=tuple(rate), drag=tuple(drag), mismatch=tuple(mismatch), sway=gamma)
+
+
+def computed_bounds(loop: _Loop, jump_tick: Sequence[float], jump_period: Sequence[float],
+                    inputs: Inputs | None = None) -> list[list[float]]:
+    """[sup|e|, sup|a|, sup|z|, sup|ẏ|] per channel; ``inputs`` None: jumps only (the first guess).
+
+    Row o (e, a + W, z, ẏ): J_tick Σ g_J + (J_period − J_tick) max_phase Σ_period g_J + h Σ g_W sup|Ẇ|
+    + h Σ g_n sup|w_n| + peak g_W sup|W(0)|; sup|a| adds sup|W|.
+    """
+    h = arb(loop.tick)
+    out = []
+    for c in range(3):
+        s = loop.sums[c]
+        jt, jp = arb(jump_tick[c]), arb(jump_period[c])
+        row = []
+        for o in range(4):
+            x = jt * arb(s.tick[o][0]) + (jp - jt) * arb(s.period[o][0])
+            if inputs is not None:
+                x += (h * arb(s.tick[o][1]) * arb(inputs.rate[c]) + h * arb(s.tick[o][2]) * arb(inputs.drag[c])
+                      + arb(s.peak[o][1]) * arb(inputs.start[c]) + (arb(inputs.mismatch[c]) if o == 1 else 0))
+            row.append(upper(x))
+        out.append(row)
+    return out
+
+
+def _thrust_peaks(loop: _Loop, box: tuple[float, float, float], gamma: float,
+                  a_bound: Sequence[float]) -> list[float]:
+    """sup|τ_cmd_c| = sup|n̂_c| + m̂_c sup|a| over the velocity box (N, N, N m)."""
+    nu = velocity_box(box[0], gamma, box[1], box[2])
+    forces = channel_forces(loop.nominal, nu)
+    return [upper(abs(forces[c]) + loop.m_hat[c] * arb(a_bound[c])) for c in range(3)]
+
+
+def actuator_authority(params: Any, v_max: Sequence[float]) -> tuple[float, float, float]:
+    """(a_u, a_w, a_r): a lower bound of the acceleration each channel delivers against drag in V.
+
+    a_c = (smallest limit over |u| <= V_u and Θ − sup|n_c| over V (sway |v| <= γ̄(V)) and Θ) / sup m_c
+    (m/s², m/s², rad/s²): what the thrusters deliver, in either direction, anywhere in V (the corner
+    of V has the largest drag). Negative when the drag (or a fin without speed) wins.
+    """
+    v = _triple("v_max", v_max)
+    gamma = upper(hull_sway_bound(params, v[0], v[2]))
+    if not math.isfinite(gamma):
+        return (-math.inf,) * 3
+    hull = hull_balls(params)
+    forces = channel_forces(hull, velocity_box(v[0], gamma, v[1], v[2]))
+    floor = thrust_floor(params, v[0])
+    masses = channel_masses(hull)
+    return tuple(lower((arb(floor[c]) - abs(forces[c])) / masses[c]) for c in range(3))
+
+
+def rate_authority_conditions(authority: Sequence[float], rate: Sequence[float]) -> list[Condition]:
+    """``rate_authority[c]``: a plan's rate limit ρ_c is something the vehicle can do, ρ_c <= a_c."""
+    units = ("m/s^2", "m/s^2", "rad/s^2")
+    return [Condition(f"rate_authority[{ax}]", f"rho_{ax} <= a_{ax} (acceleration deliverable against drag in V)",
+                      float(rate[c]), float(authority[c]), bool(rate[c] <= authority[c]),
+                      f"a_{ax} = {authority[c]:.4g} {units[c]} over V and the coefficient box")
+            for c, ax in enumerate(_CHANNELS)]
+
+
+def _triple(name: str, value: Any, strict: bool = False) -> tuple[float, float, float]:
+    """Three finite numbers >= 0 (> 0 when ``strict``), else ConfigError naming ``name[i]``."""
+    if isinstance(value, (str, bytes)) or not hasattr(value, "__len__") or len(value) != 3:
+        raise ConfigError(name, "three numbers (u, w, r)", value)
+    check = positive if strict else nonnegative
+    return tuple(check(f"{name}[{i}]", finite(f"{name}[{i}]", x)) for i, x in enumerate(value))
+
+
+def _validate(params: Any, v_max: Any, tick: Any, period: Any, jump_tick: Any, jump_period: Any,
+              rate: Any, max_iterations: Any) -> tuple:
+    if not hasattr(params, "loop_bandwidth") or not hasattr(params, "interval"):
+        raise ConfigError("params", "a VehicleParams", type(params).__name__)
+    v = _triple("v_max", v_max)
+    h, d = positive("tick", finite("tick", tick)), positive("period", finite("period", period))
+    ticks = round(d / h)
+    if ticks < 1 or abs(ticks * h - d) > 1e-9 * d:
+        raise ConfigError("period", f"a whole number >= 1 of ticks of {h} s", period)
+    jt, jp = _triple("jump_tick", jump_tick), _triple("jump_period", jump_period)
+    for c in range(3):
+        if jp[c] < jt[c]:
+            raise ConfigError(f"jump_period[{c}]", f">= jump_tick[{c}] = {jt[c]} (the total jump at a period "
+                              "boundary)", jp[c])
+    rho = None if rate is None else _triple("rate", rate)
+    if isinstance(max_iterations, bool) or not isinstance(max_iterations, int) or max_iterations < 1:
+        raise ConfigError("max_iterations", "an integer >= 1", max_iterations)
+    point_time_constant(params)
+    return v, h, d, int(ticks), jt, jp, rho
+
+
+def velocity_loop_bound(params: Any, *, v_max: Sequence[float], tick: float, period: float,
+                        jump_tick: Sequence[float], jump_period: Sequence[float],
+                        rate: Sequence[float] | None = None,
+                        max_iterations: int = LOOP_MAX_ITERATIONS) -> LoopBound:
+    """The velocity loop's error bound over the command box ``v_max`` (m/s, m/s, rad/s) and Θ.
+
+    Parameters
+    ----------
+    params : VehicleParams
+        The vehicle, possibly with coefficient intervals (the bound holds for every point).
+    v_max : (3,) floats
+        The command box V: |u_c| <= V_u, |w_c| <= V_w, |r_c| <= V_r.
+    tick, period : float
+        h and δ (s); δ a whole number of ticks.
+    jump_tick, jump_period : (3,) floats
+        Bound on the command's change at every tick, and at a period boundary (total, >= jump_tick).
+    rate : (3,) floats, optional
+        A plan's rate limit ρ (m/s², m/s², rad/s²): adds ``rate_authority[c]`` (ρ_c <= a_c).
+    max_iterations : int
+        Bound on the fixed-point iterations.
+    """
+    v, h, d, ticks, jt, jp, rho = _validate(params, v_max, tick, period, jump_tick, jump_period, rate,
+                                            max_iterations)
+    loop = _Loop(params, v, h, ticks)
+    authority = actuator_authority(params, v)
+    base = computed_bounds(loop, jt, jp)
+    assumed = [[x * (1 + LOOP_INFLATION) + 1e-12 for x in row] for row in base]
+    found, k, computed, inputs = False, 0, base, None
+    while loop.stable and k < max_iterations and not found:
+        k += 1
+        inputs = input_bounds(loop, [r[0] for r in assumed], [r[2] for r in assumed], [r[3] for r in assumed])
+        computed = computed_bounds(loop, jt, jp, inputs)
+        found = all(computed[c][o] < assumed[c][o] for c in range(3) for o in range(4))
+        if not found:
+            grown = [[x * (1 + LOOP_INFLATION) for x in row] for row in computed]
+            if not all(math.isfinite(x) for row in grown for x in row):
+                break
+            assumed = [[max(a, g) for a, g in zip(ra, rg)] for ra, rg in zip(assumed, grown)]
+    return _result(loop, params, (v, h, d, jt, jp), assumed, computed, inputs, authority, (k, max_iterations),
+                   found, rho)
+
+
+def _saturation(loop: _Loop, params: Any, v: Sequence[float], assumed: list) -> list[Condition]:
+    """``loop_saturation[X|Z|N]``: sup|n̂_c| + m̂_c Â_c < the smallest limit over |u| <= V_u + E_u and Θ."""
+    box, sway = loop.box([r[0] for r in assumed])
+    a_assumed = [r[1] for r in assumed]
+    finite_box = all(math.isfinite(x) for x in (*box, sway, *a_assumed))
+    u_bar = box[0] if finite_box else v[0]
+    floor = thrust_floor(params, u_bar)
+    peaks = _thrust_peaks(loop, box, sway, a_assumed) if finite_box else [math.inf] * 3
+    conds = []
+    for c, ch in enumerate(_FORCES):
+        why = (f"sup|n_hat_{_CHANNELS[c]}| + m_hat sup|a| over |u| <= {u_bar:.4g} m/s against {floor[c]:.4g}"
+               if floor[c] > 0 else
+               f"{_ACTUATOR[ch]} is 0 at u = 0, inside the velocity box |u| <= {u_bar:.4g} m/s: a fin's lift grows "
+               "with u², so this vehicle cannot produce it at rest")
+        conds.append(Condition(f"loop_saturation[{ch}]", f"sup|tau_cmd_{ch}| < smallest {ch} limit over the box",
+                               peaks[c], floor[c], bool(peaks[c] < floor[c]), why))
+    return conds
+
+
+def _result(loop: _Loop, params: Any, given: tuple, assumed: list, computed: list, inputs: Inputs | None,
+            authority: tuple, iterations: tuple[int, int], found: bool, rho: tuple | None) -> LoopBound:
+    """The :class:`LoopBound` with every condition of the theorem (bounds +inf when not certified)."""
+    v, h, d, jt, jp = given
+    error = tuple(r[0] for r in computed) if found else (math.inf,) * 3
+    gamma = upper(hull_sway_bound(params, upper(arb(v[0]) + arb(error[0])), upper(arb(v[2]) + arb(error[2])))) \
+        if found else math.inf
+    conds = [Condition(f"loop_stable[{ax}]", "||A_d^K||_inf < 1 (the sampled loop is stable; geometric tail)",
+                       s.rho, 1.0, s.stable, f"K = {s.terms} ticks summed term by term, A_d = exp(A h) in Arb, "
+                       f"lambda_{ax} = {lam:.4g} 1/s") for ax, s, lam in zip(_CHANNELS, loop.sums, loop.slope)]
+    ratio = max(computed[c][o] / assumed[c][o] for c in range(3) for o in range(4)) if loop.stable else None
+    conds.append(Condition("loop_fixed_point", "max computed/assumed of (sup|e|, sup|a|, sup|z|, sup|ydot|) < 1 "
+                           "(first exit)", ratio, 1.0, found, f"{iterations[0]} iterations (at most {iterations[1]})"))
+    conds += _saturation(loop, params, v, assumed)
+    conds.append(Condition("loop_sway", "gamma_bar finite (sway damped over the box)", gamma, None,
+                           math.isfinite(gamma), "hull_sway_bound over |u| <= V_u + E_u, |r| <= V_r + E_r and Θ"))
+    if rho is not None:
+        conds += rate_authority_conditions(authority, rho)
+    failed = [c.condition for c in conds if c.ok is not True]
+    inf = (math.inf,) * 3
+    pick = (lambda o: tuple(r[o] for r in computed) if found else inf)
+    return LoopBound(v_max=v, tick=h, period=d, jump_tick=jt, jump_period=jp, error=error, sway=gamma,
+                     a_bound=pick(1), z_bound=pick(2), accel_bound=pick(3), assumed=tuple(tuple(r) for r in assumed),
+                     w_start=inputs.start if inputs else inf, w_rate=inputs.rate if inputs else inf,
+                     w_n=inputs.drag if inputs else inf, gains=loop.sums, slope=loop.slope,
+                     authority=tuple(authority),
+                     thrust_peak=tuple(c.lhs if c.lhs is not None else math.inf for c in conds
+                                       if c.condition.startswith("loop_saturation")),
+                     thrust_floor=tuple(c.rhs for c in conds if c.condition.startswith("loop_saturation")),
+                     iterations=iterations[0], conditions=tuple(conds),
+                     reason="" if not failed else "not certified: " + ", ".join(failed))

@@ -81,3 +81,43 @@ def test_the_recorded_obstacles_are_those_that_ran():
     for k in range(10):
         plan = spec.plan(k)
         assert [tuple(o["center"]) for o in plan.values["obstacles"]] == [o.center for o in plan.scenario.obstacles]
+
+
+DYNAMIC = (ROOT / "examples" / "bluerov2_currents.toml").as_posix()
+
+
+def _truth_spec(entry=None, scenario: str = DYNAMIC):
+    return spec_from_dict({"scenario": scenario, "runs": 40, "seed": 2, "duration": 5.0,
+                           "sample": {"plant.truth": {"box": True} if entry is None else entry}})
+
+
+def test_the_truth_box_draws_every_interval_coefficient_inside_its_interval():
+    """Property: each run's plant is a point of the vehicle's box, and every run shares one certificate."""
+    from tubekit.app.campaign_spec import certificate_key
+    spec = _truth_spec()
+    params = spec.plan(0).scenario.plant.params
+    names = set(params.interval_fields)
+    keys, seen = set(), []
+    for k in range(40):
+        sc = spec.plan(k).scenario
+        truth = dict(sc.plant.truth)
+        assert set(truth) == names
+        for name, value in truth.items():
+            lo, hi = params.interval(name)
+            assert lo <= value <= hi
+        keys.add(certificate_key(sc))
+        seen.append(truth["Y_vv"])
+    assert len(keys) == 1                       # the truth is not a certificate input
+    lo, hi = params.interval("Y_vv")
+    assert min(seen) < lo + 0.25 * (hi - lo) and max(seen) > hi - 0.25 * (hi - lo)  # spread over the box
+    assert spec_from_stored(spec.to_dict()).plan(7).values == spec.plan(7).values
+
+
+@pytest.mark.parametrize("entry, scenario, match", [
+    ({"box": False}, DYNAMIC, r"sample\.plant\.truth"),
+    ({"uniform": [0, 1]}, DYNAMIC, r"sample\.plant\.truth"),
+    (None, SCENARIO, r"sample\.plant\.truth.*dynamic plant"),  # the kinematic plant simulates no coefficient
+])
+def test_a_bad_truth_entry_names_its_field(entry, scenario, match):
+    with pytest.raises(ConfigError, match=match):
+        _truth_spec(entry, scenario)

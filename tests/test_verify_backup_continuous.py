@@ -1,4 +1,4 @@
-"""verify.backup_continuous: the continuous yaw law's level-set proof (enclosures, the unstable point, bad χ_u)."""
+"""verify.backup.continuous: the continuous yaw law's level-set proof (enclosures, the unstable point, bad χ_u)."""
 
 from __future__ import annotations
 
@@ -11,7 +11,7 @@ from hypothesis import given, strategies as st
 from tubekit.exceptions import ConfigError
 from tubekit.model.backup import SafeSet, StationKeeping
 from verify.backup import certify_backup
-from verify.backup_continuous import (_rate_upper, cone_angle, continuous_rate_bound, shape_enclosure,
+from verify.backup.continuous import (_rate_upper, cone_angle, continuous_rate_bound, shape_enclosure,
                                       unstable_condition, yaw_shape_enclosure)
 from verify.intervals import lower, upper
 

@@ -1,4 +1,4 @@
-"""verify.backup_rate: the backup command's rate bound against finite differences along simulated trajectories."""
+"""verify.backup.rate: the backup command's rate bound against finite differences along simulated trajectories."""
 
 from __future__ import annotations
 
@@ -9,7 +9,7 @@ import pytest
 
 from tubekit.exceptions import ConfigError
 from tubekit.model.backup import SafeSet, StationKeeping, axis_angle, line_of_sight_angle, station_keeping_input
-from verify.backup_rate import backup_command_rate, backup_tick_change
+from verify.backup.rate import backup_command_rate, backup_tick_change
 
 LIMITS = (0.4, 0.3, 0.5)
 SAFE = SafeSet(level=0.75, shape=0.4, depth=0.4)

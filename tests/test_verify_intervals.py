@@ -123,3 +123,21 @@ def test_maximise_reports_an_unreached_gap_honestly():
     assert not res.converged
     assert res.gap > 1e-9
     assert res.bound >= res.sampled
+
+
+def test_bisect_sup_covers_the_interval_and_stops_on_negative_bounds():
+    """A negative bound ends a branch; the largest bound of the cover is returned, within the budget."""
+    from verify.intervals import bisect_sup
+
+    assert bisect_sup(lambda a, b: -1.0, 0.0, 1.0, 64) == (-1.0, 1)
+    seen = []
+
+    def bound(a: float, b: float) -> float:      # an upper bound of x - 0.75 over [a, b]
+        seen.append((a, b))
+        return b - 0.75
+
+    sup, used = bisect_sup(bound, 0.0, 1.0, 64)
+    assert sup == pytest.approx(0.25) and used == len(seen) <= 64 + 1
+    assert min(a for a, _ in seen) == 0.0 and max(b for _, b in seen) == 1.0
+    assert any(b < 0.75 for _, b in seen)        # the part where x - 0.75 < 0 was proved negative
+    assert bisect_sup(bound, 0.0, 1.0, 3)[1] <= 3 + 1

@@ -50,9 +50,9 @@ from verify.sampled import HorizonMargins, PeriodTube
 from verify.tiers import backup_of, key_sigma, safe_only_design, tier_conditions, tracking_design
 
 if TYPE_CHECKING:  # the dynamic plant's modules load only when a dynamic scenario is certified
-    from verify.velocity_loop import LoopBound
+    from verify.vehicle.bound import LoopBound
 
-#: Why σ = 0 on the dynamic plant (:mod:`verify.dynamic`).
+#: Why σ = 0 on the dynamic plant (:mod:`verify.vehicle.compose`).
 DYNAMIC_SIGMA_SOURCE = "dynamic plant: sigma = 0 (kappa = 0, so the velocity loop sees only bounded command jumps)"
 
 __all__ = ["Condition", "Certificate", "NotCertifiedError", "certify", "sigma_candidates", "choose_design",
@@ -127,9 +127,9 @@ class Certificate:
     safe_design : Design or None
         The safe tier's design at σ = 0 when the chosen (tracking) design does not certify, else None.
     velocity_loop : LoopBound or None
-        Dynamic plant: the velocity loop's derived error bound (:mod:`verify.velocity_loop`), else None.
+        Dynamic plant: the velocity loop's derived error bound (:mod:`verify.vehicle.bound`), else None.
     plant_conditions : tuple of Condition
-        Dynamic plant: the loop's conditions and the fixed point's (:func:`verify.dynamic.solve_dynamic`);
+        Dynamic plant: the loop's conditions and the fixed point's (:func:`verify.vehicle.compose.solve_dynamic`);
         both tiers depend on them.
     """
 
@@ -333,7 +333,7 @@ def _dynamic_assumptions(scenario: Scenario, dist: DisturbanceBounds) -> tuple[s
     return ("Dynamic plant: the 4-DOF model of docs/plant.md (surge, sway, heave, yaw; no roll or pitch; the "
             "current's own acceleration neglected in the relative-velocity dynamics) with every hydrodynamic "
             "coefficient anywhere in its interval; the controller's feedforward uses the midpoints. The velocity "
-            "loop's error and the hull's sway are derived from it (verify.velocity_loop, "
+            "loop's error and the hull's sway are derived from it (verify.vehicle.bound, "
             f"gamma_bar = {dist.gamma:.4g} m/s), not assumed.",
             "Dynamic plant: the run starts trimmed (body velocities equal to the first command, thrust equal to "
             "the feedforward).")
@@ -342,7 +342,7 @@ def _dynamic_assumptions(scenario: Scenario, dist: DisturbanceBounds) -> tuple[s
 def _solve(scenario: Scenario, region: Region, gains: GainBounds, sigmas: tuple[float, ...]):
     """(dist, designs, best, safe, backup, loop, plant conditions): kinematic directly, dynamic by the fixed point."""
     if _is_dynamic(scenario):
-        from verify.dynamic import solve_dynamic
+        from verify.vehicle.compose import solve_dynamic
         sol = solve_dynamic(scenario, region, gains, sigmas)
         return sol.dist, list(sol.designs), sol.best, sol.safe, sol.backup, sol.loop, sol.conditions
     dist = disturbance_bounds(scenario)

@@ -119,7 +119,7 @@ def _plant_conditions(d: dict) -> tuple[Condition, ...]:
 def _velocity_loop(d: dict) -> Any:
     if item(d, "velocity_loop", "certificate") is None:
         return None
-    from verify.velocity_loop import LoopBound
+    from verify.vehicle.bound import LoopBound
     return LoopBound.from_dict(block(d, "velocity_loop", "certificate"))
 
 

@@ -108,7 +108,7 @@ def hull_sway_bound(params: VehicleParams, u_bar: float, r_bar: float) -> arb:
     it is evaluated at the worst ends (largest F, smallest a and b, each from Arb balls of
     the intervals) and the mass ratio 2|m24| r̄ / m22 over the balls of m, x_g and the added masses.
     """
-    from verify.loop_model import field_ball  # a leaf module: no cycle
+    from verify.vehicle.model import field_ball  # a leaf module: no cycle
 
     def ball(name: str) -> arb:
         return field_ball(params, name)
@@ -133,8 +133,8 @@ def disturbance_bounds(scenario: Scenario, loop_error: tuple[float, float, float
 
     On the dynamic plant (``[plant] kind = "dynamic"``) ω = δ + R(ψ)(u_b − u, v_b) in the
     plane and δ_z + w_b − w in heave, so with the velocity loop's error bound
-    ``loop_error`` = (E_u, E_w, E_r) (m/s, m/s, rad/s; derived by :mod:`verify.velocity_loop`,
-    composed by :func:`verify.dynamic.solve_dynamic`): γ̄ = :func:`hull_sway_bound` over
+    ``loop_error`` = (E_u, E_w, E_r) (m/s, m/s, rad/s; derived by :mod:`verify.vehicle.bound`,
+    composed by :func:`verify.vehicle.compose.solve_dynamic`): γ̄ = :func:`hull_sway_bound` over
     |u_b| <= ū + E_u, |r_b| <= r̄ + E_r and the vehicle's coefficient box,
     ω̄_xy = max(a_x, a_y) + ‖c_xy‖ + ‖(E_u, γ̄)‖, ω̄_z = a_z + |c_z| + E_w, and the yaw-rate
     error E_r. The sway table is unused there (declared = γ̄).
@@ -146,7 +146,7 @@ def disturbance_bounds(scenario: Scenario, loop_error: tuple[float, float, float
     if scenario.plant.dynamic:
         if loop_error is None:
             raise ValueError("disturbance_bounds on the dynamic plant needs the velocity loop's error bound "
-                             "(verify.dynamic.solve_dynamic composes them)")
+                             "(verify.vehicle.compose.solve_dynamic composes them)")
         du, dw, dr = (arb(x) for x in loop_error)
         gamma = hull_sway_bound(scenario.plant.params, upper(arb(lim.u_max) + du), upper(arb(lim.r_max) + dr))
         wxy = arb(max(a[0], a[1])) + cxy + (du * du + gamma * gamma).sqrt()

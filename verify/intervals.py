@@ -30,6 +30,7 @@ import sympy as sp
 from flint import arb, arb_mat
 
 __all__ = [
+    "bisect_sup",
     "enclose",
     "point",
     "upper",
@@ -404,3 +405,24 @@ def maximise(cases: Sequence[Case], *, gap: float = 0.05, max_boxes: int = 20000
     g = relative_gap(best, ub)
     return MaxResult(sampled=best, bound=ub, gap=g, converged=g <= gap, boxes=boxes,
                      elapsed_s=time.perf_counter() - t0, argmax=arg)
+
+
+def bisect_sup(upper_bound: Callable[[float, float], float], lo: float, hi: float,
+               max_boxes: int) -> tuple[float, int]:
+    """(bound, intervals): the largest of ``upper_bound(a, b)`` over a cover of [lo, hi] by bisection.
+
+    An interval is split until its bound is negative, the intervals used and pending reach ``max_boxes``
+    (so at most ``max_boxes + 1`` evaluations), or it is narrower than 1e-9; the bound returned holds over [lo, hi] whenever each ``upper_bound(a, b)`` is an
+    upper bound over [a, b]. The proof of a negative supremum (e.g. V̇ on a level set) is a negative result.
+    """
+    pending, done, used = [(lo, hi)], [], 0
+    while pending:
+        a, b = pending.pop()
+        bound = upper_bound(a, b)
+        used += 1
+        if bound < 0.0 or used + len(pending) >= max_boxes or b - a < 1e-9:
+            done.append(bound)
+            continue
+        mid = 0.5 * (a + b)
+        pending += [(mid, b), (a, mid)]
+    return max(done), used

@@ -218,9 +218,9 @@ def _verdicts(raw: dict, cert: Any, design: Any, derived: tuple, scenario: Scena
 
 
 def _plant_bounds(cert: Any, scenario: Any, region: Any, sigma: float, led: Ledger) -> tuple[Any, tuple]:
-    """Dynamic plant: the loop bound's fixed point re-derived (:func:`verify.dynamic.solve_dynamic`); the stored
+    """Dynamic plant: the loop bound's fixed point re-derived (:func:`verify.vehicle.compose.solve_dynamic`); the stored
     bound must be at least the derived one. Returns the derived ω̄ and the plant's conditions."""
-    from verify.dynamic import solve_dynamic
+    from verify.vehicle.compose import solve_dynamic
     sol = solve_dynamic(scenario, region, cert.gains, (sigma,))
     stored = cert.velocity_loop
     if stored is None:

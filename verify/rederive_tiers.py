@@ -80,7 +80,7 @@ def _safe_design(cert: Any, safe: Design | None, led: Any) -> None:
 def check_tiers(raw: dict, cert: Any, design: Design, tiers: DerivedTiers, led: Any,
                 plant: tuple = ()) -> dict[str, bool]:
     """Record the backup, safe-design and tier checks; return the derived tiers (``plant``: the dynamic
-    plant's derived conditions, :func:`verify.dynamic.solve_dynamic`)."""
+    plant's derived conditions, :func:`verify.vehicle.compose.solve_dynamic`)."""
     _backup(raw, cert, tiers, led)
     _safe_design(cert, tiers.safe, led)
     derived = tiers_of(design, tiers.safe, tiers.backup, plant)

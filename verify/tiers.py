@@ -165,7 +165,7 @@ def tier_conditions(design: Design, safe_design: Design | None, backup: BackupCe
     """The conditions each tier depends on (module doc); ``safe_design`` replaces the tracking design's
     safe conditions when given. A missing backup leaves both tiers uncertified (an empty backup part is
     represented by a failed ``backup`` condition). ``plant``: the dynamic plant's conditions
-    (:func:`verify.dynamic.solve_dynamic`), which both tiers depend on (ω̄ holds only with the loop's bound)."""
+    (:func:`verify.vehicle.compose.solve_dynamic`), which both tiers depend on (ω̄ holds only with the loop's bound)."""
     bk = backup.conditions if backup is not None else (
         Condition("backup", "a certified backup law", None, None, False, "no backup"),)
     safe_src = safe_design.conditions if safe_design is not None else tuple(

@@ -289,8 +289,12 @@ def _coefficient_box(field: str, entry: Any, base: dict) -> Distribution:
     if entry != {"box": True}:
         raise ConfigError(field, "{ box = true } (every interval coefficient of the vehicle drawn in its interval)",
                           entry)
-    params = scenario_from_dict(base).plant.params
-    names = tuple(getattr(params, "interval_fields", ()))
+    plant = scenario_from_dict(base).plant
+    if not plant.dynamic:
+        raise ConfigError(field, "a base scenario on the dynamic plant ([plant] kind = \"dynamic\"): the kinematic "
+                          "plant simulates no coefficient", plant.kind)
+    params = plant.params
+    names = tuple(params.interval_fields)
     if not names:
         raise ConfigError(field, "a vehicle with at least one coefficient given as an interval [lo, hi]",
                           base.get("plant", {}).get("vehicle"))

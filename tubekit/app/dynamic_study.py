@@ -1,8 +1,9 @@
 """The dynamic-plant part of ``tubekit reproduce`` (issue 13): the tube controller on the 4-DOF vehicle.
 
-:func:`run_dynamic` certifies the scenario with ``[plant] kind = "dynamic"`` (the velocity
-loop's tracking bound and the hull's sway bound enter ω; usually not certified, and then the
-best-effort sets are used and flagged), runs the tube controller on the dynamic plant under
+:func:`run_dynamic` certifies the scenario on the dynamic plant (the BlueROV2 Heavy with rate-limited
+plans unless the scenario names its own vehicle; the velocity loop's derived error bound and the hull's
+sway enter ω; usually not certified, and then the best-effort sets are used and flagged), runs the tube
+controller on the dynamic plant under
 the same current with :func:`tubekit.loop.pipeline.certified_run` (metrics and promises in the
 one convention), and writes ``dynamic_trajectory.csv``,
 ``dynamic_certificate.txt`` and ``dynamic_vs_kinematic.png``.

@@ -95,7 +95,7 @@ class PlantSettings:
             raise ConfigError("plant", "a table", d)
         if "tracking_bound" in d:
             raise ConfigError("plant.tracking_bound", "absent: the velocity loop's error bound is derived from the "
-                              "vehicle by the certificate (verify.velocity_loop), never assumed", d["tracking_bound"])
+                              "vehicle by the certificate (verify.vehicle.bound), never assumed", d["tracking_bound"])
         unknown = set(d) - {"kind", "vehicle", "truth"}
         if unknown:
             raise ConfigError(f"plant.{sorted(unknown)[0]}", "one of the keys ['kind', 'truth', 'vehicle']",

@@ -1,4 +1,4 @@
-"""Rigorous impulse-response sums (verify.loop_response) against closed forms and scipy."""
+"""Rigorous impulse-response sums (verify.vehicle.response) against closed forms and scipy."""
 
 from __future__ import annotations
 
@@ -9,7 +9,7 @@ import pytest
 from scipy.integrate import quad
 from scipy.linalg import expm
 
-from verify.loop_response import impulse_sums
+from verify.vehicle.response import impulse_sums
 
 
 @pytest.mark.parametrize("k, h, n", [(2.0, 0.01, 10), (8.0, 0.02, 5), (0.5, 0.05, 4)])

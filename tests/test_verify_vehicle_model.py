@@ -1,4 +1,4 @@
-"""The velocity loop's vehicle in Arb (verify.loop_model) against the simulated plant's own functions."""
+"""The velocity loop's vehicle in Arb (verify.vehicle.model) against the simulated plant's own functions."""
 
 from __future__ import annotations
 
@@ -11,7 +11,7 @@ from tubekit.model.vehicle_params import VehicleParams
 from tubekit.model.vehicle_sets import BLUEROV2_HEAVY, REMUS100
 from tubekit.plant.dynamic import body_forces
 from verify.intervals import lower, upper
-from verify.loop_model import (arb_body_forces, body_force_gradient, channel_forces, channel_gradient, channel_masses,
+from verify.vehicle.model import (arb_body_forces, body_force_gradient, channel_forces, channel_gradient, channel_masses,
                                channel_mismatch, channel_mismatch_gradient, field_ball, hull_balls, nominal_balls,
                                point_time_constant, thrust_floor, velocity_box)
 

@@ -1,4 +1,4 @@
-"""The derived velocity-loop bound (verify.velocity_loop) against the simulated dynamic plant."""
+"""The derived velocity-loop bound (verify.vehicle.bound) against the simulated dynamic plant."""
 
 from __future__ import annotations
 
@@ -16,7 +16,7 @@ from tubekit.model.vehicles import PlantSettings
 from tubekit.plant.dynamic import DynamicPlant, body_forces
 from tubekit.scenario import Disturbance
 from verify.design import hull_sway_bound
-from verify.velocity_loop import actuator_authority, loop_matrix, rate_authority_conditions, velocity_loop_bound
+from verify.vehicle.bound import actuator_authority, loop_matrix, rate_authority_conditions, velocity_loop_bound
 
 CALM = Disturbance(amplitude=(0.0, 0.0, 0.0), sway=SwayModel(gain=0.0, amplitude=0.0, bound=0.0))
 V, H, TICKS = (0.4, 0.3, 0.5), 0.01, 10

@@ -1,4 +1,4 @@
-"""The typed result of :func:`verify.velocity_loop.velocity_loop_bound`: bounds, gains, conditions, JSON.
+"""The typed result of :func:`verify.vehicle.bound.velocity_loop_bound`: bounds, gains, conditions, JSON.
 
 In the JSON a non-finite number is ``null`` (:func:`tubekit.jsonable.to_jsonable`); upper bounds
 read ``null`` back as +inf, the authority (a lower bound) as −inf, so a round trip is exact.
@@ -12,7 +12,7 @@ from typing import Any
 
 from tubekit.exceptions import ConfigError
 from verify.design import Condition
-from verify.loop_response import ResponseSums
+from verify.vehicle.response import ResponseSums
 from verify.parts import block, bound, integer, item, number, numbers, text
 
 __all__ = ["LoopBound"]

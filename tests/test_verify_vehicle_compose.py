@@ -1,4 +1,4 @@
-"""verify.dynamic: the dynamic plant's loop bound composed with ω̄, the tube and the backup."""
+"""verify.vehicle.compose: the dynamic plant's loop bound composed with ω̄, the tube and the backup."""
 
 from __future__ import annotations
 
@@ -9,7 +9,7 @@ import pytest
 
 from tubekit.scenario import load_scenario, scenario_from_dict
 from verify.certificate import Certificate, certify
-from verify.dynamic import PLAN_CHECK_TOLERANCE, plan_jumps
+from verify.vehicle.compose import PLAN_CHECK_TOLERANCE, plan_jumps
 from verify.recheck import recheck
 
 PAPER_CURRENTS = "verify/scenarios/paper_currents.toml"

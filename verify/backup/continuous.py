@@ -31,7 +31,7 @@ from flint import arb
 
 from tubekit.model.backup import SafeSet, StationKeeping
 from verify.design import Condition
-from verify.intervals import enclose, lower, upper
+from verify.intervals import bisect_sup, enclose, lower, upper
 
 __all__ = ["continuous_rate_bound", "continuous_rate_sampled", "unstable_condition", "cone_angle",
            "shape_enclosure", "yaw_shape_enclosure"]
@@ -134,17 +134,8 @@ def continuous_rate_bound(law: StationKeeping, safe: SafeSet, omega_xy: float, d
     ``delta`` is the tick drift Δ (rad) of the axis angle; an interval is split until its bound is
     negative or the budget ``max_boxes`` is spent (then the bound returned is the largest in the cover).
     """
-    pending, done, used = [(0.0, _PI_UP)], [], 0
-    while pending:
-        a, b = pending.pop()
-        bound = _rate_upper(law, safe, omega_xy, delta, a, b, yaw_rate_error)
-        used += 1
-        if bound < 0.0 or used + len(pending) >= max_boxes or b - a < 1e-9:
-            done.append(bound)
-            continue
-        mid = 0.5 * (a + b)
-        pending += [(mid, b), (a, mid)]
-    return max(done), used
+    return bisect_sup(lambda a, b: _rate_upper(law, safe, omega_xy, delta, a, b, yaw_rate_error),
+                      0.0, _PI_UP, max_boxes)
 
 
 def _profiles(law: StationKeeping, x: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

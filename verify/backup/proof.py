@@ -30,10 +30,10 @@ only uses the law at tick starts with d >= d_tick (``backup_fade``: d_0, d_1 <= 
 1 there) and after the ramp: from the hand-over (d <= h_xy, |z − z*| <= h_z) V = c needs d >= c − β, at
 least (c − β − h_xy)/(u_b + ω̄_xy) seconds later, and |z − z*| = Z at least (Z − h_z)/(w_b + ω̄_z)
 seconds later; ``backup_ramp`` asks t_r + h below both, so every tick start that matters has s >= t_r.
-The command's rate is bounded in :mod:`verify.backup_rate`.
+The command's rate is bounded in :mod:`verify.backup.rate`.
 
 **Continuous yaw law** (``StationKeeping.yaw_law == "continuous"``): the level set is V = d + β a(χ)
-(:func:`tubekit.model.backup.axis_shape`), the rate bound is :func:`verify.backup_continuous.continuous_rate_bound`
+(:func:`tubekit.model.backup.axis_shape`), the rate bound is :func:`verify.backup.continuous.continuous_rate_bound`
 over the whole axis circle, and the condition ``backup_ridge`` is replaced by ``backup_unstable``
 (0 < χ_u < χ_c); every other condition is the same.
 """
@@ -51,10 +51,10 @@ from tubekit.exceptions import ConfigError
 from tubekit.model.backup import SafeSet, StationKeeping
 from tubekit.validation import nonnegative, positive
 from verify.design import Condition
-from verify.intervals import enclose, lower, upper
+from verify.intervals import bisect_sup, enclose, lower, upper
 from verify.parts import block, bound, integer, item, number, numbers
-from verify.backup_continuous import continuous_rate_bound, continuous_rate_sampled, cone_angle, unstable_condition
-from verify.backup_rate import backup_command_rate, backup_tick_change
+from verify.backup.continuous import continuous_rate_bound, continuous_rate_sampled, cone_angle, unstable_condition
+from verify.backup.rate import backup_command_rate, backup_tick_change
 
 __all__ = ["BackupCertificate", "planar_rate_bound", "certify_backup", "design_backup", "ramp_window",
            "backup_command_rate", "backup_tick_change", "BACKUP_MAX_BOXES", "UNSTABLE_FRACTION"]
@@ -211,17 +211,8 @@ def planar_rate_bound(law: StationKeeping, safe: SafeSet, omega_xy: float, tick:
     delta = _angle_step(law, omega_xy, tick, d_tick, yaw_rate_error)
     if law.yaw_law == "continuous":
         return continuous_rate_bound(law, safe, omega_xy, delta, max_boxes, yaw_rate_error)
-    pending, done, used = [(0.0, _HALF_PI_UP)], [], 0
-    while pending:
-        a, b = pending.pop()
-        bound = _rate_upper(law, safe, omega_xy, delta, a, b, yaw_rate_error)
-        used += 1
-        if bound < 0.0 or used + len(pending) >= max_boxes or b - a < 1e-9:
-            done.append(bound)
-            continue
-        mid = 0.5 * (a + b)
-        pending += [(mid, b), (a, mid)]
-    return max(done), used
+    return bisect_sup(lambda a, b: _rate_upper(law, safe, omega_xy, delta, a, b, yaw_rate_error),
+                      0.0, _HALF_PI_UP, max_boxes)
 
 
 def _reach_time(law: StationKeeping, safe: SafeSet, omega_xy: float, omega_z: float,

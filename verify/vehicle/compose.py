@@ -1,7 +1,7 @@
 """The dynamic plant inside the theorem: the velocity loop's bound and the backup's command rate, composed.
 
 On the dynamic plant the kinematic command v is tracked by a velocity loop (``docs/plant.md``). Its error
-E = (E_u, E_w, E_r) (:func:`verify.velocity_loop.velocity_loop_bound`) depends on how far the command
+E = (E_u, E_w, E_r) (:func:`verify.vehicle.bound.velocity_loop_bound`) depends on how far the command
 jumps; the command jumps
 
 * at period boundaries by at most J = ρ δ (the plans' rate limit ``limits.rate``, imposed by the FHOCP and
@@ -37,7 +37,7 @@ from verify.gains import GainBounds
 from verify.intervals import upper
 from verify.region import Region
 from verify.tiers import backup_of, safe_only_design, tracking_design
-from verify.velocity_loop import LoopBound, actuator_authority, velocity_loop_bound
+from verify.vehicle.bound import LoopBound, actuator_authority, velocity_loop_bound
 
 __all__ = ["DynamicSolution", "solve_dynamic", "plan_jumps", "FIXED_POINT_ROUNDS", "PLAN_CHECK_TOLERANCE"]
 

@@ -1,7 +1,7 @@
 """The velocity loop's error bound E = (E_u, E_w, E_r), derived in Arb from the vehicle (issue 22).
 
 **Model.** Per channel c ∈ (u, w, r), y = u, w or r: m_c ẏ = τ − n_c(ν; θ) with θ anywhere in the
-coefficient box Θ (yaw with the sway row eliminated, :mod:`verify.loop_model`); the actuator
+coefficient box Θ (yaw with the sway row eliminated, :mod:`verify.vehicle.model`); the actuator
 τ̇ = (sat(τ_cmd) − τ)/T_thr; the controller τ_cmd = n̂_c(ν) + m̂_c a, a = k_p e + k_i I, e = y* − y,
 İ = e, k_p = ω_b, k_i = ω_b²/4 (nominal n̂, m̂: ``tubekit.plant.dynamic``). Without saturation put
 z = (τ − τ_cmd)/m̂_c, s = a + z = (τ − n̂_c)/m̂_c and W = ẏ − s = (1 − 1/μ) ẏ + d/m̂_c (the
@@ -14,7 +14,7 @@ constant drag slope λ_c, x = (Ĩ, e, z) obeys (:func:`loop_matrix`)
 and e = (0, 1, 0) x, z = (0, 0, 1) x, ẏ = (k_i, k_p, 1) x, a = (k_i, k_p, 0) x − W; Ẇ = (μ − 1) ṡ + ḋ/m_c
 with ṡ = −z/T_thr − λ_c ẏ − w_n. A command jump J adds J (0, 1, −k_p) to x (τ is continuous). The
 trimmed start (e = I = z = 0) gives x(0) = (W(0)/k_i, 0, 0), |W(0)| <= sup|d|/m_c.
-:func:`verify.loop_response.impulse_sums` bounds every output by the sums of its sampled
+:func:`verify.vehicle.response.impulse_sums` bounds every output by the sums of its sampled
 response: jumps (J_tick at every tick, J_period − J_tick more at period boundaries, worst phase),
 the inputs Ẇ and w_n (L1), and the free response from x(0) (peak).
 
@@ -41,11 +41,11 @@ from tubekit.exceptions import ConfigError
 from tubekit.validation import finite, nonnegative, positive
 from verify.design import Condition, hull_sway_bound
 from verify.intervals import lower, upper
-from verify.loop_bound import LoopBound
-from verify.loop_model import (arb_body_forces, channel_forces, channel_gradient, channel_masses, channel_mismatch,
+from verify.vehicle.result import LoopBound
+from verify.vehicle.model import (arb_body_forces, channel_forces, channel_gradient, channel_masses, channel_mismatch,
                                channel_mismatch_gradient, hull_balls, nominal_balls, nominal_params,
                                point_time_constant, thrust_floor, velocity_box)
-from verify.loop_response import RESPONSE_PREC, ResponseSums, impulse_sums
+from verify.vehicle.response import RESPONSE_PREC, ResponseSums, impulse_sums
 
 __all__ = ["LoopBound", "velocity_loop_bound", "actuator_authority", "loop_matrix", "computed_bounds",
            "input_bounds", "Inputs", "rate_authority_conditions", "LOOP_MAX_ITERATIONS", "LOOP_INFLATION"]

@@ -1,4 +1,4 @@
-"""The typed velocity-loop result (verify.loop_bound): strict JSON round trip, summary, readers' errors."""
+"""The typed velocity-loop result (verify.vehicle.result): strict JSON round trip, summary, readers' errors."""
 
 from __future__ import annotations
 
@@ -10,8 +10,8 @@ import pytest
 from tubekit.exceptions import ConfigError
 from tubekit.jsonable import to_jsonable
 from tubekit.model.vehicle_sets import BLUEROV2_HEAVY, REMUS100
-from verify.loop_bound import LoopBound
-from verify.velocity_loop import velocity_loop_bound
+from verify.vehicle.result import LoopBound
+from verify.vehicle.bound import velocity_loop_bound
 
 KW = dict(v_max=(0.4, 0.3, 0.5), tick=0.01, period=0.1, jump_tick=(0.002, 0.002, 0.002),
           jump_period=(0.02, 0.02, 0.02))

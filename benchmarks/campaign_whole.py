@@ -2,7 +2,8 @@
 
 Usage::
 
-    python benchmarks/campaign_whole.py [--spec benchmarks/campaign_16x15.toml] [--repeats 3] [--json FILE]
+    python benchmarks/campaign_whole.py [--spec benchmarks/campaign_16x15.toml] [--repeats 3] [--max-load L]
+                                        [--reuse] [--json FILE]
 
 Each repetition starts ``python -m tubekit.app.cli campaign SPEC --out TMP --workers N --no-progress`` as a
 fresh process for N = 1 and N = 2 (the order alternates between repetitions: 1, 2, then 2, 1, ...) and
@@ -17,6 +18,9 @@ throughput (``summary.json``) and the load average. The rows of every process mu
 workers started once for the pair's side on 127.0.0.1 (``dask scheduler`` / ``dask worker --no-nanny``,
 stopped by their process ids) and warmed by one untimed campaign: the ratio without the cluster's
 start-up and the workers' first-task imports, i.e. what reusing one local cluster gives.
+
+``--max-load L``: before each pair, wait (up to 10 min) until the 1-min load average is at most ``L``
+(on a shared machine, a pair measured while other jobs hold a core says little).
 
 A benchmark, not a test: numbers depend on the machine and its load.
 """
@@ -86,7 +90,7 @@ def _cluster(folder: Path, workers: int, procs: list[subprocess.Popen]) -> str:
     return address
 
 
-def measure(spec: Path = SPEC, repeats: int = 3, reuse: bool = False) -> dict:
+def measure(spec: Path = SPEC, repeats: int = 3, reuse: bool = False, max_load: float | None = None) -> dict:
     """``repeats`` pairs of whole processes (1 and 2 workers, alternating order); the ratio of each pair."""
     pairs: list[dict] = []
     procs: list[subprocess.Popen] = []
@@ -96,7 +100,7 @@ def measure(spec: Path = SPEC, repeats: int = 3, reuse: bool = False) -> dict:
             for n, address in clusters.items():
                 if address:
                     whole_process(spec, n, Path(tmp) / f"warm_w{n}", address)  # imports and caches, untimed
-            _pairs(spec, repeats, Path(tmp), clusters, pairs)
+            _pairs(spec, repeats, Path(tmp), clusters, pairs, max_load)
         finally:
             _stop(procs)
     ratios = [p["ratio"] for p in pairs]
@@ -107,10 +111,19 @@ def measure(spec: Path = SPEC, repeats: int = 3, reuse: bool = False) -> dict:
             "identical_rows": all(p[k]["identical_rows"] for p in pairs for k in ("one", "two"))}
 
 
-def _pairs(spec: Path, repeats: int, tmp: Path, clusters: dict, pairs: list) -> None:
+def _wait_for_load(max_load: float | None) -> float:
+    """Wait (15 s steps, at most 10 min) until the 1-min load average is at most ``max_load``; that load."""
+    deadline = time.monotonic() + 600
+    while max_load is not None and os.getloadavg()[0] > max_load and time.monotonic() < deadline:
+        time.sleep(15)
+    return os.getloadavg()[0]
+
+
+def _pairs(spec: Path, repeats: int, tmp: Path, clusters: dict, pairs: list, max_load: float | None = None) -> None:
     """Append ``repeats`` timed pairs to ``pairs``."""
     reference = None
     for rep in range(repeats):
+        _wait_for_load(max_load)
         order = (1, 2) if rep % 2 == 0 else (2, 1)
         timed = {n: whole_process(spec, n, tmp / f"rep{rep}_w{n}", clusters[n]) for n in order}
         for result in timed.values():
@@ -135,8 +148,10 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--repeats", type=int, default=3)
     parser.add_argument("--json", default=None, metavar="FILE")
     parser.add_argument("--reuse", action="store_true", help="one warmed local cluster per worker count")
+    parser.add_argument("--max-load", type=float, default=None, metavar="L",
+                        help="before each pair, wait until the 1-min load average is at most L")
     args = parser.parse_args(argv)
-    result = measure(args.spec.resolve(), args.repeats, args.reuse)
+    result = measure(args.spec.resolve(), args.repeats, args.reuse, args.max_load)
     for k, pair in enumerate(result["pairs"]):
         print(f"repetition {k} (order {pair['order']}): ratio {pair['ratio']:.2f}")
         print("  " + _line(pair["one"]))

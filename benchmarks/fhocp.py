@@ -57,6 +57,7 @@ import numpy as np
 
 from tubekit import Tightening, paper_scenario
 from tubekit.fhocp import FHOCP, IpoptFHOCP, ScpOptions
+from tubekit.fhocp.options import DEFAULT_RATE_PENALTY
 from tubekit.model.kinematics import kinematics
 from tubekit.plant.kinematic import Plant
 from tubekit.scenario import Obstacle, Scenario
@@ -103,9 +104,10 @@ def detected(scenario: Scenario, s: np.ndarray) -> list:
             if np.linalg.norm(s[:3] - np.asarray(o.center)) - o.radius <= scenario.sensing_range]
 
 
-def closed_loop(scenario: Scenario, tightening: Tightening, duration: float) -> list[tuple[float, np.ndarray, list]]:
-    """Simulate the real-time SCP controller; return [(t, state, detected obstacles)]."""
-    ctrl = FHOCP(scenario, tightening, mode="realtime")
+def closed_loop(scenario: Scenario, tightening: Tightening, duration: float,
+                rate_penalty: float = DEFAULT_RATE_PENALTY) -> list[tuple[float, np.ndarray, list]]:
+    """Simulate the real-time SCP controller (rate penalty ``rate_penalty``, s); return [(t, state, detected obstacles)]."""
+    ctrl = FHOCP(scenario, tightening, mode="realtime", options=ScpOptions(rate_penalty=rate_penalty))
     dt = scenario.controller.dt
     s = np.asarray(scenario.initial_state, dtype=float)
     out = []
@@ -129,18 +131,23 @@ def _versions() -> dict:
 
 
 def make_methods(scenario: Scenario, tightening: Tightening, slots: int | None = None,
-                 with_casadi: bool = True) -> dict[str, tuple[object, bool]]:
-    """{name: (solver, converged?)}: ours and the CasADi peers, all with the same obstacle slots."""
-    rt = FHOCP(scenario, tightening, mode="realtime", options=ScpOptions(max_obstacles=slots))
+                 with_casadi: bool = True, rate_penalty: float = DEFAULT_RATE_PENALTY) -> dict[str, tuple[object, bool]]:
+    """{name: (solver, converged?)}: ours and the CasADi peers, all on one problem: the same obstacle slots
+    and the same rate penalty lambda (s). ``sqpmethod`` joins only at ``rate_penalty == 0``: its QP solver
+    (qrqp, eigen-clip) fails on the rate penalty's node-to-node coupling, so it cannot solve the same problem."""
+    opts = ScpOptions(max_obstacles=slots, rate_penalty=rate_penalty)
+    rt = FHOCP(scenario, tightening, mode="realtime", options=opts)
     slots = rt.max_obstacles
+    opts = ScpOptions(max_obstacles=slots, rate_penalty=rate_penalty)
     methods: dict[str, tuple[object, bool]] = {
         "scp_realtime": (rt, False),
-        "scp_converged": (FHOCP(scenario, tightening, mode="converged", options=ScpOptions(max_obstacles=slots)), True)}
+        "scp_converged": (FHOCP(scenario, tightening, mode="converged", options=opts), True)}
     if with_casadi:
         methods["ipopt"] = (IpoptFHOCP(scenario, tightening, max_obstacles=slots, warm_start_duals=True,
-                                       ipopt_options=IPOPT_TUNING), True)
-        methods["sqpmethod_qrqp"] = (IpoptFHOCP(scenario, tightening, max_obstacles=slots, warm_start_duals=True,
-                                                nlp_solver="sqpmethod"), True)
+                                       ipopt_options=IPOPT_TUNING, rate_penalty=rate_penalty), True)
+        if rate_penalty == 0.0:
+            methods["sqpmethod_qrqp"] = (IpoptFHOCP(scenario, tightening, max_obstacles=slots, warm_start_duals=True,
+                                                    nlp_solver="sqpmethod", rate_penalty=0.0), True)
     return methods
 
 
@@ -207,18 +214,19 @@ def summarize(rec: dict, methods: dict) -> dict[str, dict]:
     return out
 
 
-def run(duration: float, with_ipopt: bool = True, profile: bool = False, tolerance: float | None = None) -> dict:
-    """Run the benchmark and return the JSON-ready dict."""
+def run(duration: float, with_ipopt: bool = True, profile: bool = False, tolerance: float | None = None,
+        rate_penalty: float = DEFAULT_RATE_PENALTY) -> dict:
+    """Run the benchmark (every method on the problem with rate penalty ``rate_penalty``, s); a JSON-ready dict."""
     sc = paper_scenario()
     tg = benchmark_tightening(sc)
     t0 = time.perf_counter()
-    run_states = closed_loop(sc, tg, duration)
+    run_states = closed_loop(sc, tg, duration, rate_penalty)
     sim_s = time.perf_counter() - t0
-    methods = make_methods(sc, tg, with_casadi=with_ipopt)
+    methods = make_methods(sc, tg, with_casadi=with_ipopt, rate_penalty=rate_penalty)
     if tolerance is not None:
         slots = methods["scp_realtime"][0].max_obstacles
-        methods["scp_converged"] = (FHOCP(sc, tg, mode="converged",
-                                          options=ScpOptions(tolerance=tolerance, max_obstacles=slots)), True)
+        methods["scp_converged"] = (FHOCP(sc, tg, mode="converged", options=ScpOptions(
+            tolerance=tolerance, max_obstacles=slots, rate_penalty=rate_penalty)), True)
     prof = cProfile.Profile() if profile else None
     gc.disable()
     try:
@@ -246,7 +254,7 @@ def run(duration: float, with_ipopt: bool = True, profile: bool = False, toleran
                     "rt_suboptimality_max": float(np.max(rt_gap)) if len(rt_gap) else math.nan},
     }
     out["details"] = {
-        "duration_s": duration, "closed_loop_sim_s": sim_s, "obstacle_slots": methods["scp_realtime"][0].max_obstacles,
+        "duration_s": duration, "rate_penalty": rate_penalty, "closed_loop_sim_s": sim_s, "obstacle_slots": methods["scp_realtime"][0].max_obstacles,
         "rt_fallbacks": int(np.sum([bool(f) for f in rec["scp_realtime"]["failed"]])),
         "ipopt_options": IPOPT_TUNING, "order": "round-robin, rotated per state",
         "machine": {"python": platform.python_version(), "cpus": os.cpu_count(),
@@ -306,12 +314,13 @@ def _active(states: np.ndarray, obstacles: list[Obstacle], clearance: float) -> 
 
 
 def _scaling_cell(sc: Scenario, tg: Tightening, run_states: list, n_obs: int | None, per_cell: int,
-                  with_casadi: bool, rng: np.random.Generator) -> dict[str, float]:
+                  with_casadi: bool, rng: np.random.Generator,
+                  rate_penalty: float = DEFAULT_RATE_PENALTY) -> dict[str, float]:
     """Median whole-step time (ms) per method on ``per_cell`` warm steps (the solve after one at the
     previous recorded state, same obstacles), methods in rotated order; failures and active obstacles
     (in the converged SCP's plan) summed over the cell."""
     slots = None if n_obs is None else max(n_obs, 1)
-    methods = make_methods(sc, tg, slots, with_casadi)
+    methods = make_methods(sc, tg, slots, with_casadi, rate_penalty)
     names, times = list(methods), {n: [] for n in methods}
     fails, active = {n: 0 for n in methods}, 0
     starts = np.linspace(1, len(run_states) - 2, per_cell).astype(int)
@@ -340,18 +349,20 @@ def _exponent(x: list[float], y: list[float]) -> float:
     return float(np.polyfit(np.log(x), np.log(y), 1)[0])
 
 
-def scaling(per_cell: int = 4, with_casadi: bool = True, seed: int = 0) -> dict:
-    """Step time against the horizon N (paper obstacles) and against obstacles in range (N = 8)."""
+def scaling(per_cell: int = 4, with_casadi: bool = True, seed: int = 0,
+            rate_penalty: float = DEFAULT_RATE_PENALTY) -> dict:
+    """Step time against the horizon N (paper obstacles) and against obstacles in range (N = 8), every method
+    on the problem with rate penalty ``rate_penalty`` (s)."""
     base = paper_scenario()
     tg = benchmark_tightening(base)
-    run_states = closed_loop(base, tg, 30.0)
+    run_states = closed_loop(base, tg, 30.0, rate_penalty)
     rng = np.random.default_rng(seed)
     by_n, by_obs = {}, {}
     for n in SCALING_N:
         sc = dataclasses.replace(base, controller=dataclasses.replace(base.controller, horizon_steps=n))
-        by_n[n] = _scaling_cell(sc, tg, run_states, None, per_cell, with_casadi, rng)
+        by_n[n] = _scaling_cell(sc, tg, run_states, None, per_cell, with_casadi, rng, rate_penalty)
     for m in SCALING_OBSTACLES:
-        by_obs[m] = _scaling_cell(base, tg, run_states, m, per_cell, with_casadi, rng)
+        by_obs[m] = _scaling_cell(base, tg, run_states, m, per_cell, with_casadi, rng, rate_penalty)
     names = list(by_n[SCALING_N[0]]["failures"])
     fit_n = {k: _exponent(list(by_n), [by_n[n][k] for n in by_n]) for k in names}
     pos = [m for m in by_obs if m > 0]
@@ -386,6 +397,9 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--profile", action="store_true", help="cProfile the real-time steps")
     ap.add_argument("--tolerance", type=float, help="converged-mode tolerance (default: FHOCP's)")
     ap.add_argument("--scaling", action="store_true", help="run the scaling study instead (N and obstacles)")
+    ap.add_argument("--rate-penalty", type=float, default=DEFAULT_RATE_PENALTY,
+                    help="the rate penalty lambda (s) of every method's problem (default: the controller's; "
+                         "CasADi sqpmethod joins only at 0)")
     ap.add_argument("--per-cell", type=int, default=4, help="warm steps per scaling cell (default 4)")
     args = ap.parse_args(argv)
     duration = args.duration if args.duration else (20.0 if args.quick else 100.0)
@@ -393,10 +407,11 @@ def main(argv: list[str] | None = None) -> int:
     if not with_casadi:
         print("casadi not installed (pip install 'tubekit[bench]'): the CasADi peers are left out", file=sys.stderr)
     if args.scaling:
-        res = scaling(args.per_cell, with_casadi)
+        res = scaling(args.per_cell, with_casadi, rate_penalty=args.rate_penalty)
         print(scaling_table(res))
     else:
-        res = run(duration, with_ipopt=with_casadi, profile=args.profile, tolerance=args.tolerance)
+        res = run(duration, with_ipopt=with_casadi, profile=args.profile, tolerance=args.tolerance,
+                  rate_penalty=args.rate_penalty)
         print(table(res))
         if args.profile:
             print(res["details"]["rt_profile"])

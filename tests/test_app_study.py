@@ -252,7 +252,7 @@ def test_reproduce_writes_every_file_and_key(certified, tmp_path, monkeypatch):
     for name in DYNAMIC_FILES:
         assert (out / name).is_file() and (out / name).stat().st_size > 20, name  # the fake certificate is short
     dyn = metrics["dynamic"]
-    assert dyn["vehicle"] == "remus100" and len(dyn["velocity_error_max"]) == 3
+    assert dyn["vehicle"] == "bluerov2_heavy" and len(dyn["velocity_error_max"]) == 3
     assert dyn["sway_bound"] == 0.02 and 0 < dyn["sway_max"]
     dyn_csv = np.genfromtxt(out / "dynamic_trajectory.csv", delimiter=",", names=True)
     assert {"u_b", "v_b", "w_b", "r_b", "X", "Z", "N"} <= set(dyn_csv.dtype.names)

@@ -20,7 +20,8 @@ PEER_KEYS = ("median_ms", "p90_ms", "p99_ms", "failures", "cost_gap_max", "conve
 def test_quick_benchmark_writes_all_keys(tmp_path):
     pytest.importorskip("casadi")
     out = tmp_path / "fhocp.json"
-    proc = subprocess.run([sys.executable, str(ROOT / "benchmarks" / "fhocp.py"), "--quick", "--json", str(out)],
+    proc = subprocess.run([sys.executable, str(ROOT / "benchmarks" / "fhocp.py"), "--quick", "--rate-penalty", "0",
+                           "--json", str(out)],
                           capture_output=True, text=True, timeout=600, cwd=tmp_path)  # a hang guard
     assert proc.returncode == 0, proc.stderr
     assert "real-time SCP step" in proc.stdout and "sqpmethod" in proc.stdout
@@ -31,6 +32,7 @@ def test_quick_benchmark_writes_all_keys(tmp_path):
     assert res["n_states"] >= 100
     assert res["clarabel_ms_median"] <= res["rt_step_ms_median"]
     assert res["details"]["rt_fallbacks"] == 0
+    assert res["details"]["rate_penalty"] == 0.0
     assert set(PEERS) <= set(res["peers"])
     for name in PEERS:
         for key in PEER_KEYS:
@@ -38,3 +40,24 @@ def test_quick_benchmark_writes_all_keys(tmp_path):
     assert res["peers"]["ipopt"]["converged"] and not res["peers"]["scp_realtime"]["converged"]
     for key in ("rt_suboptimality_median", "rt_suboptimality_max", "rt_over_clarabel", "rt_p99_over_median"):
         assert key in res["targets"], key
+
+
+def _bench_module():
+    import importlib.util
+    spec = importlib.util.spec_from_file_location("bench_fhocp", ROOT / "benchmarks" / "fhocp.py")
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    return mod
+
+
+@pytest.mark.parametrize("lam, with_sqp", [(0.0, True), (10.0, False), (2.5, False)])
+def test_every_method_solves_one_problem(lam, with_sqp):
+    """Every method gets the same rate penalty; sqpmethod (it fails on the rate rows) joins only at 0."""
+    pytest.importorskip("casadi")
+    bench = _bench_module()
+    from tubekit import paper_scenario
+    sc = paper_scenario()
+    methods = bench.make_methods(sc, bench.benchmark_tightening(sc), rate_penalty=lam)
+    assert ("sqpmethod_qrqp" in methods) is with_sqp
+    assert {m.nlp.rate_penalty for m, _ in methods.values()} == {lam}
+    assert len({m.max_obstacles for m, _ in methods.values()}) == 1

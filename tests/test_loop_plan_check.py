@@ -133,6 +133,17 @@ def test_plan_arcs_are_the_exact_unicycle(u, r, w, psi0):
     np.testing.assert_allclose(arcs[..., 3], psi, atol=1e-12)
 
 
+@given(seed=st.integers(0, 2 ** 32 - 1), n=st.integers(1, 12), samples=st.integers(1, 12))
+def test_plan_arcs_equal_the_arcs_chained_one_by_one(seed, n, samples):
+    """Property: the vectorised plan_arcs returns the very floats of nominal_arc chained arc by arc."""
+    from tubekit.loop.plan_check import _plan_arcs_chained
+    rng = np.random.default_rng(seed)
+    x0 = rng.normal(size=4) * [5.0, 5.0, 1.0, 3.0]
+    inputs = rng.uniform(-1.0, 1.0, (n, 3)) * [0.4, 0.2, 0.6]
+    inputs[rng.random(n) < 0.3, 2] = 0.0  # straight arcs too
+    np.testing.assert_array_equal(plan_arcs(x0, inputs, 0.1, samples), _plan_arcs_chained(x0, inputs, 0.1, samples))
+
+
 # ---- the terminal condition (tightening.backup) and the safe-only tier ------------------------------------
 # PLAN ends at p* = (-1.68, 3, 0), sensed from X0 (0.32 m away). The backup's footprint with the 0.2 m vehicle
 # radius is R_f = 0.8 + 0.2 = 1.0 m, H_f = 0.1 + 0.2 = 0.3 m; its sensed spread hypot(0.32 + 0.8, 0.1).

@@ -123,6 +123,18 @@ def test_step_is_rk4_hold_and_step_tuple():
     np.testing.assert_array_equal(got, plant.step_tuple(1.0, tuple(x0), tuple(v), 0.005, 20))
 
 
+@given(t=st.floats(0.0, 200.0), psi=st.floats(-4.0, 4.0), u=st.floats(-0.5, 0.5), w=st.floats(-0.3, 0.3),
+       r=st.floats(-0.6, 0.6), n=st.integers(1, 4))
+def test_fused_step_equals_the_generic_rk4_bit_for_bit(t, psi, u, w, r, n):
+    """Property: step_tuple (the unrolled RK4) returns the very floats, and records the very omega peak, of
+    rk4_tuple on the plant's _rhs (the generic integrator it replaces in the loop)."""
+    from tubekit.plant.kinematic import rk4_tuple
+    fused, generic = _plant(), _plant()
+    x, v = (0.3, -1.2, 0.4, psi), (u, w, r)
+    assert fused.step_tuple(t, x, v, 0.005, n) == rk4_tuple(generic._rhs, t, x, v, 0.005, n)
+    assert fused.omega_peak() == generic.omega_peak()
+
+
 def test_override_replaces_current_and_sway():
     plant = Plant(_plant().disturbance, override=lambda t: (0.01 * t, -0.02, 0.0))
     x, v = np.array([0.0, 0.0, 0.0, 1.0]), np.array([0.3, 0.0, 0.2])

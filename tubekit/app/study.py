@@ -321,8 +321,9 @@ def _write_study(scenario: Scenario, out: Path, staging: Path, progress: bool, w
     if dynamic:
         from tubekit.app.dynamic_study import run_dynamic
 
-        LOGGER.info("tube run on the dynamic plant (%s) ...", scenario.plant.vehicle)
+        LOGGER.info("tube run on the dynamic plant ...")
         dyn_run, metrics["dynamic"] = run_dynamic(scenario, staging, tube.run, progress)
+        LOGGER.info("  vehicle %s", metrics["dynamic"]["vehicle"])
     if animate:
         from tubekit.app.animate import animate_top_view
 

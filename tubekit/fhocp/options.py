@@ -16,7 +16,10 @@ from tubekit.exceptions import ConfigError
 from tubekit.scenario import TerminalMode
 from tubekit.validation import choice, nonnegative, positive
 
-__all__ = ["ScpOptions", "DEFAULT_RATE_PENALTY"]
+__all__ = ["ScpOptions", "DEFAULT_RATE_PENALTY", "QP_SOLVERS"]
+
+#: The subproblem solvers by name (:attr:`ScpOptions.qp_solver`).
+QP_SOLVERS = ("clarabel", "piqp")
 
 #: The rate penalty's default weight lambda (s): damps the real-time SCP's alternating plans (issue 24 item 8),
 #: measured by the ``sign_flips_per_s`` metric of :mod:`tubekit.loop.metrics`.
@@ -70,6 +73,10 @@ class ScpOptions:
         lambda (s, >= 0) of the rate penalty lambda sum_c R_c (sum_k (v_k,c - v_{k-1},c)^2 + (v_0,c -
         v_last,c)^2) in the cost (:mod:`tubekit.fhocp.rows`); default :data:`DEFAULT_RATE_PENALTY`,
         0 switches it off (the cost of the paper's FHOCP).
+    qp_solver : str
+        :data:`QP_SOLVERS`: ``"clarabel"`` (default) solves every subproblem with Clarabel; ``"piqp"``
+        (opt-in, needs the fast path and ``pip install piqp``) tries PIQP on the QP relaxation first and
+        keeps its answer only where it meets the cones (:mod:`tubekit.fhocp.qp_relaxed`), else Clarabel.
     """
 
     max_obstacles: int | None = None
@@ -84,6 +91,7 @@ class ScpOptions:
     fast_path: bool = True
     clarabel_settings: Mapping[str, Any] | None = None
     rate_penalty: float = DEFAULT_RATE_PENALTY
+    qp_solver: str = "clarabel"
 
     def __post_init__(self) -> None:
         if self.max_obstacles is not None:
@@ -98,6 +106,11 @@ class ScpOptions:
         object.__setattr__(self, "tolerance", positive("tolerance", self.tolerance))
         object.__setattr__(self, "trust_radius", positive("trust_radius", self.trust_radius))
         object.__setattr__(self, "rate_penalty", nonnegative("rate_penalty", self.rate_penalty))
+        if self.qp_solver not in QP_SOLVERS:
+            raise ConfigError("qp_solver", f"one of {QP_SOLVERS}", self.qp_solver)
+        if self.qp_solver != "clarabel" and not self.fast_path:
+            raise ConfigError("qp_solver", "'clarabel' when fast_path=False (the QP path reads the compiled data)",
+                              self.qp_solver)
         for name in ("extrapolate", "fast_path"):
             if not isinstance(getattr(self, name), bool):
                 raise ConfigError(name, "True or False", getattr(self, name))

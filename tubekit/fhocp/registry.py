@@ -5,7 +5,9 @@ Built in:
 * ``"scp"`` (default) — :class:`tubekit.fhocp.scp.FHOCP` in ``scenario.controller.fhocp_mode``
   with default :class:`~tubekit.fhocp.options.ScpOptions`;
 * ``"ipopt"`` — :class:`tubekit.fhocp.ipopt.IpoptFHOCP`, the CasADi + IPOPT peer (optional:
-  without CasADi, :class:`~tubekit.exceptions.NotAvailableError` with the install hint).
+  without CasADi, :class:`~tubekit.exceptions.NotAvailableError` with the install hint);
+* ``"scp-piqp"`` — the SCP solver with ``ScpOptions(qp_solver="piqp")``: PIQP on the QP relaxation,
+  checked against the cones, else Clarabel (:mod:`tubekit.fhocp.qp_relaxed`; opt-in, needs PIQP).
 
 The closed loop builds its solver with :func:`make_solver` from
 ``scenario.controller.fhocp_backend``; :func:`register_backend` adds a backend.
@@ -42,7 +44,15 @@ def _ipopt(scenario: Scenario, tightening: Tightening) -> FhocpSolver:
                       terminal=scenario.controller.terminal_mode)
 
 
-_BACKENDS: dict[str, SolverFactory] = {"scp": _scp, "ipopt": _ipopt}
+def _scp_piqp(scenario: Scenario, tightening: Tightening) -> FhocpSolver:
+    """The SCP solver whose subproblems try PIQP on the QP relaxation first (same answers as ``scp``)."""
+    from tubekit.fhocp.options import ScpOptions
+    from tubekit.fhocp.qp_relaxed import import_piqp
+    import_piqp()  # NotAvailableError with the install hint before anything is built
+    return FHOCP(scenario, tightening, options=ScpOptions(qp_solver="piqp"))
+
+
+_BACKENDS: dict[str, SolverFactory] = {"scp": _scp, "ipopt": _ipopt, "scp-piqp": _scp_piqp}
 
 
 def backends() -> tuple[str, ...]:

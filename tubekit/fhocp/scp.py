@@ -192,6 +192,9 @@ class FHOCP:
         self.subproblem = ConvexSubproblem(self.nlp, self.max_obstacles, s0,
                                            self.nlp.reference(scenario.trajectory, 0.0), self.trust_radius,
                                            fast_path=self.fast_path, clarabel_settings=opts.clarabel_overrides())
+        if opts.qp_solver == "piqp":  # opt-in: PIQP on the QP relaxation, checked against the cones
+            from tubekit.fhocp.qp_relaxed import RelaxedQpProgram
+            self.subproblem.compiled = RelaxedQpProgram(self.subproblem.compiled)
         self.build_time_s = time.perf_counter() - t0
 
     def _check_workspace(self) -> None:

@@ -154,15 +154,57 @@ def measure(duration: float | None = None, profile: bool = False, repeat: int = 
     return out
 
 
+def compare_previous(repeat: int = 4) -> dict:
+    """Interleaved runs with the previous code paths (RK4 through ``rk4_tuple(plant._rhs)``, arcs chained
+    one by one) against the current ones: wall medians, their ratio, and whether the logs are identical."""
+    import contextlib
+
+    from tubekit.loop import plan_check
+    from tubekit.plant import kinematic
+    scenario = paper_scenario()
+    tightening = verify.certify(scenario, law=scenario.controller.law).best_effort_tightening()
+    _solver_import_s()
+    new_step, new_arcs = kinematic.Plant.step_tuple, plan_check.plan_arcs
+
+    def old_step(self, t, x, v, h, n):
+        return kinematic.rk4_tuple(self._rhs, t, tuple(x), v, h, n)
+
+    @contextlib.contextmanager
+    def previous():
+        kinematic.Plant.step_tuple, plan_check.plan_arcs = old_step, plan_check._plan_arcs_chained
+        try:
+            yield
+        finally:
+            kinematic.Plant.step_tuple, plan_check.plan_arcs = new_step, new_arcs
+
+    walls: dict[str, list[float]] = {"previous": [], "current": []}
+    runs: dict = {}
+    for rep in range(repeat):
+        for name in (("previous", "current") if rep % 2 == 0 else ("current", "previous")):
+            with previous() if name == "previous" else contextlib.nullcontext():
+                w0 = time.perf_counter()
+                runs[name] = run_closed_loop(scenario, tightening, tube=True, progress=False)
+                walls[name].append(time.perf_counter() - w0)
+    a, b = runs["previous"], runs["current"]
+    same = all(np.array_equal(getattr(a, f), getattr(b, f), equal_nan=True)
+               for f in ("states", "v_hat", "inputs", "rejected", "plan_slack", "nominal"))
+    med = {k: float(np.median(v)) for k, v in walls.items()}
+    return {"walls_s": walls, "median_s": med, "previous_over_current": med["previous"] / med["current"],
+            "identical_logs": same}
+
+
 def main(argv: list[str] | None = None) -> int:
     """CLI entry point."""
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--duration", type=float, default=None, help="simulated seconds (default: the scenario's)")
     parser.add_argument("--repeat", type=int, default=3, help="timed runs; the median wall decides (default 3)")
     parser.add_argument("--json", default=None, help="write the figures to this file")
-    parser.add_argument("--profile", action="store_true", help="print a cProfile of the timed run (slows it) and add its breakdown by part")
+    parser.add_argument("--profile", action="store_true",
+                        help="print a cProfile of the timed run (slows it) and add its breakdown by part")
+    parser.add_argument("--compare-previous", action="store_true",
+                        help="interleave the previous plant step and arc evaluation with the current ones instead")
     args = parser.parse_args(argv)
-    out = measure(args.duration, args.profile, args.repeat)
+    out = compare_previous() if args.compare_previous else measure(args.duration, args.profile, args.repeat)
     text = json.dumps(out, indent=2)
     print(text)
     if args.json:

@@ -106,7 +106,9 @@ def detected(scenario: Scenario, s: np.ndarray) -> list:
 
 def closed_loop(scenario: Scenario, tightening: Tightening, duration: float,
                 rate_penalty: float = DEFAULT_RATE_PENALTY) -> list[tuple[float, np.ndarray, list]]:
-    """Simulate the real-time SCP controller (rate penalty ``rate_penalty``, s); return [(t, state, detected obstacles)]."""
+    """Simulate the real-time SCP controller (rate penalty ``rate_penalty``, s).
+
+    Returns [(t, state, detected obstacles)]."""
     ctrl = FHOCP(scenario, tightening, mode="realtime", options=ScpOptions(rate_penalty=rate_penalty))
     dt = scenario.controller.dt
     s = np.asarray(scenario.initial_state, dtype=float)
@@ -131,7 +133,8 @@ def _versions() -> dict:
 
 
 def make_methods(scenario: Scenario, tightening: Tightening, slots: int | None = None,
-                 with_casadi: bool = True, rate_penalty: float = DEFAULT_RATE_PENALTY) -> dict[str, tuple[object, bool]]:
+                 with_casadi: bool = True, rate_penalty: float = DEFAULT_RATE_PENALTY,
+                 with_piqp: bool = False) -> dict[str, tuple[object, bool]]:
     """{name: (solver, converged?)}: ours and the CasADi peers, all on one problem: the same obstacle slots
     and the same rate penalty lambda (s). ``sqpmethod`` joins only at ``rate_penalty == 0``: its QP solver
     (qrqp, eigen-clip) fails on the rate penalty's node-to-node coupling, so it cannot solve the same problem."""
@@ -142,6 +145,9 @@ def make_methods(scenario: Scenario, tightening: Tightening, slots: int | None =
     methods: dict[str, tuple[object, bool]] = {
         "scp_realtime": (rt, False),
         "scp_converged": (FHOCP(scenario, tightening, mode="converged", options=opts), True)}
+    if with_piqp:  # the opt-in QP path (tubekit.fhocp.qp_relaxed), real-time mode
+        methods["scp_realtime_piqp"] = (FHOCP(scenario, tightening, mode="realtime", options=dataclasses.replace(
+            opts, qp_solver="piqp")), False)
     if with_casadi:
         methods["ipopt"] = (IpoptFHOCP(scenario, tightening, max_obstacles=slots, warm_start_duals=True,
                                        ipopt_options=IPOPT_TUNING, rate_penalty=rate_penalty), True)
@@ -215,14 +221,14 @@ def summarize(rec: dict, methods: dict) -> dict[str, dict]:
 
 
 def run(duration: float, with_ipopt: bool = True, profile: bool = False, tolerance: float | None = None,
-        rate_penalty: float = DEFAULT_RATE_PENALTY) -> dict:
+        rate_penalty: float = DEFAULT_RATE_PENALTY, with_piqp: bool = False) -> dict:
     """Run the benchmark (every method on the problem with rate penalty ``rate_penalty``, s); a JSON-ready dict."""
     sc = paper_scenario()
     tg = benchmark_tightening(sc)
     t0 = time.perf_counter()
     run_states = closed_loop(sc, tg, duration, rate_penalty)
     sim_s = time.perf_counter() - t0
-    methods = make_methods(sc, tg, with_casadi=with_ipopt, rate_penalty=rate_penalty)
+    methods = make_methods(sc, tg, with_casadi=with_ipopt, rate_penalty=rate_penalty, with_piqp=with_piqp)
     if tolerance is not None:
         slots = methods["scp_realtime"][0].max_obstacles
         methods["scp_converged"] = (FHOCP(sc, tg, mode="converged", options=ScpOptions(
@@ -254,7 +260,8 @@ def run(duration: float, with_ipopt: bool = True, profile: bool = False, toleran
                     "rt_suboptimality_max": float(np.max(rt_gap)) if len(rt_gap) else math.nan},
     }
     out["details"] = {
-        "duration_s": duration, "rate_penalty": rate_penalty, "closed_loop_sim_s": sim_s, "obstacle_slots": methods["scp_realtime"][0].max_obstacles,
+        "duration_s": duration, "rate_penalty": rate_penalty, "closed_loop_sim_s": sim_s,
+        "obstacle_slots": methods["scp_realtime"][0].max_obstacles,
         "rt_fallbacks": int(np.sum([bool(f) for f in rec["scp_realtime"]["failed"]])),
         "ipopt_options": IPOPT_TUNING, "order": "round-robin, rotated per state",
         "machine": {"python": platform.python_version(), "cpus": os.cpu_count(),
@@ -273,7 +280,7 @@ def table(res: dict) -> str:
     lines = ["| method | step median ms | p90 | p99 | solver-only median ms | failures | max cost gap |",
              "|---|---|---|---|---|---|---|"]
     label = {"scp_realtime": "real-time SCP step", "scp_converged": "converged SCP", "ipopt": "IPOPT (tuned)",
-             "sqpmethod_qrqp": "CasADi sqpmethod + qrqp"}
+             "sqpmethod_qrqp": "CasADi sqpmethod + qrqp", "scp_realtime_piqp": "real-time SCP, PIQP path"}
     for n, p in res["peers"].items():
         lines.append(f"| {label.get(n, n)} | {p['median_ms']:.3f} | {p['p90_ms']:.3f} | {p['p99_ms']:.3f} | "
                      f"{p['solver_median_ms']:.3f} | {p['failures']} | {p['cost_gap_max']:.2e} |")
@@ -400,18 +407,20 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--rate-penalty", type=float, default=DEFAULT_RATE_PENALTY,
                     help="the rate penalty lambda (s) of every method's problem (default: the controller's; "
                          "CasADi sqpmethod joins only at 0)")
+    ap.add_argument("--piqp", action="store_true", help="add the real-time SCP with the opt-in PIQP path")
+    ap.add_argument("--no-casadi", action="store_true", help="leave the CasADi peers out")
     ap.add_argument("--per-cell", type=int, default=4, help="warm steps per scaling cell (default 4)")
     args = ap.parse_args(argv)
     duration = args.duration if args.duration else (20.0 if args.quick else 100.0)
-    with_casadi = importlib.util.find_spec("casadi") is not None
-    if not with_casadi:
+    with_casadi = importlib.util.find_spec("casadi") is not None and not args.no_casadi
+    if importlib.util.find_spec("casadi") is None:
         print("casadi not installed (pip install 'tubekit[bench]'): the CasADi peers are left out", file=sys.stderr)
     if args.scaling:
         res = scaling(args.per_cell, with_casadi, rate_penalty=args.rate_penalty)
         print(scaling_table(res))
     else:
         res = run(duration, with_ipopt=with_casadi, profile=args.profile, tolerance=args.tolerance,
-                  rate_penalty=args.rate_penalty)
+                  rate_penalty=args.rate_penalty, with_piqp=args.piqp)
         print(table(res))
         if args.profile:
             print(res["details"]["rt_profile"])

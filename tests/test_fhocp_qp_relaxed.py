@@ -34,7 +34,9 @@ def test_the_piqp_path_returns_clarabels_plans_on_the_run_states():
             a = ref.solve(t + dt, np.asarray(s), SC.obstacles)
             b = alt.solve(t + dt, np.asarray(s), SC.obstacles)
             np.testing.assert_allclose(b.inputs, a.inputs, atol=1e-5)
-            assert b.merit == pytest.approx(a.merit, rel=1e-6, abs=1e-9)
+            # cold starts run the converged loop: the tolerance 1e-5 on its stopping test, with exact
+            # penalties of weight 1e3, leaves the merit equal to ~1e-4 between two solvers
+            assert b.merit == pytest.approx(a.merit, rel=1e-4)
             assert not b.fallback
     program = alt.subproblem.compiled
     assert program.qp_solves > 0 and program.clarabel_solves > 0

@@ -1,0 +1,40 @@
+"""benchmarks/closed_loop.py: its JSON keys and the profile's split by part (timings not asserted)."""
+
+from __future__ import annotations
+
+import importlib.util
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def _module():
+    spec = importlib.util.spec_from_file_location("bench_closed_loop", ROOT / "benchmarks" / "closed_loop.py")
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    return mod
+
+
+@pytest.fixture(scope="module")
+def short_run():
+    return _module().measure(duration=2.0, profile=True, repeat=2)
+
+
+def test_the_short_run_reports_every_key(short_run):
+    for key in ("wall_s", "walls_s", "realtime_factor", "realtime_factor_with_import", "solver_import_s_excluded",
+                "certify_s_excluded", "breakdown", "profile"):
+        assert key in short_run, key
+    assert len(short_run["walls_s"]) == 2
+    assert short_run["realtime_factor"] == pytest.approx(2.0 / short_run["wall_s"])
+
+
+def test_the_profile_parts_cover_the_run_without_double_counting(short_run):
+    prof = short_run["profile"]
+    parts = prof["parts_s"]
+    assert set(_module().PROFILE_PARTS) | {"other"} == set(parts)
+    # 20 periods: the FHOCP ran, the plant stepped 200 ticks, the arc check judged every plan
+    assert parts["fhocp"] > 0 and parts["plant"] > 0 and parts["arc_check"] > 0
+    assert sum(v for k, v in parts.items() if k != "other") <= prof["profiled_wall_s"] * (1 + 1e-9)
+    assert sum(prof["parts_share"].values()) == pytest.approx(1.0)

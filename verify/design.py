@@ -30,7 +30,7 @@ from tubekit.scenario import Scenario
 from tubekit.model.vehicles import VehicleParams
 
 from verify.gains import GainBounds
-from verify.intervals import lower, upper
+from verify.intervals import enclose, lower, upper
 from verify.parts import bound, flag, item, number, text
 from verify.region import Region
 from verify.sampled import HorizonMargins, PeriodTube, TubeProblem, horizon_margins, one_period_tube
@@ -108,10 +108,8 @@ def hull_sway_bound(params: VehicleParams, u_bar: float, r_bar: float) -> arb:
     it is evaluated at the worst ends (largest F, smallest a and b, each from Arb balls of
     the intervals) and the mass ratio 2|m24| r̄ / m22 over the balls of m, x_g and the added masses.
     """
-    from verify.vehicle.model import field_ball  # a leaf module: no cycle
-
-    def ball(name: str) -> arb:
-        return field_ball(params, name)
+    def ball(name: str) -> arb:  # the coefficient's interval as a ball (a point: a zero-radius ball)
+        return enclose(*params.interval(name))
 
     m = ball("m")
     m11, m22, m24 = m - ball("X_udot"), m - ball("Y_vdot"), m * ball("x_g") - ball("Y_rdot")

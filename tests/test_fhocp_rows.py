@@ -69,3 +69,14 @@ def test_projection_meets_every_row_when_rest_is_reachable(v_last, plan):
 
 def test_the_margin_leaves_room_below_j():
     assert 0.0 < RATE_MARGIN <= 1e-3
+
+
+def test_projection_meets_the_rest_where_the_envelopes_touch_up_to_rounding():
+    """Counterexample found by hypothesis in CI: 0.15 - 0.05 rounds above the rest envelope 2 x 0.05 = 0.1,
+    and the step bound used to win, leaving the terminal node at 0.15 > J."""
+    big_j = np.array([0.06, 0.05, 0.1])
+    plan = np.zeros((8, 3))
+    plan[3:, 1] = 0.25
+    v = rate_project(plan, big_j, VMAX, v_last=np.zeros(3), rest=True)
+    assert max(rate_violation(v, big_j, np.zeros(3), rest=True).values()) <= 1e-15
+    assert v[-1, 1] <= big_j[1] and np.allclose(v[3:, 1], [0.05, 0.1, 0.15, 0.1, 0.05])

@@ -47,6 +47,11 @@ def rate_violation(inputs: np.ndarray, jump: np.ndarray, v_last: np.ndarray | No
     return out
 
 
+#: Rounding forgiven where the rest envelope (N − k) J meets the step bound v_{k−1} ± J: the two are sums of
+#: the same J in another order, so equal bounds may differ by a few ulps.
+REST_ROUNDING = 1e-12
+
+
 def rate_project(inputs: np.ndarray, jump: np.ndarray, v_max: np.ndarray, v_last: np.ndarray | None = None,
                  rest: bool = False) -> np.ndarray:
     """``inputs`` (N, 3) made to meet the rate rows (forward clamp), inside the box ``v_max``.
@@ -70,8 +75,9 @@ def rate_project(inputs: np.ndarray, jump: np.ndarray, v_max: np.ndarray, v_last
                 lo, hi = max(lo, prev[c] - js[c]), min(hi, prev[c] + js[c])
             if rest:
                 reach = (n - k) * js[c]
-                if max(lo, -reach) <= min(hi, reach):
-                    lo, hi = max(lo, -reach), min(hi, reach)
+                r_lo, r_hi = max(lo, -reach), min(hi, reach)
+                if r_lo <= r_hi + REST_ROUNDING * max(1.0, reach):  # they meet, up to the rounding of the sums
+                    lo, hi = min(r_lo, r_hi), r_hi
             rows[k][c] = min(max(rows[k][c], lo), hi)
         prev = rows[k]
     return np.array(rows, dtype=float)

@@ -17,6 +17,7 @@ the box. Point-only properties (:attr:`VehicleParams.mass_entries`, :attr:`thrus
 from __future__ import annotations
 
 from dataclasses import dataclass, fields, replace
+from functools import cached_property
 from typing import Any, Mapping, Union
 
 import numpy as np
@@ -207,9 +208,11 @@ class VehicleParams:
             raise ValueError(f"VehicleParams.{what} needs a point vehicle; {list(self.interval_fields)} are "
                              "intervals: use .nominal, .sample(rng) or .interval(name)")
 
-    @property
+    @cached_property
     def mass_entries(self) -> tuple[float, float, float, float, float, float]:
-        """(m11, m22, m33, m44, m24, m42) of M (kg, kg, kg, kg m², kg m, kg m); point vehicles only."""
+        """(m11, m22, m33, m44, m24, m42) of M (kg, kg, kg, kg m², kg m, kg m); point vehicles only.
+
+        Computed once per vehicle: the dynamic plant reads it at every integrator stage."""
         self._point_only("mass_entries")
         m = self.m
         return (m - self.X_udot, m - self.Y_vdot, m - self.Z_wdot, self.I_zz - self.N_rdot,

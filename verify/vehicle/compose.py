@@ -37,7 +37,7 @@ from verify.gains import GainBounds
 from verify.intervals import upper
 from verify.region import Region
 from verify.tiers import backup_of, safe_only_design, tracking_design
-from verify.vehicle.bound import LoopBound, actuator_authority, velocity_loop_bound
+from verify.vehicle.bound import LoopBound, rate_authority_conditions, velocity_loop_bound
 
 __all__ = ["DynamicSolution", "solve_dynamic", "plan_jumps", "FIXED_POINT_ROUNDS", "PLAN_CHECK_TOLERANCE"]
 
@@ -66,8 +66,6 @@ class DynamicSolution:
         As :func:`verify.certificate.certify` computes them, with ``dist``.
     conditions : tuple of Condition
         The loop's conditions, ``loop_consistent``, ``rate_authority[*]``, ``loop_kappa``.
-    rounds : int
-        Fixed-point rounds used.
     """
 
     loop: LoopBound
@@ -78,7 +76,6 @@ class DynamicSolution:
     safe: Design | None
     backup: BackupCertificate
     conditions: tuple[Condition, ...]
-    rounds: int
 
 
 def plan_jumps(scenario: Scenario) -> tuple[float, float, float]:
@@ -92,19 +89,15 @@ def plan_jumps(scenario: Scenario) -> tuple[float, float, float]:
     return tuple(upper(arb(r) * arb(dt) + arb(PLAN_CHECK_TOLERANCE)) for r in rate)
 
 
-def _rate_conditions(scenario: Scenario, v_max: tuple[float, float, float]) -> list[Condition]:
-    """``limits_rate`` (a rate limit is set) and ``rate_authority[c]``: ρ_c <= the acceleration the actuators
-    deliver against drag at the corner of V, over the coefficient box."""
+def _rate_conditions(scenario: Scenario, loop: LoopBound) -> list[Condition]:
+    """``limits_rate`` (a rate limit is set) and ``rate_authority[c]``
+    (:func:`verify.vehicle.bound.rate_authority_conditions` against the loop bound's ``authority``)."""
     rate = getattr(scenario.limits, "rate", None)
     if rate is None:
         return [Condition("limits_rate", "limits.rate set (the plans' command jumps bounded by rho delta)", None,
                           None, False, "without a rate limit a plan may jump by 2V between periods; the loop "
                           "error after such a jump is of the order of V")]
-    auth = actuator_authority(scenario.plant.params, v_max)
-    return [Condition(f"rate_authority[{ax}]", f"rho_{ax} <= the acceleration the actuators deliver against drag "
-                      "at the corner of V (every coefficient in its interval)", float(r), float(a), bool(r <= a),
-                      "a plan's rate limit must be one the vehicle can follow")
-            for ax, r, a in zip("uwr", rate, auth)]
+    return rate_authority_conditions(loop.authority, rate)
 
 
 def _kappa_condition(sigma: float) -> Condition:
@@ -173,7 +166,7 @@ def solve_dynamic(scenario: Scenario, region: Region, gains: GainBounds,
     if rounds == 0:  # the plans' jumps alone already break the loop: report with a finite stand-in
         assumed = tuple(e if math.isfinite(e) else float(x) for e, x in zip(first.error, v_max))
         dist, designs, best, safe, backup = _tiers_at(scenario, region, gains, sigmas, assumed)
-    conds = (*loop.conditions, _consistent(loop, assumed), *_rate_conditions(scenario, v_max),
+    conds = (*loop.conditions, _consistent(loop, assumed), *_rate_conditions(scenario, loop),
              _kappa_condition(best.sigma))
     return DynamicSolution(loop=loop, assumed=assumed, dist=dist, designs=designs, best=best, safe=safe,
-                           backup=backup, conditions=conds, rounds=rounds)
+                           backup=backup, conditions=conds)

@@ -34,17 +34,13 @@ _ROUND = 2.0 ** -50   # relative: covers the float rounding of a point vehicle's
 
 
 def field_ball(params: Any, name: str) -> arb:
-    """The ball of field ``name``: ``params.interval(name)`` when the vehicle has intervals, else its point."""
-    interval = getattr(params, "interval", None)
-    if callable(interval):
-        lo, hi = interval(name)
-        return enclose(lo, hi)
-    return point(getattr(params, name))
+    """The ball of field ``name``: ``params.interval(name)`` (lo == hi for a point)."""
+    return enclose(*params.interval(name))
 
 
 def nominal_params(params: Any) -> Any:
-    """The controller's point vehicle: ``params.nominal`` (midpoints) when present, else ``params``."""
-    return getattr(params, "nominal", params)
+    """The controller's point vehicle: ``params.nominal`` (every interval at its midpoint)."""
+    return params.nominal
 
 
 def _mass_balls(f: Mapping[str, arb]) -> dict[str, arb]:

@@ -16,6 +16,7 @@ from __future__ import annotations
 import time
 
 STARTED = time.perf_counter()
+EPOCH = time.time()  # the same instant on the wall clock (the workers' task stream uses it)
 
 import argparse  # noqa: E402
 import contextlib  # noqa: E402
@@ -34,8 +35,30 @@ def _mark(what: str) -> None:
           flush=True)
 
 
+def _timeline(tasks: list[dict]) -> None:
+    """Per worker: its first task's start, its busy time, its idle time between tasks, its last task's end
+    (s since this interpreter started), and each task's compute time."""
+    by_worker: dict[str, list[tuple[float, float, str]]] = {}
+    for task in tasks:
+        for part in task["startstops"]:
+            if part["action"] == "compute":
+                by_worker.setdefault(task["worker"], []).append((part["start"] - EPOCH, part["stop"] - EPOCH,
+                                                                 task["key"].split("-")[-2]))
+    for worker, spans in sorted(by_worker.items()):
+        spans.sort()
+        busy = sum(stop - start for start, stop, _ in spans)
+        idle = sum(b[0] - a[1] for a, b in zip(spans, spans[1:]))
+        kinds = {k: sum(stop - start for start, stop, kind in spans if kind == k) for k in {s[2] for s in spans}}
+        print(f"  worker {worker}: {len(spans)} tasks, first starts {spans[0][0]:.2f} s, last ends "
+              f"{spans[-1][1]:.2f} s; busy {busy:.2f} s ({', '.join(f'{k} {v:.2f} s' for k, v in kinds.items())}), "
+              f"idle between tasks {idle:.2f} s; first task {spans[0][2]} {spans[0][1] - spans[0][0]:.2f} s",
+              file=sys.stderr, flush=True)
+
+
 def _wrap(module: object, name: str) -> None:
-    inner = getattr(module, name)
+    inner = getattr(module, name, None)
+    if inner is None:  # an older campaign module (run with another tree on PYTHONPATH)
+        return
 
     def wrapped(*args, **kwargs):
         _mark(f"{name} begins")
@@ -50,17 +73,22 @@ def _instrument() -> None:
     import tubekit.app.campaign as campaign
     import tubekit.app.certified as certified
 
-    for name in ("_execute", "_write_parquet", "summarise", "write_figures"):
+    for name in ("start_fork_server", "import_plotting", "_execute", "_write_parquet", "summarise",
+                 "write_figures"):
         _wrap(campaign, name)
     opener, writer, store = campaign.open_client, campaign.write_json, certified.write_cached
 
     @contextlib.contextmanager
     def open_client(*args, **kwargs):
+        from distributed import get_task_stream
+
         _mark("cluster starts")
         with opener(*args, **kwargs) as client:
             _mark("cluster up")
-            yield client
+            with get_task_stream(client) as stream:
+                yield client
             _mark("cluster closes")
+            _timeline(stream.data)
         _mark("cluster closed")
 
     def write_json(path, obj):

@@ -7,8 +7,9 @@ Usage::
 
 Each repetition starts ``python -m tubekit.app.cli campaign SPEC --out TMP --workers N --no-progress`` as a
 fresh process for N = 1 and N = 2 (the order alternates between repetitions: 1, 2, then 2, 1, ...) and
-times the whole process: interpreter start, the spec, the LocalCluster on 127.0.0.1 (worker processes and
-their imports), the certificates (on the workers), the runs, the tables and figures, the shutdown.
+times the whole process: interpreter start, the spec, the LocalCluster on 127.0.0.1 (its fork server's
+imports and warm-up, the forked workers), the certificates (on the workers), the runs, the tables and
+figures, the shutdown (the process ends when its output pipes close: the fork server's exit included).
 Reported: every wall time, the ratio wall(1 worker) / wall(2 workers) of each repetition (the two runs
 of a pair are adjacent in time, so they share the machine's load), the median ratio, each process's own
 throughput (``summary.json``) and the load average. The rows of every process must be identical
@@ -21,6 +22,10 @@ start-up and the workers' first-task imports, i.e. what reusing one local cluste
 
 ``--max-load L``: before each pair, wait (up to 10 min) until the 1-min load average is at most ``L``
 (on a shared machine, a pair measured while other jobs hold a core says little).
+
+``--baseline DIR``: also time, in every repetition and right beside the current code's pair, a pair of
+processes running the ``tubekit`` of the source tree ``DIR`` (put first on ``PYTHONPATH``; e.g. an export
+of an earlier commit), so "before" and "after" share the machine's load; the rows must be identical too.
 
 A benchmark, not a test: numbers depend on the machine and its load.
 """
@@ -43,13 +48,18 @@ ROOT = Path(__file__).resolve().parents[1]
 SPEC = ROOT / "benchmarks" / "campaign_16x15.toml"
 
 
-def whole_process(spec: Path, workers: int, out: Path, scheduler: str | None = None) -> dict:
-    """Wall time (s) of one ``tubekit campaign`` process with ``workers`` local workers (or on ``scheduler``)."""
+def whole_process(spec: Path, workers: int, out: Path, scheduler: str | None = None,
+                  source: Path | None = None) -> dict:
+    """Wall time (s) of one ``tubekit campaign`` process with ``workers`` local workers (or on ``scheduler``),
+    running the ``tubekit`` of the source tree ``source`` if given (first on ``PYTHONPATH``)."""
     command = [sys.executable, "-m", "tubekit.app.cli", "campaign", str(spec), "--out", str(out), "--no-progress",
                *(["--scheduler", scheduler] if scheduler else ["--workers", str(workers)])]
+    env = dict(os.environ)
+    if source is not None:
+        env["PYTHONPATH"] = os.pathsep.join([str(source), *filter(None, [env.get("PYTHONPATH")])])
     load = os.getloadavg()[0]
     started = time.perf_counter()
-    done = subprocess.run(command, capture_output=True, text=True, timeout=900, check=False)
+    done = subprocess.run(command, capture_output=True, text=True, timeout=900, check=False, env=env)
     wall = time.perf_counter() - started
     if done.returncode != 0:
         raise RuntimeError(f"{' '.join(command)} exited {done.returncode}: {done.stderr.strip()[-2000:]}")
@@ -90,9 +100,12 @@ def _cluster(folder: Path, workers: int, procs: list[subprocess.Popen]) -> str:
     return address
 
 
-def measure(spec: Path = SPEC, repeats: int = 3, reuse: bool = False, max_load: float | None = None) -> dict:
-    """``repeats`` pairs of whole processes (1 and 2 workers, alternating order); the ratio of each pair."""
+def measure(spec: Path = SPEC, repeats: int = 3, reuse: bool = False, max_load: float | None = None,
+            baseline: Path | None = None) -> dict:
+    """``repeats`` pairs of whole processes (1 and 2 workers, alternating order); the ratio of each pair
+    (and, with ``baseline``, of a pair running that source tree beside each)."""
     pairs: list[dict] = []
+    before: list[dict] = []
     procs: list[subprocess.Popen] = []
     with tempfile.TemporaryDirectory(prefix="tubekit-campaign-bench-") as tmp:
         try:
@@ -100,14 +113,23 @@ def measure(spec: Path = SPEC, repeats: int = 3, reuse: bool = False, max_load: 
             for n, address in clusters.items():
                 if address:
                     whole_process(spec, n, Path(tmp) / f"warm_w{n}", address)  # imports and caches, untimed
-            _pairs(spec, repeats, Path(tmp), clusters, pairs, max_load)
+            _pairs(spec, repeats, Path(tmp), clusters, pairs, max_load, baseline, before)
         finally:
             _stop(procs)
+    result = {"spec": str(spec), "repeats": repeats, "reuse": reuse, "pairs": pairs, **_medians(pairs)}
+    if baseline is not None:
+        result["baseline"] = {"source": str(baseline), "pairs": before, **_medians(before)}
+        result["identical_rows"] = result["identical_rows"] and result["baseline"]["identical_rows"]
+    return result
+
+
+def _medians(pairs: list[dict]) -> dict:
+    """Median, min and max ratio, median wall times, whether every process wrote the reference rows."""
     ratios = [p["ratio"] for p in pairs]
-    return {"spec": str(spec), "repeats": repeats, "reuse": reuse, "pairs": pairs,
-            "median_ratio": statistics.median(ratios), "min_ratio": min(ratios), "max_ratio": max(ratios),
+    return {"median_ratio": statistics.median(ratios), "min_ratio": min(ratios), "max_ratio": max(ratios),
             "median_wall_s": {"one": statistics.median(p["one"]["wall_s"] for p in pairs),
                               "two": statistics.median(p["two"]["wall_s"] for p in pairs)},
+            "median_load_1min": statistics.median(p[k]["load_1min"] for p in pairs for k in ("one", "two")),
             "identical_rows": all(p[k]["identical_rows"] for p in pairs for k in ("one", "two"))}
 
 
@@ -119,19 +141,23 @@ def _wait_for_load(max_load: float | None) -> float:
     return os.getloadavg()[0]
 
 
-def _pairs(spec: Path, repeats: int, tmp: Path, clusters: dict, pairs: list, max_load: float | None = None) -> None:
-    """Append ``repeats`` timed pairs to ``pairs``."""
-    reference = None
+def _pairs(spec: Path, repeats: int, tmp: Path, clusters: dict, pairs: list, max_load: float | None = None,
+           baseline: Path | None = None, before: list | None = None) -> None:
+    """Append ``repeats`` timed pairs to ``pairs`` (and, with ``baseline``, as many to ``before``)."""
+    reference: list = []
     for rep in range(repeats):
         _wait_for_load(max_load)
         order = (1, 2) if rep % 2 == 0 else (2, 1)
-        timed = {n: whole_process(spec, n, tmp / f"rep{rep}_w{n}", clusters[n]) for n in order}
-        for result in timed.values():
-            rows = result.pop("rows")
-            reference = rows if reference is None else reference
-            result["identical_rows"] = rows == reference
-        pairs.append({"order": list(order), "one": timed[1], "two": timed[2],
-                      "ratio": timed[1]["wall_s"] / timed[2]["wall_s"]})
+        sides = [(None, pairs)] + ([(baseline, before)] if baseline is not None else [])
+        for source, into in (sides if rep % 2 == 0 else sides[::-1]):
+            name = "base" if source else "cur"
+            timed = {n: whole_process(spec, n, tmp / f"rep{rep}_{name}_w{n}", clusters[n], source) for n in order}
+            for result in timed.values():
+                rows = result.pop("rows")
+                reference = reference or rows
+                result["identical_rows"] = rows == reference
+            into.append({"order": list(order), "one": timed[1], "two": timed[2],
+                         "ratio": timed[1]["wall_s"] / timed[2]["wall_s"]})
 
 
 def _line(result: dict) -> str:
@@ -150,17 +176,23 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--reuse", action="store_true", help="one warmed local cluster per worker count")
     parser.add_argument("--max-load", type=float, default=None, metavar="L",
                         help="before each pair, wait until the 1-min load average is at most L")
+    parser.add_argument("--baseline", type=Path, default=None, metavar="DIR",
+                        help="also time the tubekit of source tree DIR, a pair beside each pair")
     args = parser.parse_args(argv)
-    result = measure(args.spec.resolve(), args.repeats, args.reuse, args.max_load)
-    for k, pair in enumerate(result["pairs"]):
-        print(f"repetition {k} (order {pair['order']}): ratio {pair['ratio']:.2f}")
-        print("  " + _line(pair["one"]))
-        print("  " + _line(pair["two"]))
+    baseline = args.baseline.resolve() if args.baseline else None
+    result = measure(args.spec.resolve(), args.repeats, args.reuse, args.max_load, baseline)
+    sides = [("", result)] + ([(f"baseline {baseline}: ", result["baseline"])] if baseline else [])
+    for label, side in sides:
+        for k, pair in enumerate(side["pairs"]):
+            print(f"{label}repetition {k} (order {pair['order']}): ratio {pair['ratio']:.2f}")
+            print("  " + _line(pair["one"]))
+            print("  " + _line(pair["two"]))
     reused = " (reused clusters)" if args.reuse else ""
-    print(f"whole-process speedup 2 vs 1 workers{reused}: median {result['median_ratio']:.2f}x "
-          f"(min {result['min_ratio']:.2f}, max {result['max_ratio']:.2f}) over {args.repeats} interleaved pairs; "
-          f"median wall {result['median_wall_s']['one']:.2f} s vs {result['median_wall_s']['two']:.2f} s; "
-          f"rows identical: {result['identical_rows']}")
+    for label, side in sides[::-1]:
+        print(f"{label}whole-process speedup 2 vs 1 workers{reused}: median {side['median_ratio']:.2f}x "
+              f"(min {side['min_ratio']:.2f}, max {side['max_ratio']:.2f}) over {args.repeats} interleaved pairs; "
+              f"median wall {side['median_wall_s']['one']:.2f} s vs {side['median_wall_s']['two']:.2f} s; "
+              f"median load {side['median_load_1min']:.2f}; rows identical: {side['identical_rows']}")
     if args.json:
         Path(args.json).write_text(json.dumps(result, indent=2) + "\n", encoding="utf-8")
     return 0

@@ -4,6 +4,10 @@ Usage::
 
     python benchmarks/closed_loop.py [--duration S] [--repeat K] [--json FILE] [--profile]
 
+``--floor`` adds the solver's floor: one run with every FHOCP step's bare Clarabel time (``solver_time_s``)
+summed, and ``floor_realtime_factor`` = simulated seconds / that sum: the real-time factor the loop would
+have if everything but Clarabel's own ``solve()`` cost nothing (an upper bound for any compiled glue).
+
 ``--profile`` adds one profiled run and its split by part (:data:`PROFILE_PARTS`: FHOCP, arc check, nominal
 arcs, logging, sensing, plant, law, saturation, the tick loop's own Python) as shares of that run.
 
@@ -154,6 +158,38 @@ def measure(duration: float | None = None, profile: bool = False, repeat: int = 
     return out
 
 
+def solver_floor(scenario, tightening) -> dict:
+    """One run with the bare Clarabel time of every FHOCP step summed (``--floor``, module doc)."""
+    from tubekit.fhocp.registry import make_solver
+    total = {"solver_s": 0.0, "step_s": 0.0, "steps": 0}
+
+    class _Timed:
+        def __init__(self, inner) -> None:
+            self.inner = inner
+
+        def __getattr__(self, name):
+            return getattr(self.inner, name)
+
+        def solve(self, *args, **kwargs):
+            res = self.inner.solve(*args, **kwargs)
+            total["solver_s"] += float(res.solver_time_s)
+            total["step_s"] += float(res.solve_time_s)
+            total["steps"] += 1
+            return res
+
+    w0 = time.perf_counter()
+    run_closed_loop(scenario, tightening, tube=True, progress=False,
+                    solver_factory=lambda sc, tg: _Timed(make_solver(sc, tg)))
+    wall = time.perf_counter() - w0
+    sim = float(scenario.duration)
+    return {"wall_s": wall, "realtime_factor": sim / wall, "clarabel_solve_s": total["solver_s"],
+            "fhocp_step_s": total["step_s"], "steps": total["steps"],
+            "clarabel_ms_per_step": 1e3 * total["solver_s"] / max(1, total["steps"]),
+            "floor_realtime_factor": sim / total["solver_s"] if total["solver_s"] > 0 else None,
+            "glue_budget_ms_per_step_at_100x": 1e3 * (sim / 100.0 - total["solver_s"]) / max(1, total["steps"]),
+            "glue_now_ms_per_step": 1e3 * (wall - total["solver_s"]) / max(1, total["steps"])}
+
+
 def compare_previous(repeat: int = 4) -> dict:
     """Interleaved runs with the previous code paths (RK4 through ``rk4_tuple(plant._rhs)``, arcs chained
     one by one) against the current ones: wall medians, their ratio, and whether the logs are identical."""
@@ -201,10 +237,16 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--json", default=None, help="write the figures to this file")
     parser.add_argument("--profile", action="store_true",
                         help="print a cProfile of the timed run (slows it) and add its breakdown by part")
+    parser.add_argument("--floor", action="store_true",
+                        help="add one run with the bare Clarabel time summed: the real-time factor's ceiling")
     parser.add_argument("--compare-previous", action="store_true",
                         help="interleave the previous plant step and arc evaluation with the current ones instead")
     args = parser.parse_args(argv)
     out = compare_previous() if args.compare_previous else measure(args.duration, args.profile, args.repeat)
+    if args.floor and not args.compare_previous:
+        scenario = paper_scenario()
+        tightening = verify.certify(scenario, law=scenario.controller.law).best_effort_tightening()
+        out["floor"] = solver_floor(scenario, tightening)
     text = json.dumps(out, indent=2)
     print(text)
     if args.json:

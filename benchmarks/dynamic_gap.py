@@ -5,12 +5,19 @@ derived error bound E (``verify.vehicle.bound.velocity_loop_bound``) with the pl
 the backup's per-tick jumps, the hull's sway bound γ̄, and the resulting ω̄_xy on the paper's currents
 against what ``keep_up[u]`` and ``yaw_budget`` allow (``docs/plant.md`` section 4).
 
-Usage: ``python benchmarks/dynamic_gap.py``
+``--rates`` adds what the backup's command rate costs: E for per-tick jumps of 0 and (0.003, 0.0013, 0.003)
+(the continuous backup's, at safe radii 4.6-5.5 m) on von Benzon's point, on the same point with linear drag
+only (no slope variation, no mismatch: the loop's own ramp error), at loop bandwidths 10-25 rad/s, and on
+boxes of ±5 % and ±20 %; and the certificate of the most favourable variant of the paper's scenario tried
+(``favourable_scenario``): its failed conditions and the ratio derived/assumed E of ``loop_consistent``.
+
+Usage: ``python benchmarks/dynamic_gap.py [--rates]``
 """
 
 from __future__ import annotations
 
 import math
+import sys
 
 from tubekit.model.vehicles import VEHICLES
 from verify.design import hull_sway_bound
@@ -35,8 +42,65 @@ def boxes():
         yield f"von Benzon ±{round(f * 100)}%", VEHICLES["bluerov2_heavy"].with_overrides(over)
 
 
+#: The continuous backup's per-tick jumps at safe radii 4.6-5.5 m (the gentlest the design grid certifies on the
+#: favourable scenario; ``verify.backup.backup_tick_change``), rounded up.
+GENTLE_BACKUP_JUMPS = (0.003, 0.0013, 0.003)
+#: The favourable variant's command box (m/s, m/s, rad/s): the paper's with r_max 0.3 (less sway).
+FAVOURABLE_V = (0.4, 0.3, 0.3)
+
+
+def _point(**over: float):
+    """von Benzon's point with ``over`` applied (e.g. a loop bandwidth, or linear drag)."""
+    return VEHICLES["bluerov2_heavy"].with_overrides({**VON_BENZON, **over})
+
+
+def _box(f: float):
+    """von Benzon's values ±``f`` (a fraction) on every nonzero coefficient."""
+    return VEHICLES["bluerov2_heavy"].with_overrides(
+        {k: ((v * (1 + f), v * (1 - f)) if v else v) for k, v in VON_BENZON.items()})
+
+
+def rate_rows():
+    """(label, E) for the backup's per-tick jumps on the variants of the module doc."""
+    linear = {"X_uu": 0.0, "Z_ww": 0.0, "N_rr": 0.0, "X_u": -60.0, "Z_w": -60.0, "N_r": -0.5}
+    variants = [("point, bandwidth 10 rad/s", _point()), ("point, linear drag only", _point(**linear))]
+    variants += [(f"point, bandwidth {bw:g} rad/s", _point(loop_bandwidth=bw)) for bw in (15.0, 20.0, 25.0)]
+    variants += [("von Benzon ±5 %", _box(0.05)), ("von Benzon ±20 %", _box(0.2))]
+    for name, params in variants:
+        for tick in ((0.0, 0.0, 0.0), GENTLE_BACKUP_JUMPS):
+            b = velocity_loop_bound(params, v_max=FAVOURABLE_V, tick=0.01, period=0.1, jump_tick=tick,
+                                    jump_period=tuple(max(a, c) for a, c in zip(PLAN_JUMPS, tick)))
+            yield f"{name}, per-tick {tick}", b
+
+
+def favourable_scenario():
+    """The paper's currents scenario made as easy as tried: von Benzon's point (no interval), current amplitude
+    0.03 m/s, r_max 0.3 rad/s, ε = 1 m (start 1.5 m from the target)."""
+    from tubekit.scenario import load_scenario
+    base = load_scenario("examples/bluerov2_currents.toml")
+    plant = base.plant.__class__(kind="dynamic", vehicle="bluerov2_heavy", overrides=tuple(VON_BENZON.items()))
+    return base.with_changes(plant=plant, epsilon=1.0, initial_state=(-1.5, 3.0, 0.2, 0.0),
+                             **{"limits.r_max": FAVOURABLE_V[2], "disturbance.amplitude": (0.03, 0.03, 0.03)})
+
+
+def rates() -> None:
+    """Print the backup-rate table and the favourable scenario's verdict."""
+    for label, b in rate_rows():
+        print(f"{label:58s} E = {[round(x, 4) for x in b.error]}, gamma = {b.sway:.4f}; "
+              f"failed {[c.condition for c in b.failures]}")
+    import verify
+    sc = favourable_scenario()
+    cert = verify.certify(sc, law=sc.controller.law)
+    cons = next(c for c in cert.plant_conditions if c.condition == "loop_consistent")
+    print(f"favourable scenario: failed {[c.condition for c in cert.failures]}; loop_consistent: derived/assumed "
+          f"E = {cons.lhs} ({cons.detail})")
+
+
 def main() -> None:
-    """Print the table of docs/plant.md section 4."""
+    """Print the table of docs/plant.md section 4 (and, with ``--rates``, the backup-rate table)."""
+    if "--rates" in sys.argv[1:]:
+        rates()
+        return
     for name, params in boxes():
         for tick in ((0.0, 0.0, 0.0), BACKUP_JUMPS):
             b = velocity_loop_bound(params, v_max=V, tick=0.01, period=0.1, jump_tick=tick,

@@ -38,3 +38,17 @@ def test_the_profile_parts_cover_the_run_without_double_counting(short_run):
     assert parts["fhocp"] > 0 and parts["plant"] > 0 and parts["arc_check"] > 0
     assert sum(v for k, v in parts.items() if k != "other") <= prof["profiled_wall_s"] * (1 + 1e-9)
     assert sum(prof["parts_share"].values()) == pytest.approx(1.0)
+
+
+def test_the_solver_floor_is_a_ceiling_of_the_real_time_factor():
+    """The floor run sums the bare Clarabel time of every step: it is part of each step and of the wall."""
+    from tubekit import paper_scenario
+    import verify
+    mod = _module()
+    sc = paper_scenario().with_changes(duration=1.0)
+    tg = verify.certify(sc, law=sc.controller.law).best_effort_tightening()
+    floor = mod.solver_floor(sc, tg)
+    assert floor["steps"] == 10  # one FHOCP step per 0.1 s period
+    assert 0.0 < floor["clarabel_solve_s"] < floor["fhocp_step_s"] < floor["wall_s"]
+    assert floor["floor_realtime_factor"] > floor["realtime_factor"]
+    assert floor["floor_realtime_factor"] == pytest.approx(1.0 / floor["clarabel_solve_s"])

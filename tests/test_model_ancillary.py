@@ -123,3 +123,13 @@ def test_corrected_law_raises_on_singular_jacobian():
     state = np.array([0.0, 1.0, 0.0, 0.0])  # bearing pi/2, psi = 0: cos(psi - bearing) = 0 exactly
     with pytest.raises(ConfigError, match="state"):
         get_law("corrected")(state, _state(1.0, 0.0, 0.1), np.zeros(3), 1.0)
+
+
+def test_only_the_registered_builtin_laws_are_builtin(monkeypatch):
+    from tubekit.model.ancillary import BUILTIN_LAWS, is_builtin
+
+    assert BUILTIN_LAWS == ("paper", "corrected") and all(is_builtin(n) for n in BUILTIN_LAWS)
+    monkeypatch.setitem(LAWS, "test-user", AncillaryLaw("test-user", lambda J: J, "test"))
+    assert not is_builtin("test-user") and not is_builtin("no-such-law")
+    monkeypatch.setitem(LAWS, "paper", AncillaryLaw("paper", lambda J: J, "a replacement"))
+    assert not is_builtin("paper")

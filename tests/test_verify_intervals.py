@@ -141,3 +141,24 @@ def test_bisect_sup_covers_the_interval_and_stops_on_negative_bounds():
     assert min(a for a, _ in seen) == 0.0 and max(b for _, b in seen) == 1.0
     assert any(b < 0.75 for _, b in seen)        # the part where x - 0.75 < 0 was proved negative
     assert bisect_sup(bound, 0.0, 1.0, 3)[1] <= 3 + 1
+
+
+def test_arb_source_names_its_function_and_prefixes_its_exact_constants():
+    from verify.intervals import arb_source
+
+    source, consts = arb_source([sp.Rational(1, 3) * X + Y, sp.Rational(-5, 7) * X], [X, Y], name="g", prefix="_c")
+    assert source.startswith("def g(a0, a1):") and consts == {"_c0": (1, 3), "_c1": (-5, 7)}
+    namespace = {"_arb": arb, **{k: arb(p) / q for k, (p, q) in consts.items()}}
+    exec(source, namespace)
+    out = namespace["g"](arb(3), arb(1))
+    assert out[0].contains(2) and (7 * out[1]).contains(-15)  # 1/3 * 3 + 1 = 2; 7 * (-5/7 * 3) = -15
+
+
+def test_vectorised_broadcasts_every_entry_to_float():
+    from verify.intervals import vectorised
+
+    f = vectorised(lambda x, y: [x + y, 0, 2 * y])
+    out = f(np.array([1.0, 2.0]), 3.0)
+    assert out.dtype == float and out.shape == (2, 3)
+    np.testing.assert_array_equal(out, [[4.0, 0.0, 6.0], [5.0, 0.0, 6.0]])
+    assert vectorised(lambda x: [x])(2.0).shape == (1,)

@@ -9,6 +9,10 @@ J = [[c, 0, 0], [0, 1, 0], [-e_o c / e_d, 0, c]] with c = s sqrt(1 - e_o²)
 only; its sup is certified by :func:`verify.intervals.maximise` (Arb
 branch-and-bound, budget in boxes). Entries that simplify to a constant are
 taken exactly.
+
+The objectives |K_jl|, G_jj, -G_jj and |G_jl| of the built-in laws ship compiled
+(:mod:`verify.compiled`, printed from :func:`gain_objectives`), so a certificate
+needs no sympy; any other law is derived and compiled on the spot.
 """
 
 from __future__ import annotations
@@ -16,28 +20,48 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 from functools import lru_cache
+from typing import TYPE_CHECKING
 
 import numpy as np
-import sympy as sp
 
 from tubekit.model.ancillary import get_law
 from tubekit.exceptions import ConfigError
 
+from verify.compiled import Term, gain_terms
 from verify.intervals import Case, compile_arb, compile_numpy, enclose, maximise, upper
 from verify.parts import flag, matrix, numbers
 from verify.region import Region
 
-__all__ = ["GainBounds", "GainProof", "gain_bounds", "gain_entries", "polar_jacobian", "prove_gain_bounds"]
+if TYPE_CHECKING:  # sympy is imported only to derive a law's objectives (the built-in ones ship compiled)
+    import sympy as sp
 
-_ED, _EO = sp.symbols("e_d e_o", real=True)
+__all__ = ["GainBounds", "GainProof", "gain_bounds", "gain_entries", "gain_objectives", "polar_jacobian",
+           "polar_symbols", "prove_gain_bounds", "GAIN_KEYS"]
+
 #: Relative gap the gain bounds aim for (they enter the tube linearly).
 GAIN_GAP = 0.01
+#: The objectives bounded per hemisphere: |K_jl| for every entry, G_jj and -G_jj on the diagonal, |G_jl| off it
+#: (keyed by kind and row-major index 3 j + l).
+GAIN_KEYS: tuple[tuple[str, int], ...] = (
+    tuple(("k_abs", i) for i in range(9)) + tuple((kind, 4 * j) for j in range(3) for kind in ("g", "neg_g"))
+    + tuple(("g_abs", 3 * j + l) for j in range(3) for l in range(3) if j != l))
+
+
+@lru_cache(maxsize=1)
+def polar_symbols() -> tuple[sp.Symbol, sp.Symbol]:
+    """The sympy symbols e_d, e_o (real)."""
+    import sympy as sp
+
+    return sp.symbols("e_d e_o", real=True)
 
 
 def polar_jacobian(sign: int) -> sp.Matrix:
     """J(e_d, e_o) in the hemisphere cos(ψ - θ) = sign · sqrt(1 - e_o²)."""
-    c = sign * sp.sqrt(1 - _EO ** 2)
-    return sp.Matrix([[c, 0, 0], [0, 1, 0], [-_EO * c / _ED, 0, c]])
+    import sympy as sp
+
+    ed, eo = polar_symbols()
+    c = sign * sp.sqrt(1 - eo ** 2)
+    return sp.Matrix([[c, 0, 0], [0, 1, 0], [-eo * c / ed, 0, c]])
 
 
 @dataclass(frozen=True)
@@ -66,6 +90,8 @@ class GainBounds:
 @lru_cache(maxsize=32)
 def gain_entries(law: str, sign: int) -> tuple[tuple[sp.Expr, ...], tuple[sp.Expr, ...]]:
     """Simplified K and G = J K entries (row-major) of ``law`` in one hemisphere."""
+    import sympy as sp
+
     lw = get_law(law)
     if lw.symbolic_gain is None:
         raise ConfigError("law", "a law with a symbolic gain (symbolic_gain, needed to bound K(e) over R)", law)
@@ -77,17 +103,48 @@ def gain_entries(law: str, sign: int) -> tuple[tuple[sp.Expr, ...], tuple[sp.Exp
     return tuple(sp.cancel(k) for k in K), tuple(G)
 
 
-def _sup(exprs: list[sp.Expr], region: Region, max_boxes: int) -> tuple[float, bool]:
-    """Certified sup of expr over the region box, over all (hemisphere) variants given."""
-    consts = [e for e in exprs if not e.free_symbols]
+def gain_objectives(law: str, sign: int) -> dict[tuple[str, int], sp.Expr]:
+    """The objectives of :data:`GAIN_KEYS` for ``law`` in hemisphere ``sign``: |K_i|, G_i, -G_i, |G_i| (sympy)."""
+    import sympy as sp
+
+    K, G = gain_entries(law, sign)
+    out = {}
+    for kind, i in GAIN_KEYS:
+        if kind == "k_abs":
+            out[(kind, i)] = sp.Abs(K[i])
+        elif kind == "g":
+            out[(kind, i)] = G[i]
+        elif kind == "neg_g":
+            out[(kind, i)] = -G[i]
+        else:
+            out[(kind, i)] = sp.Abs(G[i])
+    return out
+
+
+@lru_cache(maxsize=32)
+def _derived_terms(law: str, sign: int) -> dict[tuple[str, int], Term]:
+    """:func:`gain_objectives` compiled now (a constant taken exactly as a float)."""
+    args = list(polar_symbols())
+    return {key: Term(constant=float(e)) if not e.free_symbols else
+            Term(arb=compile_arb([e], args), numpy=compile_numpy([e], args))
+            for key, e in gain_objectives(law, sign).items()}
+
+
+def _terms(law: str, sign: int) -> dict[tuple[str, int], Term]:
+    """The objectives of ``law`` in hemisphere ``sign``: shipped compiled (:mod:`verify.compiled`) or derived."""
+    shipped = gain_terms(law, sign)
+    return shipped if shipped is not None else _derived_terms(law, sign)
+
+
+def _sup(terms: list[Term], region: Region, max_boxes: int) -> tuple[float, bool]:
+    """Certified sup of the objectives over the region box, over all (hemisphere) variants given."""
+    consts = [t.constant for t in terms if t.constant is not None]
     cases = []
-    for i, e in enumerate(x for x in exprs if x.free_symbols):
-        f_arb = compile_arb([e], [_ED, _EO])
-        f_np = compile_numpy([e], [_ED, _EO])
+    for i, t in enumerate(x for x in terms if x.constant is None):
         cases.append(Case(label=str(i), names=("e_d", "e_o"), lo=np.array([region.e_d[0], region.e_o[0]]),
                           hi=np.array([region.e_d[1], region.e_o[1]]),
-                          interval=lambda b, f=f_arb: f(*b)[0],
-                          point=lambda X, f=f_np: np.asarray(f(X[:, 0], X[:, 1]), dtype=float).reshape(-1)))
+                          interval=lambda b, f=t.arb: f(*b)[0],
+                          point=lambda X, f=t.numpy: np.asarray(f(X[:, 0], X[:, 1]), dtype=float).reshape(-1)))
     best = max((float(c) for c in consts), default=-np.inf)
     if not cases:
         return best, True
@@ -98,21 +155,21 @@ def _sup(exprs: list[sp.Expr], region: Region, max_boxes: int) -> tuple[float, b
 def gain_bounds(law: str, region: Region, max_boxes: int = 4000) -> GainBounds:
     """Certified entry bounds of K and G = J K for ``law`` over ``region`` (both hemispheres if 'both')."""
     signs = region.hemisphere_signs
-    per = [gain_entries(law, s) for s in signs]
+    per = [_terms(law, s) for s in signs]
     conv = True
     k_abs, g_off = [[0.0] * 3 for _ in range(3)], [[0.0] * 3 for _ in range(3)]
     g_lo, g_hi = [0.0] * 3, [0.0] * 3
     for j in range(3):
         for l in range(3):
             idx = 3 * j + l
-            k_abs[j][l], ok1 = _sup([sp.Abs(K[idx]) for K, _ in per], region, max_boxes)
+            k_abs[j][l], ok1 = _sup([T[("k_abs", idx)] for T in per], region, max_boxes)
             if j == l:
-                g_hi[j], ok2 = _sup([G[idx] for _, G in per], region, max_boxes)
-                neg, ok3 = _sup([-G[idx] for _, G in per], region, max_boxes)
+                g_hi[j], ok2 = _sup([T[("g", idx)] for T in per], region, max_boxes)
+                neg, ok3 = _sup([T[("neg_g", idx)] for T in per], region, max_boxes)
                 g_lo[j] = -neg
                 conv = conv and ok2 and ok3
             else:
-                g_off[j][l], ok2 = _sup([sp.Abs(G[idx]) for _, G in per], region, max_boxes)
+                g_off[j][l], ok2 = _sup([T[("g_abs", idx)] for T in per], region, max_boxes)
                 conv = conv and ok2
             conv = conv and ok1
     return GainBounds(k_abs=tuple(map(tuple, k_abs)), g_lo=tuple(g_lo), g_hi=tuple(g_hi),
@@ -131,23 +188,18 @@ class GainProof:
     boxes: int
 
 
-@lru_cache(maxsize=256)
-def _compiled(expr: sp.Expr):
-    return compile_arb([expr], [_ED, _EO]), compile_numpy([expr], [_ED, _EO])
-
-
-def _prove_at_most(exprs: list[sp.Expr], region: Region, limit: float, max_boxes: int) -> tuple[str, float, int]:
-    """Prove sup expr <= ``limit`` over R for every expr: Arb on a bisection of the box (the split rule of
+def _prove_at_most(terms: list[Term], region: Region, limit: float, max_boxes: int) -> tuple[str, float, int]:
+    """Prove sup f <= ``limit`` over R for every objective f: Arb on a bisection of the box (the split rule of
     :func:`verify.intervals.maximise`, so a bound ``gain_bounds`` reached is re-proved within its budget)."""
     lo0, hi0 = np.array([region.e_d[0], region.e_o[0]]), np.array([region.e_d[1], region.e_o[1]])
     scale = np.where(hi0 > lo0, hi0 - lo0, 1.0)
     grid = np.meshgrid(np.linspace(lo0[0], hi0[0], 33), np.linspace(lo0[1], hi0[1], 33))
     worst, boxes = -math.inf, 0
-    for e in exprs:
-        if not e.free_symbols:
-            worst = max(worst, float(e))
+    for t in terms:
+        if t.constant is not None:
+            worst = max(worst, t.constant)
             continue
-        f_arb, f_np = _compiled(e)
+        f_arb, f_np = t.arb, t.numpy
         vals = np.asarray(f_np(grid[0], grid[1]), dtype=float)
         worst = max(worst, float(np.nanmax(vals)) if np.any(np.isfinite(vals)) else -math.inf)
         stack = [(lo0.copy(), hi0.copy())]
@@ -177,17 +229,17 @@ def prove_gain_bounds(law: str, region: Region, gains: GainBounds, max_boxes: in
     Each bound b is proved as sup f <= b (for ``g_lo``: sup(-G_jj) <= -b) by bisection with Arb
     enclosures; a sampled value above b refutes it. ``max_boxes`` is the budget per entry (boxes).
     """
-    per = [gain_entries(law, s) for s in region.hemisphere_signs]
+    per = [_terms(law, s) for s in region.hemisphere_signs]
     out: list[GainProof] = []
     for j in range(3):
         for l in range(3):
             idx = 3 * j + l
-            items = [(f"gains.k_abs[{j}][{l}]", [sp.Abs(K[idx]) for K, _ in per], gains.k_abs[j][l], 1.0)]
+            items = [(f"gains.k_abs[{j}][{l}]", [T[("k_abs", idx)] for T in per], gains.k_abs[j][l], 1.0)]
             if j == l:
-                items += [(f"gains.g_hi[{j}]", [G[idx] for _, G in per], gains.g_hi[j], 1.0),
-                          (f"gains.g_lo[{j}]", [-G[idx] for _, G in per], -gains.g_lo[j], -1.0)]
+                items += [(f"gains.g_hi[{j}]", [T[("g", idx)] for T in per], gains.g_hi[j], 1.0),
+                          (f"gains.g_lo[{j}]", [T[("neg_g", idx)] for T in per], -gains.g_lo[j], -1.0)]
             else:
-                items.append((f"gains.g_off[{j}][{l}]", [sp.Abs(G[idx]) for _, G in per], gains.g_off[j][l], 1.0))
+                items.append((f"gains.g_off[{j}][{l}]", [T[("g_abs", idx)] for T in per], gains.g_off[j][l], 1.0))
             for name, exprs, limit, sign in items:
                 status, worst, boxes = _prove_at_most(exprs, region, float(limit), max_boxes)
                 out.append(GainProof(name, sign * float(limit), status, sign * worst, boxes))

@@ -23,11 +23,13 @@ import itertools
 import math
 import time
 from dataclasses import dataclass, field
-from typing import Callable, Sequence
+from typing import TYPE_CHECKING, Callable, Sequence
 
 import numpy as np
-import sympy as sp
 from flint import arb, arb_mat
+
+if TYPE_CHECKING:  # sympy is imported on first compilation: the precompiled objectives need none
+    import sympy as sp
 
 __all__ = [
     "bisect_sup",
@@ -35,8 +37,10 @@ __all__ = [
     "point",
     "upper",
     "lower",
+    "arb_source",
     "compile_arb",
     "compile_numpy",
+    "vectorised",
     "sym_eig_bounds",
     "Case",
     "MaxResult",
@@ -109,16 +113,19 @@ class _ArbPrinter:
     Floats are rejected: a decimal float inside an expression would not be exact.
     """
 
-    def __init__(self, names: dict[sp.Symbol, str]) -> None:
+    def __init__(self, names: dict[sp.Symbol, str], prefix: str = "_k") -> None:
         self.names = names
-        self.consts: dict[str, arb] = {}
+        self.prefix = prefix
+        self.consts: dict[str, tuple[int, int]] = {}
 
     def _const(self, value: sp.Rational) -> str:
-        key = f"_k{len(self.consts)}"
-        self.consts[key] = arb(int(value.p)) / int(value.q)
+        key = f"{self.prefix}{len(self.consts)}"
+        self.consts[key] = (int(value.p), int(value.q))
         return key
 
     def code(self, e: sp.Expr) -> str:
+        import sympy as sp
+
         if isinstance(e, sp.Symbol):
             if e not in self.names:
                 raise ValueError(f"compile_arb: free symbol {e} is not an argument")
@@ -160,6 +167,28 @@ class _ArbPrinter:
         raise ValueError(f"compile_arb: unsupported expression {sp.srepr(e)[:80]}")
 
 
+def arb_source(exprs: Sequence[sp.Expr], args: Sequence[sp.Symbol], name: str = "_f",
+               prefix: str = "_k") -> tuple[str, dict[str, tuple[int, int]]]:
+    """Python source of ``name(a0, a1, ...) -> list[arb]`` enclosing ``exprs``, and its rational constants.
+
+    The source refers to ``_arb`` (:class:`flint.arb`), ``_pw`` (:func:`_pow_int`), ``_abs`` (:func:`_abs`)
+    and to the constants, named ``prefix`` + number and given as exact (numerator, denominator) pairs
+    (each bound to ``arb(p) / q``). Common subexpressions are evaluated once (``sympy.cse``).
+    """
+    import sympy as sp
+
+    exprs = [sp.sympify(e) for e in exprs]
+    names = {s: f"a{i}" for i, s in enumerate(args)}
+    repl, reduced = sp.cse(exprs, symbols=sp.numbered_symbols("_t"))
+    printer = _ArbPrinter(names, prefix)
+    lines = [f"def {name}({', '.join(names[s] for s in args)}):"]
+    for sym, sub in repl:
+        names[sym] = str(sym)
+        lines.append(f"    {sym} = {printer.code(sub)}")
+    lines.append("    return [" + ", ".join(printer.code(e) for e in reduced) + "]")
+    return "\n".join(lines), printer.consts
+
+
 def compile_arb(exprs: Sequence[sp.Expr], args: Sequence[sp.Symbol]) -> Callable[..., list[arb]]:
     """Compile sympy expressions into ``f(*arb_args) -> list[arb]`` (rigorous enclosures).
 
@@ -168,36 +197,38 @@ def compile_arb(exprs: Sequence[sp.Expr], args: Sequence[sp.Symbol]) -> Callable
     expressions for every point of the argument balls (where defined; a ball
     touching a singularity returns a non-finite result).
     """
-    exprs = [sp.sympify(e) for e in exprs]
-    names = {s: f"a{i}" for i, s in enumerate(args)}
-    repl, reduced = sp.cse(exprs, symbols=sp.numbered_symbols("_t"))
-    printer = _ArbPrinter(names)
-    lines = [f"def _f({', '.join(names[s] for s in args)}):"]
-    for sym, sub in repl:
-        names[sym] = str(sym)
-        lines.append(f"    {sym} = {printer.code(sub)}")
-    lines.append("    return [" + ", ".join(printer.code(e) for e in reduced) + "]")
-    namespace: dict = {"_arb": arb, "_pw": _pow_int, "_abs": _abs, **printer.consts}
-    exec("\n".join(lines), namespace)  # noqa: S102 - generated from sympy, no user text
+    source, consts = arb_source(exprs, args)
+    namespace: dict = {"_arb": arb, "_pw": _pow_int, "_abs": _abs,
+                       **{k: arb(p) / q for k, (p, q) in consts.items()}}
+    exec(source, namespace)  # noqa: S102 - generated from sympy, no user text
     return namespace["_f"]
 
 
-def compile_numpy(exprs: Sequence[sp.Expr], args: Sequence[sp.Symbol]) -> Callable[..., np.ndarray]:
-    """Compile sympy expressions into a vectorised numpy function.
-
-    ``f(*arrays)`` returns an array of shape ``broadcast(arrays).shape + (len(exprs),)``.
-    Used only for sampling (the *sampled* side of a bound pair), never for bounds.
-    """
-    fn = sp.lambdify(list(args), [sp.sympify(e) for e in exprs], modules="numpy", cse=True)
+def vectorised(fn: Callable[..., Sequence]) -> Callable[..., np.ndarray]:
+    """``fn(*arrays) -> sequence of arrays`` as ``f(*arrays)`` returning shape ``broadcast + (len,)`` (floats)."""
 
     def call(*values: np.ndarray) -> np.ndarray:
         arrays = [np.asarray(v, dtype=float) for v in values]
         shape = np.broadcast_shapes(*(a.shape for a in arrays)) if arrays else ()
         with np.errstate(all="ignore"):
             out = fn(*arrays)
-        return np.stack([np.broadcast_to(np.asarray(o, dtype=float), shape) for o in out], axis=-1)
+            res = np.empty(shape + (len(out),))
+            for i, o in enumerate(out):
+                res[..., i] = o  # each entry broadcast and cast to float, as np.stack of broadcast_to would
+        return res
 
     return call
+
+
+def compile_numpy(exprs: Sequence[sp.Expr], args: Sequence[sp.Symbol]) -> Callable[..., np.ndarray]:
+    """Compile sympy expressions into a vectorised numpy function (:func:`vectorised` of ``sympy.lambdify``).
+
+    ``f(*arrays)`` returns an array of shape ``broadcast(arrays).shape + (len(exprs),)``.
+    Used only for sampling (the *sampled* side of a bound pair), never for bounds.
+    """
+    import sympy as sp
+
+    return vectorised(sp.lambdify(list(args), [sp.sympify(e) for e in exprs], modules="numpy", cse=True))
 
 
 # --------------------------------------------------------------------------- eigenvalues

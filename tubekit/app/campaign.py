@@ -2,43 +2,41 @@
 
 Pipeline (client side): validate the spec (:mod:`tubekit.app.campaign_spec`) and plan every run →
 load the certificates stored in ``DIR/certificates/`` (:func:`tubekit.app.certified.read_cached`: checksum,
-design key, scenario) → open a :class:`distributed.Client` (a LocalCluster of N worker processes on
-127.0.0.1, or ``--scheduler``) → submit one certification task per missing certificate input
+design key, scenario) → start the workers' fork server, warming up on the first scenario, while this
+process imports what its tables and figures need (:mod:`tubekit.app.campaign_cluster`) → open a
+:class:`distributed.Client` (a LocalCluster of N worker processes on 127.0.0.1 forked from that server,
+or ``--scheduler``) → submit one certification task per missing certificate input
 (:func:`tubekit.app.certified.issue_certificate`, keyed by :func:`tubekit.app.certified.input_key`) and
 the unfinished runs, each depending on its certificate's task (``retries``) → store each certificate as
 ``DIR/certificates/<key>.json`` and each finished run as ``DIR/runs/run_KKKKKK.json`` the moment it
-completes → assemble ``DIR/runs.parquet`` atomically → ``summary.json`` (with the throughput) → figures.
+completes → assemble ``DIR/runs.parquet`` atomically → ``summary.json`` (with the throughput) → figures,
+while the cluster closes.
 
-Worker side (:func:`simulate_task`): the run's scenario under the shipped tightening (each simulation is
-:func:`tubekit.loop.pipeline.certified_run`; the verdict travels in ``Tightening.certified``), plus
-``falsify.sequences`` runs where the current is replaced by a random piecewise-constant disturbance
-within the certificate's bounds (:func:`verify.falsify.closed_loop.piecewise_disturbance`, one ω per FHOCP
-period, drawn from the run's seed); the row keeps the worst figure of each metric over those runs.
-Nothing in a row depends on the worker, the order or the scheduler except ``wall_s``.
+Worker side: :func:`tubekit.app.campaign_task.simulate_task` (one run, its row).
 """
 
 from __future__ import annotations
 
+import atexit
 import contextlib
+import gc
 import json
 import logging
 import os
 import sys
-import threading
 import time
 from concurrent.futures import ThreadPoolExecutor
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, Callable, Iterator
+from typing import Any, Callable
 
-import numpy as np
-
-from tubekit.exceptions import ConfigError, TubekitError
+from tubekit.exceptions import ConfigError
 from tubekit.jsonable import write_json
 from tubekit.scenario import Scenario
 from tubekit.tightening import Tightening
 from tubekit.app.campaign_spec import CampaignSpec, RunPlan, spec_from_stored
-from tubekit.app.exit_codes import children_ignore_interrupts
+from tubekit.app.campaign_cluster import open_client, start_fork_server
+from tubekit.app.campaign_task import RunTask, row_of, simulate_all, simulate_task
 from tubekit.app.output import check_output_dir
 from tubekit.app.campaign_summary import (FIGURES, METRIC_COLUMNS, import_plotting, summarise, summary_line,
                                           write_figures)
@@ -52,100 +50,6 @@ LOGGER = logging.getLogger("tubekit.campaign")
 RETRIES = 3
 #: Folder of a campaign directory holding its certificates, one ``<input key>.json`` each.
 CERTIFICATES = "certificates"
-
-
-@dataclass(frozen=True)
-class RunTask:
-    """Everything a worker needs for one run (pickled to the worker); ``tightening.certified`` is the verdict
-    (None: the tightening of the certificate task the run depends on, see :func:`simulate_task`)."""
-
-    run: int
-    seed: int
-    scenario: Scenario
-    tightening: Tightening | None
-    sequences: int
-
-
-# ---- one run (worker side) ------------------------------------------------------------------------------
-
-def _disturbances(task: RunTask) -> list[Callable | None]:
-    """None (the scenario's current), then ``sequences`` piecewise-constant ω within the certificate's bounds."""
-    if task.sequences == 0:
-        return [None]
-    from verify.falsify.closed_loop import piecewise_disturbance
-
-    bound = task.tightening.disturbance
-    omega_xy, omega_z = bound.omega_xy, bound.omega_z
-    rng = np.random.default_rng([task.seed, 1])
-    dt = task.scenario.controller.dt
-    return [None] + [piecewise_disturbance(omega_xy, omega_z, dt, rng.random((task.scenario.steps, 3)))
-                     for _ in range(task.sequences)]
-
-
-def _simulate_all(task: RunTask) -> list[Any]:
-    """Each simulation of the run: a :class:`tubekit.loop.pipeline.CertifiedRun` per disturbance."""
-    from tubekit.loop.pipeline import certified_run
-
-    return [certified_run(task.scenario, task.tightening, label="tube", disturbance=disturbance)
-            for disturbance in _disturbances(task)]
-
-
-def _figures_of(sim: Any) -> dict[str, Any]:
-    metrics = sim.metrics
-    return {"max_rho_ratio": sim.ratio, "min_clearance": float(metrics["min_clearance"]),
-            "min_e_d": float(metrics["min_e_d"]), "tracking_rmse": float(metrics["tracking_rmse"]),
-            "saturated_steps": int(metrics["saturated_steps"]), "broken": list(sim.broken),
-            "replaced_steps": int(metrics["replaced_steps"]), "backup_s": float(metrics["backup_s"]),
-            "backup_engagements": int(metrics["backup_engagements"]),
-            "safety_broken": [p.name for p in sim.promises if p.tier == "safe" and p.name in sim.broken],
-            "premises_held": sim.premises_held}
-
-
-def _tiers_of(tightening: Tightening) -> dict[str, bool]:
-    """``safe_tier`` and ``tracking_tier``: the tiers the run's certificate gives."""
-    from tubekit.loop.promises import tiers_given
-
-    given = tiers_given(tightening)
-    return {"safe_tier": bool(given.get("safe")), "tracking_tier": bool(given.get("tracking"))}
-
-
-def simulate_task(task: RunTask, issued: Any = None) -> dict[str, Any]:
-    """Run ``task`` and return its row (without the sampled values); ``wall_s`` is the only timing.
-
-    ``issued`` (a :class:`tubekit.app.certified.IssuedCertificate`, the result of the certificate task the
-    run depends on) gives the tightening when ``task.tightening`` is None.
-    """
-    if issued is not None:
-        task = replace(task, tightening=issued.tightening)
-    started = time.perf_counter()
-    try:
-        sims = _simulate_all(task)
-    except TubekitError as exc:  # a run that cannot be simulated is recorded, not retried
-        return {"run": task.run, "seed": task.seed, "certified": bool(task.tightening.certified),
-                **_tiers_of(task.tightening), "max_rho_ratio": None, "min_clearance": None, "min_e_d": None,
-                "tracking_rmse": None, "saturated_steps": None, "replaced_steps": None, "backup_s": None,
-                "backup_engagements": None, "violated": False, "safety_broken": "", "premises_held": False,
-                "broken": "", "worst_sequence": -1, "error": str(exc).splitlines()[0],
-                "wall_s": time.perf_counter() - started}
-    return _row_of(task, sims, started)
-
-
-def _row_of(task: RunTask, sims: list[Any], started: float) -> dict[str, Any]:
-    """The row of a run: the worst figure of each metric over its simulations."""
-    figures = [_figures_of(sim) for sim in sims]
-    worst = int(np.argmax([f["max_rho_ratio"] for f in figures]))
-    return {"run": task.run, "seed": task.seed, "certified": bool(task.tightening.certified),
-            **_tiers_of(task.tightening), "max_rho_ratio": figures[worst]["max_rho_ratio"],
-            "min_clearance": min(f["min_clearance"] for f in figures),
-            "min_e_d": min(f["min_e_d"] for f in figures),
-            "tracking_rmse": max(f["tracking_rmse"] for f in figures),
-            "saturated_steps": max(f["saturated_steps"] for f in figures),
-            **{k: max(f[k] for f in figures) for k in ("replaced_steps", "backup_s", "backup_engagements")},
-            "violated": any(f["broken"] for f in figures),
-            "safety_broken": ",".join(sorted({n for f in figures for n in f["safety_broken"]})),
-            "premises_held": all(f["premises_held"] for f in figures),
-            "broken": ",".join(sorted({n for f in figures for n in f["broken"]})),
-            "worst_sequence": worst, "error": "", "wall_s": time.perf_counter() - started}
 
 
 # ---- certificates and the cluster (client side) ---------------------------------------------------------
@@ -173,29 +77,6 @@ def cached_certificates(out: Path, scenarios: dict[str, Scenario]) -> dict[str, 
         return {}
     found = {key: read_cached(folder, scenario) for key, scenario in scenarios.items()}
     return {key: design.tightening for key, design in found.items() if design is not None}
-
-
-@contextlib.contextmanager
-def open_client(workers: int, scheduler: str | None) -> Iterator[Any]:
-    """A :class:`distributed.Client`: on ``scheduler`` (tcp://HOST:PORT), else on a LocalCluster of
-    ``workers`` single-threaded worker processes bound to 127.0.0.1 (dashboard on 127.0.0.1, a free port)."""
-    from distributed import Client, LocalCluster
-
-    if scheduler is not None:
-        if not scheduler.startswith(("tcp://", "tls://")):
-            raise ConfigError("--scheduler", "an address tcp://HOST:PORT", scheduler)
-        try:
-            client = Client(scheduler, timeout="15s")
-        except (OSError, TimeoutError) as exc:
-            raise ConfigError("--scheduler", "a reachable dask scheduler", scheduler, str(exc)) from None
-        with client:
-            yield client
-        return
-    with children_ignore_interrupts():  # Ctrl-C: the client stops the workers, no worker traceback (exit 130)
-        cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, host="127.0.0.1",
-                               scheduler_port=0, dashboard_address="127.0.0.1:0", silence_logs=logging.ERROR)
-    with cluster, Client(cluster) as client:
-        yield client
 
 
 # ---- the campaign directory -----------------------------------------------------------------------------
@@ -290,7 +171,6 @@ def _execute(client: Any, tasks: list[RunTask], plans: dict[int, RunPlan], out: 
 
     keys = {task.run: input_key(task.scenario) for task in tasks}
     cert_futures, futures = _submit(client, tasks, keys, missing, key)
-    threading.Thread(target=import_plotting, name="tubekit-import-plotting", daemon=True).start()
     with tqdm(total=len(futures), unit="run", disable=not (progress and sys.stderr.isatty())) as bar:
         for future in as_completed(cert_futures + futures):
             row = future.result()
@@ -322,6 +202,8 @@ def run_campaign(spec: CampaignSpec, out: str | Path, *, workers: int = 2, sched
         The summary (also in ``out/summary.json``).
     """
     started = time.perf_counter()
+    atexit.unregister(gc.freeze)  # once: at this process's exit its final collections skip what is alive
+    atexit.register(gc.freeze)  # (~0.3 s of a campaign client's exit: dask, pyarrow, matplotlib)
     out = Path(out)
     if isinstance(workers, bool) or not isinstance(workers, int) or workers < 1:
         raise ConfigError("--workers", "an integer >= 1", workers)
@@ -340,6 +222,9 @@ def run_campaign(spec: CampaignSpec, out: str | Path, *, workers: int = 2, sched
     LOGGER.info("campaign: %d runs (%d already finished), %d distinct certificates (%d stored), %s", spec.runs,
                 spec.runs - len(todo), len(scenarios), len(certs), scheduler or f"LocalCluster of {workers} workers")
     nworkers = 0
+    if scheduler is None and (todo or missing):  # the workers' fork server warms up while the client ...
+        start_fork_server(next(iter(missing.values()), todo[0].scenario if todo else None))
+    import_plotting()  # ... imports what the end needs (in this thread: a second one would slow both)
     with ThreadPoolExecutor(1, thread_name_prefix="tubekit-campaign-finish") as pool:
         with open_client(workers, scheduler) if todo or missing else contextlib.nullcontext() as client:
             _prepare_dir(out, spec)  # after the scheduler answered: a bad --scheduler writes nothing
@@ -386,8 +271,8 @@ def replay_run(campaign_dir: str | Path, run: int) -> tuple[dict, dict | None, A
         cert = certify_plans([plan])[key]
     task = RunTask(run, plan.seed, plan.scenario, cert, spec.falsify_sequences)
     started = time.perf_counter()
-    sims = _simulate_all(task)
-    row = _row_of(task, sims, started)
+    sims = simulate_all(task)
+    row = row_of(task, sims, started)
     row = {"run": run, "seed": plan.seed, **_flat_values(plan.values), **{k: row[k] for k in METRIC_COLUMNS}}
     worst = sims[row["worst_sequence"]].run
     path = _run_file(folder, run)

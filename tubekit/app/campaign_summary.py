@@ -145,9 +145,10 @@ def _speed(rate: dict) -> str:
 
 
 def import_plotting() -> None:
-    """Import what :func:`write_figures` needs (matplotlib's Figure and Agg, ~0.5 s): called in a thread while
-    the client waits for the runs, so the figures at the end do not pay for it."""
+    """Import what the tables and :func:`write_figures` need (pyarrow's parquet writer, matplotlib's Figure
+    and Agg, ~0.6 s): called in a thread while the client waits for its workers, so the end does not pay it."""
     import matplotlib.backends.backend_agg  # noqa: F401
+    import pyarrow.parquet  # noqa: F401
 
     import tubekit.app.plots_campaign  # noqa: F401  (matplotlib.figure, matplotlib.ticker)
 

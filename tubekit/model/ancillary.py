@@ -30,7 +30,7 @@ from tubekit.model import _generated_dynamics as generated
 from tubekit.model.errors import error_coordinates, numeric
 from tubekit.exceptions import ConfigError
 
-__all__ = ["AncillaryLaw", "get_law", "register_law", "jacobian_at", "LAWS"]
+__all__ = ["AncillaryLaw", "get_law", "register_law", "jacobian_at", "LAWS", "BUILTIN_LAWS", "is_builtin"]
 
 
 def _identity_gain(J: np.ndarray) -> np.ndarray:
@@ -164,6 +164,15 @@ LAWS: dict[str, AncillaryLaw] = {
                               symbolic_gain=_inverse_symbolic,
                               closed_form=generated.corrected_kappa),
 }
+
+#: The built-in laws, whose certificate objectives ship compiled (``verify.compiled``).
+BUILTIN_LAWS: tuple[str, ...] = tuple(LAWS)
+_BUILTIN: dict[str, AncillaryLaw] = dict(LAWS)
+
+
+def is_builtin(name: str) -> bool:
+    """True when ``name`` is registered as the built-in law of that name (its symbolic gain is the shipped one)."""
+    return name in _BUILTIN and LAWS.get(name) is _BUILTIN[name]
 
 
 def register_law(law: AncillaryLaw) -> AncillaryLaw:

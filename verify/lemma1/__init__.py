@@ -1,10 +1,34 @@
-"""The paper's continuous-time Lemma 1: L1, L2, J_lower, ξ̄ and the σ and tube radius they give (a reference)."""
+"""The paper's continuous-time Lemma 1: L1, L2, J_lower, ξ̄ and the σ and tube radius they give (a reference).
+
+The names below are imported on first use (PEP 562): the polar model is sympy, the bounds and the route
+of the built-in laws are not (:mod:`verify.compiled`).
+"""
 
 from __future__ import annotations
 
-from verify.lemma1.bounds import BOUND_NAMES, BoundResult, Bounds, compute_bounds
-from verify.lemma1.polar import PolarModel, law_gain, polar_model
-from verify.lemma1.route import ROUTE_BUDGET, ROUTE_NAMES, PaperRoute, RouteQuantity, paper_route
+import importlib
+from typing import Any
 
-__all__ = ["compute_bounds", "Bounds", "BoundResult", "BOUND_NAMES", "PolarModel", "polar_model", "law_gain",
-           "paper_route", "PaperRoute", "RouteQuantity", "ROUTE_NAMES", "ROUTE_BUDGET"]
+#: Public name -> the module that defines it.
+_LAZY: dict[str, str] = {
+    "compute_bounds": "verify.lemma1.bounds", "Bounds": "verify.lemma1.bounds",
+    "BoundResult": "verify.lemma1.bounds", "BOUND_NAMES": "verify.lemma1.bounds",
+    "PolarModel": "verify.lemma1.polar", "polar_model": "verify.lemma1.polar", "law_gain": "verify.lemma1.polar",
+    "paper_route": "verify.lemma1.route", "PaperRoute": "verify.lemma1.route", "RouteQuantity": "verify.lemma1.route",
+    "ROUTE_NAMES": "verify.lemma1.route", "ROUTE_BUDGET": "verify.lemma1.route",
+}
+
+__all__ = list(_LAZY)
+
+
+def __getattr__(name: str) -> Any:
+    """Import a public name's module on first use."""
+    if name in _LAZY:
+        value = getattr(importlib.import_module(_LAZY[name]), name)
+        globals()[name] = value
+        return value
+    raise AttributeError(f"module 'verify.lemma1' has no attribute {name!r}")
+
+
+def __dir__() -> list[str]:
+    return sorted(set(globals()) | set(_LAZY))

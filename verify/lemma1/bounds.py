@@ -11,34 +11,30 @@ omega_bar * ||d xi / d omega||_2.
 
 Objectives are enclosed in Arb (:mod:`verify.intervals`): a matrix 2-norm as
 sqrt(lambda_max(A^T A)) of the symbolically simplified Gram matrix, lambda_min of
-a symmetric matrix via :func:`verify.intervals.sym_eig_bounds`.
+a symmetric matrix via :func:`verify.intervals.sym_eig_bounds`. The objectives (one matrix per case)
+are built and compiled by :mod:`verify.lemma1.objectives` (sympy); for the built-in laws they ship
+compiled (:mod:`verify.compiled`), so a certificate's route needs no sympy.
 """
 
 from __future__ import annotations
 
-import itertools
 import math
 from dataclasses import dataclass, field
 from functools import lru_cache
+from typing import Callable
 
 import numpy as np
-import sympy as sp
 from flint import arb
 
 from tubekit.model.ancillary import LAWS
-from tubekit.model.derivation import symbols
-from tubekit.exceptions import ConfigError, TubekitError
+from tubekit.exceptions import ConfigError
 
-from verify.intervals import Case, MaxResult, compile_arb, compile_numpy, maximise, point, sym_eig_bounds, upper
-from verify.lemma1.forms import simplified
-from verify.lemma1.polar import (A_V, B_V, E_D, E_O, E_Z, GAMMA, H_XY, P_Z, R_M, THETA, U_M, W_M, PolarModel, law_gain,
-                    polar_model)
+from verify.compiled import LAW_BOUNDS, Objective, route_objectives
+from verify.compiled import linear_in_speed as shipped_linear_in_speed
+from verify.intervals import Case, MaxResult, maximise, point, sym_eig_bounds, upper
 from verify.region import Region
 
 __all__ = [
-    "PolarModel",
-    "polar_model",
-    "law_gain",
     "BoundResult",
     "Bounds",
     "compute_bounds",
@@ -50,39 +46,21 @@ BOUND_NAMES = ("L1", "L2", "J_lower", "xi_bar", "zeta_theta", "K_row_u", "K_row_
 
 
 # --------------------------------------------------------------------------- objectives
-def _gram(A: sp.Matrix) -> sp.Matrix:
-    """A^T A, simplified (read from the shipped forms when they hold this A)."""
-    return simplified("gram", A, lambda M: (M.T * M).applyfunc(sp.simplify))
-
-
-def _sym_part(A: sp.Matrix) -> sp.Matrix:
-    """(A + A^T) / 2, simplified (read from the shipped forms when they hold this A)."""
-    return simplified("sym", A, lambda M: ((M + M.T) / 2).applyfunc(sp.simplify))
-
-
-def _dims(expr_syms: set, region: Region) -> list[tuple[sp.Symbol, float, float]]:
-    """(symbol, lo, hi) of the branch-and-bound dimensions an objective depends on (m, -, rad)."""
-    dims = []
-    for sym, rng in ((E_D, region.e_d), (E_Z, region.e_z), (E_O, region.e_o), (THETA, (0.0, 2 * math.pi)),
-                     (GAMMA, (0.0, 2 * math.pi))):
-        if sym in expr_syms:
-            dims.append((sym, float(rng[0]), float(rng[1])))
-    return dims
+def _dims(names: tuple[str, ...], region: Region) -> list[tuple[float, float]]:
+    """(lo, hi) of each branch-and-bound dimension (m, -, rad)."""
+    ranges = {"e_d": region.e_d, "e_z": region.e_z, "e_o": region.e_o, "theta": (0.0, 2 * math.pi),
+              "gamma": (0.0, 2 * math.pi)}
+    return [(float(ranges[n][0]), float(ranges[n][1])) for n in names]
 
 
 @lru_cache(maxsize=128)
-def _compiled(kind: str, A: sp.Matrix, dim_syms: tuple, par_syms: tuple):
-    """Arb and numpy evaluators of an objective on matrix ``A``.
-
-    ``kind``: ``"norm"`` (||A||_2) or ``"lmin"`` (lambda_min of the symmetric part of A).
-    """
-    args = list(dim_syms) + list(par_syms)
-    n_r, n_c = A.shape
-    G = _gram(A) if kind == "norm" else _sym_part(A)
-    m = G.shape[0]
+def _evaluators(obj: Objective) -> tuple[Callable[[list[arb]], arb], Callable[[np.ndarray, np.ndarray], np.ndarray]]:
+    """(interval, pointwise) of an objective: ``kind`` ``norm`` (||A||_2) or ``lmin`` (-lambda_min of the
+    symmetric part of A, so that every bound is a sup)."""
+    kind, f_arb, f_np = obj.kind, obj.arb, obj.numpy
+    n_r, n_c = obj.shape
+    m = n_c
     idx = [(i, j) for i in range(m) for j in range(i, m)]
-    f_arb = compile_arb([G[i, j] for i, j in idx], args)
-    f_np = compile_numpy(list(A), args)
 
     def entries(balls: list[arb]) -> list[list[arb]]:
         vals = f_arb(*balls)
@@ -123,66 +101,32 @@ def _compiled(kind: str, A: sp.Matrix, dim_syms: tuple, par_syms: tuple):
     return interval, pointwise
 
 
-def _case(kind: str, A: sp.Matrix, region: Region, params: dict[sp.Symbol, float], label: str) -> Case:
-    A = sp.ImmutableMatrix(A)
-    free = A.free_symbols
-    dims = _dims(free, region)
-    dim_syms = tuple(d[0] for d in dims)
-    par_syms = tuple(sorted((p for p in params if p in free), key=str))
-    missing = free - set(dim_syms) - set(par_syms)
-    if missing:
-        raise TubekitError(f"bounds: unexpected free symbols {sorted(map(str, missing))} in {label}")
-    interval, pointwise = _compiled(kind, A, dim_syms, par_syms)
-    pars = np.array([params[p] for p in par_syms], dtype=float)
+def _case(obj: Objective, region: Region, params: dict[str, float]) -> Case:
+    """The branch-and-bound case of ``obj`` over ``region`` with its parameters (by name) fixed."""
+    dims = _dims(obj.dims, region)
+    interval, pointwise = _evaluators(obj)
+    pars = np.array([params[p] for p in obj.pars], dtype=float)
     par_balls = [point(p) for p in pars]
     return Case(
-        label=label,
-        names=tuple(str(s) for s in dim_syms),
-        lo=np.array([d[1] for d in dims], dtype=float),
-        hi=np.array([d[2] for d in dims], dtype=float),
+        label=obj.label,
+        names=obj.dims,
+        lo=np.array([d[0] for d in dims], dtype=float),
+        hi=np.array([d[1] for d in dims], dtype=float),
         interval=lambda balls, _f=interval, _p=par_balls: _f(list(balls) + _p),
         point=lambda X, _f=pointwise, _p=pars: _f(np.asarray(X, dtype=float).reshape(len(X), -1), _p),
     )
 
 
-def _vertex_cases(A: sp.Matrix, box: dict[sp.Symbol, float]) -> list[tuple[sp.Matrix, str]]:
-    """Substitute the vertices of a symmetric box {|x_k| <= box[x_k]} for the symbols A depends on.
+def _objectives(name: str, law: str, s: int) -> tuple[Objective, ...]:
+    """The cases of bound ``name`` in hemisphere ``s``: shipped compiled, or derived now (another law, stale code)."""
+    shipped = route_objectives(name, law, s)
+    if shipped is not None:
+        return shipped
+    from verify.lemma1.objectives import derived_objectives
 
-    A is linear in these symbols (checked); ||A(-x)|| = ||A(x)||, so vertices
-    are taken up to a global sign.
-    """
-    syms = [x for x in box if x in A.free_symbols]
-    if not syms:
-        return [(A, "")]
-    zero = A.subs({x: 0 for x in syms})
-    lin = A - zero
-    if zero != sp.zeros(*A.shape) or any(lin.diff(x).diff(y) != sp.zeros(*A.shape) for x in syms for y in syms):
-        raise TubekitError("bounds: the vertex rule needs an objective linear and homogeneous in the box variables")
-    out = []
-    for signs in itertools.product((1, -1), repeat=len(syms) - 1):
-        signs = (1,) + signs
-        sub = {x: sg * box[x] for x, sg in zip(syms, signs)}
-        label = ",".join(f"{x}={'+' if sg > 0 else '-'}" for x, sg in zip(syms, signs))
-        out.append((A.subs(sub), label))
-    return out
+    return derived_objectives(name, law or "paper", s)
 
 
-def _velocity_cases(A: sp.Matrix) -> list[tuple[sp.Matrix, str]]:
-    """Extreme points of the velocity set: circle of radius h_xy in (a, b), vertices +-p_z in zdot_d."""
-    zd = symbols()["zdot_d"]
-    has_a, has_b = A_V in A.free_symbols, B_V in A.free_symbols
-    if has_a and has_b:
-        A = A.subs({A_V: H_XY * sp.cos(GAMMA), B_V: H_XY * sp.sin(GAMMA)})
-        box = {zd: P_Z}
-    else:
-        box = {A_V: H_XY, B_V: H_XY, zd: P_Z}
-    if zd in A.free_symbols and (has_a and has_b):
-        # circle x {+-p_z}: both signs of zdot_d are needed (the circle is already symmetric)
-        return [(A.subs(zd, P_Z), "zdot_d=+"), (A.subs(zd, -P_Z), "zdot_d=-")]
-    return _vertex_cases(A, box)
-
-
-# --------------------------------------------------------------------------- results
 @dataclass(frozen=True)
 class BoundResult:
     """A certified bound with its sampled counterpart.
@@ -278,33 +222,22 @@ def _holds_over(name: str, region: Region) -> str:
 
 def _hemisphere_cases(name: str, law: str, s: int, region: Region, par: dict[str, float]) -> list[Case]:
     """The branch-and-bound cases of bound ``name`` in hemisphere ``s`` (extreme points of its parameters)."""
-    pm = polar_model(s)
-    hem = "toward" if s < 0 else "away"
+    if name not in BOUND_NAMES:
+        raise ConfigError("bound", f"one of {BOUND_NAMES}", name)
     if name == "L1":
-        sy = symbols()
-        box = {sy["u"]: U_M, sy["w"]: W_M, sy["r"]: R_M}
-        vals = {U_M: par["u"], W_M: par["w"], R_M: par["r"]}
-        return [_case("norm", A, region, vals, f"{hem} {lab}".strip()) for A, lab in _vertex_cases(pm.dh_de, box)]
-    if name in ("L2", "zeta_theta"):
-        M = pm.dzeta_de if name == "L2" else pm.dzeta_dtheta
-        vals = {H_XY: par["h_xy"], P_Z: par["p_z"]}
-        return [_case("norm", A, region, vals, f"{hem} {lab}".strip()) for A, lab in _velocity_cases(M)]
-    if name == "xi_bar":
-        return [_case("norm", pm.dxi_domega, region, {}, hem)]
-    if name == "J_lower":
-        return [_case("lmin", law_gain(law, s)[1], region, {}, hem)]
-    if name == "JK_norm":
-        return [_case("norm", law_gain(law, s)[1], region, {}, hem)]
-    if name.startswith("K_row_"):
-        i = "uwr".index(name[-1])
-        return [_case("norm", law_gain(law, s)[0][i, :].T, region, {}, hem)]
-    raise ConfigError("bound", f"one of {BOUND_NAMES}", name)
+        values = {"u_max": par["u"], "w_max": par["w"], "r_max": par["r"]}
+    elif name in ("L2", "zeta_theta"):
+        values = {"h_xy": par["h_xy"], "p_z": par["p_z"]}
+    else:
+        values = {}
+    return [_case(obj, region, values) for obj in _objectives(name, law, s)]
 
 
 @lru_cache(maxsize=512)
 def _solve(name: str, law: str, signs: tuple, e_d: tuple, e_z: tuple, e_o: tuple, params: tuple,
            gap: float, budget: int) -> MaxResult:
-    """Branch-and-bound maximum of bound ``name`` over the error box (hashable arguments: cached)."""
+    """Branch-and-bound maximum of bound ``name`` over the error box (hashable arguments: cached; ``law`` is ""
+    for a bound that does not depend on the law)."""
     region = Region(e_d=e_d, e_z=e_z, e_o=e_o, heading="both" if len(signs) == 2 else
                     ("toward" if signs[0] < 0 else "away"), pd_dot_max=(0.0, 0.0, 0.0), pd_dot_xy_max=0.0,
                     omega_bar=0.0, v_max=(1.0, 1.0, 1.0))
@@ -315,19 +248,18 @@ def _solve(name: str, law: str, signs: tuple, e_d: tuple, e_z: tuple, e_o: tuple
     return maximise(cases, gap=gap, max_boxes=budget)
 
 
-@lru_cache(maxsize=8)
 def _linear_in_speed(name: str, s: int) -> bool:
-    """True if the L2 / zeta_theta objective is ||M|| with M linear in (a, b) and free of zdot_d.
+    """True if the L2 / zeta_theta objective is ||M|| with M linear in (a, b) and free of zdot_d
+    (:func:`verify.lemma1.objectives.linear_in_speed`; shipped with the compiled objectives).
 
     Then its sup over the disc of radius h is h times the sup over the unit disc.
     """
-    pm = polar_model(s)
-    M = pm.dzeta_de if name == "L2" else pm.dzeta_dtheta
-    if symbols()["zdot_d"] in M.free_symbols:
-        return False
-    zero = M.subs({A_V: 0, B_V: 0})
-    second = [M.diff(x).diff(y) for x in (A_V, B_V) for y in (A_V, B_V)]
-    return zero == sp.zeros(*M.shape) and all(d == sp.zeros(*M.shape) for d in second)
+    shipped = shipped_linear_in_speed(name, s)
+    if shipped is not None:
+        return shipped
+    from verify.lemma1.objectives import linear_in_speed
+
+    return linear_in_speed(name, s)
 
 
 def compute_bounds(region: Region, law: str, *, gap: float = 0.05, max_boxes: int = 20000,
@@ -367,9 +299,9 @@ def compute_bounds(region: Region, law: str, *, gap: float = 0.05, max_boxes: in
     params, scale = _solver_parameters(region)
     items: dict[str, BoundResult] = {}
     for name in names:
-        key_law = law if name in ("J_lower", "JK_norm") or name.startswith("K_row_") else ""
+        key_law = law if name in LAW_BOUNDS else ""
         info0 = _solve.cache_info().hits
-        res = _solve(name, key_law or "paper", *common, params.get(name, ()), float(gap), int(max_boxes))
+        res = _solve(name, key_law, *common, params.get(name, ()), float(gap), int(max_boxes))
         cached = _solve.cache_info().hits > info0
         items[name] = _bound_result(name, res, scale.get(name), region, cached)
     return Bounds(law=law, items=items)

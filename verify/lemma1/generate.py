@@ -15,7 +15,8 @@ import sympy as sp
 
 from tubekit.jsonable import write_text
 
-from verify.lemma1 import bounds, forms, polar
+from verify import compiled
+from verify.lemma1 import bounds, forms, objectives, polar
 from verify.region import Region
 
 __all__ = ["generated_source", "GENERATED_PATH", "GENERATED_LAWS"]
@@ -32,13 +33,16 @@ _REGION = Region(e_d=(0.5, 2.0), e_z=(-1.0, 1.0), e_o=(-0.5, 0.5), heading="both
 
 def _clear_caches() -> None:
     """Forget every derived or compiled form held in memory."""
-    for f in (polar.polar_model, polar.law_gain, bounds._compiled, bounds._solve, bounds._linear_in_speed):
+    for f in (polar.polar_model, polar.law_gain, objectives._compiled, objectives.linear_in_speed, bounds._solve,
+              bounds._evaluators):
         f.cache_clear()
 
 
 def _derive_all() -> tuple[dict[int, dict[str, object]], dict[str, str]]:
-    """(polar fields per hemisphere as srepr, the recorded simplifications), with the shipped forms unused."""
+    """(polar fields per hemisphere as srepr, the recorded simplifications), with the shipped forms unused
+    (and the compiled objectives of :mod:`verify.compiled`, which would skip the simplifications)."""
     forms.recording(True)
+    was = compiled.use(False)
     _clear_caches()
     try:
         models = {s: polar.polar_model(s) for s in (-1, 1)}
@@ -46,6 +50,7 @@ def _derive_all() -> tuple[dict[int, dict[str, object]], dict[str, str]]:
             bounds.compute_bounds(_REGION, law, max_boxes=1)
     finally:
         table = forms.recording(False)
+        compiled.use(was)
         _clear_caches()
     entries = {s: {**{name: sp.srepr(sp.ImmutableMatrix(getattr(m, name))) for name in forms.POLAR_FIELDS},
                    "zeta_rotation_form": bool(m.zeta_rotation_form)} for s, m in models.items()}

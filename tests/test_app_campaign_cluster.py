@@ -83,3 +83,16 @@ def test_ctrl_c_stops_the_workers_and_exits_130_in_one_line(tmp_path):
     while _group(proc.pid) and time.monotonic() < deadline:
         time.sleep(0.1)
     assert not _group(proc.pid)  # the fork server and every worker are gone with the client
+
+
+def test_the_warm_up_copy_is_short_and_never_certifies_a_dynamic_design():
+    """The warm-up runs 1 s and, for a dynamic campaign, on the kinematic plant (its certificate is discarded)."""
+    from tubekit.app.campaign_cluster import WARM_DURATION_S, warm_scenario
+    from tubekit.scenario import load_scenario
+    root = Path(__file__).resolve().parents[1]
+    kinematic = load_scenario(SCENARIO)
+    dynamic = load_scenario(root / "examples" / "bluerov2_currents.toml")
+    assert warm_scenario(kinematic) == kinematic.with_changes(duration=1.0) and WARM_DURATION_S == 1.0
+    warm = warm_scenario(dynamic)
+    assert warm.plant.kind == "kinematic" and dynamic.plant.kind == "dynamic"
+    assert warm.duration == 1.0 and warm.trajectory == dynamic.trajectory and warm.limits == dynamic.limits

@@ -7,8 +7,8 @@ when it stops it finalises that interpreter (~1 s). Each worker pays all of it, 
 two workers pay it on the cores the campaign needs. Here multiprocessing's fork server is started
 (:func:`start_fork_server`) as soon as the campaign is validated; it imports
 :mod:`tubekit.app.campaign_worker`, which certifies and simulates one short copy of the campaign's first
-scenario, while the client reads its stored certificates, imports what its tables and figures need and
-starts the scheduler. Every worker is a fork of that server (dask's
+scenario (:func:`warm_scenario`: on the kinematic plant when the campaign's is dynamic), while the client
+reads its stored certificates, imports what its tables and figures need and starts the scheduler. Every worker is a fork of that server (dask's
 ``distributed.worker.multiprocessing-method = "forkserver"``): imported and warm at birth, and it leaves
 through ``os._exit``, so the cluster closes at once. Nothing a run computes depends on this: the rows
 are those of spawned workers.
@@ -21,6 +21,7 @@ workers (exit 130). The fork server ends with the client process (multiprocessin
 from __future__ import annotations
 
 import contextlib
+import dataclasses
 import json
 import logging
 import multiprocessing
@@ -32,12 +33,23 @@ from tubekit.app.exit_codes import children_ignore_interrupts
 from tubekit.exceptions import ConfigError
 from tubekit.scenario import Scenario
 
-__all__ = ["open_client", "start_fork_server", "PRELOAD", "WARM_DURATION_S"]
+__all__ = ["open_client", "start_fork_server", "warm_scenario", "PRELOAD", "WARM_DURATION_S"]
 
 #: The modules the fork server imports: the worker's machinery, then the campaign's side of it, warmed.
 PRELOAD = ("distributed", "tubekit.app.campaign_worker")
 #: Simulated seconds of the fork server's warm-up run (s).
 WARM_DURATION_S = 1.0
+
+
+def warm_scenario(scenario: Scenario) -> Scenario:
+    """The fork server's warm-up copy of ``scenario``: :data:`WARM_DURATION_S` s long and, on the dynamic plant,
+    on the kinematic one. The warm-up's certificate is discarded (the workers certify every design again), and a
+    dynamic certificate's fixed point and backup design can take seconds, paid twice; the kinematic copy
+    imports and runs the same ``verify``, cvxpy and loop code."""
+    warm = scenario.with_changes(duration=WARM_DURATION_S)
+    if warm.plant.kind == "dynamic":
+        warm = warm.with_changes(plant=dataclasses.replace(warm.plant, kind="kinematic"))
+    return warm
 
 
 def start_fork_server(scenario: Scenario | None) -> bool:
@@ -48,7 +60,7 @@ def start_fork_server(scenario: Scenario | None) -> bool:
 
     The server inherits the environment at its start: dask's ``distributed.nanny.pre-spawn-environ``
     (one BLAS thread per worker, as spawned workers get; the Nanny sets it in this process too) and
-    :data:`WARM_SCENARIO_ENV`, which is removed from this process again at once.
+    :data:`WARM_SCENARIO_ENV` (:func:`warm_scenario`), which is removed from this process again at once.
     """
     if "forkserver" not in multiprocessing.get_all_start_methods():
         return False
@@ -57,7 +69,7 @@ def start_fork_server(scenario: Scenario | None) -> bool:
 
     os.environ.update({k: str(v) for k, v in dask.config.get("distributed.nanny.pre-spawn-environ", {}).items()})
     if scenario is not None:
-        os.environ[WARM_SCENARIO_ENV] = json.dumps(scenario.with_changes(duration=WARM_DURATION_S).to_dict())
+        os.environ[WARM_SCENARIO_ENV] = json.dumps(warm_scenario(scenario).to_dict())
     try:
         multiprocessing.get_context("forkserver").set_forkserver_preload(list(PRELOAD))
         with children_ignore_interrupts():  # the server, hence every worker forked from it, ignores Ctrl-C

@@ -35,10 +35,11 @@ def _kernel_source(t, x0, x1, x2, x3, u, w, r, h, n, a0, a1, a2, c0, c1, c2, rat
     sw = gain * u * r
     hh, h6 = 0.5 * h, h / 6.0
     p0, p1 = 0.0, 0.0
+    s, c = math.sin(rate * t), math.cos(rate * t)
+    e1, e2, e3, es = a0 * s + c0, a1 * c + c1, a2 * s + c2, sw + samp * math.sin(srate * t)
     for _ in range(n):
         tm, te = t + 0.5 * h, t + h
-        s, c = math.sin(rate * t), math.cos(rate * t)
-        d1, d2, d3, vs = a0 * s + c0, a1 * c + c1, a2 * s + c2, sw + samp * math.sin(srate * t)
+        d1, d2, d3, vs = e1, e2, e3, es
         s, c = math.sin(rate * tm), math.cos(rate * tm)
         m1, m2, m3, ms = a0 * s + c0, a1 * c + c1, a2 * s + c2, sw + samp * math.sin(srate * tm)
         s, c = math.sin(rate * te), math.cos(rate * te)

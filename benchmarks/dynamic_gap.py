@@ -37,16 +37,21 @@ KEEP_UP = 0.4 - 0.1885         # u_max - the circle's speed pi/50 * 3 m (m/s)
 YAW_BUDGET = 0.5 * 0.5         # r_max * epsilon (m/s)
 
 
+def _box(f: float):
+    """von Benzon's values ±``f`` (a fraction) on every nonzero coefficient; ``f`` = 0: the point."""
+    return VEHICLES["bluerov2_heavy"].with_overrides(
+        {k: ((v * (1 + f), v * (1 - f)) if (v and f) else v) for k, v in VON_BENZON.items()})
+
+
 def boxes():
     """(label, vehicle): the published box, then von Benzon's values ±10 %, ±2 %, and the point."""
     yield "published box", VEHICLES["bluerov2_heavy"]
     for f in (0.1, 0.02, 0.0):
-        over = {k: ((v * (1 + f), v * (1 - f)) if (v and f) else v) for k, v in VON_BENZON.items()}
-        yield f"von Benzon ±{round(f * 100)}%", VEHICLES["bluerov2_heavy"].with_overrides(over)
+        yield f"von Benzon ±{round(f * 100)}%", _box(f)
 
 
-#: The continuous backup's per-tick jumps at safe radii 4.6-5.5 m (the gentlest the design grid certifies on the
-#: favourable scenario; ``verify.backup.backup_tick_change``), rounded up.
+#: The continuous backup's per-tick jumps at safe radii 4.6-5.5 m (the candidates the design grid tries on the
+#: favourable scenario, refuted there by ``backup_level_set``; ``verify.backup.backup_tick_change``), rounded up.
 GENTLE_BACKUP_JUMPS = (0.003, 0.0013, 0.003)
 #: The favourable variant's command box (m/s, m/s, rad/s): the paper's with r_max 0.3 (less sway).
 FAVOURABLE_V = (0.4, 0.3, 0.3)
@@ -55,12 +60,6 @@ FAVOURABLE_V = (0.4, 0.3, 0.3)
 def _point(**over: float):
     """von Benzon's point with ``over`` applied (e.g. a loop bandwidth, or linear drag)."""
     return VEHICLES["bluerov2_heavy"].with_overrides({**VON_BENZON, **over})
-
-
-def _box(f: float):
-    """von Benzon's values ±``f`` (a fraction) on every nonzero coefficient."""
-    return VEHICLES["bluerov2_heavy"].with_overrides(
-        {k: ((v * (1 + f), v * (1 - f)) if v else v) for k, v in VON_BENZON.items()})
 
 
 def rate_rows():

@@ -3,19 +3,14 @@ and one real (tiny) measurement's keys (timings not asserted)."""
 
 from __future__ import annotations
 
-import importlib.util
-from pathlib import Path
 
 import pytest
 
-ROOT = Path(__file__).resolve().parents[1]
+from .scripts import ROOT, load_script
 
 
 def _module():
-    spec = importlib.util.spec_from_file_location("bench_certify_process", ROOT / "benchmarks" / "certify_process.py")
-    mod = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(mod)
-    return mod
+    return load_script("benchmarks/certify_process.py", "bench_certify_process")
 
 
 BENCH = _module()

@@ -2,19 +2,14 @@
 
 from __future__ import annotations
 
-import importlib.util
-from pathlib import Path
 
 import pytest
 
-ROOT = Path(__file__).resolve().parents[1]
+from .scripts import load_script
 
 
 def _module():
-    spec = importlib.util.spec_from_file_location("bench_closed_loop", ROOT / "benchmarks" / "closed_loop.py")
-    mod = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(mod)
-    return mod
+    return load_script("benchmarks/closed_loop.py", "bench_closed_loop")
 
 
 @pytest.fixture(scope="module")

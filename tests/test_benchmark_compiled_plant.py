@@ -2,22 +2,16 @@
 
 from __future__ import annotations
 
-import importlib.util
-from pathlib import Path
-
 import numpy as np
 
 from tubekit import paper_scenario
 from tubekit.plant.kinematic import Plant
 
-ROOT = Path(__file__).resolve().parents[1]
+from .scripts import load_script
 
 
 def _module():
-    spec = importlib.util.spec_from_file_location("bench_compiled_plant", ROOT / "benchmarks" / "compiled_plant.py")
-    mod = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(mod)
-    return mod
+    return load_script("benchmarks/compiled_plant.py", "bench_compiled_plant")
 
 
 def test_the_kernel_source_equals_the_plant_step_bit_for_bit():

@@ -6,11 +6,10 @@ import json
 import math
 import subprocess
 import sys
-from pathlib import Path
 
 import pytest
 
-ROOT = Path(__file__).resolve().parents[1]
+from .scripts import ROOT, load_script
 KEYS = ("rt_step_ms_median", "rt_step_ms_p99", "converged_ms_median", "ipopt_ms_median", "clarabel_ms_median",
         "ratio_rt_vs_ipopt", "ratio_converged_vs_ipopt", "cost_gap_max", "n_states")
 PEERS = ("scp_realtime", "scp_converged", "ipopt", "sqpmethod_qrqp")
@@ -43,11 +42,7 @@ def test_quick_benchmark_writes_all_keys(tmp_path):
 
 
 def _bench_module():
-    import importlib.util
-    spec = importlib.util.spec_from_file_location("bench_fhocp", ROOT / "benchmarks" / "fhocp.py")
-    mod = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(mod)
-    return mod
+    return load_script("benchmarks/fhocp.py", "bench_fhocp")
 
 
 @pytest.mark.parametrize("lam, with_sqp", [(0.0, True), (10.0, False), (2.5, False)])

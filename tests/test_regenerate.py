@@ -9,21 +9,16 @@ without its numbers). When a test here fails, run ``python docs/regenerate.py``.
 
 from __future__ import annotations
 
-import importlib.util
 import json
 import re
-from pathlib import Path
 
 import pytest
 
-ROOT = Path(__file__).resolve().parents[1]
+from .scripts import ROOT, load_script
 
 
 def _regenerate():
-    spec = importlib.util.spec_from_file_location("regenerate", ROOT / "docs" / "regenerate.py")
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
+    return load_script("docs/regenerate.py", "regenerate")
 
 
 REGEN = _regenerate()

@@ -163,7 +163,9 @@ class Plant:
 
     def _rk4_fused(self, t: float, y: tuple, v: Sequence[float], h: float, n: int) -> Floats4:
         """``n`` RK4 steps of :meth:`_rhs` (no override), unrolled on scalars; δ(t) and the wave sway are
-        evaluated once per distinct stage time (the midpoint serves k2 and k3)."""
+        evaluated once per distinct stage time (the midpoint serves k2 and k3; a step's end serves the next
+        step's start, the same float t + h), and k3 is k2 (ψ's rate is r at every stage, so both stages sit
+        at the same ψ and time)."""
         u, w, r = v
         (a0, a1, a2), (c0, c1, c2) = self._amplitude, self._constant
         rate, samp, srate, peak = self._current_rate, self._sway_amplitude, self._sway_rate, self._peak
@@ -172,10 +174,11 @@ class Plant:
         x0, x1, x2, x3 = y
         hh, h6 = 0.5 * h, h / 6.0
         p0, p1 = peak
+        s, c = sin(rate * t), cos(rate * t)
+        e1, e2, e3, es = a0 * s + c0, a1 * c + c1, a2 * s + c2, sw + samp * sin(srate * t)
         for _ in range(n):
             tm, te = t + 0.5 * h, t + h
-            s, c = sin(rate * t), cos(rate * t)
-            d1, d2, d3, vs = a0 * s + c0, a1 * c + c1, a2 * s + c2, sw + samp * sin(srate * t)
+            d1, d2, d3, vs = e1, e2, e3, es
             s, c = sin(rate * tm), cos(rate * tm)
             m1, m2, m3, ms = a0 * s + c0, a1 * c + c1, a2 * s + c2, sw + samp * sin(srate * tm)
             s, c = sin(rate * te), cos(rate * te)
@@ -191,10 +194,8 @@ class Plant:
             o1, o2 = m1 - ms * sp, m2 + ms * cp
             p0, p1 = max(p0, hypot(o1, o2)), max(p1, abs(m3))
             k20, k21, k22 = u * cp + o1, u * sp + o2, w + m3
-            # k3 at (t + h/2, y + h/2 k2): psi's rate is r at every stage
-            sp, cp = sin(q3), cos(q3)
-            o1, o2 = m1 - ms * sp, m2 + ms * cp
-            k30, k31, k32 = u * cp + o1, u * sp + o2, w + m3
+            # k3 at (t + h/2, y + h/2 k2) = k2: the same ψ (x3 + h/2 r) and the same time
+            k30, k31, k32 = k20, k21, k22
             # k4 at (t + h, y + h k3)
             q3 = x3 + h * r
             sp, cp = sin(q3), cos(q3)

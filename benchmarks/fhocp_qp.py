@@ -144,7 +144,9 @@ def main(argv: list[str] | None = None) -> int:
     text = json.dumps(res, indent=2)
     print(text)
     if args.json:
-        args.json.write_text(text + "\n")
+        from tubekit.jsonable import write_text
+
+        write_text(args.json, text + "\n")
     return 0
 
 

@@ -33,6 +33,8 @@ import sys
 import tempfile
 from pathlib import Path
 
+from tubekit.jsonable import write_text
+
 ROOT = Path(__file__).resolve().parents[1]
 SIDECAR = ROOT / "docs" / "artefacts.json"
 REPRODUCE_MD = ROOT / "docs" / "reproduce.md"
@@ -158,7 +160,7 @@ def write_measured_table(fp: dict) -> None:
         text = text[:text.index(BEGIN)] + block + text[text.index(END) + len(END):]
     else:
         text = text.rstrip() + "\n\n## Measured (generated)\n\n" + block + "\n"
-    REPRODUCE_MD.write_text(text)
+    write_text(REPRODUCE_MD, text)
 
 
 def _tubekit(*args: str) -> None:
@@ -223,8 +225,8 @@ def main(argv: list[str] | None = None) -> int:
     write_measured_table(fp)
     files = dict(stored.get("files", {}))
     files.update({rel: sha256(ROOT / rel) for rel in written})
-    SIDECAR.write_text(json.dumps({"command": "python docs/regenerate.py", "fingerprint": fp, "campaign": campaign,
-                                   "files": dict(sorted(files.items()))}, indent=1) + "\n")
+    write_text(SIDECAR, json.dumps({"command": "python docs/regenerate.py", "fingerprint": fp, "campaign": campaign,
+                                    "files": dict(sorted(files.items()))}, indent=1) + "\n")
     print(f"wrote {len(written)} artefacts and {SIDECAR.relative_to(ROOT)}")
     return 0
 

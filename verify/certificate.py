@@ -47,7 +47,7 @@ from verify.gains import GainBounds, gain_bounds
 from verify.parts import EBar, SigmaChoice, SigmaTrial
 from verify.region import Region
 from verify.sampled import HorizonMargins, PeriodTube
-from verify.tiers import backup_of, key_sigma, safe_only_design, tier_conditions, tracking_design
+from verify.tiers import key_sigma, solve_tiers, tier_conditions
 
 if TYPE_CHECKING:  # the dynamic plant's modules load only when a dynamic scenario is certified
     from verify.vehicle.bound import LoopBound
@@ -346,10 +346,8 @@ def _solve(scenario: Scenario, region: Region, gains: GainBounds, sigmas: tuple[
         sol = solve_dynamic(scenario, region, gains, sigmas)
         return sol.dist, list(sol.designs), sol.best, sol.safe, sol.backup, sol.loop, sol.conditions
     dist = disturbance_bounds(scenario)
-    designs = [tracking_design(scenario, region, gains, s, dist) for s in sigmas]
-    best = choose_design(designs)
-    safe = None if best.certified else safe_only_design(scenario, region, gains, dist)
-    return dist, designs, best, safe, backup_of(scenario, dist, (safe or best).margins), None, ()
+    designs, best, safe, backup = solve_tiers(scenario, region, gains, sigmas, dist)
+    return dist, list(designs), best, safe, backup, None, ()
 
 
 def certify(scenario: Scenario, law: str | AncillaryLaw | None = None, *, region: Region | None = None,

@@ -28,8 +28,8 @@ from tubekit.model.backup import SafeSet, StationKeeping
 from tubekit.scenario import Scenario
 
 from verify.backup import BackupCertificate, certify_backup, design_backup
-from verify.design import Condition, Design, DisturbanceBounds, arc_rates, evaluate_design, input_tightening, \
-    state_conditions, sway_condition, tube_problem
+from verify.design import Condition, Design, DisturbanceBounds, arc_rates, choose_design, evaluate_design, \
+    input_tightening, state_conditions, sway_condition, tube_problem
 from verify.gains import GainBounds
 from verify.intervals import lower, upper
 from verify.region import Region
@@ -37,7 +37,7 @@ from verify.sampled import HorizonMargins, PeriodTube, _asin_ratio, horizon_marg
 from verify.workspace import initial_workspace, target_in_workspace
 
 __all__ = ["SAFE_CONDITIONS", "SAFE_PREFIX", "is_safe_condition", "tracking_design", "position_tube",
-           "safe_only_design", "backup_of", "recertify_backup", "initial_backup", "tier_conditions",
+           "safe_only_design", "backup_of", "solve_tiers", "recertify_backup", "initial_backup", "tier_conditions",
            "tiers_of", "key_sigma"]
 
 #: Names (or name prefixes ending in "[") of the tracking design's conditions the safe tier depends on.
@@ -142,6 +142,16 @@ def backup_of(scenario: Scenario, dist: DisturbanceBounds, margins: HorizonMargi
                             tick=tick, handover=(np.finfo(float).max, np.finfo(float).max),
                             yaw_rate_error=dist.yaw_rate_error)
     return _with_initial(scenario, bc)
+
+
+def solve_tiers(scenario: Scenario, region: Region, gains: GainBounds, sigmas: tuple[float, ...],
+                dist: DisturbanceBounds) -> tuple[tuple[Design, ...], Design, Design | None, BackupCertificate]:
+    """(designs, best, safe, backup) at ``dist``: the tracking design per σ (1/s) of ``sigmas``, the chosen one
+    (:func:`verify.design.choose_design`), the safe-only design when it does not certify, and the backup."""
+    designs = tuple(tracking_design(scenario, region, gains, s, dist) for s in sigmas)
+    best = choose_design(list(designs))
+    safe = None if best.certified else safe_only_design(scenario, region, gains, dist)
+    return designs, best, safe, backup_of(scenario, dist, (safe or best).margins)
 
 
 def recertify_backup(scenario: Scenario, law: StationKeeping, safe: SafeSet, dist: DisturbanceBounds,

@@ -124,6 +124,11 @@ def _flat_values(values: dict[str, Any]) -> dict[str, Any]:
     return flat
 
 
+def _stored_row(plan: RunPlan, row: dict[str, Any]) -> dict[str, Any]:
+    """A worker's ``row`` as stored: run, seed, ``plan``'s sampled values (:func:`_flat_values`), the metrics."""
+    return {"run": row["run"], "seed": row["seed"], **_flat_values(plan.values), **{k: row[k] for k in METRIC_COLUMNS}}
+
+
 def read_rows(out: str | Path) -> list[dict[str, Any]]:
     """Every stored run of campaign ``out`` (``runs/*.json``), by run number."""
     rows = []
@@ -160,16 +165,15 @@ def _submit(client: Any, tasks: list[RunTask], keys: dict[int, str], missing: di
     return list(certs.values()), runs
 
 
-def _execute(client: Any, tasks: list[RunTask], plans: dict[int, RunPlan], out: Path, key: str,
-             progress: bool, missing: dict[str, Scenario], certs: dict[str, Tightening]) -> None:
-    """Certify ``missing`` and run ``tasks`` on the workers; store each certificate (into ``certs`` and
-    ``out/certificates``) and each row the moment it completes."""
+def _execute(client: Any, tasks: list[RunTask], plans: dict[int, RunPlan], keys: dict[int, str], out: Path,
+             key: str, progress: bool, missing: dict[str, Scenario], certs: dict[str, Tightening]) -> None:
+    """Certify ``missing`` and run ``tasks`` on the workers (``keys``: each run's input key); store each
+    certificate (into ``certs`` and ``out/certificates``) and each row the moment it completes."""
     from distributed import as_completed
     from tqdm.auto import tqdm
 
-    from tubekit.app.certified import IssuedCertificate, input_key, write_cached
+    from tubekit.app.certified import IssuedCertificate, write_cached
 
-    keys = {task.run: input_key(task.scenario) for task in tasks}
     cert_futures, futures = _submit(client, tasks, keys, missing, key)
     with tqdm(total=len(futures), unit="run", disable=not (progress and sys.stderr.isatty())) as bar:
         for future in as_completed(cert_futures + futures):
@@ -178,8 +182,7 @@ def _execute(client: Any, tasks: list[RunTask], plans: dict[int, RunPlan], out: 
                 write_cached(out / CERTIFICATES, row)
                 certs[row.key] = row.tightening
                 continue
-            row = {"run": row["run"], "seed": row["seed"], **_flat_values(plans[row["run"]].values),
-                   **{k: row[k] for k in METRIC_COLUMNS}}
+            row = _stored_row(plans[row["run"]], row)
             write_json(_run_file(out, row["run"]), row)
             bar.update(1)
             future.release()
@@ -212,12 +215,13 @@ def run_campaign(spec: CampaignSpec, out: str | Path, *, workers: int = 2, sched
     plans = {k: spec.plan(k) for k in range(spec.runs)}  # every sample is validated before anything is written
     from tubekit.app.certified import input_key
 
-    scenarios = {input_key(p.scenario): p.scenario for p in reversed(plans.values())}  # the first run's scenario
+    keys = {k: input_key(p.scenario) for k, p in plans.items()}
+    scenarios = {keys[k]: p.scenario for k, p in reversed(plans.items())}  # the first run's scenario
     resumed = (out / "campaign.json").exists()
     certs = cached_certificates(out, scenarios) if resumed else {}
     missing = {key: scenario for key, scenario in scenarios.items() if key not in certs}
     done = _finished(out) if resumed else set()
-    todo = [RunTask(k, p.seed, p.scenario, certs.get(input_key(p.scenario)), spec.falsify_sequences)
+    todo = [RunTask(k, p.seed, p.scenario, certs.get(keys[k]), spec.falsify_sequences)
             for k, p in plans.items() if k not in done]
     LOGGER.info("campaign: %d runs (%d already finished), %d distinct certificates (%d stored), %s", spec.runs,
                 spec.runs - len(todo), len(scenarios), len(certs), scheduler or f"LocalCluster of {workers} workers")
@@ -229,7 +233,7 @@ def run_campaign(spec: CampaignSpec, out: str | Path, *, workers: int = 2, sched
         with open_client(workers, scheduler) if todo or missing else contextlib.nullcontext() as client:
             _prepare_dir(out, spec)  # after the scheduler answered: a bad --scheduler writes nothing
             if client is not None:
-                _execute(client, todo, plans, out, spec.fingerprint[:12], progress, missing, certs)
+                _execute(client, todo, plans, keys, out, spec.fingerprint[:12], progress, missing, certs)
                 nworkers = len(client.scheduler_info().get("workers", {}))
             facts = {"workers": nworkers, "scheduler": scheduler or "LocalCluster"}
             finishing = pool.submit(_finish, out, spec, certs, todo, started, facts)  # while the cluster stops
@@ -273,7 +277,7 @@ def replay_run(campaign_dir: str | Path, run: int) -> tuple[dict, dict | None, A
     started = time.perf_counter()
     sims = simulate_all(task)
     row = row_of(task, sims, started)
-    row = {"run": run, "seed": plan.seed, **_flat_values(plan.values), **{k: row[k] for k in METRIC_COLUMNS}}
+    row = _stored_row(plan, row)
     worst = sims[row["worst_sequence"]].run
     path = _run_file(folder, run)
     previous = json.loads(path.read_text(encoding="utf-8")) if path.exists() else None

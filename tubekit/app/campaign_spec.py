@@ -36,7 +36,6 @@ Every error is a :class:`~tubekit.exceptions.ConfigError` naming the spec field.
 from __future__ import annotations
 
 import hashlib
-import importlib.util
 import json
 import math
 from dataclasses import dataclass
@@ -50,7 +49,7 @@ from tubekit.exceptions import ConfigError, TubekitError
 from tubekit.scenario import Scenario, load_scenario, paper_scenario, read_toml, scenario_from_dict
 
 __all__ = ["Distribution", "CampaignSpec", "RunPlan", "load_spec", "spec_from_dict", "run_seed",
-           "certificate_key", "spec_from_stored", "require_dependencies", "NOT_CERTIFICATE_INPUTS", "SPEC_KEYS",
+           "certificate_key", "certificate_inputs", "spec_from_stored", "NOT_CERTIFICATE_INPUTS", "SPEC_KEYS",
            "draw_cluster", "CLUSTER_KEYS"]
 
 #: Top-level keys of a spec.
@@ -200,13 +199,6 @@ def _cluster(field: str, params: Any, base: dict) -> Distribution:
     return Distribution("cluster", options=tuple(sorted(options.items())))
 
 
-def require_dependencies() -> None:
-    """Raise ImportError naming the extra when dask.distributed or pyarrow is missing (cheap: nothing imported)."""
-    for module in ("distributed", "pyarrow"):
-        if importlib.util.find_spec(module) is None:
-            raise ImportError(f"No module named '{module}' (pip install -e '.[campaign]')")
-
-
 def run_seed(seed: int, run: int) -> int:
     """The integer seed of run ``run``: child ``run`` of ``SeedSequence(seed)``, one 63-bit word."""
     child = np.random.SeedSequence(seed, spawn_key=(run,))
@@ -215,14 +207,18 @@ def run_seed(seed: int, run: int) -> int:
 
 def certificate_key(scenario: Scenario) -> str:
     """What ``verify.certify`` reads of ``scenario``, as text: equal keys share one certificate."""
-    data = scenario.to_dict()
+    return json.dumps(certificate_inputs(scenario.to_dict()), sort_keys=True)
+
+
+def certificate_inputs(data: dict) -> dict:
+    """Scenario dict ``data`` without the keys of :data:`NOT_CERTIFICATE_INPUTS` (removed in place; returned)."""
     for dotted in NOT_CERTIFICATE_INPUTS:
         *parents, leaf = dotted.split(".")
         table = data
         for part in parents:
             table = table.get(part, {})
         table.pop(leaf, None)
-    return json.dumps(data, sort_keys=True)
+    return data
 
 
 def _set_dotted(data: dict, key: str, value: Any) -> None:

@@ -98,7 +98,7 @@ def summarise(rows: list[dict], spec: CampaignSpec, certs: dict[str, Tightening]
     """``summary.json``: the largest max_rho_ratio beside the certified radius (1 in the tube's box norm), counts."""
     certified = [r for r in rows if r["certified"]]
     tubes = np.array([t.tube for t in certs.values() if t.certified], dtype=float).reshape(-1, 3)
-    largest = _worst(rows, 1)
+    worst = _worst(rows)
     largest_cert = _worst(certified, 1)
     return {
         "runs": len(rows), "planned_runs": spec.runs, "seed": spec.seed, "duration_s": spec.duration,
@@ -108,7 +108,7 @@ def summarise(rows: list[dict], spec: CampaignSpec, certs: dict[str, Tightening]
         "certificate_radius": 1.0,
         "certificate_tube_box": {"min": tubes.min(axis=0).tolist() if tubes.size else None,
                                  "max": tubes.max(axis=0).tolist() if tubes.size else None},
-        "largest_max_rho_ratio": largest[0] if largest else None,
+        "largest_max_rho_ratio": worst[0] if worst else None,
         "largest_max_rho_ratio_certified": largest_cert[0] if largest_cert else None,
         "violations": sum(bool(r["violated"]) for r in rows),
         "violations_certified": sum(bool(r["violated"]) for r in certified),  # of a given tier, its premises held
@@ -117,7 +117,7 @@ def summarise(rows: list[dict], spec: CampaignSpec, certs: dict[str, Tightening]
         **_tier_summary(rows, spec.duration),
         "metrics": {k: _quantiles(rows, k) for k in ("max_rho_ratio", "min_clearance", "min_e_d", "tracking_rmse",
                                                      "saturated_steps", "replaced_steps", "backup_s", "wall_s")},
-        "worst_runs": _worst(rows),
+        "worst_runs": worst,
         **facts,
         "throughput": throughput(facts["computed_runs"], spec.duration * (1 + spec.falsify_sequences),
                                  facts["campaign_wall_s"], facts.get("computed_runs_wall_s", 0.0)),

@@ -84,16 +84,10 @@ class IssuedCertificate:
 
 def _input_text(data: dict) -> str:
     """Canonical JSON of a scenario dict without the keys certify does not read
-    (:data:`tubekit.app.campaign_spec.NOT_CERTIFICATE_INPUTS`)."""
-    from tubekit.app.campaign_spec import NOT_CERTIFICATE_INPUTS
+    (:func:`tubekit.app.campaign_spec.certificate_inputs`)."""
+    from tubekit.app.campaign_spec import certificate_inputs
 
-    data = json.loads(json.dumps(to_jsonable(data)))
-    for dotted in NOT_CERTIFICATE_INPUTS:
-        *parents, leaf = dotted.split(".")
-        table = data
-        for part in parents:
-            table = table.get(part, {})
-        table.pop(leaf, None)
+    data = certificate_inputs(json.loads(json.dumps(to_jsonable(data))))
     return json.dumps(data, sort_keys=True, separators=(",", ":"))
 
 

@@ -347,12 +347,13 @@ class _ClosedLoop:
         i0, h = k * clock.ticks, clock.plant_step
         vh = tuple(float(c) for c in period.v_hat)
         law_s = 0.0
+        if period.anchor is not None and not (i0 and log.backup_active[i0 - 1]):
+            self.t_h = clock.t[i0]  # the hand-over: the backup starts this period
         for j in range(clock.ticks):
             i = i0 + j
             xs = np.asarray(x)
             log.states[i] = xs
             if period.anchor is not None:
-                self.t_h = clock.t[i0] if j == 0 and not (i0 and log.backup_active[i0 - 1]) else self.t_h  # hand-over
                 v = station_keeping_input(self.tightening.backup.law, x, period.anchor, float(clock.t[i] - self.t_h))
                 log.kappa[i] = 0.0
                 log.v_hat[i] = v

@@ -111,6 +111,8 @@ class DynamicPlant:
         self._mass = self.model.mass_entries
         self._kp, self._ki = self.model.loop_bandwidth, 0.25 * self.model.loop_bandwidth ** 2
         self._tau_inv = 1.0 / self.params.thruster_time_constant
+        # thrusters' limits are constant: read once, not at every integrator stage (fins: per stage)
+        self._limits = self.params.thrust_limits if self.params.actuation == "thrusters" else None
         self.state: tuple[float, ...] | None = None  # (u, v, w, r, X, Z, N, I_u, I_w, I_r)
         self._log: list[tuple[float, ...]] = []
         self._peak = [0.0, 0.0]  # largest ||omega_xy||, |omega_z| over every evaluation (m/s)
@@ -134,7 +136,7 @@ class DynamicPlant:
         e = (command[0] - nu[0], command[1] - nu[2], command[2] - nu[3])
         a = [self._kp * ei + self._ki * ii for ei, ii in zip(e, integral)]
         raw = (n1 + m11 * a[0], n3 + m33 * a[1], n4 - m42 * n2 / m22 + (m44 - m42 * m24 / m22) * a[2])
-        sat = tuple(min(max(c, -lim), lim) for c, lim in zip(raw, self.params.thrust_limits_at(nu[0])))
+        sat = tuple(min(max(c, -lim), lim) for c, lim in zip(raw, self._limits or self.params.thrust_limits_at(nu[0])))
         return sat, tuple(s != c for s, c in zip(sat, raw))
 
     def _rhs(self, t: float, y: Sequence[float], command: Sequence[float]) -> tuple[float, ...]:

@@ -24,10 +24,11 @@ ridge condition of the ridge law disappears.
 
 from __future__ import annotations
 
+import functools
 import math
 
 import numpy as np
-from flint import arb
+from flint import arb, ctx
 
 from tubekit.model.backup import SafeSet, StationKeeping
 from verify.design import Condition
@@ -53,16 +54,24 @@ def unstable_condition(law: StationKeeping, omega_xy: float) -> Condition:
                      omega_xy < closing, f"χ_u {law.unstable:.4g} rad, χ_c {cone_angle(law.surge, omega_xy):.4g} rad")
 
 
+@functools.lru_cache(maxsize=64)
+def _arc_ends(unstable: float, prec: int) -> tuple[tuple[int, int, float, float], ...]:
+    """(shift, arc, lo, hi) of the arcs [0, χ_u] + kπ, [χ_u, π] + kπ, k = −1, 0, 1 (rad, rounded outward):
+    fixed by the law, so computed once per χ_u and working precision, not once per bisection interval."""
+    pi, cut = arb.pi(), arb(unstable)
+    return tuple((shift, arc, lower(start + shift * pi), upper(stop + shift * pi))
+                 for shift in (-1, 0, 1) for arc, start, stop in ((0, arb(0), cut), (1, cut, pi)))
+
+
 def _pieces(lo: float, hi: float, cut: arb) -> list[tuple[arb, int]]:
     """Split [lo, hi] ⊂ [−π, 2π] (rad) into balls on one arc each, shifted by a multiple of π into [0, π]:
-    (ball, arc), arc 0 = [0, χ_u] (ρ >= 0), arc 1 = [χ_u, π] (ρ <= 0)."""
+    (ball, arc), arc 0 = [0, χ_u] (ρ >= 0), arc 1 = [χ_u, π] (ρ <= 0). ``cut`` = arb(χ_u), an exact float."""
     pi = arb.pi()
     out = []
-    for shift in (-1, 0, 1):
-        for arc, start, stop in ((0, arb(0), cut), (1, cut, pi)):
-            a, b = max(lo, lower(start + shift * pi)), min(hi, upper(stop + shift * pi))
-            if a <= b:
-                out.append((enclose(a, b) - shift * pi, arc))
+    for shift, arc, start, stop in _arc_ends(float(cut), ctx.prec):
+        a, b = max(lo, start), min(hi, stop)
+        if a <= b:
+            out.append((enclose(a, b) - shift * pi, arc))
     return out
 
 

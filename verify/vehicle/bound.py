@@ -31,6 +31,7 @@ little after t* (the signals are right-continuous, jumps isolated): a contradict
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass
 from typing import Any, Sequence
@@ -131,6 +132,22 @@ class _Loop:
         """∂n̂_c/∂y_c / m̂_c over the velocity box (1/s): the drag's slope in the channel's own speed."""
         grads = channel_gradient(self.nominal, velocity_box(box[0], gamma, box[1], box[2]))
         return [grads[c][_OWN[c]] / self.m_hat[c] for c in range(3)]
+
+
+@functools.lru_cache(maxsize=8)
+def _cached_loop(params: Any, v_max: tuple, tick: float, ticks: int, prec: int) -> _Loop:
+    """:class:`_Loop` memoised on its inputs and the working precision ``prec`` (bits) it is built at."""
+    return _Loop(params, v_max, tick, ticks)
+
+
+def _loop_of(params: Any, v_max: tuple, tick: float, ticks: int) -> _Loop:
+    """The :class:`_Loop` (its impulse-response sums) of a vehicle, V and h, built once per (hashable) vehicle: it
+    does not depend on the jump bounds, which the fixed point of :mod:`verify.vehicle.compose` changes each round."""
+    try:
+        hash(params)
+    except TypeError:
+        return _Loop(params, v_max, tick, ticks)
+    return _cached_loop(params, v_max, tick, ticks, ctx.prec)
 
 
 def _rates(loop: _Loop, nu: Sequence[arb], accel: Sequence[float]) -> tuple[arb, arb, arb, arb]:
@@ -280,7 +297,7 @@ def velocity_loop_bound(params: Any, *, v_max: Sequence[float], tick: float, per
     """
     v, h, d, ticks, jt, jp, rho = _validate(params, v_max, tick, period, jump_tick, jump_period, rate,
                                             max_iterations)
-    loop = _Loop(params, v, h, ticks)
+    loop = _loop_of(params, v, h, ticks)
     authority = actuator_authority(params, v)
     base = computed_bounds(loop, jt, jp)
     assumed = [[x * (1 + LOOP_INFLATION) + 1e-12 for x in row] for row in base]

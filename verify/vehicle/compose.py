@@ -32,11 +32,11 @@ from flint import arb
 from tubekit.scenario import Scenario
 
 from verify.backup import BackupCertificate, backup_tick_change
-from verify.design import Condition, Design, DisturbanceBounds, choose_design, disturbance_bounds
+from verify.design import Condition, Design, DisturbanceBounds, disturbance_bounds
 from verify.gains import GainBounds
 from verify.intervals import upper
 from verify.region import Region
-from verify.tiers import backup_of, safe_only_design, tracking_design
+from verify.tiers import solve_tiers
 from verify.vehicle.bound import LoopBound, rate_authority_conditions, velocity_loop_bound
 
 __all__ = ["DynamicSolution", "solve_dynamic", "plan_jumps", "FIXED_POINT_ROUNDS", "PLAN_CHECK_TOLERANCE"]
@@ -109,11 +109,7 @@ def _kappa_condition(sigma: float) -> Condition:
 def _tiers_at(scenario: Scenario, region: Region, gains: GainBounds, sigmas: tuple[float, ...],
               assumed: tuple[float, float, float]):
     dist = disturbance_bounds(scenario, loop_error=assumed)
-    designs = tuple(tracking_design(scenario, region, gains, s, dist) for s in sigmas)
-    best = choose_design(list(designs))
-    safe = None if best.certified else safe_only_design(scenario, region, gains, dist)
-    backup = backup_of(scenario, dist, (safe or best).margins)
-    return dist, designs, best, safe, backup
+    return (dist, *solve_tiers(scenario, region, gains, sigmas, dist))
 
 
 def _loop_at(scenario: Scenario, backup: BackupCertificate, dist: DisturbanceBounds,

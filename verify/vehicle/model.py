@@ -19,7 +19,7 @@ from typing import Any, Mapping, Sequence
 from flint import arb
 
 from tubekit.exceptions import ConfigError
-from verify.intervals import enclose, point, upper
+from verify.intervals import _abs, enclose, point, upper
 
 __all__ = ["COEFFICIENTS", "MASS_FIELDS", "field_ball", "nominal_params", "hull_balls", "nominal_balls",
            "arb_body_forces", "body_force_gradient", "channel_forces", "channel_gradient", "channel_masses",
@@ -63,11 +63,6 @@ def nominal_balls(params: Any) -> dict[str, arb]:
     out = {k: point(getattr(nom, k)) for k in COEFFICIENTS}
     out.update(zip(("m11", "m22", "m33", "m44", "m24", "m42"), (point(x) for x in nom.mass_entries)))
     return out
-
-
-def _abs(x: arb) -> arb:
-    """|x| as the ball [min |x|, max |x|] (Arb's ``abs`` keeps the radius, so |[−a, a]| would reach below 0)."""
-    return arb(x.abs_lower()).union(arb(x.abs_upper()))
 
 
 def arb_body_forces(c: Mapping[str, arb], nu: Sequence[arb]) -> tuple[arb, arb, arb, arb]:

@@ -117,7 +117,7 @@ def first_round(sc) -> None:
     region = Region.from_scenario(sc)
     gains = gain_bounds(sc.controller.law, region)
     dist, _, _, _, backup = compose._tiers_at(sc, region, gains, (0.0,), assumed)
-    loop = compose._loop_at(sc, backup, dist, assumed)
+    loop = compose._loop_at(sc, backup.law, backup.safe_set, dist, assumed)
     ratio = max(e / a for e, a in zip(loop.error, assumed))
     law = backup.law
     print(f"{sc.name}: round 1 assumes E = {[round(a, 4) for a in assumed]} -> omega_xy {dist.omega_xy:.4f} "

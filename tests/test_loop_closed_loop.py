@@ -419,3 +419,20 @@ def test_with_a_rate_limit_no_command_jumps_more_than_j_between_periods():
     assert np.all(steps <= jump + 1e-9), steps.max(axis=0)
     first = np.flatnonzero(backup[:-1] & ~backup[1:])[0]          # the resume: from the backup's last command
     assert np.all(np.abs(v[first + 1] - v[first]) <= jump + 1e-9)
+
+
+def test_with_a_rate_limit_the_run_starts_at_rest_and_a_ramped_backup_starts_from_the_last_command():
+    """The first plan starts within J of 0 (the vehicle starts at rest); at the hand-over the ramped backup's first
+    command is the last applied one (the blend), and every tick's command stays in V."""
+    sc = _scenario(duration=4.0).with_changes(**{"limits.rate": [0.5, 0.5, 1.0]})
+    ramped = dataclasses.replace(BACKUP, law=dataclasses.replace(BACKUP.law, surge_fade=0.2, yaw_fade=0.2, ramp=1.0))
+    res = run_closed_loop(sc, tightening=_safe_only(sc, backup=ramped), solver_factory=_FailingFhocp, progress=False)
+    jump = np.array([0.5, 0.5, 1.0]) * sc.controller.dt
+    assert np.all(np.abs(res.v_hat[0]) <= jump + 1e-9)
+    backup = res.backup_active[:-1]
+    start = np.flatnonzero(backup)[0]
+    np.testing.assert_array_equal(res.inputs[start], res.inputs[start - 1])
+    want = station_keeping_input(ramped.law, tuple(res.states[start + 3]), tuple(res.backup_anchor[start + 3]),
+                                 3 * sc.controller.dt / res.ticks_per_step, tuple(res.inputs[start - 1]))
+    np.testing.assert_allclose(res.inputs[start + 3], want, atol=1e-15)
+    assert not np.any(res.saturated)

@@ -233,3 +233,14 @@ def test_rate_rows_pass_within_the_tolerance_and_only_the_rows_that_apply(statio
     assert check_rates(stationary, _tight(backup=BACKUP), _with_u([0.0, 0.4] * 4)).where == "no rate limit"
     assert check_plan(sc, _tight(backup=BACKUP), 0.0, X0, RAMP, [], sign=-1, v_last=[0.0, 0.0, 0.0]).ok
     assert 0.0 < RATE_TOLERANCE <= 1e-9
+
+
+def test_a_ramped_backup_blends_so_plans_need_not_end_at_rest(stationary):
+    """A backup with a ramp starts from the last applied command: the terminal-rest row is dropped."""
+    import dataclasses
+    ramped = dataclasses.replace(BACKUP, law=dataclasses.replace(BACKUP.law, surge_fade=0.1, yaw_fade=0.1, ramp=1.0))
+    ends_moving = _with_u([0.05, 0.1, 0.15, 0.2, 0.25, 0.25, 0.2, 0.15])
+    sc = _rated(stationary)
+    assert _tight(backup=BACKUP).terminal_rest and not _tight(backup=ramped).terminal_rest
+    assert check_rates(sc, _tight(backup=BACKUP), ends_moving).where == "rate: terminal rest"
+    assert check_rates(sc, _tight(backup=ramped), ends_moving).ok

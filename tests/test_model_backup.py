@@ -152,6 +152,33 @@ def test_after_the_ramp_and_beyond_the_fades_the_law_is_the_unfaded_one():
             station_keeping_input(unfaded, state, (0.0, 0.0, 0.0)))
 
 
+def test_with_a_ramp_the_command_starts_at_the_hand_over_command_and_fades_it_out():
+    start = (0.15, -0.1, 0.3)
+    state = (3.0, 0.0, 1.0, math.pi / 2)  # unramped: u = 0 (abeam), w = -0.3, r = -0.5
+    assert station_keeping_input(SMOOTH, state, (0.0, 0.0, 0.0), 0.0, start) == start
+    u, w, r = station_keeping_input(SMOOTH, state, (0.0, 0.0, 0.0), 0.5, start)  # s / t_r = 0.25
+    assert u == pytest.approx(0.75 * 0.15) and w == pytest.approx(-0.3 * 0.25 - 0.75 * 0.1)
+    assert r == pytest.approx(-0.5 * 0.25 + 0.75 * 0.3)
+    assert station_keeping_input(SMOOTH, state, (0.0, 0.0, 0.0), 2.0, start) == \
+        station_keeping_input(SMOOTH, state, (0.0, 0.0, 0.0), 2.0)
+    assert SMOOTH.blends and not LAW.blends
+
+
+def test_without_a_ramp_the_hand_over_command_is_ignored():
+    state = (1.0, 0.5, 0.05, 0.3)
+    assert station_keeping_input(LAW, state, (0.0, 0.0, 0.0), 0.0, (0.2, 0.3, 0.5)) == \
+        station_keeping_input(LAW, state, (0.0, 0.0, 0.0), 0.0)
+
+
+@given(x=st.floats(-3, 3), y=st.floats(-3, 3), z=st.floats(-1, 1), psi=st.floats(-7, 7), s=st.floats(0, 5),
+       a=st.floats(-1, 1), b=st.floats(-1, 1), c=st.floats(-1, 1))
+def test_the_blended_command_never_leaves_the_box(x, y, z, psi, s, a, b, c):
+    """Property: a hand-over command in V blended into the law stays in V (u_b, w_b, k inside V)."""
+    start = (0.2 * a, 0.3 * b, 0.5 * c)
+    u, w, r = station_keeping_input(SMOOTH, (x, y, z, psi), (0.0, 0.0, 0.0), s, start)
+    assert abs(u) <= 0.2 + 1e-12 and abs(w) <= 0.3 + 1e-12 and abs(r) <= 0.5 + 1e-12
+
+
 def test_the_law_is_continuous_at_the_anchor_with_a_fade():
     # approaching the anchor from any heading the faded surge and yaw go to zero
     for psi in np.linspace(-3, 3, 7):

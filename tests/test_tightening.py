@@ -97,3 +97,7 @@ def test_only_a_certified_backup_imposes_the_terminal_condition():
     assert replace(base, backup=plan, tiers={"safe": True, "tracking": False}).terminal_backup is plan
     assert replace(base, backup=plan, tiers={"safe": False, "tracking": False}).terminal_backup is None
     assert base.terminal_backup is None
+    assert replace(base, backup=plan).terminal_rest and not base.terminal_rest
+    ramped = BackupPlan(replace(plan.law, surge_fade=0.1, yaw_fade=0.1, ramp=1.0), plan.safe_set, plan.handover)
+    assert not replace(base, backup=ramped).terminal_rest  # it blends from the last command instead
+    assert not replace(base, backup=plan, tiers={"safe": False, "tracking": False}).terminal_rest

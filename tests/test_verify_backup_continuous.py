@@ -6,7 +6,7 @@ import math
 
 import numpy as np
 import pytest
-from hypothesis import given, strategies as st
+from hypothesis import given, settings, strategies as st
 
 from tubekit.exceptions import ConfigError
 from tubekit.model.backup import SafeSet, StationKeeping
@@ -131,3 +131,16 @@ def test_the_level_set_bound_exceeds_the_plant_s_rate(x, held, bearing, err, cur
     rate = (level(h) - level(-h)) / (2 * h)
     lo, hi = max(0.0, x - 1e-3), min(math.pi, x + 1e-3)
     assert rate <= _rate_upper(LAW, SAFE, wxy, delta, lo, hi, 0.05) + 1e-5
+
+
+@settings(max_examples=25, deadline=None)
+@given(level=st.floats(1.0, 12.0), omega=st.floats(0.0, 0.15), yaw_err=st.floats(0.0, 0.1))
+def test_the_shapes_at_once_are_the_shapes_one_by_one(level, omega, yaw_err):
+    """Property: continuous_rate_sampled_shapes gives, for each β, the sampled rate of that β alone (the design's
+    filter evaluated at once; the same sum in another order, so up to rounding)."""
+    from verify.backup.continuous import continuous_rate_sampled, continuous_rate_sampled_shapes
+    law = StationKeeping(0.2, 0.2, 0.3, 0.15, 0.1, 2.0, 2.0, 5.0, "continuous", 0.6)
+    shapes = np.round(np.arange(0.05, level - 0.1, 0.35), 6)
+    at_once = continuous_rate_sampled_shapes(law, level, shapes, omega, yaw_err=yaw_err)
+    one_by_one = [continuous_rate_sampled(law, SafeSet(level, float(b), 1.0), omega, yaw_err=yaw_err) for b in shapes]
+    np.testing.assert_allclose(at_once, one_by_one, rtol=0, atol=1e-12)

@@ -19,19 +19,20 @@ ARGS = dict(omega_xy=0.12, omega_z=0.1, limits=LIMITS, loop_error=(0.0, 0.0, 0.0
 
 
 def test_the_bound_by_hand():
-    # S = 0.2 + 0.12 = 0.32, S_z = 0.3 + 0.1 = 0.4, Y = 0.5 + 0.05 = 0.55 (module doc):
-    # surge 0.2 (max(0.32/0.4, 1/2) + 0.55 + 0.32/0.4) = 0.2 * 2.15
-    # heave 0.3 (0.4/0.1 + 1/2) = 0.3 * 4.5
-    # yaw   0.5 (max(0.32/0.2, 1/2) + (0.55 + 0.32/0.2)/0.5) = 0.5 * (1.6 + 4.3)
+    # the ramp blends the hand-over's command (anywhere in V): S = max(0.2, 0.4) + 0.12 = 0.52,
+    # S_z = 0.3 + 0.1 = 0.4, Y = 0.5 + 0.05 = 0.55, and the blend adds V / t_r = (0.2, 0.15, 0.25) (module doc):
+    # surge 0.2 (max(0.52/0.4, 1/2) + 0.55 + 0.52/0.4) + 0.2 = 0.2 * 3.15 + 0.2
+    # heave 0.3 (0.4/0.1 + 1/2) + 0.15 = 0.3 * 4.5 + 0.15
+    # yaw   0.5 (max(0.52/0.2, 1/2) + (0.55 + 0.52/0.2)/0.5) + 0.25 = 0.5 * (2.6 + 6.3) + 0.25
     surge, heave, yaw = backup_command_rate(SMOOTH, SAFE, **ARGS)
-    assert surge == pytest.approx(0.43, rel=1e-12) and surge >= 0.43
-    assert heave == pytest.approx(1.35, rel=1e-12) and heave >= 1.35
-    assert yaw == pytest.approx(2.95, rel=1e-12) and yaw >= 2.95
+    assert surge == pytest.approx(0.83, rel=1e-12) and surge >= 0.83
+    assert heave == pytest.approx(1.5, rel=1e-12) and heave >= 1.5
+    assert yaw == pytest.approx(4.7, rel=1e-12) and yaw >= 4.7
 
 
 @pytest.mark.parametrize("changes, finite", [
     ({"surge_fade": 0.0, "yaw_fade": 0.0, "ramp": 0.0}, (False, False, False)),  # the unfaded law
-    ({"ramp": 0.0}, (False, False, False)),          # no ramp: the command does not start at 0
+    ({"ramp": 0.0}, (False, False, False)),          # no ramp: the command jumps at the hand-over
     ({"surge_fade": 0.0}, (False, True, True)),      # the line of sight's 1/d is not cancelled in surge
     ({"yaw_fade": 0.0}, (True, True, False)),
 ])
@@ -42,17 +43,19 @@ def test_without_fade_or_ramp_the_rate_is_infinite(changes, finite):
 
 
 def _run(rng: np.random.Generator, seconds: float = 3.0, dt: float = 1e-3, tick: float = 0.01, law=SMOOTH):
-    """A random trajectory of the plant inside the speed bounds: the law held per tick, body velocities off by
-    up to E, random piecewise-constant currents at up to ω̄; returns the law's command at every step, the
-    held commands at every tick and whether the axis angle wrapped in each step."""
+    """A random trajectory of the plant inside the speed bounds: the law held per tick (blending a random
+    hand-over command in V), body velocities off by up to E, random piecewise-constant currents at up to ω̄;
+    returns the law's command at every step, the held commands at every tick and whether the axis angle
+    wrapped in each step."""
     d, bearing = rng.uniform(0.0, 0.7), rng.uniform(-math.pi, math.pi)
+    start = tuple(float(v) for v in rng.uniform(-1.0, 1.0, 3) * np.array(LIMITS))
     x = np.array([d * math.cos(bearing), d * math.sin(bearing), rng.uniform(-0.3, 0.3), rng.uniform(-4, 4)])
     per_tick = int(round(tick / dt))
     cmds, held, wraps = [], [], []
     chi_prev = None
     for i in range(int(round(seconds / dt))):
         s = i * dt
-        cmd = station_keeping_input(law, tuple(x), (0.0, 0.0, 0.0), s)
+        cmd = station_keeping_input(law, tuple(x), (0.0, 0.0, 0.0), s, start)
         if i % per_tick == 0:
             v = cmd
             held.append(cmd)
@@ -125,12 +128,12 @@ CONTINUOUS = StationKeeping(**{**SMOOTH.__dict__, "yaw_law": "continuous", "unst
 
 
 def test_the_continuous_law_has_the_same_rate_and_a_tick_change_of_rate_times_h():
-    # ρ is Lipschitz 1/χ_0 like sat(χ/χ_0), so the yaw rate is 2.95 rad/s² as by hand above, and it now
-    # holds across the ridge: the tick change is 2.95 × 0.01 = 0.0295 rad/s instead of 2 k = 1 rad/s
+    # ρ is Lipschitz 1/χ_0 like sat(χ/χ_0), so the yaw rate is 4.7 rad/s² as by hand above, and it now
+    # holds across the ridge: the tick change is 4.7 × 0.01 = 0.047 rad/s instead of 2 r_max = 1 rad/s
     rates = backup_command_rate(CONTINUOUS, SAFE, **ARGS)
-    assert rates[2] == pytest.approx(2.95, rel=1e-12)
+    assert rates[2] == pytest.approx(4.7, rel=1e-12)
     jump = backup_tick_change(CONTINUOUS, SAFE, tick=0.01, **ARGS)
-    assert jump[2] == pytest.approx(0.0295, rel=1e-12) and jump[2] >= 0.0295
+    assert jump[2] == pytest.approx(0.047, rel=1e-12) and jump[2] >= 0.047
     assert backup_tick_change(SMOOTH, SAFE, tick=0.01, **ARGS)[2] == 1.0
 
 

@@ -80,13 +80,15 @@ def _smooth_plan(omega_xy: float, yaw_rate_error: float) -> BackupPlan:
     return BackupPlan(cert.law, cert.safe_set, handover=(0.125, 0.08))
 
 
-@pytest.mark.parametrize("omega_xy, yaw_rate_error", [(0.12, 0.0), (0.2, 0.05)])
-def test_the_certified_smooth_set_survives_the_search(omega_xy, yaw_rate_error):
-    """Greedy and evolution from hand-over starts, the ramp running from s = 0, the adversary choosing the yaw
-    error."""
+@pytest.mark.parametrize("omega_xy, yaw_rate_error, command", [(0.12, 0.0, (0.0, 0.0, 0.0)),
+                                                                 (0.2, 0.05, (0.0, 0.0, 0.0)),
+                                                                 (0.12, 0.0, (0.4, 0.3, 0.5))])
+def test_the_certified_smooth_set_survives_the_search(omega_xy, yaw_rate_error, command):
+    """Greedy and evolution from hand-over starts, the ramp running from s = 0 (blending the hand-over's command, a
+    corner of V in the last case), the adversary choosing the yaw error."""
     plan = _smooth_plan(omega_xy, yaw_rate_error)
     result = falsify_backup(plan, omega_xy=omega_xy, omega_z=0.1, tick=0.01, budget=5, seconds=4.0, seed=2,
-                            yaw_rate_error=yaw_rate_error)
+                            yaw_rate_error=yaw_rate_error, command=command)
     assert plan.law.yaw_law == "continuous"  # the smooth design's yaw law has no jump abeam
     assert result.check(), result.summary()
     assert result.worst.level_ratio > 0.3  # the attack is not idle: V is pushed from <= 0.125 + β towards c

@@ -94,3 +94,39 @@ def test_an_edited_loop_bound_is_caught_by_recheck():
     result = recheck(data)
     assert not result.ok
     assert any(c["name"].startswith("velocity_loop") and not c["ok"] for c in result.checks)
+
+
+# ---- the shipped dynamic scenario that certifies (issue 22 item 5) ------------------------------------------
+
+SLOW = "examples/bluerov2_slow.toml"
+
+
+@pytest.fixture(scope="module")
+def slow_cert():
+    return certify(load_scenario(SLOW))
+
+
+def test_the_slow_bluerov2_scenario_certifies_both_tiers_with_a_closed_fixed_point(slow_cert):
+    """The fixed point closes: the derived E is below the assumed E_a in every channel, the backup that the gentle
+    search chose is certified and its per-tick jumps are what the loop bound used."""
+    assert slow_cert.certified and slow_cert.tiers == {"safe": True, "tracking": True}
+    consistent = next(c for c in slow_cert.plant_conditions if c.condition == "loop_consistent")
+    assert consistent.ok and consistent.lhs < 1.0
+    loop, law = slow_cert.velocity_loop, slow_cert.backup.law
+    assert all(0.0 < e < 0.07 for e in loop.error)
+    assert law.yaw_law == "continuous" and law.blends and law.yaw_band == pytest.approx(law.unstable / 2)
+    assert slow_cert.backup.certified and slow_cert.backup.safe_set.level > 5.0  # the gentle set, not the smallest
+
+
+def test_a_run_of_the_slow_scenario_keeps_every_promise(slow_cert):
+    """20 s of the certified design on the dynamic plant at a corner of the coefficient box: every promise kept."""
+    import tubekit
+    sc = load_scenario(SLOW)
+    corner = {k: v[0] for k, v in vars(sc.plant.params).items() if not k.startswith("_") and isinstance(v, tuple)}
+    sc = sc.with_changes(plant=sc.plant.__class__(kind="dynamic", vehicle="bluerov2_heavy",
+                                                  overrides=sc.plant.overrides, truth=tuple(corner.items())))
+    run = tubekit.simulate(sc, slow_cert, duration=20.0, progress=False)
+    promises = tubekit.check_promises(run)
+    assert len(corner) >= 10
+    assert promises and all(p.ok for p in promises), [p for p in promises if not p.ok]
+    assert run.metrics["replaced_steps"] == 0

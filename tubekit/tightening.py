@@ -185,6 +185,13 @@ class Tightening:
         return self.backup
 
     @property
+    def terminal_rest(self) -> bool:
+        """True when a plan must end at rest, |v̂_{N−1}| <= J: a terminal backup that starts from 0 instead of
+        blending from the last applied command (:attr:`tubekit.model.backup.BackupPlan.terminal_rest`)."""
+        backup = self.terminal_backup
+        return backup is not None and backup.terminal_rest
+
+    @property
     def horizon_arcs(self) -> int:
         """Number of arcs with certified margins (0: no arc check)."""
         return int(np.asarray(self.margins).shape[0])

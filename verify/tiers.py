@@ -28,6 +28,7 @@ from tubekit.model.backup import SafeSet, StationKeeping
 from tubekit.scenario import Scenario
 
 from verify.backup import BackupCertificate, certify_backup, design_backup
+from verify.backup.search import Fits
 from verify.design import Condition, Design, DisturbanceBounds, arc_rates, choose_design, evaluate_design, \
     input_tightening, state_conditions, sway_condition, tube_problem
 from verify.gains import GainBounds
@@ -128,15 +129,16 @@ def initial_backup(scenario: Scenario, law: StationKeeping, safe: SafeSet) -> Co
                      "the backup anchored at the start is safe: no plan is needed at t = 0")
 
 
-def backup_of(scenario: Scenario, dist: DisturbanceBounds, margins: HorizonMargins | None) -> BackupCertificate:
+def backup_of(scenario: Scenario, dist: DisturbanceBounds, margins: HorizonMargins | None,
+              fits: Fits | None = None) -> BackupCertificate:
     """:func:`verify.backup.design_backup` for ``scenario`` (ω̄ of ``dist``, V, tick 1/f, hand-over from
-    ``margins``), with ``backup_initial`` appended to its conditions."""
+    ``margins``; ``fits``: the dynamic plant's gentle design), with ``backup_initial`` appended to its conditions."""
     limits = tuple(float(x) for x in scenario.limits.vector)
     tick = 1.0 / float(scenario.controller.ancillary_rate_hz)
     hand = _handover(margins)
     bc = design_backup(omega_xy=dist.omega_xy, omega_z=dist.omega_z, limits=limits, tick=tick,
                        handover=hand if math.isfinite(hand[0]) else (0.0, 0.0),
-                       yaw_rate_error=dist.yaw_rate_error, smooth=scenario.plant.kind == "dynamic")
+                       yaw_rate_error=dist.yaw_rate_error, smooth=scenario.plant.kind == "dynamic", fits=fits)
     if not math.isfinite(hand[0]):
         bc = certify_backup(bc.law, bc.safe_set, omega_xy=dist.omega_xy, omega_z=dist.omega_z, limits=limits,
                             tick=tick, handover=(np.finfo(float).max, np.finfo(float).max),
@@ -145,13 +147,15 @@ def backup_of(scenario: Scenario, dist: DisturbanceBounds, margins: HorizonMargi
 
 
 def solve_tiers(scenario: Scenario, region: Region, gains: GainBounds, sigmas: tuple[float, ...],
-                dist: DisturbanceBounds) -> tuple[tuple[Design, ...], Design, Design | None, BackupCertificate]:
+                dist: DisturbanceBounds, fits: Fits | None = None,
+                ) -> tuple[tuple[Design, ...], Design, Design | None, BackupCertificate]:
     """(designs, best, safe, backup) at ``dist``: the tracking design per σ (1/s) of ``sigmas``, the chosen one
-    (:func:`verify.design.choose_design`), the safe-only design when it does not certify, and the backup."""
+    (:func:`verify.design.choose_design`), the safe-only design when it does not certify, and the backup
+    (:func:`backup_of`, ``fits`` passed on)."""
     designs = tuple(tracking_design(scenario, region, gains, s, dist) for s in sigmas)
     best = choose_design(list(designs))
     safe = None if best.certified else safe_only_design(scenario, region, gains, dist)
-    return designs, best, safe, backup_of(scenario, dist, (safe or best).margins)
+    return designs, best, safe, backup_of(scenario, dist, (safe or best).margins, fits)
 
 
 def recertify_backup(scenario: Scenario, law: StationKeeping, safe: SafeSet, dist: DisturbanceBounds,

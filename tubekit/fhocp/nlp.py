@@ -296,7 +296,8 @@ class FhocpNlp:
     rate_jump : array (3,) or None
         The imposed J (1 - RATE_MARGIN) of the rate rows (None: no rate limit).
     terminal_rest : bool
-        Impose |v_{N-1}| <= J (with a rate limit and a certified backup).
+        Impose |v_{N-1}| <= J (with a rate limit and a certified backup that starts from rest,
+        ``Tightening.terminal_rest``; a ramped backup blends from the last command instead).
     rate_penalty : float
         lambda (s, >= 0) of the rate penalty.
     """
@@ -383,7 +384,7 @@ class FhocpNlp:
                    penalty=penalty,
                    terminal_penalty=penalty / 20.0 if terminal_penalty is None else terminal_penalty,
                    backup_terminal=backup, rate_jump=None if jump is None else jump * (1.0 - RATE_MARGIN),
-                   terminal_rest=jump is not None and backup is not None, rate_penalty=rate_penalty)
+                   terminal_rest=jump is not None and tightening.terminal_rest, rate_penalty=rate_penalty)
 
     @property
     def n(self) -> int:

@@ -5,7 +5,8 @@ With J = ``scenario.limits.rate`` * dt (per component, m/s, m/s, rad/s) every pl
 
 * (a) |v_{k+1} - v_k| <= J between consecutive nodes;
 * (b) |v_0 - v_last| <= J, v_last the command applied in the last tick before the plan starts;
-* (c) |v_{N-1}| <= J (terminal rest) when the tightening gates plans by a certified backup.
+* (c) |v_{N-1}| <= J (terminal rest) when the tightening gates plans by a certified backup that starts from
+  rest (``Tightening.terminal_rest``; a ramped backup blends from the last applied command instead).
 
 The FHOCP imposes them with J (1 - :data:`RATE_MARGIN`) (room for the solver's tolerance);
 :func:`rate_project` removes what the solver's tolerance leaves over; the exact plan check

@@ -22,29 +22,26 @@ sense → solve (:meth:`_ClosedLoop.solve`, :class:`PlanMemory`) → nominal arc
 ticks (:meth:`_ClosedLoop.run_ticks`: ancillary law, :func:`saturate`, plant) →
 log (:class:`_Log`).
 
-What runs is the scenario's: the ancillary law ``controller.law`` (a registered name), the
-FHOCP backend ``controller.fhocp_backend`` in mode ``controller.fhocp_mode``
-(:func:`tubekit.fhocp.registry.make_solver`), the plant ``plant.kind``; σ is the
-tightening's. A variant is a changed scenario (``scenario.with_changes(...)``) or tightening
-(``dataclasses.replace(tightening, sigma=...)``).
+What runs is the scenario's: the ancillary law ``controller.law`` (a registered name), the FHOCP backend
+``controller.fhocp_backend`` in mode ``controller.fhocp_mode`` (:func:`tubekit.fhocp.registry.make_solver`),
+the plant ``plant.kind``; σ is the tightening's. A variant is a changed scenario
+(``scenario.with_changes(...)``) or tightening (``dataclasses.replace(tightening, sigma=...)``).
 
 Fallbacks: a FHOCP result flagged ``fallback`` is used (its first input) and
 counted; a result whose first input is not finite, a :class:`SolverError` or a plan
 the arc check (with the terminal condition) rejects is replaced by the last accepted
-plan shifted by the steps elapsed and counted as ``replaced``. Once that plan is
-exhausted the backup law (:func:`tubekit.model.backup.station_keeping_input`, held
-over each tick, no κ) runs about the anchor p* = the nominal end of the last accepted
-plan (:class:`tubekit.loop.memory.PlanMemory`), logged as ``backup_active``, until a
-plan is accepted again; only a tightening without a backup keeps the zero input
-(logged as a warning). A non-finite κ
-(J singular) is replaced by zero and counted. Nothing non-finite reaches the
-plant.
+plan shifted by the steps elapsed and counted as ``replaced``. Once that plan is exhausted the backup
+law (:func:`tubekit.model.backup.station_keeping_input`, held over each tick, no κ) runs about the anchor
+p* = the nominal end of the last accepted plan (:class:`tubekit.loop.memory.PlanMemory`), logged as
+``backup_active``, until a plan is accepted again; only a tightening without a backup keeps the zero
+input (logged as a warning). A non-finite κ (J singular) is replaced by zero and counted. Nothing
+non-finite reaches the plant.
 
 Rate limit (``scenario.limits.rate``): every solve gets ``v_last``, the command of the last tick
-before the plan starts (the previous plan's node, the replayed node, or the backup's last command; none
-at t = 0), when the solver's ``solve`` takes that keyword; the exact check then verifies the plan's
-rate rows against it (:func:`tubekit.loop.plan_check.check_rates`, also without margins), so every
-command jump between periods is at most J = rate · dt.
+before the plan starts (the previous plan's node, the replayed node, the backup's last command; 0 at t = 0:
+the run starts at rest), when the solver's ``solve`` takes that keyword; the exact check verifies the rate
+rows against it (:func:`tubekit.loop.plan_check.check_rates`), so no command jumps by more than J = rate · dt
+between periods. A ramped backup blends the last applied command into its law: the hand-over does not jump.
 
 Logging: one row per tick plus a final row at t = duration (inputs NaN there).
 The nominal x̂ logged at a sampling instant is the left limit x̂(t_k⁻), before the
@@ -261,8 +258,9 @@ class _ClosedLoop:
         self.memory = PlanMemory()
         self.log = _Log.allocate(clock)
         self.sign = HEMISPHERE_SIGN[scenario.region.heading]
-        self.v_last: np.ndarray | None = None  # the command of the last tick before the next plan
+        self.v_last = None if scenario.limits.rate is None else np.zeros(3)  # the last tick's command (at rest)
         self.passes_v_last = _takes_v_last(solver)
+        self.t_h, self.v_h = 0.0, (0.0, 0.0, 0.0)  # the last hand-over to the backup: time (s), applied command
 
     def sense(self, xk: np.ndarray) -> tuple[Obstacle, ...]:
         """Obstacles known after sensing at the position of ``xk``."""
@@ -348,13 +346,15 @@ class _ClosedLoop:
         vh = tuple(float(c) for c in period.v_hat)
         law_s = 0.0
         if period.anchor is not None and not (i0 and log.backup_active[i0 - 1]):
-            self.t_h = clock.t[i0]  # the hand-over: the backup starts this period
+            self.t_h = clock.t[i0]  # the hand-over: the backup starts this period, from the last applied command
+            self.v_h = tuple(float(c) for c in log.inputs[i0 - 1]) if i0 else (0.0, 0.0, 0.0)
         for j in range(clock.ticks):
             i = i0 + j
             xs = np.asarray(x)
             log.states[i] = xs
             if period.anchor is not None:
-                v = station_keeping_input(self.tightening.backup.law, x, period.anchor, float(clock.t[i] - self.t_h))
+                v = station_keeping_input(self.tightening.backup.law, x, period.anchor, float(clock.t[i] - self.t_h),
+                                          self.v_h)
                 log.kappa[i] = 0.0
                 log.v_hat[i] = v
             elif self.sigma > 0.0:

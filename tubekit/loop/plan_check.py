@@ -9,8 +9,9 @@ follows), that
 * v̂_j is in V̄;
 * with a rate limit (``scenario.limits.rate``, J = rate · dt per component), the rate rows
   (:func:`check_rates`): |v̂_{j+1} − v̂_j| <= J, |v̂_0 − v_last| <= J (v_last the command applied in the
-  last tick before the plan, when given) and, when the tightening gates plans by a certified backup,
-  the terminal rest |v̂_{n−1}| <= J, each up to the absolute tolerance :data:`RATE_TOLERANCE`;
+  last tick before the plan, when given) and, when the tightening gates plans by a certified backup that
+  starts from rest (``tightening.terminal_rest``: no ramp to blend from the last command), the terminal
+  rest |v̂_{n−1}| <= J, each up to the absolute tolerance :data:`RATE_TOLERANCE`;
 * ε + M_d[j] <= e_d <= e_d_max - M_d[j], |e_z| <= e_z_max - M_z[j],
   |e_o| <= e_o_max - M_o[j], and the heading stays in the certified hemisphere;
 * the vehicle ball inflated by M_pos[j] is clear of every known obstacle and
@@ -132,7 +133,7 @@ def check_rates(scenario: Scenario, tight: Tightening, inputs: np.ndarray,
         return PlanCheck(False, -math.inf, "plan shape or values")
     if tight.horizon_arcs:
         v = v[:tight.horizon_arcs]
-    slacks = rate_slacks(v, jump, v_last, tight.terminal_backup is not None)
+    slacks = rate_slacks(v, jump, v_last, tight.terminal_rest)
     where, worst = min(slacks.items(), key=lambda kv: kv[1])
     return PlanCheck(worst >= -RATE_TOLERANCE, worst, where)
 

@@ -17,8 +17,11 @@ hand-over: with s the time since the hand-over (s),
 * w = −w_b sat((z − z*)/z_0) min(1, s/t_r),
 
 d_0 = ``surge_fade``, d_1 = ``yaw_fade`` (m), t_r = ``ramp`` (s); a zero fade or ramp drops its term.
-The command then starts at 0 at the hand-over and, away from the ridge χ = ±π/2 (everywhere with the
-continuous yaw law below), is Lipschitz along every trajectory (:func:`verify.backup.backup_command_rate`).
+With a ramp the command applied at the hand-over, v_h, fades out over the same t_r: the law returns
+the above plus (1 − min(1, s/t_r)) v_h. The command is then continuous at the hand-over (no plan has
+to end at rest), stays in V (a convex combination of v_h ∈ V and the law) and, away from the ridge
+χ = ±π/2 (everywhere with the continuous yaw law below), is Lipschitz along every trajectory
+(:func:`verify.backup.backup_command_rate`).
 
 **Continuous yaw** (``yaw_law="continuous"``, issue 22). The yaw law above jumps from −k to +k where the
 hull crosses abeam (the ridge χ = ±π/2). The continuous law replaces sat(χ/χ_0) by ρ(φ), π-periodic
@@ -150,10 +153,17 @@ class StationKeeping:
         """True when every input of the law lies in V = {|u| <= u_max, |w| <= w_max, |r| <= r_max}."""
         return self.surge <= u_max and self.heave <= w_max and self.yaw_rate <= r_max
 
-    def __call__(self, state: np.ndarray, anchor: np.ndarray, elapsed: float = math.inf) -> np.ndarray:
+    @property
+    def blends(self) -> bool:
+        """True when the ramp is on: the command applied at the hand-over fades out over t_r (module doc)."""
+        return self.ramp > 0.0
+
+    def __call__(self, state: np.ndarray, anchor: np.ndarray, elapsed: float = math.inf,
+                 start: tuple[float, float, float] = (0.0, 0.0, 0.0)) -> np.ndarray:
         """v = (u, w, r) (m/s, m/s, rad/s) at ``state`` [x, y, z, ψ] about ``anchor`` [x*, y*, z*] (m),
-        ``elapsed`` seconds after the hand-over."""
-        return np.array(station_keeping_input(self, tuple(map(float, state)), tuple(map(float, anchor)), elapsed))
+        ``elapsed`` seconds after the hand-over, ``start`` the command applied at the hand-over."""
+        return np.array(station_keeping_input(self, tuple(map(float, state)), tuple(map(float, anchor)), elapsed,
+                                              tuple(map(float, start))))
 
 
 def _fade(value: float, scale: float) -> float:
@@ -162,11 +172,12 @@ def _fade(value: float, scale: float) -> float:
 
 
 def station_keeping_input(law: StationKeeping, state: tuple[float, float, float, float],
-                          anchor: tuple[float, float, float],
-                          elapsed: float = math.inf) -> tuple[float, float, float]:
+                          anchor: tuple[float, float, float], elapsed: float = math.inf,
+                          start: tuple[float, float, float] = (0.0, 0.0, 0.0)) -> tuple[float, float, float]:
     """The law on float tuples (the closed loop's inner loop): (u, w, r) in m/s, m/s, rad/s.
 
     ``elapsed`` is the time s (s) since the backup took over; the default (∞) is the law after its ramp.
+    ``start`` is the command (m/s, m/s, rad/s) applied at the hand-over; with a ramp it fades out over t_r.
     """
     x, y, z, psi = state
     phi = line_of_sight_angle(x, y, psi, anchor[0], anchor[1])
@@ -177,6 +188,9 @@ def station_keeping_input(law: StationKeeping, state: tuple[float, float, float,
     turn = yaw_shape(law, phi) if law.yaw_law == "continuous" else _sat(chi / law.yaw_band)
     r = -law.yaw_rate * turn * min(_fade(d, law.yaw_fade), ramp)
     w = -law.heave * _sat((z - anchor[2]) / law.heave_band) * ramp
+    if law.ramp > 0.0 and ramp < 1.0:
+        rest = 1.0 - ramp
+        return u + rest * start[0], w + rest * start[1], r + rest * start[2]
     return u, w, r
 
 
@@ -249,6 +263,12 @@ class BackupPlan:
     law: StationKeeping
     safe_set: SafeSet
     handover: tuple[float, float] = (0.0, 0.0)
+
+    @property
+    def terminal_rest(self) -> bool:
+        """True when plans must end at rest (|v̂_{N−1}| <= J): the law starts from 0 instead of blending from the
+        command applied at the hand-over (:attr:`StationKeeping.blends`)."""
+        return not self.law.blends
 
     def footprint(self, vehicle_radius: float) -> tuple[float, float]:
         """(horizontal radius, half height) (m) of the safe set inflated by the vehicle ball."""

@@ -27,10 +27,12 @@ error is at most Z lies in S: that is the hand-over condition.
 
 **Fades and ramp** (``StationKeeping.surge_fade`` d_0, ``yaw_fade`` d_1, ``ramp`` t_r). The argument above
 only uses the law at tick starts with d >= d_tick (``backup_fade``: d_0, d_1 <= d_tick, so the fades are
-1 there) and after the ramp: from the hand-over (d <= h_xy, |z − z*| <= h_z) V = c needs d >= c − β, at
-least (c − β − h_xy)/(u_b + ω̄_xy) seconds later, and |z − z*| = Z at least (Z − h_z)/(w_b + ω̄_z)
-seconds later; ``backup_ramp`` asks t_r + h below both, so every tick start that matters has s >= t_r.
-The command's rate is bounded in :mod:`verify.backup.rate`.
+1 there) and after the ramp. During the ramp the command blends the one applied at the hand-over (in V)
+into the law, so the vehicle's speed is at most U + ω̄_xy horizontally and W + ω̄_z in depth,
+(U, W) = (max(u_b, ū), max(w_b, w̄)): from the hand-over (d <= h_xy, |z − z*| <= h_z) V = c needs
+d >= c − β, at least (c − β − h_xy)/(U + ω̄_xy) seconds later, and |z − z*| = Z at least
+(Z − h_z)/(W + ω̄_z) seconds later; ``backup_ramp`` asks t_r + h below both, so every tick start that
+matters has s >= t_r, where the blend is over. The command's rate is bounded in :mod:`verify.backup.rate`.
 
 **Continuous yaw law** (``StationKeeping.yaw_law == "continuous"``): the level set is V = d + β a(χ)
 (:func:`tubekit.model.backup.axis_shape`), the rate bound is :func:`verify.backup.continuous.continuous_rate_bound`
@@ -40,7 +42,6 @@ over the whole axis circle, and the condition ``backup_ridge`` is replaced by ``
 
 from __future__ import annotations
 
-import dataclasses
 import math
 from dataclasses import asdict, dataclass
 
@@ -53,11 +54,11 @@ from tubekit.validation import nonnegative, positive
 from verify.design import Condition
 from verify.intervals import bisect_sup, enclose, lower, upper
 from verify.parts import block, bound, integer, item, number, numbers
-from verify.backup.continuous import continuous_rate_bound, continuous_rate_sampled, cone_angle, unstable_condition
+from verify.backup.continuous import continuous_rate_bound, continuous_rate_sampled, unstable_condition
 from verify.backup.rate import backup_command_rate, backup_tick_change
 
-__all__ = ["BackupCertificate", "planar_rate_bound", "certify_backup", "design_backup", "ramp_window",
-           "backup_command_rate", "backup_tick_change", "BACKUP_MAX_BOXES", "UNSTABLE_FRACTION"]
+__all__ = ["BackupCertificate", "planar_rate_bound", "certify_backup", "ramp_window", "tick_distance", "rate_sampled",
+           "backup_command_rate", "backup_tick_change", "BACKUP_MAX_BOXES"]
 
 #: Bisection budget of :func:`planar_rate_bound` (intervals of χ examined): a work unit, not seconds.
 BACKUP_MAX_BOXES = 4096
@@ -158,7 +159,7 @@ def _typed(cls: type, d: dict, where: str, keys: tuple[str, ...], optional: tupl
         raise ConfigError(f"{where}.{exc.field.split('.')[-1]}", exc.expected, exc.received) from None
 
 
-def _tick_distance(law: StationKeeping, safe: SafeSet, omega_xy: float, tick: float) -> float:
+def tick_distance(law: StationKeeping, safe: SafeSet, omega_xy: float, tick: float) -> float:
     """A float <= c − β − h (u_b + ω̄_xy) (m): the least distance to the anchor during a tick that ends on V = c."""
     return lower(arb(safe.level) - arb(safe.shape) - arb(tick) * (arb(law.surge) + arb(omega_xy)))
 
@@ -184,7 +185,7 @@ def _rate_upper(law: StationKeeping, safe: SafeSet, omega_xy: float, delta: floa
     return upper(rate)
 
 
-def _rate_sampled(law: StationKeeping, safe: SafeSet, omega_xy: float, n: int = 721, yaw_err: float = 0.0) -> float:
+def rate_sampled(law: StationKeeping, safe: SafeSet, omega_xy: float, n: int = 721, yaw_err: float = 0.0) -> float:
     """The largest V̇ (m/s) at sampled χ with the input of the same instant (no hold) and the worst ω."""
     if law.yaw_law == "continuous":
         return continuous_rate_sampled(law, safe, omega_xy, 2 * n - 1, yaw_err)
@@ -205,7 +206,7 @@ def planar_rate_bound(law: StationKeeping, safe: SafeSet, omega_xy: float, tick:
     over the final cover of [0, π/2] (``inf`` when c − β cannot absorb a tick's motion). The yaw
     rate error E_r (rad/s) widens χ̇ (the law's fades and ramp are 1 on the level set: ``backup_fade``).
     """
-    d_tick = _tick_distance(law, safe, omega_xy, tick)
+    d_tick = tick_distance(law, safe, omega_xy, tick)
     if not d_tick > 0.0:
         return math.inf, 0
     delta = _angle_step(law, omega_xy, tick, d_tick, yaw_rate_error)
@@ -215,24 +216,34 @@ def planar_rate_bound(law: StationKeeping, safe: SafeSet, omega_xy: float, tick:
                       0.0, _HALF_PI_UP, max_boxes)
 
 
+def _ramp_speeds(law: StationKeeping, limits: tuple[float, float, float]) -> tuple[float, float]:
+    """(U, W) (m/s): the largest surge and heave commands during the ramp, max(u_b, ū) and max(w_b, w̄): the ramp
+    blends the command applied at the hand-over (in V) into the law (module doc)."""
+    return max(law.surge, float(limits[0])), max(law.heave, float(limits[1]))
+
+
 def _reach_time(law: StationKeeping, safe: SafeSet, omega_xy: float, omega_z: float,
-                handover: tuple[float, float]) -> float:
-    """A float <= min((c − β − h_xy)/(u_b + ω̄_xy), (Z − h_z)/(w_b + ω̄_z)) (s): no exit of S before it."""
-    planar = (arb(safe.level) - arb(safe.shape) - arb(handover[0])) / (arb(law.surge) + arb(omega_xy))
-    depth = (arb(safe.depth) - arb(handover[1])) / (arb(law.heave) + arb(omega_z))
+                handover: tuple[float, float], limits: tuple[float, float, float]) -> float:
+    """A float <= min((c − β − h_xy)/(U + ω̄_xy), (Z − h_z)/(W + ω̄_z)) (s), (U, W) of :func:`_ramp_speeds`: no
+    exit of S before it."""
+    surge, heave = _ramp_speeds(law, limits)
+    planar = (arb(safe.level) - arb(safe.shape) - arb(handover[0])) / (arb(surge) + arb(omega_xy))
+    depth = (arb(safe.depth) - arb(handover[1])) / (arb(heave) + arb(omega_z))
     return min(lower(planar), lower(depth))
 
 
 def ramp_window(law: StationKeeping, safe: SafeSet, *, omega_xy: float, omega_z: float, tick: float,
-                handover: tuple[float, float]) -> float:
-    """A float t (s) with t + h <= min((c − β − h_xy)/(u_b + ω̄_xy), (Z − h_z)/(w_b + ω̄_z)), within a
-    relative 1e-9 of the largest: the longest ramp t_r that ``backup_ramp`` admits (negative when none does)."""
-    t = lower(arb(_reach_time(law, safe, omega_xy, omega_z, handover)) - arb(tick))
+                handover: tuple[float, float], limits: tuple[float, float, float]) -> float:
+    """A float t (s) with t + h <= min((c − β − h_xy)/(U + ω̄_xy), (Z − h_z)/(W + ω̄_z)), (U, W) = (max(u_b, ū),
+    max(w_b, w̄)), within a relative 1e-9 of the largest: the longest ramp t_r that ``backup_ramp`` admits (negative
+    when none does)."""
+    t = lower(arb(_reach_time(law, safe, omega_xy, omega_z, handover, limits)) - arb(tick))
     return t * (1 - 1e-9) if t > 0 else t
 
 
 def _smooth_conditions(law: StationKeeping, safe: SafeSet, dist: tuple[float, float], tick: float,
-                       handover: tuple[float, float], d_tick: float) -> tuple[Condition, ...]:
+                       handover: tuple[float, float], d_tick: float,
+                       limits: tuple[float, float, float]) -> tuple[Condition, ...]:
     """``backup_fade`` (when a fade is on) and ``backup_ramp`` (when the ramp is on), with both numbers."""
     out = []
     if law.surge_fade > 0.0 or law.yaw_fade > 0.0:
@@ -241,10 +252,11 @@ def _smooth_conditions(law: StationKeeping, safe: SafeSet, dist: tuple[float, fl
                              fade <= d_tick, "the law is unfaded at every tick start near V = c"))
     if law.ramp > 0.0:
         need = upper(arb(law.ramp) + arb(tick))
-        window = _reach_time(law, safe, dist[0], dist[1], handover)
-        out.append(Condition("backup_ramp", "t_r + h <= (c − β − h_xy)/(u_b + ω̄_xy) and t_r + h <= "
-                             "(Z − h_z)/(w_b + ω̄_z)", need, window, need <= window,
-                             "the ramp ends before V = c or |z − z*| = Z can be reached"))
+        window = _reach_time(law, safe, dist[0], dist[1], handover, limits)
+        out.append(Condition("backup_ramp", "t_r + h <= (c − β − h_xy)/(max(u_b, u_max) + ω̄_xy) and t_r + h <= "
+                             "(Z − h_z)/(max(w_b, w_max) + ω̄_z)", need, window, need <= window,
+                             "the ramp (which blends the hand-over's command into the law) ends before V = c or "
+                             "|z − z*| = Z can be reached"))
     return tuple(out)
 
 
@@ -252,7 +264,7 @@ def _conditions(law: StationKeeping, safe: SafeSet, dist: tuple[float, float], l
                 tick: float, handover: tuple[float, float], rate: float, yaw_err: float) -> tuple[Condition, ...]:
     """Every inequality of the theorem, with both numbers."""
     wxy, wz = dist
-    d_tick = _tick_distance(law, safe, wxy, tick)
+    d_tick = tick_distance(law, safe, wxy, tick)
     delta = _angle_step(law, wxy, tick, d_tick, yaw_err) if d_tick > 0 else math.inf
     ridge = (upper((arb(law.surge) * arb(min(1.0, 2 * delta)) + arb(wxy)) / arb(d_tick) + arb(yaw_err))
              if d_tick > 0 else math.inf)
@@ -273,7 +285,7 @@ def _conditions(law: StationKeeping, safe: SafeSet, dist: tuple[float, float], l
              handover[0] <= safe.handover_radius),
         cond("backup_handover_depth", "hand-over depth error <= Z", handover[1], safe.depth,
              handover[1] <= safe.depth),
-    ) + _smooth_conditions(law, safe, dist, tick, handover, d_tick)
+    ) + _smooth_conditions(law, safe, dist, tick, handover, d_tick, limits)
 
 
 def certify_backup(law: StationKeeping, safe: SafeSet, *, omega_xy: float, omega_z: float,
@@ -304,121 +316,5 @@ def certify_backup(law: StationKeeping, safe: SafeSet, *, omega_xy: float, omega
     rate, boxes = planar_rate_bound(law, safe, wxy, h, max_boxes, e_r)
     conditions = _conditions(law, safe, (wxy, wz), tuple(float(x) for x in limits), h, handover, rate, e_r)
     return BackupCertificate(law=law, safe_set=safe, omega_xy=wxy, omega_z=wz, tick=h, rate_bound=rate,
-                             rate_sampled=_rate_sampled(law, safe, wxy, yaw_err=e_r), boxes=boxes,
+                             rate_sampled=rate_sampled(law, safe, wxy, yaw_err=e_r), boxes=boxes,
                              conditions=conditions, handover=handover, yaw_rate_error=e_r)
-
-
-def _candidates(limits: tuple[float, float, float], omega_xy: float) -> list[tuple[float, float]]:
-    """(u_b, k) pairs to try: surge fractions of u_max above ω̄_xy, the full yaw rate."""
-    return [(f * limits[0], limits[2]) for f in (0.5, 0.625, 0.75, 0.875, 1.0) if f * limits[0] > omega_xy]
-
-
-#: Yaw bands χ_0 (rad) the smooth design tries, widest first (a wide band keeps the yaw command's rate low).
-SMOOTH_YAW_BANDS = (math.pi / 4, math.pi / 8, 0.05)
-#: Bisection budget of each candidate of the smooth design (a refuted candidate costs its whole budget).
-SMOOTH_SEARCH_BOXES = 1024
-#: The smooth design's unstable axis angle χ_u as a fraction of the cone angle χ_c = acos √(ω̄_xy/u_b).
-UNSTABLE_FRACTION = 0.8
-
-
-def design_backup(*, omega_xy: float, omega_z: float, limits: tuple[float, float, float], tick: float,
-                  handover: tuple[float, float] = (0.0, 0.0), max_boxes: int = BACKUP_MAX_BOXES,
-                  yaw_rate_error: float = 0.0, smooth: bool = False, min_level: float = 0.2) -> BackupCertificate:
-    """The certified station-keeping design with the smallest safe radius >= ``min_level`` (m) on a fixed grid
-    (deterministic; a larger ``min_level`` gives wider fades and a longer ramp: a gentler command).
-
-    The grid (surge fractions, shapes β, levels c) is searched with the float rate of
-    :func:`_rate_sampled` as a filter; each candidate that passes is then proved by
-    :func:`certify_backup`. Returns the last refuted candidate when none is certified.
-
-    ``smooth=True`` (issue 22) designs the rate-bounded law: for each candidate (c, β) the fades are
-    d_0 = d_1 = d_tick (the largest ``backup_fade`` admits: the gentlest fade), the depth band is
-    Z = max(Z_0, h_z + T_xy (w_b + ω̄_z)) with T_xy = (c − β − h_xy)/(u_b + ω̄_xy) (so the heave
-    channel never shortens the ramp), the heave band z_0 = Z − h (w_b + ω̄_z) (the widest
-    ``backup_depth_hold`` admits), the ramp t_r = :func:`ramp_window` (the longest ``backup_ramp``
-    admits); yaw bands χ_0 are tried widest first (:data:`SMOOTH_YAW_BANDS`), the first that certifies
-    is returned. Wider fades, bands and ramps all lower :func:`backup_command_rate`. The smooth design's
-    yaw law is the continuous one (no jump abeam) with χ_u = :data:`UNSTABLE_FRACTION` · χ_c for each u_b;
-    each candidate gets at most :data:`SMOOTH_SEARCH_BOXES` intervals.
-    """
-    wxy, wz, h = nonnegative("omega_xy", omega_xy), nonnegative("omega_z", omega_z), positive("tick", tick)
-    e_r = nonnegative("yaw_rate_error", yaw_rate_error)
-    last: BackupCertificate | None = None
-    for band in (SMOOTH_YAW_BANDS if smooth else (0.05,)):
-        found, last = _search(wxy, wz, tuple(float(x) for x in limits), h, handover, max_boxes, e_r, band, smooth,
-                              positive("min_level", min_level))
-        if found:
-            return last
-    return last
-
-
-def _search(wxy: float, wz: float, limits: tuple[float, float, float], h: float, handover: tuple[float, float],
-            max_boxes: int, e_r: float, yaw_band: float, smooth: bool,
-            min_level: float = 0.2) -> tuple[bool, BackupCertificate]:
-    """(certified?, the smallest certified design at ``yaw_band``, else the last refuted one)."""
-    heave = limits[1]
-    band = max(1e-3, 0.5 * handover[1])
-    depth = max(handover[1], band + h * (heave + wz)) * (1 + 1e-9)
-    best: BackupCertificate | None = None
-    last: BackupCertificate | None = None
-    for surge, yaw in _candidates(limits, wxy):
-        law = StationKeeping(surge=surge, yaw_rate=yaw, yaw_band=yaw_band, heave=heave, heave_band=band,
-                             **_yaw_law(surge, wxy, smooth))
-        for level in np.round(np.arange(max(0.2, min_level), max(6.0, min_level) + 1e-4, 0.05), 6):
-            if best is not None and level >= best.safe_set.level:
-                break
-            shape = _best_shape(law, float(level), wxy, handover[0], e_r)
-            if shape is None:
-                continue
-            safe = SafeSet(level=float(level), shape=shape, depth=depth)
-            trial, safe = _smoothed(law, safe, wxy, wz, h, handover) if smooth else (law, safe)
-            last = certify_backup(trial, safe, omega_xy=wxy, omega_z=wz, limits=limits, tick=h, handover=handover,
-                                  max_boxes=min(max_boxes, SMOOTH_SEARCH_BOXES) if smooth else max_boxes,
-                                  yaw_rate_error=e_r)
-            if last.certified:
-                best = last
-                break
-    if best is not None:
-        return True, best
-    if last is None:
-        law = StationKeeping(surge=limits[0], yaw_rate=limits[2], yaw_band=yaw_band, heave=heave, heave_band=band,
-                             **_yaw_law(limits[0], wxy, smooth))
-        last = certify_backup(law, SafeSet(level=6.0, shape=1.0, depth=depth), omega_xy=wxy, omega_z=wz,
-                              limits=limits, tick=h, handover=handover, yaw_rate_error=e_r,
-                              max_boxes=min(max_boxes, SMOOTH_SEARCH_BOXES) if smooth else max_boxes)
-    return False, last
-
-
-def _yaw_law(surge: float, wxy: float, smooth: bool) -> dict:
-    """The yaw law's keywords: the continuous law with χ_u = UNSTABLE_FRACTION · χ_c when ``smooth`` (without a
-    cone, ω̄_xy >= u_b, χ_u = UNSTABLE_FRACTION · π/2: the refuted fallback then names ``backup_unstable``)."""
-    if not smooth:
-        return {}
-    cone = cone_angle(surge, wxy)
-    return {"yaw_law": "continuous", "unstable": UNSTABLE_FRACTION * (cone if cone > 0.0 else math.pi / 2)}
-
-
-def _smoothed(law: StationKeeping, safe: SafeSet, wxy: float, wz: float, h: float,
-              handover: tuple[float, float]) -> tuple[StationKeeping, SafeSet]:
-    """The smooth design's fades, depth band, heave band and ramp for (c, β) (see :func:`design_backup`)."""
-    d_tick = _tick_distance(law, safe, wxy, h)
-    if not d_tick > 0.0:
-        return law, safe
-    t_xy = (arb(safe.level) - arb(safe.shape) - arb(handover[0])) / (arb(law.surge) + arb(wxy))
-    depth = max(safe.depth, upper(arb(handover[1]) + t_xy * (arb(law.heave) + arb(wz))))
-    safe = SafeSet(level=safe.level, shape=safe.shape, depth=depth)
-    band = max(law.heave_band, lower(arb(depth) - arb(h) * (arb(law.heave) + arb(wz))) * (1 - 1e-9))
-    ramp = ramp_window(law, safe, omega_xy=wxy, omega_z=wz, tick=h, handover=handover)
-    law = dataclasses.replace(law, surge_fade=d_tick, yaw_fade=d_tick, heave_band=band, ramp=max(0.0, ramp))
-    return law, safe
-
-
-def _best_shape(law: StationKeeping, level: float, omega_xy: float, handover: float,
-                yaw_err: float = 0.0) -> float | None:
-    """The shape β on a grid with the most negative sampled level-set rate at ``level``, or None."""
-    best, value = None, 0.0
-    for shape in np.round(np.arange(0.05, level - handover, 0.05), 6):
-        rate = _rate_sampled(law, SafeSet(level=level, shape=float(shape), depth=1.0), omega_xy, yaw_err=yaw_err)
-        if rate < value:
-            best, value = float(shape), rate
-    return best

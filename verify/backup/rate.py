@@ -4,13 +4,17 @@ The faded, ramped law (:class:`tubekit.model.backup.StationKeeping`, issue 22) w
 the hand-over, d the distance to the anchor, φ the line-of-sight angle and χ the axis angle:
 
     u = u_b F cos φ,   F = min(1, d/d_0, s/t_r);    r = −k sat(χ/χ_0) G,   G = min(1, d/d_1, s/t_r);
-    w = −w_b sat((z − z*)/z_0) R,   R = min(1, s/t_r).
+    w = −w_b sat((z − z*)/z_0) R,   R = min(1, s/t_r),
+
+plus the blend (1 − R) v_h of the command v_h ∈ V applied at the hand-over, whose rate is at most
+|v_h| |Ṙ| <= V_c / t_r per channel: every bound below has V_c / t_r added (the blend term).
 
 Along the plant during the backup (every quantity below is a bound that holds for almost every t):
 
 * horizontal speed |ṗ_xy| <= S = min(u_b, ū) + ω̄_xy (ω̄_xy already holds the loop's E_u and the sway γ̄),
   so |ḋ| <= S and the bearing θ of the vehicle from the anchor turns at |θ̇| <= S/d;
 * vertical speed |ż| <= S_z = min(w_b, w̄) + ω̄_z (ω̄_z holds E_w); yaw rate |ψ̇| <= Y = min(k, r̄) + E_r;
+  with a ramp the blended command is anywhere in V, so S, S_z and Y use max(u_b, ū), max(w_b, w̄), max(k, r̄);
 * φ = ψ − θ − π, so |φ̇| <= Y + S/d, and χ̇ = φ̇ away from the ridge χ = ±π/2;
 * a minimum of Lipschitz functions is differentiable almost everywhere with the derivative of an
   active term: |Ḟ| <= max(S/d_0, 1/t_r), |Ġ| <= max(S/d_1, 1/t_r), |Ṙ| <= 1/t_r.
@@ -41,8 +45,8 @@ the whole circle (:func:`tubekit.model.backup.yaw_shape`), |ρ| <= 1: there is n
 the yaw bound above holds for all time, d/dt (ρ G) = ρ' φ̇ G + ρ Ġ. :func:`backup_tick_change` is then
 rate × h for all three channels.
 
-Without a ramp the command does not start at 0 at the hand-over, and without a fade the line of
-sight's 1/d is not cancelled: the corresponding rate is ``inf``.
+Without a ramp the command jumps at the hand-over, and without a fade the line of sight's 1/d is not
+cancelled: the corresponding rate is ``inf``.
 """
 
 from __future__ import annotations
@@ -68,9 +72,11 @@ def _inputs(law: StationKeeping, safe: SafeSet, omega_xy: float, omega_z: float,
         raise ConfigError("limits/loop_error", "three numbers each", (limits, loop_error))
     lim = [positive(f"limits[{i}]", x) for i, x in enumerate(limits)]
     err = [nonnegative(f"loop_error[{i}]", x) for i, x in enumerate(loop_error)]
-    speed = arb(min(law.surge, lim[0])) + arb(wxy)
-    speed_z = arb(min(law.heave, lim[1])) + arb(wz)
-    yaw = arb(min(law.yaw_rate, lim[2])) + arb(err[2])
+    # with a ramp the command blends the hand-over's (anywhere in V) into the law: the limits bound it
+    pick = max if law.ramp > 0.0 else min
+    speed = arb(pick(law.surge, lim[0])) + arb(wxy)
+    speed_z = arb(pick(law.heave, lim[1])) + arb(wz)
+    yaw = arb(pick(law.yaw_rate, lim[2])) + arb(err[2])
     return speed, speed_z, yaw
 
 
@@ -103,13 +109,14 @@ def backup_command_rate(law: StationKeeping, safe: SafeSet, *, omega_xy: float, 
     ramp = arb(law.ramp)
     surge = heave = yaw_rate = math.inf
     if law.ramp > 0.0:
-        heave = upper(arb(law.heave) * (speed_z / arb(law.heave_band) + 1 / ramp))
+        blend = [arb(float(v)) / ramp for v in limits]  # the hand-over's command fading out: |v_h| / t_r
+        heave = upper(arb(law.heave) * (speed_z / arb(law.heave_band) + 1 / ramp) + blend[1])
     if law.ramp > 0.0 and law.surge_fade > 0.0:
         line = speed / arb(law.surge_fade)
-        surge = upper(arb(law.surge) * (_max(line, 1 / ramp) + yaw + line))
+        surge = upper(arb(law.surge) * (_max(line, 1 / ramp) + yaw + line) + blend[0])
     if law.ramp > 0.0 and law.yaw_fade > 0.0:
         line = speed / arb(law.yaw_fade)
-        yaw_rate = upper(arb(law.yaw_rate) * (_max(line, 1 / ramp) + (yaw + line) / arb(law.yaw_band)))
+        yaw_rate = upper(arb(law.yaw_rate) * (_max(line, 1 / ramp) + (yaw + line) / arb(law.yaw_band)) + blend[2])
     return surge, heave, yaw_rate
 
 
@@ -123,16 +130,16 @@ def backup_tick_change(law: StationKeeping, safe: SafeSet, *, omega_xy: float, o
                        tick: float) -> tuple[float, float, float]:
     """Bounds (m/s, m/s, rad/s) on the change of the held command from one tick to the next during the backup.
 
-    Surge and heave: rate × h (:func:`backup_command_rate`); the first tick's command is 0 (the ramp),
-    so the hand-over itself is the plan's last command against 0. Yaw: with the continuous law also
-    rate × h; with the ridge law 2 min(k, r̄), because the ridge can be crossed inside S and the command
-    then flips sign (module doc). Every channel is capped by twice its largest command.
+    Surge and heave: rate × h (:func:`backup_command_rate`); with a ramp the first tick's command is the one
+    applied at the hand-over (the blend), so the hand-over itself does not jump. Yaw: with the continuous law
+    also rate × h; with the ridge law 2 min(k, r̄), because the ridge can be crossed inside S and the command
+    then flips sign (module doc). Every channel is capped by 2 V_c (the command stays in V).
     """
     h = positive("tick", tick)
     rates = backup_command_rate(law, safe, omega_xy=omega_xy, omega_z=omega_z, limits=limits,
                                 loop_error=loop_error)
     surge, heave, yaw = (upper(arb(r) * arb(h)) if math.isfinite(r) else math.inf for r in rates)
-    cap = (2 * min(law.surge, limits[0]), 2 * min(law.heave, limits[1]), 2 * min(law.yaw_rate, float(limits[2])))
+    cap = tuple(2.0 * float(v) for v in limits)
     if law.yaw_law != "continuous":
         yaw = cap[2]
     return min(surge, cap[0]), min(heave, cap[1]), min(yaw, cap[2])

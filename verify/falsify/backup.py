@@ -86,15 +86,16 @@ def _rk4_tick(state: np.ndarray, v: tuple[float, float, float], omega: np.ndarra
 
 
 def simulate_backup(plan: BackupPlan, start: np.ndarray, adversary: Adversary, *, tick: float,
-                    seconds: float) -> tuple[float, float]:
-    """Run the law about the origin under ``adversary`` for ``seconds``; (max V / c, max |z| / Z) over the ticks."""
+                    seconds: float, command: tuple[float, float, float] = (0.0, 0.0, 0.0)) -> tuple[float, float]:
+    """Run the law about the origin under ``adversary`` for ``seconds``, blending ``command`` (the command applied
+    at the hand-over, m/s, m/s, rad/s) when the law has a ramp; (max V / c, max |z| / Z) over the ticks."""
     law, safe = plan.law, plan.safe_set
     state = np.asarray(start, dtype=float)
     anchor = np.zeros(3)
     level = backup_lyapunov(state, anchor, safe.shape, law)
     depth = abs(state[2])
     for k in range(int(round(seconds / tick))):
-        v = station_keeping_input(law, tuple(map(float, state)), (0.0, 0.0, 0.0), k * tick)
+        v = station_keeping_input(law, tuple(map(float, state)), (0.0, 0.0, 0.0), k * tick, command)
         state = _rk4_tick(state, v, adversary(k * tick, state, v), tick)
         level = max(level, backup_lyapunov(state, anchor, safe.shape, law))
         depth = max(depth, abs(state[2]))
@@ -192,7 +193,7 @@ def _validate(budget: int, seconds: float, piece: float, tick: float) -> None:
 
 def falsify_backup(plan: BackupPlan, *, omega_xy: float, omega_z: float, tick: float, budget: int = 12,
                    seconds: float = 20.0, piece: float = 1.0, seed: int = 0, directions: int = 8,
-                   yaw_rate_error: float = 0.0) -> BackupAttack:
+                   yaw_rate_error: float = 0.0, command: tuple[float, float, float] = (0.0, 0.0, 0.0)) -> BackupAttack:
     """Search hand-over starts and currents within (ω̄_xy, ω̄_z) for a run that leaves the safe set.
 
     Parameters
@@ -214,6 +215,9 @@ def falsify_backup(plan: BackupPlan, *, omega_xy: float, omega_z: float, tick: f
         Current directions the greedy adversary compares each tick.
     yaw_rate_error : float
         E_r (rad/s): the adversary also chooses ψ̇ − r in [−E_r, E_r] (0: the kinematic plant's exact yaw).
+    command : (float, float, float)
+        The command applied at the hand-over (m/s, m/s, rad/s; a ramped law blends it out over its ramp): a corner
+        of V is the hardest start; the greedy runs alternate its surge and yaw signs.
     """
     _validate(budget, seconds, piece, tick)
     if not isinstance(yaw_rate_error, (int, float)) or not math.isfinite(yaw_rate_error) or yaw_rate_error < 0:
@@ -224,8 +228,10 @@ def falsify_backup(plan: BackupPlan, *, omega_xy: float, omega_z: float, tick: f
     greedy = _greedy(plan, omega_xy, omega_z, tick, directions, yaw_rate_error)
     for _ in range(max(1, budget // 4)):
         start = handover_start(plan, rng.uniform(0, 1, BACKUP_START_DIM))
+        sign = 1.0 if len(runs) % 2 == 0 else -1.0
+        cmd = (sign * command[0], command[1], sign * command[2])
         runs.append(BackupRun("greedy", tuple(map(float, start)),
-                              *simulate_backup(plan, start, greedy, tick=tick, seconds=seconds)))
+                              *simulate_backup(plan, start, greedy, tick=tick, seconds=seconds, command=cmd)))
     pieces = max(1, int(math.ceil(seconds / piece)))
 
     def evaluate(genome: np.ndarray) -> BackupRun:
@@ -233,7 +239,7 @@ def falsify_backup(plan: BackupPlan, *, omega_xy: float, omega_z: float, tick: f
         adversary = _piecewise(omega_xy, omega_z, piece, genome[BACKUP_START_DIM:].reshape(pieces, cols),
                                yaw_rate_error)
         return BackupRun("evolution", tuple(map(float, start)),
-                         *simulate_backup(plan, start, adversary, tick=tick, seconds=seconds))
+                         *simulate_backup(plan, start, adversary, tick=tick, seconds=seconds, command=command))
 
     if len(runs) < budget:
         parent = rng.uniform(0, 1, BACKUP_START_DIM + cols * pieces)

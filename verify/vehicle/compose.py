@@ -5,16 +5,19 @@ E = (E_u, E_w, E_r) (:func:`verify.vehicle.bound.velocity_loop_bound`) depends o
 jumps; the command jumps
 
 * at period boundaries by at most J = ρ δ (the plans' rate limit ``limits.rate``, imposed by the FHOCP and
-  checked by the plan check: between nodes, against the last applied command, and the terminal rest that
-  makes the hand-over to the backup continuous up to J), and
+  checked by the plan check: between nodes and against the last applied command, 0 at t = 0); not at the
+  hand-over, where the ramped backup starts from the last applied command (a backup without a ramp makes
+  plans end at rest instead, ``Tightening.terminal_rest``), and
 * at every tick during the backup by at most :func:`verify.backup.backup_tick_change` (the backup law's
   command rate × h, :func:`verify.backup.backup_command_rate`, finite because the law is faded near its
   anchor, ramped after the hand-over and, with the continuous yaw law, free of the ridge's jump).
 
 E in turn enters ω̄ (:func:`verify.design.disturbance_bounds`), the tube, the hand-over margins and the
 backup's proof, which fix the backup's command rate. :func:`solve_dynamic` closes this loop as a checked
-fixed point: it *assumes* a bound E_a, derives everything from it, computes E from the resulting jump
-bounds, and certifies only when E <= E_a component-wise (condition ``loop_consistent``). Every step is
+fixed point: it *assumes* a bound E_a, derives everything from it (the backup designed so that its command
+rate keeps E below E_a when it can: ``fits``, the gentle search of :mod:`verify.backup.search`), computes E
+from the resulting jump bounds, and certifies only when E < E_a component-wise (condition
+``loop_consistent``). Every step is
 monotone in E_a, so the derived statements hold with E_a in place of E (first exit: the loop error is
 continuous between jumps and the L1 bound covers the jumps).
 
@@ -29,6 +32,7 @@ from dataclasses import dataclass
 
 from flint import arb
 
+from tubekit.model.backup import SafeSet, StationKeeping
 from tubekit.scenario import Scenario
 
 from verify.backup import BackupCertificate, backup_tick_change
@@ -45,9 +49,12 @@ __all__ = ["DynamicSolution", "solve_dynamic", "plan_jumps", "FIXED_POINT_ROUNDS
 #: import the loop, a test keeps the two equal): an accepted plan jumps by at most ρ δ + this.
 PLAN_CHECK_TOLERANCE = 1e-9
 #: Rounds of the fixed point E_a -> E (a work unit: the verdict is the same on any machine).
-FIXED_POINT_ROUNDS = 6
-#: Growth of the assumed bound over the derived one between rounds.
+FIXED_POINT_ROUNDS = 10
+#: The first round's assumed bound over the plans-only one.
 _INFLATE = 1.25
+#: Growth of the assumed bound over the derived one between rounds (small: a larger E_a widens ω̄ and the yaw
+#: error, and the gentle backups that fit at E_a may no longer certify at a much larger one).
+_STEP = 1.05
 
 
 @dataclass(frozen=True)
@@ -80,8 +87,8 @@ class DynamicSolution:
 
 def plan_jumps(scenario: Scenario) -> tuple[float, float, float]:
     """J = ρ δ + the plan check's tolerance per channel (m/s, m/s, rad/s): the largest command change an accepted
-    plan makes per period (between nodes, against the last command, into the terminal rest); 2V without a rate
-    limit (any two commands in V)."""
+    plan makes per period (between nodes, against the last command; into the terminal rest where one is
+    imposed); 2V without a rate limit (any two commands in V)."""
     lim, dt = scenario.limits, float(scenario.controller.dt)
     rate = getattr(lim, "rate", None)
     if rate is None:
@@ -109,15 +116,29 @@ def _kappa_condition(sigma: float) -> Condition:
 def _tiers_at(scenario: Scenario, region: Region, gains: GainBounds, sigmas: tuple[float, ...],
               assumed: tuple[float, float, float]):
     dist = disturbance_bounds(scenario, loop_error=assumed)
-    return (dist, *solve_tiers(scenario, region, gains, sigmas, dist))
+    return (dist, *solve_tiers(scenario, region, gains, sigmas, dist, fits=_fits(scenario, dist, assumed)))
 
 
-def _loop_at(scenario: Scenario, backup: BackupCertificate, dist: DisturbanceBounds,
+def _ratio(error: tuple[float, ...], assumed: tuple[float, float, float]) -> float:
+    """max over u, w, r of E / E_a (inf when E is not finite or E_a is 0 with E > 0)."""
+    return max((e / a if a > 0 else (math.inf if e > 0 else 0.0)) for e, a in zip(error, assumed))
+
+
+def _fits(scenario: Scenario, dist: DisturbanceBounds, assumed: tuple[float, float, float]):
+    """``fits(law, safe)`` for :func:`verify.backup.design_backup`: E / E_a of the loop bound the candidate's
+    command rate gives (inf when the loop bound fails)."""
+    def ratio(law: StationKeeping, safe: SafeSet) -> float:
+        loop = _loop_at(scenario, law, safe, dist, assumed)
+        return _ratio(loop.error, assumed) if loop.certified else math.inf
+    return ratio
+
+
+def _loop_at(scenario: Scenario, law: StationKeeping, safe: SafeSet, dist: DisturbanceBounds,
              assumed: tuple[float, float, float]) -> LoopBound:
     """The loop bound for the jump bounds that ``assumed`` implies (plans: J; backup: its rate × h)."""
     v_max = tuple(float(x) for x in scenario.limits.vector)
     tick = 1.0 / float(scenario.controller.ancillary_rate_hz)
-    per_tick = backup_tick_change(backup.law, backup.safe_set, omega_xy=dist.omega_xy, omega_z=dist.omega_z,
+    per_tick = backup_tick_change(law, safe, omega_xy=dist.omega_xy, omega_z=dist.omega_z,
                                   limits=v_max, loop_error=assumed, tick=tick)
     per_period = tuple(max(j, t) for j, t in zip(plan_jumps(scenario), per_tick))
     return velocity_loop_bound(scenario.plant.params, v_max=v_max, tick=tick, period=float(scenario.controller.dt),
@@ -125,7 +146,7 @@ def _loop_at(scenario: Scenario, backup: BackupCertificate, dist: DisturbanceBou
 
 
 def _consistent(loop: LoopBound, assumed: tuple[float, float, float]) -> Condition:
-    ratio = max((e / a if a > 0 else (math.inf if e > 0 else 0.0)) for e, a in zip(loop.error, assumed))
+    ratio = _ratio(loop.error, assumed)
     ok = bool(loop.certified and ratio < 1.0)
     return Condition("loop_consistent", "E derived from the jump bounds < E assumed by omega_bar, the tube and the "
                      "backup (largest ratio over u, w, r)", ratio if math.isfinite(ratio) else None, 1.0, ok,
@@ -155,10 +176,10 @@ def solve_dynamic(scenario: Scenario, region: Region, gains: GainBounds,
     while rounds < FIXED_POINT_ROUNDS and all(math.isfinite(a) for a in assumed):
         rounds += 1
         dist, designs, best, safe, backup = _tiers_at(scenario, region, gains, sigmas, assumed)
-        loop = _loop_at(scenario, backup, dist, assumed)
+        loop = _loop_at(scenario, backup.law, backup.safe_set, dist, assumed)
         if not loop.certified or all(e < a for e, a in zip(loop.error, assumed)):
             break
-        assumed = tuple(max(a, _INFLATE * e) for a, e in zip(assumed, loop.error))
+        assumed = tuple(max(a, _STEP * e) for a, e in zip(assumed, loop.error))
     if rounds == 0:  # the plans' jumps alone already break the loop: report with a finite stand-in
         assumed = tuple(e if math.isfinite(e) else float(x) for e, x in zip(first.error, v_max))
         dist, designs, best, safe, backup = _tiers_at(scenario, region, gains, sigmas, assumed)

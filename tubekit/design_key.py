@@ -34,8 +34,9 @@ from tubekit.exceptions import ConfigError
 
 __all__ = ["THEOREM_VERSION", "design_fields", "design_key", "first_difference", "require_matching"]
 
-#: Version of the theorem a certificate states; a certificate of another version is not this design.
-THEOREM_VERSION = "sampled-data-tube+backup+velocity-loop/4"
+#: Version of the theorem a certificate states; a certificate of another version is not this design (5: the ramped
+#: backup blends the last applied command and a rate-limited run starts at rest).
+THEOREM_VERSION = "sampled-data-tube+backup+velocity-loop/5"
 
 _SCENARIO_KEYS = ("limits", "trajectory", "epsilon", "region", "obstacles", "vehicle_radius", "sensing_range",
                   "workspace", "duration")

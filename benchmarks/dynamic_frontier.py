@@ -1,0 +1,56 @@
+"""Which (u_max, current) pairs certify on the dynamic plant: the frontier of ``examples/bluerov2_slow.toml``.
+
+For each surge limit u_max and current amplitude (per axis) of a grid, the shipped dynamic scenario with those two
+numbers changed is certified (``verify.certify``; the BlueROV2 Heavy at von Benzon's values ±2 %, everything else as
+shipped), and the table says ``both`` (both tiers certified) or the first failed conditions. Nothing is timed.
+
+Usage: ``python benchmarks/dynamic_frontier.py [--u-max 0.2 0.3 ...] [--current 0.02 0.04 ...]`` (about 4 s per cell).
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+
+from tubekit.scenario import load_scenario
+
+SCENARIO = Path(__file__).resolve().parent.parent / "examples" / "bluerov2_slow.toml"
+U_MAX = (0.2, 0.25, 0.3, 0.35, 0.4)
+CURRENT = (0.02, 0.03, 0.04, 0.05, 0.06, 0.08, 0.1)
+
+
+def cell(u_max: float, current: float) -> str:
+    """``both`` when the scenario with ``u_max`` (m/s) and the current amplitude ``current`` (m/s per axis)
+    certifies both tiers, else its first three failed conditions."""
+    import verify
+    sc = load_scenario(SCENARIO).with_changes(**{"limits.u_max": u_max,
+                                                 "disturbance.amplitude": (current, current, current)})
+    cert = verify.certify(sc)
+    if cert.certified:
+        return "both"
+    names = [c.condition for c in cert.failures]
+    return ", ".join(names[:3]) + (", ..." if len(names) > 3 else "")
+
+
+def table(u_values, currents) -> list[str]:
+    """The markdown table: one row per u_max, one column per current."""
+    lines = ["| u_max (m/s) \\ current (m/s) | " + " | ".join(f"{c:g}" for c in currents) + " |",
+             "|---" * (len(currents) + 1) + "|"]
+    for u in u_values:
+        lines.append(f"| {u:g} | " + " | ".join(cell(u, c) for c in currents) + " |")
+    return lines
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--u-max", type=float, nargs="+", default=list(U_MAX))
+    parser.add_argument("--current", type=float, nargs="+", default=list(CURRENT))
+    args = parser.parse_args(argv)
+    for line in table(args.u_max, args.current):
+        print(line, flush=True)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

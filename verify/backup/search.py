@@ -58,7 +58,7 @@ Fits = Callable[[StationKeeping, SafeSet], float]
 
 
 def _candidates(limits: tuple[float, float, float], omega_xy: float) -> list[tuple[float, float]]:
-    """(u_b, k) pairs to try: surge fractions of u_max above ω̄_xy (largest first when gentle), the full yaw rate."""
+    """(u_b, k) pairs to try: surge fractions of u_max above ω̄_xy, the full yaw rate."""
     return [(f * limits[0], limits[2]) for f in (0.5, 0.625, 0.75, 0.875, 1.0) if f * limits[0] > omega_xy]
 
 

@@ -5,6 +5,7 @@ from __future__ import annotations
 import json
 import math
 
+import numpy as np
 import pytest
 
 from tubekit.scenario import load_scenario, scenario_from_dict
@@ -130,3 +131,34 @@ def test_a_run_of_the_slow_scenario_keeps_every_promise(slow_cert):
     assert len(corner) >= 10
     assert promises and all(p.ok for p in promises), [p for p in promises if not p.ok]
     assert run.metrics["replaced_steps"] == 0
+
+
+def test_a_forced_backup_from_a_moving_state_keeps_every_promise_and_tracking_resumes(slow_cert):
+    """The FHOCP fails for 15 s (periods 100..249): the replay runs out and the ramped backup takes over from the
+    moving vehicle, blending its last command out; then plans are accepted again. Every promise of the certificate
+    holds (the recursive-feasibility premise fails by construction, which voids nothing of the safe tier)."""
+    import tubekit
+    from tubekit.exceptions import SolverError
+    from tubekit.fhocp import FHOCP
+    from tubekit.loop.closed_loop import run_closed_loop
+
+    class _Failing:
+        def __init__(self, scenario, tightening):
+            self.inner, self.k = FHOCP(scenario, tightening), 0
+
+        def solve(self, t, state, obstacles, v_last=None):
+            self.k += 1
+            if 100 <= self.k - 1 < 250:
+                raise SolverError("injected")
+            return self.inner.solve(t, state, obstacles, v_last=v_last)
+
+    sc = load_scenario(SLOW).with_changes(duration=40.0)
+    res = run_closed_loop(sc, tightening=slow_cert.tightening, solver_factory=_Failing, progress=False)
+    m = res.metrics
+    assert m["backup_engagements"] == 1 and m["backup_s"] > 10.0
+    assert not res.backup_active[-2]  # tracking resumed
+    start = int(np.flatnonzero(res.backup_active[:-1])[0])
+    np.testing.assert_array_equal(res.inputs[start], res.inputs[start - 1])  # the blend: no jump at the hand-over
+    assert np.linalg.norm(res.inputs[start - 1]) > 0.05  # the vehicle was moving
+    broken = [p.name for p in tubekit.check_promises(res) if not p.ok and p.name != "recursive_feasibility"]
+    assert broken == []

@@ -176,7 +176,20 @@ def test_the_blended_command_never_leaves_the_box(x, y, z, psi, s, a, b, c):
     """Property: a hand-over command in V blended into the law stays in V (u_b, w_b, k inside V)."""
     start = (0.2 * a, 0.3 * b, 0.5 * c)
     u, w, r = station_keeping_input(SMOOTH, (x, y, z, psi), (0.0, 0.0, 0.0), s, start)
-    assert abs(u) <= 0.2 + 1e-12 and abs(w) <= 0.3 + 1e-12 and abs(r) <= 0.5 + 1e-12
+    assert abs(u) <= 0.2 and abs(w) <= 0.3 and abs(r) <= 0.5  # exactly: the loop would clip one ulp over
+
+
+def test_the_blend_never_rounds_above_the_box():
+    """Counterexample (review of issue 22): k R + (1 − R) r̄ with k = r̄ = 0.2 rounded to 0.20000000000000004 at some
+    ticks of the ramp, which the loop clips (the safe tier promises no clipped tick). Every tick of a whole ramp,
+    from corners of V, stays inside V exactly."""
+    law = StationKeeping(surge=0.3, yaw_rate=0.2, yaw_band=0.3161, heave=0.15, heave_band=3.75, surge_fade=8.1455,
+                         yaw_fade=8.1455, ramp=17.86, yaw_law="continuous", unstable=0.6322)
+    for start in ((0.3, 0.0, 0.2), (-0.3, 0.15, -0.2), (0.3, -0.15, 0.2)):
+        for psi in (1.2, -1.2, 2.0, 0.4):
+            for k in range(1787):
+                u, w, r = station_keeping_input(law, (0.1346, 0.0, 0.3, psi), (0.0, 0.0, 0.0), k * 0.01, start)
+                assert abs(u) <= 0.3 and abs(w) <= 0.15 and abs(r) <= 0.2, (start, psi, k, (u, w, r))
 
 
 def test_the_law_is_continuous_at_the_anchor_with_a_fade():

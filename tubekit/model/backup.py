@@ -189,9 +189,20 @@ def station_keeping_input(law: StationKeeping, state: tuple[float, float, float,
     r = -law.yaw_rate * turn * min(_fade(d, law.yaw_fade), ramp)
     w = -law.heave * _sat((z - anchor[2]) / law.heave_band) * ramp
     if law.ramp > 0.0 and ramp < 1.0:
-        rest = 1.0 - ramp
-        return u + rest * start[0], w + rest * start[1], r + rest * start[2]
+        return _blended(law, (u, w, r), start, 1.0 - ramp)
     return u, w, r
+
+
+def _blended(law: StationKeeping, command: tuple[float, float, float], start: tuple[float, float, float],
+             rest: float) -> tuple[float, float, float]:
+    """The law's ``command`` plus ``rest`` (1 − s/t_r) times the hand-over's ``start``, each channel clamped to
+    ±max(its law bound, |start_c|): exactly, |law| <= bound · s/t_r, so the sum lies there and the clamp only
+    removes rounding (k R + (1 − R) r̄ can round one ulp above r̄, which the loop would clip)."""
+    out = []
+    for value, blend, bound in zip(command, start, (law.surge, law.heave, law.yaw_rate)):
+        top = max(bound, abs(blend))
+        out.append(min(max(value + rest * blend, -top), top))
+    return out[0], out[1], out[2]
 
 
 def yaw_shape(law: StationKeeping, phi: float) -> float:

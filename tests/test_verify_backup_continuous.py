@@ -135,12 +135,24 @@ def test_the_level_set_bound_exceeds_the_plant_s_rate(x, held, bearing, err, cur
 
 @settings(max_examples=25, deadline=None)
 @given(level=st.floats(1.0, 12.0), omega=st.floats(0.0, 0.15), yaw_err=st.floats(0.0, 0.1))
-def test_the_shapes_at_once_are_the_shapes_one_by_one(level, omega, yaw_err):
-    """Property: continuous_rate_sampled_shapes gives, for each β, the sampled rate of that β alone (the design's
-    filter evaluated at once; the same sum in another order, so up to rounding)."""
-    from verify.backup.continuous import continuous_rate_sampled, continuous_rate_sampled_shapes
+def test_the_sampled_rate_is_the_formula_for_every_shape(level, omega, yaw_err):
+    """Property: continuous_rate_sampled_shapes gives, for each β, the largest sampled
+    −u_b cos²x + ω̄ √(1 + (g/d)²) + g (−k ρ(x) + u_b cos x sin x / d) + |g| E_r, d = c − β a(x), g = β a'(x), here
+    from the model's own a (``axis_shape``, a' by central differences) and ρ (``yaw_shape``), one β at a time."""
+    from tubekit.model.backup import axis_shape, yaw_shape
+    from verify.backup.continuous import continuous_rate_sampled_shapes
     law = StationKeeping(0.2, 0.2, 0.3, 0.15, 0.1, 2.0, 2.0, 5.0, "continuous", 0.6)
     shapes = np.round(np.arange(0.05, level - 0.1, 0.35), 6)
-    at_once = continuous_rate_sampled_shapes(law, level, shapes, omega, yaw_err=yaw_err)
-    one_by_one = [continuous_rate_sampled(law, SafeSet(level, float(b), 1.0), omega, yaw_err=yaw_err) for b in shapes]
-    np.testing.assert_allclose(at_once, one_by_one, rtol=0, atol=1e-12)
+    xs = np.linspace(0.0, math.pi, 1441)
+    a = np.array([axis_shape(law, float(x)) for x in xs])
+    h = 1e-7
+    slope = np.array([(axis_shape(law, float(x) + h) - axis_shape(law, float(x) - h)) / (2 * h) for x in xs])
+    rho = np.array([yaw_shape(law, float(x)) for x in xs])
+    want = []
+    for beta in shapes:
+        d, g = level - beta * a, beta * slope
+        rate = (-0.2 * np.cos(xs) ** 2 + omega * np.sqrt(1 + (g / d) ** 2)
+                + g * (-0.2 * rho + 0.2 * np.cos(xs) * np.sin(xs) / d) + np.abs(g) * yaw_err)
+        want.append(rate.max())
+    got = continuous_rate_sampled_shapes(law, level, shapes, omega, yaw_err=yaw_err)
+    np.testing.assert_allclose(got, want, rtol=0, atol=1e-5)

@@ -187,9 +187,9 @@ class Tightening:
     @property
     def terminal_rest(self) -> bool:
         """True when a plan must end at rest, |v̂_{N−1}| <= J: a terminal backup that starts from 0 instead of
-        blending from the last applied command (:attr:`tubekit.model.backup.BackupPlan.terminal_rest`)."""
+        blending from the last applied command (:attr:`tubekit.model.backup.StationKeeping.blends`)."""
         backup = self.terminal_backup
-        return backup is not None and backup.terminal_rest
+        return backup is not None and not backup.law.blends
 
     @property
     def horizon_arcs(self) -> int:

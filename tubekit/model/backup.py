@@ -275,12 +275,6 @@ class BackupPlan:
     safe_set: SafeSet
     handover: tuple[float, float] = (0.0, 0.0)
 
-    @property
-    def terminal_rest(self) -> bool:
-        """True when plans must end at rest (|v̂_{N−1}| <= J): the law starts from 0 instead of blending from the
-        command applied at the hand-over (:attr:`StationKeeping.blends`)."""
-        return not self.law.blends
-
     def footprint(self, vehicle_radius: float) -> tuple[float, float]:
         """(horizontal radius, half height) (m) of the safe set inflated by the vehicle ball."""
         return self.safe_set.radius + vehicle_radius, self.safe_set.depth + vehicle_radius

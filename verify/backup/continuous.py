@@ -161,8 +161,9 @@ def _profiles(law: StationKeeping, x: np.ndarray) -> tuple[np.ndarray, np.ndarra
 
 def continuous_rate_sampled_shapes(law: StationKeeping, level: float, shapes: np.ndarray, omega_xy: float,
                                    n: int = 1441, yaw_err: float = 0.0) -> np.ndarray:
-    """:func:`continuous_rate_sampled` (m/s) for every shape β of ``shapes`` at the level ``level`` (m), at once
-    (the same sum, term by term, in two work arrays)."""
+    """The largest V̇ (m/s) at sampled x ∈ [0, π] with the input of the same instant (no hold) and the worst ω, for
+    every shape β of ``shapes`` at the level ``level`` (m), at once (the design's filter):
+    −u_b cos²x + ω̄_xy √(1 + (g/d)²) + g (−k ρ + u_b cos x sin x / d) + |g| E_r, d = c − β a, g = β a'."""
     x = np.linspace(0.0, math.pi, n)
     a, slope, rho = _profiles(law, x)
     cos = np.cos(x)
@@ -189,10 +190,5 @@ def continuous_rate_sampled_shapes(law: StationKeeping, level: float, shapes: np
 
 def continuous_rate_sampled(law: StationKeeping, safe: SafeSet, omega_xy: float, n: int = 1441,
                             yaw_err: float = 0.0) -> float:
-    """The largest V̇ (m/s) at sampled x ∈ [0, π] with the input of the same instant (no hold) and the worst ω."""
-    x = np.linspace(0.0, math.pi, n)
-    a, slope, rho = _profiles(law, x)
-    d, g = safe.level - safe.shape * a, safe.shape * slope
-    rate = (-law.surge * np.cos(x) ** 2 + omega_xy * np.sqrt(1 + (g / d) ** 2)
-            + g * (-law.yaw_rate * rho + law.surge * np.cos(x) * np.sin(x) / d) + np.abs(g) * yaw_err)
-    return float(rate.max())
+    """:func:`continuous_rate_sampled_shapes` (m/s) for the shape of ``safe``."""
+    return float(continuous_rate_sampled_shapes(law, safe.level, np.array([safe.shape]), omega_xy, n, yaw_err)[0])

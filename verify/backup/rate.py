@@ -73,7 +73,7 @@ def _inputs(law: StationKeeping, safe: SafeSet, omega_xy: float, omega_z: float,
     lim = [positive(f"limits[{i}]", x) for i, x in enumerate(limits)]
     err = [nonnegative(f"loop_error[{i}]", x) for i, x in enumerate(loop_error)]
     # with a ramp the command blends the hand-over's (anywhere in V) into the law: the limits bound it
-    pick = max if law.ramp > 0.0 else min
+    pick = max if law.blends else min
     speed = arb(pick(law.surge, lim[0])) + arb(wxy)
     speed_z = arb(pick(law.heave, lim[1])) + arb(wz)
     yaw = arb(pick(law.yaw_rate, lim[2])) + arb(err[2])
@@ -106,15 +106,16 @@ def backup_command_rate(law: StationKeeping, safe: SafeSet, *, omega_xy: float, 
         Each channel's bound; ``inf`` for surge without d_0 or t_r, yaw without d_1 or t_r, heave without t_r.
     """
     speed, speed_z, yaw = _inputs(law, safe, omega_xy, omega_z, limits, loop_error)
+    if not law.blends:  # no ramp: the command jumps at the hand-over
+        return math.inf, math.inf, math.inf
     ramp = arb(law.ramp)
-    surge = heave = yaw_rate = math.inf
-    if law.ramp > 0.0:
-        blend = [arb(float(v)) / ramp for v in limits]  # the hand-over's command fading out: |v_h| / t_r
-        heave = upper(arb(law.heave) * (speed_z / arb(law.heave_band) + 1 / ramp) + blend[1])
-    if law.ramp > 0.0 and law.surge_fade > 0.0:
+    blend = [arb(float(v)) / ramp for v in limits]  # the hand-over's command fading out: |v_h| / t_r
+    heave = upper(arb(law.heave) * (speed_z / arb(law.heave_band) + 1 / ramp) + blend[1])
+    surge = yaw_rate = math.inf
+    if law.surge_fade > 0.0:
         line = speed / arb(law.surge_fade)
         surge = upper(arb(law.surge) * (_max(line, 1 / ramp) + yaw + line) + blend[0])
-    if law.ramp > 0.0 and law.yaw_fade > 0.0:
+    if law.yaw_fade > 0.0:
         line = speed / arb(law.yaw_fade)
         yaw_rate = upper(arb(law.yaw_rate) * (_max(line, 1 / ramp) + (yaw + line) / arb(law.yaw_band)) + blend[2])
     return surge, heave, yaw_rate

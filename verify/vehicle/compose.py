@@ -126,23 +126,45 @@ def _ratio(error: tuple[float, ...], assumed: tuple[float, float, float]) -> flo
 
 def _fits(scenario: Scenario, dist: DisturbanceBounds, assumed: tuple[float, float, float]):
     """``fits(law, safe)`` for :func:`verify.backup.design_backup`: E / E_a of the loop bound the candidate's
-    command rate gives (inf when the loop bound fails)."""
+    command rate gives (inf when the loop bound fails). The scenario's part is read once, not per candidate."""
+    fixed = _LoopInputs.of(scenario)
+
     def ratio(law: StationKeeping, safe: SafeSet) -> float:
-        loop = _loop_at(scenario, law, safe, dist, assumed)
+        loop = fixed.loop(law, safe, dist, assumed)
         return _ratio(loop.error, assumed) if loop.certified else math.inf
     return ratio
 
 
+@dataclass(frozen=True)
+class _LoopInputs:
+    """What the loop bound reads from the scenario: the vehicle, V, h, δ and the plans' jumps J."""
+
+    params: object
+    v_max: tuple[float, float, float]
+    tick: float
+    period: float
+    plans: tuple[float, float, float]
+
+    @classmethod
+    def of(cls, scenario: Scenario) -> "_LoopInputs":
+        return cls(params=scenario.plant.params, v_max=tuple(float(x) for x in scenario.limits.vector),
+                   tick=1.0 / float(scenario.controller.ancillary_rate_hz), period=float(scenario.controller.dt),
+                   plans=plan_jumps(scenario))
+
+    def loop(self, law: StationKeeping, safe: SafeSet, dist: DisturbanceBounds,
+             assumed: tuple[float, float, float]) -> LoopBound:
+        """The loop bound for the jump bounds that ``assumed`` implies (plans: J; backup: its rate × h)."""
+        per_tick = backup_tick_change(law, safe, omega_xy=dist.omega_xy, omega_z=dist.omega_z,
+                                      limits=self.v_max, loop_error=assumed, tick=self.tick)
+        per_period = tuple(max(j, t) for j, t in zip(self.plans, per_tick))
+        return velocity_loop_bound(self.params, v_max=self.v_max, tick=self.tick, period=self.period,
+                                   jump_tick=per_tick, jump_period=per_period)
+
+
 def _loop_at(scenario: Scenario, law: StationKeeping, safe: SafeSet, dist: DisturbanceBounds,
              assumed: tuple[float, float, float]) -> LoopBound:
-    """The loop bound for the jump bounds that ``assumed`` implies (plans: J; backup: its rate × h)."""
-    v_max = tuple(float(x) for x in scenario.limits.vector)
-    tick = 1.0 / float(scenario.controller.ancillary_rate_hz)
-    per_tick = backup_tick_change(law, safe, omega_xy=dist.omega_xy, omega_z=dist.omega_z,
-                                  limits=v_max, loop_error=assumed, tick=tick)
-    per_period = tuple(max(j, t) for j, t in zip(plan_jumps(scenario), per_tick))
-    return velocity_loop_bound(scenario.plant.params, v_max=v_max, tick=tick, period=float(scenario.controller.dt),
-                               jump_tick=per_tick, jump_period=per_period)
+    """The loop bound for ``law`` (:meth:`_LoopInputs.loop`)."""
+    return _LoopInputs.of(scenario).loop(law, safe, dist, assumed)
 
 
 def _consistent(loop: LoopBound, assumed: tuple[float, float, float]) -> Condition:

@@ -23,7 +23,7 @@ import math
 import sys
 
 from tubekit.model.vehicles import VEHICLES
-from verify.design import hull_sway_bound
+from verify.theorem.design import hull_sway_bound
 from verify.vehicle.bound import velocity_loop_bound
 
 #: von Benzon et al. (2022): the BlueROV2 Heavy's coefficients (kg, kg/s, kg/m; docs/plant.md section 3.2).
@@ -107,8 +107,8 @@ def slow_scenario():
 def first_round(sc) -> None:
     """Print the first round of the fixed point of ``sc`` (module doc) and the certificate's failures."""
     import verify
-    from verify.gains import gain_bounds
-    from verify.region import Region
+    from verify.theorem.gains import gain_bounds
+    from verify.kernel.region import Region
     from verify.vehicle import compose  # its private steps, so the round is the certificate's own
     v_max = tuple(float(x) for x in sc.limits.vector)
     plans = velocity_loop_bound(sc.plant.params, v_max=v_max, tick=0.01, period=0.1, jump_tick=(0.0, 0.0, 0.0),

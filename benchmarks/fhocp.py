@@ -76,7 +76,7 @@ def benchmark_tightening(scenario: Scenario) -> Tightening:
     reg = scenario.region
     return Tightening(v_max=scenario.limits.vector.copy(), e_d_min=scenario.epsilon + 0.05,
                       e_o_max=reg.e_o_max, e_z_max=reg.e_z_max, e_d_max=reg.e_d_max,
-                      obstacle_margin=0.05, rho_tilde=0.05, sigma=0.0)
+                      obstacle_margin=0.05, sigma=0.0)
 
 
 def plant_step(scenario: Scenario, t: float, s: np.ndarray, v: np.ndarray, dt: float,
@@ -145,7 +145,7 @@ def make_methods(scenario: Scenario, tightening: Tightening, slots: int | None =
     methods: dict[str, tuple[object, bool]] = {
         "scp_realtime": (rt, False),
         "scp_converged": (FHOCP(scenario, tightening, mode="converged", options=opts), True)}
-    if with_piqp:  # the opt-in QP path (tubekit.fhocp.qp_relaxed), real-time mode
+    if with_piqp:  # the opt-in QP path (tubekit.fhocp.qp.relaxed), real-time mode
         methods["scp_realtime_piqp"] = (FHOCP(scenario, tightening, mode="realtime", options=dataclasses.replace(
             opts, qp_solver="piqp")), False)
     if with_casadi:

@@ -62,17 +62,8 @@ def record_problems(duration: float) -> tuple[list[tuple], object]:
 
 
 def _cone_dims(compiled) -> tuple[int, int, list[int]]:
-    import clarabel
-    zero = nonneg = 0
-    soc: list[int] = []
-    for c in compiled.cones:
-        if isinstance(c, clarabel.ZeroConeT):
-            zero = c.dim
-        elif isinstance(c, clarabel.NonnegativeConeT):
-            nonneg = c.dim
-        else:
-            soc.append(c.dim)
-    return zero, nonneg, soc
+    dims = compiled.dims  # tubekit.fhocp.qp.base.ConeDims
+    return dims.zero, dims.nonneg, list(dims.soc)
 
 
 def _cones_hold(s: np.ndarray, soc: list[int], tol: float = 1e-6) -> bool:
@@ -88,12 +79,13 @@ def compare(problems: list[tuple], compiled) -> dict:
     """Interleaved bare solves (module doc); medians and p99 in ms, cone check and plan differences."""
     import clarabel
     import piqp
-    from tubekit.fhocp.fastpath import clarabel_settings
+    from tubekit.fhocp.qp.clarabel import clarabel_cones, clarabel_settings
 
     zero, nonneg, soc = _cone_dims(compiled)
     m_lin = zero + nonneg
     P0, q0, A0, b0 = problems[0]
-    cl = clarabel.DefaultSolver(P0, q0, A0, b0, compiled.cones, clarabel_settings(compiled._settings_overrides))
+    cl = clarabel.DefaultSolver(P0, q0, A0, b0, clarabel_cones(compiled.dims),
+                                clarabel_settings(compiled.backend.settings))
     full = lambda P: (P + sp.triu(P, 1).T).tocsc()  # PIQP takes the whole symmetric P
     qp = piqp.SparseSolver()
     qp.settings.eps_abs = qp.settings.eps_rel = 1e-7

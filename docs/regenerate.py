@@ -95,7 +95,7 @@ def certificate_fingerprint() -> dict:
     for name, source, law in CERTIFICATES:
         scenario = _scenario(source)
         cert = verify.certify(scenario, law=law or scenario.controller.law)
-        out[name] = _round({"certified": bool(cert.certified), "tiers": {k: bool(v) for k, v in cert.tiers.items()},
+        out[name] = _round({"certified": bool(cert.certified), "tiers": cert.tiers.to_dict(),
                             "sigma": cert.sigma.value, "tube": [float(r) for r in cert.tube.rho]})
     return out
 
@@ -193,7 +193,7 @@ def regenerate_campaign(campaign_dir: Path) -> dict:
     epsilon = float(spec.get("base", {}).get("epsilon", 0.5))
     ecdf_figure(rows, epsilon).savefig(ROOT / CAMPAIGN_FIGURE, dpi=100)
     summary = json.loads((campaign_dir / "summary.json").read_text())
-    return {"runs": summary.get("runs"), "certified_runs": summary.get("certified_runs"),
+    return {"runs": summary.get("runs"), "runs_by_tier": summary.get("runs_by_tier"),
             "largest_max_rho_ratio": (summary.get("largest_max_rho_ratio") or {}).get("max_rho_ratio")}
 
 

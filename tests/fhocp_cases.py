@@ -38,11 +38,13 @@ STATES = [(t, s) for t, s in RUN_STATES if t in (2.0, 8.0, 10.0, 11.0, 12.0, 25.
 
 
 def tightening(scenario=SC) -> Tightening:
-    """The untightened sets with e_d_min + 5 cm and a 5 cm obstacle margin (no certificate needed)."""
+    """The untightened sets with e_d_min + 5 cm and a 5 cm obstacle margin (no certificate needed); it states both
+    tiers, so a backup added to it is enforced as a certified one would be (the terminal rows)."""
+    from tubekit.tiers import Tiers
     reg = scenario.region
     return Tightening(v_max=scenario.limits.vector.copy(), e_d_min=scenario.epsilon + 0.05,
                       e_o_max=reg.e_o_max, e_z_max=reg.e_z_max, e_d_max=reg.e_d_max,
-                      obstacle_margin=0.05, rho_tilde=0.05, sigma=0.0)
+                      obstacle_margin=0.05, sigma=0.0, tiers=Tiers(True, True))
 
 
 def backup_plan():

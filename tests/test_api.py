@@ -56,3 +56,13 @@ def test_a_certificate_runs_the_tube_with_its_own_tightening(pc_cert):
 def test_a_tightening_is_accepted_directly(pc_cert):
     run = tubekit.simulate(_pc(), pc_cert.tightening, duration=0.2, progress=False)
     assert isinstance(run.tightening, Tightening) and run.tightening.certified
+
+
+@pytest.mark.parametrize("start", [(0.0, 2.5, 0.0, 0.0), (2.5, 0.7, 0.0, 0.0), (-9.55, 3.0, 0.2, 0.0)],
+                         ids=["other start", "beside an obstacle", "at the wall"])
+def test_a_certificate_never_runs_from_another_start(pc_cert, start):
+    """Issue 30, attack 1: with the certificate of paper_currents and a scenario that differs only in its start, the
+    run used to start "safe: certified" and collide or leave the workspace (clearance -0.050 m); the start is part of
+    the design now, so the run is refused before any tick, naming initial_state."""
+    with pytest.raises(ConfigError, match=r"design_key\.initial_state: expected the certificate's value"):
+        tubekit.simulate(_pc().with_changes(initial_state=start), pc_cert, duration=0.3, progress=False)

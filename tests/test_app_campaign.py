@@ -18,8 +18,9 @@ import pytest
 pytest.importorskip("distributed")
 pq = pytest.importorskip("pyarrow.parquet")
 
-from tubekit.app.campaign import read_rows, run_campaign  # noqa: E402
-from tubekit.app.campaign_spec import certificate_key, load_spec, run_seed  # noqa: E402
+from tubekit.app.campaign import FIGURES, read_rows, run_campaign  # noqa: E402
+from tubekit.app.campaign_spec import load_spec, run_seed  # noqa: E402
+from tubekit.app.certified import input_key as certificate_key  # noqa: E402
 from tubekit.app.cli import main  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -100,7 +101,7 @@ def test_run_seeds_are_spawned_children_and_independent_of_the_run_count(tmp_pat
 
 
 def test_the_current_period_is_not_a_certificate_input(tmp_path):
-    """NOT_CERTIFICATE_INPUTS stays true: certify ignores the current's period."""
+    """The current's period is not a design input (DesignInputs resets it): certify ignores it."""
     import verify
 
     spec = load_spec(_spec(tmp_path))
@@ -266,3 +267,22 @@ def test_a_cluster_campaign_reports_safety_backup_and_tracking(tmp_path):
     assert {"obstacles.count", "backup_s", "safety_broken", "safe_tier", "tracking_tier"} <= set(table[0])
     assert [json.loads(r["obstacles"]) and r["obstacles.count"] for r in table] == \
         [len(json.loads(r["obstacles"])) for r in table]
+
+
+# ---- issue 35: the paper's own scenario (safe tier only, σ = 0: no tube) ------------------------------------
+
+def test_a_campaign_on_the_papers_scenario_exits_0_with_its_figures_and_runs_per_tier(tmp_path):
+    """``scenario = "paper"`` certifies the safe tier only, at σ = 0 (no tube: every ratio is null). The CLI
+    exits 0, draws both figures and counts the runs per tier; no run is called certified."""
+    spec = _spec(tmp_path, 2, "", 'scenario = "paper"\nruns = 2\nseed = 3\nduration = 2.0\n')
+    out = tmp_path / "out"
+    done = subprocess.run([sys.executable, "-m", "tubekit", "campaign", str(spec), "--out", str(out),
+                           "--workers", "1", "--no-progress"], capture_output=True, text=True, timeout=300)
+    assert done.returncode == 0, done.stderr
+    assert "Traceback" not in done.stderr
+    assert all((out / "figures" / name).stat().st_size > 0 for name in FIGURES)
+    summary = json.loads((out / "summary.json").read_text())
+    assert "certified_runs" not in summary and summary["runs"] == 2
+    assert summary["runs_by_tier"] == {"both": 0, "safe_only": 2, "none": 0}
+    assert summary["tracking_tier_runs"] == 0 and summary["largest_max_rho_ratio"] is None
+    assert "0 with both tiers, 2 with the safe tier only, 0 uncertified; no tube ratio" in done.stdout

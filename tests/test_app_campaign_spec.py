@@ -93,7 +93,7 @@ def _truth_spec(entry=None, scenario: str = DYNAMIC):
 
 def test_the_truth_box_draws_every_interval_coefficient_inside_its_interval():
     """Property: each run's plant is a point of the vehicle's box, and every run shares one certificate."""
-    from tubekit.app.campaign_spec import certificate_key
+    from tubekit.app.certified import input_key
     spec = _truth_spec()
     params = spec.plan(0).scenario.plant.params
     names = set(params.interval_fields)
@@ -105,7 +105,7 @@ def test_the_truth_box_draws_every_interval_coefficient_inside_its_interval():
         for name, value in truth.items():
             lo, hi = params.interval(name)
             assert lo <= value <= hi
-        keys.add(certificate_key(sc))
+        keys.add(input_key(sc))
         seen.append(truth["Y_vv"])
     assert len(keys) == 1                       # the truth is not a certificate input
     lo, hi = params.interval("Y_vv")

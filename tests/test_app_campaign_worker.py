@@ -29,7 +29,7 @@ def test_a_fresh_import_with_the_variable_certifies_and_runs_the_scenario_once()
     """In a new interpreter (as in the fork server): the warm-up ran, the loop and verify are loaded."""
     scenario = json.dumps(paper_scenario().with_changes(duration=0.5).to_dict())
     probe = ("import sys, tubekit.app.campaign_worker as w; "
-             "print(w.WARMED_S is not None, 'tubekit.loop.pipeline' in sys.modules, 'verify.certificate' in sys.modules)")
+             "print(w.WARMED_S is not None, 'tubekit.loop.pipeline' in sys.modules, 'verify.certificate.certify' in sys.modules)")
     done = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True, timeout=120,
                           env={**os.environ, WARM_SCENARIO_ENV: scenario})
     assert done.returncode == 0, done.stderr

@@ -55,26 +55,31 @@ def _edited(d: dict, **changes) -> dict:
 
 
 def _resummed(d: dict) -> dict:
-    from verify.certificate_json import checksum_of
+    from verify.certificate.jsonio import checksum_of
 
     return {**d, "checksum": checksum_of(d)}
 
 
-def _fields_edited(d: dict) -> dict:
-    return _resummed({**d, "design_fields": {**d["design_fields"], "epsilon": 9.0}})
+def _design_edited(d: dict) -> dict:
+    """The stored design's epsilon edited, the checksum re-stamped, the design key left."""
+    inputs = {**d["inputs"], "scenario": {**d["inputs"]["scenario"], "epsilon": 0.45}}
+    return _resummed({**d, "inputs": inputs})
 
 
-def _scenario_data_for_another_epsilon(d: dict) -> dict:
-    return _resummed({**d, "scenario_data": {**d["scenario_data"], "epsilon": 0.45}})
+def _rekeyed_for_another_epsilon(d: dict) -> dict:
+    """A consistent certificate of another design (epsilon 0.45): key and checksum re-stamped."""
+    from tubekit.design_inputs import DesignInputs
+    inputs = {**d["inputs"], "scenario": {**d["inputs"]["scenario"], "epsilon": 0.45}}
+    return _resummed({**d, "inputs": inputs, "design_key": DesignInputs.from_dict(inputs).key()})
 
 
 @pytest.mark.parametrize("edit, other_scenario, field", [
     (lambda d: [d], None, r"^certificate: expected a certificate JSON object"),
     (lambda d: _edited(d, scenario="renamed after issue"), None, r"^certificate\.checksum: "),
-    (_fields_edited, None, r"^certificate\.design_key: expected the key of its design_fields"),
-    (lambda d: d, {"initial_state": (-0.7, 3.1, 0.0, 0.1)}, r"^certificate\.scenario_data: "),
-    (lambda d: d, {"epsilon": 0.45}, r"^certificate\.scenario_data: "),
-    (_scenario_data_for_another_epsilon, {"epsilon": 0.45}, r"^design_key\.epsilon: "),
+    (_design_edited, None, r"^certificate\.design_key: expected the key of its design inputs"),
+    (lambda d: d, {"initial_state": (-0.7, 3.1, 0.0, 0.1)}, r"^design_key\.initial_state: "),
+    (lambda d: d, {"epsilon": 0.45}, r"^design_key\.epsilon: "),
+    (_rekeyed_for_another_epsilon, None, r"^design_key\.epsilon: "),
 ])
 def test_a_certificate_that_fails_a_check_is_refused_naming_it(stored, scenario, edit, other_scenario, field):
     target = scenario.with_changes(**other_scenario) if other_scenario else scenario
@@ -83,7 +88,7 @@ def test_a_certificate_that_fails_a_check_is_refused_naming_it(stored, scenario,
 
 
 def test_issue_certificate_gives_the_key_a_checksummed_dict_and_the_best_effort_tightening(pc_cert, scenario):
-    from verify.certificate_json import checksum_of
+    from verify.certificate.jsonio import checksum_of
 
     issued = issue_certificate(scenario)
     assert isinstance(issued, IssuedCertificate) and issued.key == input_key(scenario)

@@ -2,9 +2,12 @@
 
 from __future__ import annotations
 
+from tubekit.tiers import Tiers
+
 import subprocess
 import sys
 
+import numpy as np
 import pytest
 
 from tubekit import __version__
@@ -67,7 +70,7 @@ def _fake_certify(scenario, law=None):
         certified = False
         failures = [SimpleNamespace(condition="fake")]
         disturbance = SimpleNamespace(gamma=0.02)  # read by the dynamic-plant part of reproduce
-        tiers = {"safe": False, "tracking": False}
+        tiers = Tiers(False, False)
         tier_failures = {"safe": ("fake",), "tracking": ("fake",)}
 
         def to_dict(self):
@@ -77,7 +80,7 @@ def _fake_certify(scenario, law=None):
             return "fake certificate"
 
         def best_effort_tightening(self, min_input_fraction=0.5):
-            return dc_replace(Tightening.untightened(scenario), sigma=0.5, rho_tilde=0.03,
+            return dc_replace(Tightening.untightened(scenario), sigma=0.5, tube=np.array([0.03, 0.0, 0.0]),
                               disturbance=(0.0, 0.0, 0.02))
     return Fake()
 
@@ -104,7 +107,7 @@ def _raise(exc):
 
 
 def _error_rows():
-    from verify.certificate import NotCertifiedError
+    from verify.certificate.certify import NotCertifiedError
 
     from tubekit.exceptions import ConfigError, NotAvailableError, ShapeError, SolverError, TubekitError
 

@@ -12,8 +12,8 @@ from tubekit.scenario import load_scenario, paper_scenario
 from verify import SCENARIOS_DIR, certify
 
 CERTIFIABLE = str(SCENARIOS_DIR / "certifiable.toml")
-KEYS = {"certified", "law", "region", "problem", "tube", "margins", "sigma", "v_bar", "horizon", "failures",
-        "conditions", "assumptions", "premises", "scenario_data", "elapsed_s"}
+KEYS = {"certified", "law", "region", "problem", "tube", "margins", "sigma", "v_bar", "inputs", "failures",
+        "conditions", "assumptions", "premises", "design_key", "elapsed_s"}
 
 
 def test_certify_paper_scenario_with_the_papers_law_exits_3(tmp_path, capsys):
@@ -24,7 +24,8 @@ def test_certify_paper_scenario_with_the_papers_law_exits_3(tmp_path, capsys):
     assert {"e_d", "e_z", "e_o", "heading", "pd_dot_max", "omega_bar", "v_max"} <= set(d["region"])
     assert d["region"]["e_d"] == [0.1, 3.0] and d["region"]["heading"] == "toward"
     assert {"rho", "theta", "kappa", "certified"} <= set(d["tube"])
-    assert {"steps", "dt"} <= set(d["horizon"])
+    ctrl = d["inputs"]["scenario"]["controller"]
+    assert (ctrl["dt"], ctrl["horizon_steps"], ctrl["ancillary_rate_hz"]) == (0.1, 8, 100.0)
     # physics, not the tube: target + current outrun the vehicle, and at e_d = 0.1 the current turns the
     # line of sight at 0.12 / 0.1 = 1.2 rad/s > r_max = 0.5 rad/s
     assert {f["condition"] for f in d["failures"]} >= {"keep_up[u]", "yaw_budget"}

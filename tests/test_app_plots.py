@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from tubekit.tiers import Tiers
+
 import warnings
 from dataclasses import replace
 
@@ -56,7 +58,7 @@ def test_rho_period_peaks_are_the_maxima(short_run):
 
 def _tightening(sc, margin=0.1):
     base = Tightening.untightened(sc)
-    return replace(base, obstacle_margin=margin, v_max=base.v_max * 0.8, rho_tilde=0.05)
+    return replace(base, obstacle_margin=margin, v_max=base.v_max * 0.8, tube=np.array([0.05, 0.0, 0.0]))
 
 
 def _legend_texts(fig) -> list[str]:
@@ -246,9 +248,9 @@ def test_the_backup_is_shaded_once_per_stretch_with_one_legend_entry():
 def test_tier_title_names_the_failed_conditions_of_a_tier_not_given():
     from tubekit.app.plots import tier_title
 
-    assert tier_title({"safe": True, "tracking": False}, {"tracking": ["keep_up", "yaw_budget"]}) == \
+    assert tier_title(Tiers(True, False), {"tracking": ["keep_up", "yaw_budget"]}) == \
         "safe: certified; tracking: not certified (keep_up, yaw_budget)"
-    assert tier_title({"safe": True, "tracking": True}) == "safe: certified; tracking: certified"
+    assert tier_title(Tiers(True, True)) == "safe: certified; tracking: certified"
     assert "nothing is promised" in tier_title(None)
 
 

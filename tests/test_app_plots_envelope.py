@@ -1,4 +1,4 @@
-"""The envelope figure's file check (the figure itself is drawn in tests/test_verify_envelope.py)."""
+"""The envelope figure's file check (the figure itself is drawn in tests/test_verify_studies_envelope.py)."""
 
 from __future__ import annotations
 

@@ -15,6 +15,7 @@ import numpy as np
 import pytest
 
 import verify
+from tubekit.tiers import Tiers
 from tubekit import Tightening
 from tubekit.app.cli import main
 from tubekit.app.study import OUTPUT_FILES, QUICK_DURATION_S
@@ -32,7 +33,7 @@ class FakeCertificate:
         self.scenario, self.certified = scenario, certified
         self.failures = [] if certified else [SimpleNamespace(condition="fake")]
         self.disturbance = SimpleNamespace(gamma=0.02)  # what the dynamic part of reproduce reads
-        self.tiers = {"safe": certified, "tracking": certified}
+        self.tiers = Tiers(certified, certified)
         self.tier_failures = {"safe": () if certified else ("fake",), "tracking": () if certified else ("fake",)}
 
     def to_dict(self):
@@ -43,8 +44,9 @@ class FakeCertificate:
 
     def best_effort_tightening(self, min_input_fraction=0.5):
         base = Tightening.untightened(self.scenario)  # the verdict and gamma travel in the tightening
-        return dataclasses.replace(base, sigma=0.5, rho_tilde=0.03, e_d_min=self.scenario.epsilon + 0.03,
-                                   obstacle_margin=0.02, v_max=base.v_max * 0.9, certified=self.certified,
+        return dataclasses.replace(base, sigma=0.5, tube=np.array([0.03, 0.0, 0.0]),
+                                   e_d_min=self.scenario.epsilon + 0.03, obstacle_margin=0.02,
+                                   v_max=base.v_max * 0.9, tiers=Tiers(self.certified, self.certified),
                                    disturbance=(0.25, 0.15, self.disturbance.gamma))  # covers the current
 
 

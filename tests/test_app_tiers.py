@@ -2,11 +2,13 @@
 
 from __future__ import annotations
 
+from tubekit.tiers import Tiers
+
 from types import SimpleNamespace
 
 from tubekit.app.tiers import activity_line, report_title, tier_lines, tier_report
 
-SAFE_ONLY = SimpleNamespace(tiers={"safe": True, "tracking": False},
+SAFE_ONLY = SimpleNamespace(tiers=Tiers(True, False),
                             tier_failures={"safe": (), "tracking": ("keep_up", "yaw_budget")})
 PROMISES = [
     {"name": "tube", "tier": "tracking", "depends_on": ["disturbance", "recursive_feasibility"]},

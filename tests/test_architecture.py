@@ -26,6 +26,8 @@ from functools import lru_cache
 from pathlib import Path
 from typing import Callable, Iterable
 
+import pytest
+
 ROOT = Path(__file__).resolve().parents[1]
 PACKAGES = ("tubekit", "verify")
 APP = "tubekit.app"
@@ -34,12 +36,22 @@ APP_LAYER = (APP, "tubekit.__main__")
 GUI_AND_CLI = ("argparse", "matplotlib", "mpl_toolkits")
 MODEL = "tubekit.model"
 MODEL_MAY_IMPORT = (MODEL, "tubekit.exceptions", "tubekit.validation", "tubekit.version")
-CONFIGURATION = ("tubekit.scenario", "tubekit.tightening", "tubekit.checks", "tubekit.design_key")
+CONFIGURATION = ("tubekit.settings", "tubekit.scenario", "tubekit.tightening", "tubekit.checks", "tubekit.design_inputs",
+                 "tubekit.tiers")
 RUN_AND_APP = ("tubekit.plant", "tubekit.fhocp", "tubekit.loop", APP)
 PLANT_AND_SOLVER = ("tubekit.plant", "tubekit.fhocp")
 LOOP = "tubekit.loop"
 THE_RUN = ("tubekit.plant", "tubekit.fhocp", LOOP)
 FALSIFIERS = "verify.falsify"
+#: verify's roles, bottom up: the Arb kernel; the theorem (with the backup's proof and the dynamic vehicle's
+#: bound); the paper's Lemma 1 (a reference beside the theorem); the certificate artefact; re-checks, studies
+#: and tools; the falsifiers (the only verify that runs the loop).
+VERIFY_KERNEL = "verify.kernel"
+VERIFY_THEOREM = ("verify.theorem", "verify.backup", "verify.vehicle")
+VERIFY_REFERENCE = "verify.lemma1"
+VERIFY_CERTIFICATE = "verify.certificate"
+VERIFY_STUDIES = "verify.studies"
+VERIFY_ROLES = (VERIFY_KERNEL, *VERIFY_THEOREM, VERIFY_REFERENCE, VERIFY_CERTIFICATE, VERIFY_STUDIES, FALSIFIERS)
 MAX_MODULE_LINES = 500
 MAX_FUNCTION_LINES = 80
 
@@ -205,6 +217,33 @@ def verify_runs_the_loop(mod: str, target: str) -> bool:
     return _within(mod, "verify") and not _within(mod, FALSIFIERS) and _within_any(target, THE_RUN)
 
 
+def verify_kernel_reaches_up(mod: str, target: str) -> bool:
+    """verify.kernel imports no other part of verify (not even the package root)."""
+    return _within(mod, VERIFY_KERNEL) and _within(target, "verify") and not _within(target, VERIFY_KERNEL)
+
+
+def verify_theorem_reaches_up(mod: str, target: str) -> bool:
+    """The theorem (verify.theorem, verify.backup, verify.vehicle) imports only the kernel and itself of verify."""
+    return (_within_any(mod, VERIFY_THEOREM) and _within(target, "verify")
+            and not _within_any(target, (VERIFY_KERNEL, *VERIFY_THEOREM)))
+
+
+def verify_reference_reaches_up(mod: str, target: str) -> bool:
+    """verify.lemma1 (the paper's Lemma 1, a reference) imports only the kernel and itself of verify."""
+    return (_within(mod, VERIFY_REFERENCE) and _within(target, "verify")
+            and not _within_any(target, (VERIFY_KERNEL, VERIFY_REFERENCE)))
+
+
+def verify_certificate_reaches_up(mod: str, target: str) -> bool:
+    """The certificate artefact imports no re-check, study or falsifier."""
+    return _within(mod, VERIFY_CERTIFICATE) and _within_any(target, (VERIFY_STUDIES, FALSIFIERS))
+
+
+def verify_studies_reach_the_falsifiers(mod: str, target: str) -> bool:
+    """Re-checks and studies import no falsifier."""
+    return _within(mod, VERIFY_STUDIES) and _within(target, FALSIFIERS)
+
+
 def gui_or_cli_outside_the_app(mod: str, target: str) -> bool:
     """argparse, matplotlib and mpl_toolkits are imported only in the app layer."""
     return not _is_app(mod) and _within_any(target, GUI_AND_CLI)
@@ -265,7 +304,7 @@ def _report(rule: str, offenders: list[str]) -> str:
 def test_the_packages_are_found():
     """Guard: the walk sees both packages (an empty walk would pass every rule)."""
     names = set(modules())
-    assert {"tubekit", "verify", "tubekit.scenario", "verify.region", "tubekit.model.errors",
+    assert {"tubekit", "verify", "tubekit.scenario", "verify.kernel.region", "tubekit.model.errors",
             "tubekit.loop.result", "tubekit.app.cli", "verify.falsify.closed_loop"} <= names, sorted(names)
 
 
@@ -300,6 +339,22 @@ def test_the_core_never_imports_verify():
 def test_verify_runs_the_loop_only_in_the_falsifiers():
     offenders = _offenders(verify_runs_the_loop)
     assert not offenders, _report(f"verify outside {FALSIFIERS} must not import {', '.join(THE_RUN)}", offenders)
+
+
+def test_every_verify_module_belongs_to_a_role():
+    """verify has no flat module besides its package root: each lives in one role subpackage."""
+    flat = sorted(m.rel for m in modules().values()
+                  if _within(m.name, "verify") and m.name != "verify" and not _within_any(m.name, VERIFY_ROLES))
+    assert not flat, _report("verify modules outside a role subpackage", flat)
+
+
+@pytest.mark.parametrize("rule", [verify_kernel_reaches_up, verify_theorem_reaches_up, verify_reference_reaches_up,
+                                  verify_certificate_reaches_up, verify_studies_reach_the_falsifiers],
+                         ids=lambda rule: rule.__name__)
+def test_verify_roles_import_only_downwards(rule):
+    """Each verify role imports only the roles under it (kernel < theorem, reference < certificate < studies)."""
+    offenders = _offenders(rule)
+    assert not offenders, _report(rule.__doc__, offenders)
 
 
 def test_argparse_and_matplotlib_only_in_the_app_layer():
@@ -377,11 +432,11 @@ def test_the_app_rule_catches_a_lazy_import_from_the_loop():
     lazy = _fake("tubekit.loop.result", "class SimulationResult:\n    def plot(self):\n"
                  "        from tubekit.app.plots import plot_run\n        return plot_run(self)\n")
     relative = _fake("tubekit.loop.result", "def plot(run):\n    from ..app import plots\n")
-    by_name = _fake("verify.report", "import importlib\n\ndef f():\n"
+    by_name = _fake("verify.certificate.report", "import importlib\n\ndef f():\n"
                     "    return importlib.import_module('tubekit.app.plots')\n")
     assert _offenders(imports_the_app_layer, among=[lazy]) == ["tubekit/loop/result.py:3 -> tubekit.app.plots"]
     assert _offenders(imports_the_app_layer, among=[relative]) == ["tubekit/loop/result.py:2 -> tubekit.app.plots"]
-    assert _offenders(imports_the_app_layer, among=[by_name]) == ["verify/report.py:4 -> tubekit.app.plots"]
+    assert _offenders(imports_the_app_layer, among=[by_name]) == ["verify/certificate/report.py:4 -> tubekit.app.plots"]
     inside = _fake("tubekit.app.study", "from tubekit.app.plots import plot_run\nfrom . import output\n")
     shim = _fake("tubekit.__main__", "def run():\n    from tubekit.app.cli import main\n")
     assert _offenders(imports_the_app_layer, among=[inside, shim]) == []
@@ -390,20 +445,29 @@ def test_the_app_rule_catches_a_lazy_import_from_the_loop():
 def test_the_layer_rules_flag_only_what_they_name():
     model = _fake("tubekit.model.kinematics", "from tubekit.validation import positive\n"
                   "from tubekit.model import errors\nfrom .. import scenario\nimport tubekit\n"
-                  "def f():\n    import verify.region\n")
+                  "def f():\n    import verify.kernel.region\n")
     assert _offenders(model_reaches_above, among=[model]) == [
         "tubekit/model/kinematics.py:3 -> tubekit.scenario", "tubekit/model/kinematics.py:4 -> tubekit",
-        "tubekit/model/kinematics.py:6 -> verify.region"]
-    config = _fake("tubekit.design_key", "from tubekit.model import errors\nfrom tubekit.fhocp.result import Status\n")
+        "tubekit/model/kinematics.py:6 -> verify.kernel.region"]
+    config = _fake("tubekit.design_inputs", "from tubekit.model import errors\nfrom tubekit.fhocp.result import Status\n")
     assert _offenders(configuration_reaches_the_run, among=[config]) == [
-        "tubekit/design_key.py:2 -> tubekit.fhocp.result"]
+        "tubekit/design_inputs.py:2 -> tubekit.fhocp.result"]
     solver = _fake("tubekit.fhocp.scp", "from tubekit.plant import base\nfrom tubekit.loop.sensing import x\n")
     assert _offenders(plant_or_solver_reaches_the_loop, among=[solver]) == [
         "tubekit/fhocp/scp.py:2 -> tubekit.loop.sensing"]
-    checker = _fake("verify.design", "from tubekit.scenario import Scenario\nimport tubekit.loop.plan_check\n")
+    checker = _fake("verify.theorem.design", "from tubekit.scenario import Scenario\nimport tubekit.loop.plan_check\n")
     falsifier = _fake("verify.falsify.closed_loop", "import tubekit.loop.plan_check\n")
     assert _offenders(verify_runs_the_loop, among=[checker, falsifier]) == [
-        "verify/design.py:2 -> tubekit.loop.plan_check"]
+        "verify/theorem/design.py:2 -> tubekit.loop.plan_check"]
+    kernel = _fake("verify.kernel.region", "from verify.kernel import intervals\nfrom verify.theorem import design\n")
+    theorem = _fake("verify.backup.proof", "from verify.theorem.design import Condition\n"
+                    "from verify.certificate.record import CertificateRecord\n")
+    artefact = _fake("verify.certificate.report", "from verify.theorem import tiers\nfrom verify.studies import recheck\n")
+    assert _offenders(verify_kernel_reaches_up, among=[kernel]) == ["verify/kernel/region.py:2 -> verify.theorem.design"]
+    assert _offenders(verify_theorem_reaches_up, among=[theorem]) == [
+        "verify/backup/proof.py:2 -> verify.certificate.record"]
+    assert _offenders(verify_certificate_reaches_up, among=[artefact]) == [
+        "verify/certificate/report.py:2 -> verify.studies.recheck"]
     core = _fake("tubekit.loop.promises", "def f():\n    import matplotlib.pyplot as plt\n    import verify\n")
     assert _offenders(gui_or_cli_outside_the_app, among=[core]) == ["tubekit/loop/promises.py:2 -> matplotlib.pyplot"]
     assert _offenders(core_imports_verify, among=[core]) == ["tubekit/loop/promises.py:3 -> verify"]

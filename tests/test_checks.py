@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import re
+
 import pytest
 
 from tubekit.checks import (LOG_BYTES_PER_TICK, MAX_HORIZON_STEPS, MEMORY_BUDGET_BYTES, RUNS_PER_STUDY,
@@ -139,3 +141,29 @@ def test_require_one_period_refuses_counts_that_overflow(duration):
     """Issue 24 item 1: duration / dt beyond MAX_PERIODS (or beyond a float) is a ConfigError, not OverflowError."""
     with pytest.raises(ConfigError, match=r"^--duration: expected at most 1e\+09 FHOCP periods of 0\.1 s"):
         require_one_period("--duration", duration, 0.1)
+
+
+@pytest.mark.parametrize("changes, named", [
+    ({"limits.r_max": 30.0}, r"limits\.r_max = 30 rad/s .*30 deg/s = 0\.5236 rad/s"),
+    ({"initial_state": (-0.5, 3.0, 0.2, 90.0)}, r"initial_state\[3\] .* = 90 rad .*90 deg = 1\.571 rad"),
+    ({"limits.rate": (0.1, 0.1, 10.0)}, r"limits\.rate\[2\] = 10 rad/s\^2"),
+])
+def test_a_value_that_looks_like_degrees_gets_a_hint(changes, named):
+    """Issue 35, item 7: r_max = 30 meant as deg/s and a heading of 90 meant as degrees now say so."""
+    from tubekit.checks import unit_hints
+    hints = unit_hints(paper_scenario().with_changes(**changes))
+    assert len(hints) == 1 and re.search(named, hints[0])
+    assert unit_hints(paper_scenario()) == ()
+
+
+def test_the_api_warns_and_the_cli_logs_the_hint(tmp_path, caplog):
+    import tubekit
+    from tubekit.app.commands_verify import load_checked
+    sc = paper_scenario().with_changes(**{"limits.r_max": 30.0})
+    with pytest.warns(UserWarning, match="limits.r_max = 30 rad/s"):
+        tubekit.simulate(sc, None, duration=0.1, progress=False)
+    path = tmp_path / "deg.toml"
+    path.write_text("[limits]\nr_max = 30.0\n")
+    with caplog.at_level("WARNING"):
+        load_checked(str(path))
+    assert any("hint: limits.r_max = 30 rad/s" in r.getMessage() for r in caplog.records)

@@ -33,7 +33,7 @@ def test_resolve_does_not_recanonicalise(monkeypatch):
     solver = FHOCP(SC, tightening(), mode="converged")
     t, s = STATES[1]
     solver.solve(t, np.array(s), OBSTACLES)
-    clarabel_obj = solver.compiled._solver
+    clarabel_obj = solver.compiled.backend._solver
     rebuilds = solver.compiled.rebuilds
 
     def forbidden(*args, **kwargs):
@@ -50,7 +50,7 @@ def test_resolve_does_not_recanonicalise(monkeypatch):
     for k, (t, s) in enumerate(STATES):
         res = solver.solve(t, np.array(s), OBSTACLES if k % 2 else ())
         assert not res.fallback
-    assert solver.compiled._solver is clarabel_obj          # persistent Clarabel solver
+    assert solver.compiled.backend._solver is clarabel_obj  # persistent Clarabel solver
     assert solver.compiled.rebuilds == rebuilds              # never rebuilt
     assert solver.compiled.updates > updates                 # data updates instead
 

@@ -6,8 +6,11 @@ import cvxpy as cp
 import numpy as np
 import pytest
 
-from tubekit.exceptions import SolverError
-from tubekit.fhocp.fastpath import CLARABEL_STATUS, CompiledConeProgram
+from tubekit.exceptions import ConfigError, SolverError
+from tubekit.fhocp.fastpath import CompiledConeProgram
+from tubekit.fhocp.qp.base import ConeDims
+from tubekit.fhocp.qp.clarabel import ClarabelBackend
+from tubekit.fhocp.qp.piqp import PiqpBackend
 
 
 def _problem():
@@ -61,7 +64,51 @@ def test_parameter_without_value_is_an_error():
         comp.load_parameter_values(prob)
 
 
-def test_every_clarabel_status_is_mapped_explicitly():
-    assert set(CLARABEL_STATUS.values()) <= {"optimal", "optimal_inaccurate", "infeasible", "infeasible_inaccurate",
-                                             "unbounded", "unbounded_inaccurate", "user_limit", "solver_error"}
-    assert CLARABEL_STATUS["Solved"] == "optimal" and CLARABEL_STATUS["PrimalInfeasible"] == "infeasible"
+def _socp():
+    x = cp.Variable(2)
+    c = cp.Parameter(2)
+    c.value = np.array([2.0, 0.0])
+    return cp.Problem(cp.Minimize(cp.sum_squares(x - c)), [cp.norm(x) <= 1.0]), x, c
+
+
+def test_the_program_is_the_data_the_backend_gets():
+    prob, x, c = _socp()
+    comp = CompiledConeProgram(prob)
+    comp.load_parameter_values(prob)
+    assert isinstance(comp.backend, ClarabelBackend) and comp.dims.soc and comp.dims.rows == comp.m
+    prog = comp.program()
+    P, q, A, b, d = comp.data()
+    assert (prog.P() != P).nnz == 0 and (prog.A() != A).nnz == 0
+    assert np.array_equal(prog.q, q) and np.array_equal(prog.b, b) and prog.offset == d
+    assert prog.p_changed is False  # P is a constant of this problem: never sent again
+
+
+def test_the_backend_is_a_constructor_argument():
+    prob, x, c = _socp()
+    backend = ClarabelBackend({"tol_feas": 1e-9})
+    comp = CompiledConeProgram(prob, backend=backend)
+    assert comp.backend is backend
+    comp.load_parameter_values(prob)
+    sol = comp.solve()
+    assert comp.value(sol, x) == pytest.approx([1.0, 0.0], abs=1e-6) and comp.rebuilds == 1
+    with pytest.raises(ConfigError, match="^settings: "):
+        CompiledConeProgram(prob, {"tol_feas": 1e-9}, backend=backend)
+    with pytest.raises(ConfigError, match="^backend: "):
+        CompiledConeProgram(prob, backend="clarabel")  # type: ignore[arg-type]
+
+
+def test_a_backend_without_cones_is_refused_on_a_cone_program():
+    pytest.importorskip("piqp")
+    prob, _x, _c = _socp()
+    with pytest.raises(ConfigError, match="takes second-order cones"):
+        CompiledConeProgram(prob, backend=PiqpBackend())
+
+
+def test_only_zero_nonnegative_and_second_order_cones_compile():
+    from types import SimpleNamespace
+
+    from tubekit.fhocp.fastpath import cone_dims
+    dims = SimpleNamespace(zero=1, nonneg=2, soc=[3], exp=0, psd=[], p3d=[])
+    assert cone_dims(dims) == ConeDims(1, 2, (3,))
+    with pytest.raises(SolverError, match="second-order"):
+        cone_dims(SimpleNamespace(zero=1, nonneg=2, soc=[], exp=1, psd=[], p3d=[]))

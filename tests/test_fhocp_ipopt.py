@@ -108,6 +108,7 @@ def test_sqpmethod_peer_solves_the_same_nlp():
 def test_ipopt_carries_the_backup_terminal_rows_where_they_bind():
     """The same sensed-region case as the SCP's: with a 1.2 m sensing range the plan end must stay within
     0.195 m of the start; IPOPT meets the rows that the free plan breaks."""
+    pytest.importorskip("casadi")
     from tubekit.fhocp.ipopt import IpoptFHOCP
     sc = SC.with_changes(sensing_range=1.2)
     t, s = CASES[0]

@@ -19,7 +19,7 @@ from .fhocp_cases import backup_plan, tightening
 
 SC = paper_scenario()
 TIGHT = Tightening(v_max=np.array([0.3, 0.2, 0.4]), e_d_min=0.3, e_o_max=0.8, e_z_max=0.9, e_d_max=2.9,
-                   obstacle_margin=0.05, rho_tilde=0.05, sigma=10.0)
+                   obstacle_margin=0.05, sigma=10.0)
 NLP = FhocpNlp.from_scenario(SC, TIGHT, terminal="off")
 
 

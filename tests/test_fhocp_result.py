@@ -10,7 +10,7 @@ import pytest
 from tubekit import SolverError
 from tubekit.fhocp import FHOCP, FhocpResult
 from tubekit.fhocp.convex import CVXPY_STATUS
-from tubekit.fhocp.fastpath import CLARABEL_STATUS
+from tubekit.fhocp.qp.clarabel import CLARABEL_STATUS
 from tubekit.fhocp.ipopt import IPOPT_STATUS
 from tubekit.fhocp.result import RESULT_STATUSES, Status, shift_steps, shifted_plan, status_from
 

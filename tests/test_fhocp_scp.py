@@ -186,7 +186,7 @@ def test_clarabel_failure_status_triggers_fallback(monkeypatch):
         iterations = 3
 
     stub = type("Stub", (), {"update": lambda self, **kw: None, "solve": lambda self: Failed()})()
-    monkeypatch.setattr(solver.compiled, "_solver", stub)
+    monkeypatch.setattr(solver.compiled.backend, "_solver", stub)
     with pytest.warns(FallbackWarning, match="solver_error"):
         res = solver.solve(t + SC.controller.dt, np.array(s), OBSTACLES)
     assert res.fallback and np.all(np.isfinite(res.inputs))

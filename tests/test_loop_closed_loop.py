@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from tubekit.tiers import Tiers
+
 import dataclasses
 import math
 
@@ -232,9 +234,8 @@ def test_plan_memory_shifts_the_last_good_plan_then_stops():
     good = Pursuit(sc, None).solve(0.0, np.asarray(sc.initial_state, dtype=float), ())
     memory = PlanMemory()
     np.testing.assert_array_equal(memory.replacement(), 0.0)  # nothing to shift yet
-    assert memory.remember(good) is False and memory.age == 0
-    flagged = dataclasses.replace(good, fallback=True)
-    assert memory.remember(flagged) is True and memory.age == 1  # a flagged plan is not remembered
+    assert memory.remember(good.inputs, good.fallback) is False and memory.age == 0
+    assert memory.remember(good.inputs, True) is True and memory.age == 1  # a flagged plan is not remembered
     np.testing.assert_array_equal(memory.replacement(), good.inputs[2])
     for _ in range(len(good.inputs)):
         last = memory.replacement()
@@ -335,11 +336,11 @@ def _safe_only(sc, backup=BACKUP):
     """Arc check on positions only (tracking not certified), zero margins, with or without a backup."""
     n = sc.controller.horizon_steps
     return dataclasses.replace(Tightening.untightened(sc), margins=np.zeros((n, 4)), backup=backup,
-                               tiers={"safe": True, "tracking": False})
+                               tiers=Tiers(True, False))
 
 
 def test_the_backup_takes_over_when_the_replay_is_exhausted_and_tracking_resumes():
-    sc = _scenario(duration=4.0)
+    sc = _scenario(duration=4.0).with_changes(**{"controller.candidate": False})
     n = sc.controller.horizon_steps
     fail = range(5, 25)   # periods 5..24 fail; the plan of period 4 replays for n - 1 periods, then the backup
 
@@ -368,7 +369,7 @@ def test_the_backup_takes_over_when_the_replay_is_exhausted_and_tracking_resumes
 
 
 def test_the_backup_law_is_the_station_keeping_input_at_every_tick():
-    sc = _scenario(duration=2.0)
+    sc = _scenario(duration=2.0).with_changes(**{"controller.candidate": False})
     res = run_closed_loop(sc, tightening=_safe_only(sc), progress=False,
                           solver_factory=lambda s, t: Pursuit(s, t, nan_at=range(1, 100)))
     on = np.flatnonzero(res.backup_active[:-1])
@@ -380,7 +381,7 @@ def test_the_backup_law_is_the_station_keeping_input_at_every_tick():
 
 
 def test_without_a_backup_the_exhausted_replay_keeps_the_zero_input_and_says_so(caplog):
-    sc = _scenario(duration=2.0)
+    sc = _scenario(duration=2.0).with_changes(**{"controller.candidate": False})
     with caplog.at_level("WARNING", logger="tubekit.loop.closed_loop"):
         res = run_closed_loop(sc, tightening=_safe_only(sc, backup=None), progress=False,
                               solver_factory=lambda s, t: Pursuit(s, t, nan_at=range(1, 100)))
@@ -424,7 +425,7 @@ def test_with_a_rate_limit_no_command_jumps_more_than_j_between_periods():
 def test_with_a_rate_limit_the_run_starts_at_rest_and_a_ramped_backup_starts_from_the_last_command():
     """The first plan starts within J of 0 (the vehicle starts at rest); at the hand-over the ramped backup's first
     command is the last applied one (the blend), and every tick's command stays in V."""
-    sc = _scenario(duration=4.0).with_changes(**{"limits.rate": [0.5, 0.5, 1.0]})
+    sc = _scenario(duration=4.0).with_changes(**{"limits.rate": [0.5, 0.5, 1.0], "controller.candidate": False})
     ramped = dataclasses.replace(BACKUP, law=dataclasses.replace(BACKUP.law, surge_fade=0.2, yaw_fade=0.2, ramp=1.0))
     res = run_closed_loop(sc, tightening=_safe_only(sc, backup=ramped), solver_factory=_FailingFhocp, progress=False)
     jump = np.array([0.5, 0.5, 1.0]) * sc.controller.dt
@@ -436,3 +437,110 @@ def test_with_a_rate_limit_the_run_starts_at_rest_and_a_ramped_backup_starts_fro
                                  3 * sc.controller.dt / res.ticks_per_step, tuple(res.inputs[start - 1]))
     np.testing.assert_allclose(res.inputs[start + 3], want, atol=1e-15)
     assert not np.any(res.saturated)
+
+
+# ---- issue 30: every path safe (attacks 2 and 3 on the certified paper_currents) -------------------------------
+
+@pytest.fixture(scope="module")
+def paper_currents():
+    """The certified paper_currents design (both tiers, σ = 0) and a 3 s run of it (a shorter run is covered)."""
+    import verify
+    from tubekit.scenario import load_scenario
+
+    sc = load_scenario(verify.SCENARIOS_DIR / "paper_currents.toml")
+    cert = verify.certify(sc)
+    assert cert.certified and cert.tightening.sigma == 0.0
+    return sc.with_changes(duration=3.0), cert.tightening
+
+
+class _Tampered:
+    """The scenario's own FHOCP whose result is edited by ``edit(result, tightening)`` before the loop reads it."""
+
+    def __init__(self, edit):
+        self.edit = edit
+
+    def __call__(self, sc, tight):
+        from tubekit.fhocp.registry import make_solver
+        solver = make_solver(sc, tight)
+        edit = self.edit
+
+        class _Solver:
+            def solve(self, t, state, obstacles, v_last=None):
+                return edit(solver.solve(t, state, obstacles, v_last=v_last), tight)
+        return _Solver()
+
+
+def _extra_rows(result, tight):
+    """Attack 2: the N checked rows, then 60 more driving straight at full speed (never checked)."""
+    extra = np.tile([0.4, 0.0, 0.0], (60, 1))
+    return dataclasses.replace(result, inputs=np.vstack([result.inputs, extra]))
+
+
+def test_a_plan_with_more_rows_than_the_horizon_is_refused(paper_currents):
+    """Issue 30, attack 2: the loop used to store and replay every row; now a result with more than N rows is a
+    failed solve: nothing of it runs (no plan is accepted, the certified backup holds the vehicle)."""
+    sc, tight = paper_currents
+    res = run_closed_loop(sc, tight, solver_factory=_Tampered(_extra_rows), progress=False)
+    assert np.all(res.replaced[:-1]) and not np.any(res.saturated[:-1])
+    assert res.metrics["min_clearance"] > 0.0
+
+
+def _other_first_input(result, tight):
+    """Attack 2b: ``first_input`` that is not the plan's first row (the row the check verified)."""
+    class _Lying(type(result)):
+        @property
+        def first_input(self):
+            return np.array([0.4, 0.0, 0.5])
+    return _Lying(**{f.name: getattr(result, f.name) for f in dataclasses.fields(result)})
+
+
+def test_a_first_input_other_than_the_first_row_is_refused(paper_currents):
+    sc, tight = paper_currents
+    res = run_closed_loop(sc, tight, solver_factory=_Tampered(_other_first_input), progress=False)
+    assert np.all(res.replaced[:-1])
+    assert not np.any(np.all(np.isclose(res.v_hat[:-1], [0.4, 0.0, 0.5]), axis=1))
+
+
+def _above_v_bar(result, tight):
+    """Attack 3: the first row pushed 5e-10 m/s above V̄ = V (σ = 0), inside the check's old tolerance of 1e-9."""
+    inputs = np.array(result.inputs, dtype=float)
+    inputs[0, 0] = float(tight.v_max[0]) + 5e-10
+    return dataclasses.replace(result, inputs=inputs)
+
+
+def test_no_tolerance_outside_the_proof_a_plan_above_v_bar_never_clips(paper_currents):
+    """Issue 30, attack 3: a plan 5e-10 above V̄ was accepted and then clipped at every tick (220 clipped ticks in
+    100 s on paper_currents, breaking "inputs never clipped"); the loop now projects the plan onto V̄ and checks it
+    exactly, so the command applied is in V and nothing saturates."""
+    sc, tight = paper_currents
+    res = run_closed_loop(sc, tight, solver_factory=_Tampered(_above_v_bar), progress=False)
+    assert not np.any(res.saturated[:-1])
+    assert np.max(np.abs(res.inputs[:-1, 0])) <= float(tight.v_max[0])
+    assert not np.all(res.replaced[:-1])            # the projected plans are accepted
+
+
+def test_a_rejected_plan_is_replaced_by_the_shifted_candidate_and_tracking_is_kept(paper_currents):
+    """Issue 31: the solver answers once, then never again (every later result is refused); the loop no longer
+    replays that plan to its end and hands over to the backup: the shifted candidate passes the exact check
+    every period, so a plan is followed the whole time and every promise of both tiers is kept."""
+    import tubekit
+    sc, tight = paper_currents
+
+    class OnceThenNothing:
+        def __init__(self, s, t):
+            from tubekit.fhocp.registry import make_solver
+            self.solver, self.k = make_solver(s, t), -1
+
+        def solve(self, t, state, obstacles, v_last=None):
+            self.k += 1
+            if self.k > 0:
+                raise SolverError("refused on purpose")
+            return self.solver.solve(t, state, obstacles, v_last=v_last)
+
+    res = run_closed_loop(sc, tight, solver_factory=OnceThenNothing, progress=False)
+    assert np.all(res.candidate[1:]) and not res.candidate[0]
+    assert not np.any(res.backup_active) and np.all(res.plan_age == 0)
+    assert all(p.ok for p in tubekit.check_promises(res))
+    off = run_closed_loop(sc.with_changes(**{"controller.candidate": False}), tight, solver_factory=OnceThenNothing,
+                          progress=False)
+    assert np.any(off.backup_active) and not np.any(off.candidate)   # without it: replay, then the backup

@@ -5,15 +5,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from tubekit.fhocp.result import FhocpResult
 from tubekit.loop.memory import ZERO_INPUT, PlanMemory
 
 PLAN = np.column_stack([np.linspace(0.1, 0.4, 4), np.zeros(4), np.full(4, 0.2)])
-
-
-def _result(inputs=PLAN, fallback=False) -> FhocpResult:
-    return FhocpResult(status="optimal", states=np.zeros((len(inputs) + 1, 4)), inputs=inputs, cost=0.0,
-                       iterations=1, solve_time_s=0.0, setup_time_s=0.0, max_violation=0.0, fallback=fallback, t=0.0)
 
 
 def test_nothing_to_replay_is_exhausted_with_no_anchor():
@@ -24,7 +18,7 @@ def test_nothing_to_replay_is_exhausted_with_no_anchor():
 
 def test_an_accepted_plan_sets_the_anchor_and_replays_for_its_length_minus_one():
     memory = PlanMemory()
-    memory.remember(_result(), accepted=True, end=np.array([1.0, 2.0, 3.0, 0.5]))
+    memory.remember(PLAN, False, accepted=True, end=np.array([1.0, 2.0, 3.0, 0.5]))
     np.testing.assert_array_equal(memory.anchor, [1.0, 2.0, 3.0])
     replayed = [memory.replacement() for _ in range(3)]
     np.testing.assert_array_equal(replayed, PLAN[1:])
@@ -35,18 +29,18 @@ def test_an_accepted_plan_sets_the_anchor_and_replays_for_its_length_minus_one()
 
 def test_a_plan_remembered_without_acceptance_keeps_the_old_anchor():
     memory = PlanMemory(anchor=np.array([5.0, 5.0, 0.0]))
-    memory.remember(_result(), accepted=False, end=np.array([1.0, 2.0, 3.0, 0.0]))
+    memory.remember(PLAN, False, accepted=False, end=np.array([1.0, 2.0, 3.0, 0.0]))
     np.testing.assert_array_equal(memory.anchor, [5.0, 5.0, 0.0])
     assert not memory.exhausted and memory.age == 0
 
 
 def test_a_flagged_or_non_finite_plan_is_not_kept_and_ages_the_old_one():
     memory = PlanMemory()
-    memory.remember(_result(), accepted=True, end=np.zeros(4))
-    assert memory.remember(_result(fallback=True)) is True and memory.age == 1
+    memory.remember(PLAN, False, accepted=True, end=np.zeros(4))
+    assert memory.remember(PLAN, True) is True and memory.age == 1
     bad = PLAN.copy()
     bad[2, 0] = np.nan
-    memory.remember(_result(bad), accepted=True, end=np.ones(4))
+    memory.remember(bad, False, accepted=True, end=np.ones(4))
     assert memory.age == 2 and np.all(memory.anchor == 0.0)
 
 

@@ -11,11 +11,12 @@ import pytest
 
 from tubekit.jsonable import dumps
 from tubekit.loop.pipeline import CertifiedRun, certified_run
-from tubekit.loop.promises import PREMISES, check_promises
+from tubekit.loop.promises import check_promises
 from tubekit.model.backup import BackupPlan, axis_angle, line_of_sight_angle
 from tubekit.model.trajectory import Line
 from tubekit.scenario import Obstacle
 from tubekit.scenario import paper_scenario
+from tubekit.tiers import Tiers
 from tubekit.tightening import DisturbanceBound, Tightening
 
 pytest.importorskip("tubekit.fhocp")
@@ -30,7 +31,7 @@ def short():
 def zero_tube_certified(short):
     """A run under a tightening flagged certified whose tube is zero, its disturbance bound covering the
     scenario's current (so the premises hold): any disturbed run breaks the tube promise."""
-    tight = dataclasses.replace(Tightening.untightened(short), sigma=0.5, certified=True,
+    tight = dataclasses.replace(Tightening.untightened(short), sigma=0.5, tiers=Tiers(True, True),
                                 disturbance=DisturbanceBound(1.0, 1.0, 1.0))
     return certified_run(short, tight)
 
@@ -53,14 +54,14 @@ def test_a_certified_run_that_breaks_a_promise_fails_its_check(zero_tube_certifi
     assert done.certified and not done.promises_kept and done.check() is False
     assert "tube" in done.broken and done.metrics["promises_broken"] == list(done.broken)
     assert "broken: " in done.summary() and "tube" in done.summary().split("broken: ")[1]
-    assert done.tiers == {"safe": True, "tracking": True}
+    assert done.tiers == Tiers(True, True)
     line = done.summary()
     assert "\n" not in line and "certified" in line and "tube" in line
 
 
 def test_a_premise_failure_is_never_a_broken_promise(short):
     """The same zero tube, but a zero disturbance bound: the premise fails, so nothing is broken."""
-    tight = dataclasses.replace(Tightening.untightened(short), sigma=0.5, certified=True)
+    tight = dataclasses.replace(Tightening.untightened(short), sigma=0.5, tiers=Tiers(True, True))
     done = certified_run(short, tight)
     by_name = {p.name: p for p in done.promises}
     assert not by_name["disturbance"].ok and not by_name["tube"].ok
@@ -70,12 +71,12 @@ def test_a_premise_failure_is_never_a_broken_promise(short):
 
 
 def test_a_tier_the_certificate_did_not_give_is_reported_but_never_broken(short):
-    tight = dataclasses.replace(Tightening.untightened(short), sigma=0.0, certified=True,
-                                disturbance=DisturbanceBound(1.0, 1.0, 1.0), tiers={"safe": True, "tracking": False})
+    tight = dataclasses.replace(Tightening.untightened(short), sigma=0.0,
+                                disturbance=DisturbanceBound(1.0, 1.0, 1.0), tiers=Tiers(True, False))
     done = certified_run(short, tight)
     by_name = {p.name: p for p in done.promises}
     assert not by_name["tube"].ok and by_name["tube"].tier == "tracking" and not by_name["tube"].given
-    assert done.broken == () and done.check() is True and done.tiers == {"safe": True, "tracking": False}
+    assert done.broken == () and done.check() is True and done.tiers == Tiers(True, False)
 
 
 def test_the_same_run_uncertified_claims_nothing(short):
@@ -113,7 +114,7 @@ class BetweenTicks:
 
 def test_a_disturbance_over_its_bound_between_ticks_fails_the_premise_not_a_promise(short):
     """The issue's counterexample: the ticks see 0.12 m/s, the plant receives 0.36 m/s in between."""
-    tight = dataclasses.replace(Tightening.untightened(short), sigma=0.0, certified=True,
+    tight = dataclasses.replace(Tightening.untightened(short), sigma=0.0, tiers=Tiers(True, True),
                                 disturbance=DisturbanceBound(0.12, 0.1, 0.0))
     done = certified_run(short, tight, disturbance=BetweenTicks(0.12))
     ticks = done.run.omega[:-1]
@@ -140,8 +141,8 @@ def runaway():
     n, reg = sc.controller.horizon_steps, sc.region
     tight = dataclasses.replace(
         Tightening.untightened(sc), e_d_min=sc.epsilon + 0.05, obstacle_margin=0.05, margins=np.full((n, 4), 0.02),
-        tube=np.full(3, 0.05), disturbance=DisturbanceBound(0.12, 0.1, 0.02), certified=True,
-        backup=BackupPlan(cert.law, cert.safe_set, cert.handover), tiers={"safe": True, "tracking": True})
+        tube=np.full(3, 0.05), disturbance=DisturbanceBound(0.12, 0.1, 0.02),
+        backup=BackupPlan(cert.law, cert.safe_set, cert.handover), tiers=Tiers(True, True))
     return certified_run(sc, tight)
 
 
@@ -155,7 +156,7 @@ def test_the_backup_engages_and_every_safety_promise_holds(runaway):
         assert by_name[name].depends_on == ("disturbance",)
     assert by_name["disturbance"].ok and done.metrics["min_clearance"] > 0.0
     # recursive feasibility fails (no plan for many periods) - it guards tracking only
-    assert not by_name["recursive_feasibility"].ok and by_name["tube"].depends_on == PREMISES
+    assert not by_name["recursive_feasibility"].ok and by_name["tube"].depends_on == ("disturbance", "recursive_feasibility")
     assert done.broken == () and done.check() is True
 
 

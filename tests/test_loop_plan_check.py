@@ -16,6 +16,7 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
+from tubekit.tiers import Tiers
 from tubekit.loop.plan_check import RATE_TOLERANCE, PlanCheck, check_plan, check_rates, plan_arcs
 from tubekit.model.backup import BackupPlan, SafeSet, StationKeeping
 from tubekit.scenario import Obstacle
@@ -28,8 +29,8 @@ GRAZE = Obstacle((-2.0 + 0.14, 3.5, 0.0), 0.3002)
 
 def _tight(**changes) -> Tightening:
     base = dict(v_max=np.array([0.4, 0.3, 0.5]), e_d_min=0.5, e_o_max=0.5, e_z_max=1.0, e_d_max=3.0,
-                obstacle_margin=0.0, rho_tilde=0.0, sigma=1.0, margins=np.zeros((8, 4)), rates=np.zeros(4),
-                tube=np.zeros(3), region=np.array([0.5, 3.0, 1.0, 0.5]), certified=True)
+                obstacle_margin=0.0, sigma=1.0, margins=np.zeros((8, 4)), rates=np.zeros(4),
+                tube=np.zeros(3), region=np.array([0.5, 3.0, 1.0, 0.5]), tiers=Tiers(True, True))
     base.update(changes)
     return Tightening(**base)
 
@@ -188,7 +189,7 @@ def test_without_the_tracking_tier_only_position_constraints_are_checked(station
     tight = _tight(e_o_max=0.01, region=np.array([0.5, 3.0, 1.0, 0.01]), backup=BACKUP)
     assert check_plan(stationary, tight, 0.0, x0, PLAN, [], sign=-1).where == "|e_o|"
     safe_only = _tight(e_o_max=0.01, region=np.array([0.5, 3.0, 1.0, 0.01]), backup=BACKUP,
-                       tiers={"safe": True, "tracking": False})
+                       tiers=Tiers(True, False))
     res = check_plan(stationary, safe_only, 0.0, x0, PLAN, [], sign=-1)
     assert res.ok and res.where.startswith("terminal")
     blocked = Obstacle((-1.5, 4.2, 0.0), 0.3)  # 0.15 m from the footprint about the end (-1.686, 3.064)

@@ -10,13 +10,17 @@ from __future__ import annotations
 
 import math
 from dataclasses import replace
+from pathlib import Path
 
 import numpy as np
 import pytest
 
-from tubekit.loop.promises import Promise, check_promises
+from tubekit.loop.promises import PREMISES, TIER_OF, Promise, broken_promises, check_promises, current_bound
 from tubekit.loop.result import SimulationResult
+from tubekit.plant.kinematic import Plant
+from tubekit.scenario import Disturbance
 from tubekit.tightening import Tightening
+from tubekit.tiers import Tiers
 from tubekit.model.vehicles import PlantSettings
 
 TICKS, STEPS = 10, 3
@@ -25,9 +29,9 @@ TUBE = np.array([0.01, 0.01, 0.02])
 
 def _tight(**changes) -> Tightening:
     base = dict(v_max=np.array([0.35, 0.28, 0.35]), e_d_min=0.6, e_o_max=0.3, e_z_max=0.9, e_d_max=2.9,
-                obstacle_margin=0.1, rho_tilde=float(np.linalg.norm(TUBE)), sigma=10.0, margins=np.zeros((8, 4)),
+                obstacle_margin=0.1, sigma=10.0, margins=np.zeros((8, 4)),
                 rates=np.zeros(4), tube=TUBE, region=np.array([0.5, 3.0, 1.0, 0.5]),
-                disturbance=np.array([0.04, 0.02, 0.02]), certified=True)
+                disturbance=np.array([0.04, 0.02, 0.02]), tiers=Tiers(True, True))
     base.update(changes)
     return Tightening(**base)
 
@@ -179,9 +183,201 @@ def test_a_best_effort_run_is_refused_unless_asked(stationary):
     naming what is missing, instead of measuring an infinite tube ratio; ``uncertified=True`` measures it."""
     from tubekit.exceptions import ConfigError
 
-    best_effort = _run(stationary, tightening=_tight(certified=False, tube=np.zeros(3)))
+    best_effort = _run(stationary, tightening=_tight(tiers=Tiers(), tube=np.zeros(3)))
     with pytest.raises(ConfigError, match=r"^run\.tightening: expected a certified tightening .* best-effort "
                                           r"tightening, tube = \[0\.0, 0\.0, 0\.0\]"):
         check_promises(best_effort)
     figures = {p.name: p for p in check_promises(best_effort, uncertified=True)}
     assert figures["tube"].observed == math.inf  # asked for: a zero tube gives an infinite ratio
+
+
+# ---- issue 30: on the dynamic plant the premise is the water current; the derived bounds are promises ----------
+
+LOOP = (0.005, 0.005, 0.01)  # E (m/s, m/s, rad/s): the certificate's derived loop bound in these runs
+GAMMA = 0.02                 # γ̄ (m/s): its derived bound on the hull's sway
+WATER = Disturbance(amplitude=(0.0, 0.0, 0.0), constant=(0.03, 0.0, 0.02))  # a steady current at its bound
+
+
+def _design(scenario) -> dict:
+    """Tightening fields recording the design a certificate of ``scenario`` read (its current, its box)."""
+    from tubekit.design_inputs import DesignInputs
+    return {"design": DesignInputs.of(scenario, sigma=10.0)}
+
+
+def _dynamic(stationary, **changes) -> SimulationResult:
+    """A clean run on the dynamic plant: the hull at the command (no loop error, no sway) in the steady current
+    WATER, so ω = δ; ω̄ composed as the certificate does: ω̄_xy = ‖c_xy‖ + ‖(E_u, γ̄)‖, ω̄_z = |c_z| + E_w."""
+    sc = replace(stationary, plant=PlantSettings("dynamic", "bluerov2_heavy"), disturbance=WATER)
+    cxy, cz = current_bound(sc)
+    tight = _tight(velocity_loop=LOOP, disturbance=np.array([cxy + math.hypot(LOOP[0], GAMMA), cz + LOOP[1], GAMMA]),
+                   **_design(sc))
+    run = _run(stationary, scenario=sc, tightening=tight)
+    water = Plant(WATER).current(run.t)
+    water[-1] = np.nan
+    fields = dict(body=np.zeros((len(run.t), 4)), thrust=np.zeros((len(run.t), 3)), omega=water)
+    fields.update(changes)
+    return replace(run, **fields)
+
+
+def _off_the_hull(run, row: int, du: float = 0.0, vb: float = 0.0, dw: float = 0.0) -> SimulationResult:
+    """``run`` with the hull off its command at ``row`` (ψ = 0): ω gains (u_b - u, v_b, w_b - w), as the plant logs."""
+    body, omega = run.body.copy(), run.omega.copy()
+    body[row, :3] += [du, vb, dw]
+    omega[row] += [du, vb, dw]
+    return replace(run, body=body, omega=omega)
+
+
+def test_the_current_bound_is_the_certificates_current_term(stationary):
+    """max(a_x, a_y) + ||c_xy|| and a_z + |c_z| (verify.theorem.design.disturbance_bounds), by hand."""
+    sc = replace(stationary, disturbance=Disturbance(amplitude=(0.01, 0.04, 0.03), constant=(0.03, 0.04, -0.02)))
+    assert current_bound(sc) == pytest.approx((0.04 + 0.05, 0.03 + 0.02))
+
+
+def test_on_the_dynamic_plant_a_loop_error_over_its_bound_is_a_broken_promise_not_a_failed_premise(stationary):
+    """Issue 30: w_b - w = 0.02 > E_w = 0.005 lifts ω_z to 0.04 > ω̄_z = 0.025, while the current stays at its
+    bound 0.02: the premise (the current) holds and velocity_loop is broken (exit 4), no longer suppressed."""
+    clean = _dynamic(stationary)
+    assert all(p.ok for p in check_promises(clean)), [p for p in check_promises(clean) if not p.ok]
+    run = _off_the_hull(clean, 4, dw=0.02)
+    assert run.omega[4, 2] > run.tightening.disturbance.omega_z  # the old premise (total ω) fails here
+    by = {p.name: p for p in check_promises(run)}
+    assert by["disturbance"].ok and by["plant_in_box"].ok
+    assert not by["velocity_loop"].ok and by["velocity_loop"].observed == pytest.approx(4.0)
+    assert by["velocity_loop"].depends_on == ("disturbance", "recursive_feasibility", "plant_in_box")
+    assert broken_promises(list(by.values())) == ("velocity_loop",)
+
+
+def test_on_the_dynamic_plant_hull_sway_over_gamma_bar_is_a_broken_promise_not_a_failed_premise(stationary):
+    """v_b = 0.05 > γ̄ = 0.02 lifts ||ω_xy|| to ||(0.03, 0.05)|| = 0.058 > ω̄_xy = 0.051: sway is broken."""
+    run = _off_the_hull(_dynamic(stationary), 7, vb=0.05)
+    assert math.hypot(*run.omega[7, :2]) > run.tightening.disturbance.omega_xy
+    by = {p.name: p for p in check_promises(run)}
+    assert by["disturbance"].ok and not by["sway"].ok and by["sway"].observed == pytest.approx(0.05)
+    assert broken_promises(list(by.values())) == ("sway",)
+
+
+def test_the_dynamic_premise_reads_the_logged_current_and_its_peak_between_ticks(stationary):
+    """With the plant's ``current`` column and ``current_peak`` the premise reads them, not ω: a total ω
+    peak far over ω̄ leaves it held; a current peak over its bound between ticks fails it, and then the
+    broken loop bound is void (a premise failure is never a broken promise)."""
+    clean = _dynamic(stationary)
+    run = replace(_off_the_hull(clean, 4, dw=0.02), current=clean.omega.copy(), current_peak=(0.03, 0.02),
+                  omega_peak=(0.5, 0.5))
+    by = {p.name: p for p in check_promises(run)}
+    assert by["disturbance"].ok and "0.03, 0.02 m/s" in by["disturbance"].detail
+    assert broken_promises(list(by.values())) == ("velocity_loop",)
+    stormy = replace(run, current_peak=(0.03, 0.026))  # 0.006 m/s over a_z + |c_z| = 0.02, between ticks
+    by = {p.name: p for p in check_promises(stormy)}
+    assert not by["disturbance"].ok and by["disturbance"].observed == pytest.approx(0.006, abs=1e-11)
+    assert not by["velocity_loop"].ok and broken_promises(list(by.values())) == ()
+
+
+def test_the_kinematic_premise_still_reads_the_total_omega(stationary):
+    """On the kinematic plant ω = current + the sway model is what the certificate assumes: unchanged."""
+    run = _run(stationary)
+    omega = run.omega.copy()
+    omega[3] = [0.03, 0.04, 0.0]
+    by = {p.name: p for p in check_promises(replace(run, omega=omega))}
+    assert not by["disturbance"].ok and "plant_in_box" not in by
+    assert by["tube"].depends_on == ("disturbance", "recursive_feasibility")
+
+
+def test_plant_in_box_is_a_premise_of_both_tiers_on_the_dynamic_plant(stationary):
+    assert "plant_in_box" in PREMISES and TIER_OF["plant_in_box"] == "premise"
+    by = {p.name: p for p in check_promises(_dynamic(stationary))}
+    assert by["plant_in_box"].ok and by["plant_in_box"].tier == "premise" and by["plant_in_box"].depends_on == ()
+    for name in ("tube", "clearance", "sway", "velocity_loop"):
+        assert "plant_in_box" in by[name].depends_on
+
+
+def _scaled(factor: float) -> PlantSettings:
+    """The BlueROV2 Heavy with every coefficient of its nominal point times ``factor`` (a point vehicle)."""
+    nominal = PlantSettings("dynamic", "bluerov2_heavy").params.nominal.to_dict()
+    return PlantSettings("dynamic", "bluerov2_heavy",
+                         overrides={k: factor * v for k, v in nominal.items() if k != "actuation"})
+
+
+@pytest.mark.parametrize("factor", [0.2, 0.5, 1.6])
+def test_a_vehicle_outside_the_certified_box_fails_plant_in_box(stationary, factor):
+    """Issue 30: the vehicle simulated is the certified one with every coefficient times 0.2, 0.5 or 1.6; the
+    certificate's box is its design's vehicle. The premise fails naming the first coefficient outside (m), and
+    the promises resting on it are void."""
+    clean = _dynamic(stationary)
+    moved = replace(clean.scenario, plant=_scaled(factor))
+    run = _off_the_hull(replace(clean, scenario=moved), 4, dw=0.02)
+    by = {p.name: p for p in check_promises(run)}
+    p = by["plant_in_box"]
+    m = PlantSettings("dynamic", "bluerov2_heavy").params.m
+    assert not p.ok and p.observed > 1 and f"first m = {factor * m:.6g} outside [{m:.6g}, {m:.6g}]" in p.detail
+    assert by["disturbance"].ok and not by["velocity_loop"].ok and broken_promises(list(by.values())) == ()
+
+
+def test_a_truth_anywhere_in_the_box_keeps_plant_in_box(stationary):
+    """The midpoints (no truth) and a corner of the box (every interval at its low end) are in the box."""
+    clean = _dynamic(stationary)
+    box = clean.scenario.plant.params
+    assert box.interval_fields  # the shipped BlueROV2 Heavy is a box
+    corner = PlantSettings("dynamic", "bluerov2_heavy", truth={k: box.interval(k)[0] for k in box.interval_fields})
+    for run in (clean, replace(clean, scenario=replace(clean.scenario, plant=corner))):
+        p = _promise(run, "plant_in_box")
+        assert p.ok and p.observed == 0.0 and "every coefficient inside" in p.detail
+    no_design = replace(clean, tightening=replace(clean.tightening, design=None),
+                        scenario=replace(clean.scenario, plant=_scaled(1.6)))
+    assert _promise(no_design, "plant_in_box").ok  # no design recorded: the run's own vehicle is the box
+
+
+SLOW = Path(__file__).resolve().parents[1] / "examples" / "bluerov2_slow.toml"
+
+
+@pytest.fixture(scope="module")
+def slow_cert():
+    """The certificate of examples/bluerov2_slow.toml (both tiers, a few seconds)."""
+    import verify
+    from tubekit import load_scenario
+    return verify.certify(load_scenario(SLOW))
+
+
+def test_a_real_dynamic_run_over_its_loop_bound_reports_velocity_loop_broken(slow_cert):
+    """End to end (issue 30): the certified examples/bluerov2_slow.toml for 4 s, with the loop bound E replaced by
+    E / 1000 and ω̄ recomposed from it (current bound + ||(E_u, γ̄)||, + E_w). The loop error exceeds that E
+    hundreds of times and the total ω exceeds ω̄_z (the premise as it was failed and suppressed the promise);
+    the water current the plant logged stays within its certified bound, so velocity_loop is broken."""
+    import tubekit
+    from tubekit import load_scenario
+    sc = load_scenario(SLOW)
+    tight = slow_cert.tightening
+    tiny = tuple(e / 1000.0 for e in tight.velocity_loop)
+    cxy, cz = current_bound(sc)
+    gamma = tight.disturbance.sway
+    tight = replace(tight, velocity_loop=tiny, disturbance=(cxy + math.hypot(tiny[0], gamma), cz + tiny[1], gamma))
+    run = tubekit.simulate(sc, tight, duration=4.0, progress=False)
+    assert run.omega_peak[1] > tight.disturbance.omega_z
+    by = {p.name: p for p in check_promises(run)}
+    assert not by["velocity_loop"].ok and by["velocity_loop"].observed > 100.0
+    assert by["disturbance"].ok and by["plant_in_box"].ok and by["recursive_feasibility"].ok
+    assert "velocity_loop" in broken_promises(list(by.values()))
+    np.testing.assert_array_equal(run.current, Plant(sc.disturbance).current(run.t))  # logged apart from ω
+    assert run.current_peak[0] <= cxy + 1e-12 and run.current_peak[1] <= cz + 1e-12
+
+
+def _p(name, ok, tier, depends_on=("disturbance",), observed=0.0):
+    from tubekit.loop.promises import Promise
+    return Promise(name, observed, 1.0, ok, "", tier=tier, depends_on=depends_on, given=True)
+
+
+@pytest.mark.parametrize("promises, tiers, want", [
+    ([_p("clearance", True, "safe"), _p("tube", True, "tracking", ("disturbance", "recursive_feasibility")),
+      _p("disturbance", True, "premise", ()), _p("recursive_feasibility", True, "premise", ())],
+     Tiers(True, True), {"safe": "certified, kept", "tracking": "certified, kept"}),
+    ([_p("clearance", True, "safe"), _p("tube", False, "tracking", ("disturbance", "recursive_feasibility")),
+      _p("disturbance", True, "premise", ()), _p("recursive_feasibility", False, "premise", ())],
+     Tiers(True, True), {"safe": "certified, kept",
+                         "tracking": "certified, not in force (recursive_feasibility failed)"}),
+    ([_p("clearance", False, "safe"), _p("disturbance", True, "premise", ())],
+     Tiers(True, False), {"safe": "certified, BROKEN (clearance)", "tracking": "not certified"}),
+    ([_p("clearance", True, "safe")], Tiers(), {"safe": "not certified", "tracking": "not certified"}),
+])
+def test_each_tier_says_what_happened_on_the_run(promises, tiers, want):
+    """Issue 31, item 3: a certified tier is reported with its outcome (kept, BROKEN, not in force), never alone."""
+    from tubekit.loop.promises import tier_outcomes
+    assert tier_outcomes(promises, tiers) == want

@@ -18,8 +18,9 @@ from tubekit.exceptions import ConfigError
 from tubekit.jsonable import dumps
 from tubekit.loop.metrics import METRIC_KEYS, RUN_KEYS
 from tubekit.loop.promises import check_promises
-from tubekit.loop.result import CSV_COLUMNS, LOG_FIELDS, LogArrays, SimulationResult, allocate_log
+from tubekit.loop.result import CSV_COLUMNS, DYNAMIC_COLUMNS, LOG_FIELDS, LogArrays, SimulationResult, allocate_log
 from tubekit.tightening import Tightening
+from tubekit.tiers import Tiers
 
 TICKS, STEPS = 10, 3
 ROWS = STEPS * TICKS + 1
@@ -28,9 +29,9 @@ TUBE = np.array([0.01, 0.01, 0.02])
 
 def _tight(**changes) -> Tightening:
     base = dict(v_max=np.array([0.35, 0.28, 0.35]), e_d_min=0.6, e_o_max=0.3, e_z_max=0.9, e_d_max=2.9,
-                obstacle_margin=0.1, rho_tilde=float(np.linalg.norm(TUBE)), sigma=10.0, margins=np.zeros((8, 4)),
+                obstacle_margin=0.1, sigma=10.0, margins=np.zeros((8, 4)),
                 rates=np.zeros(4), tube=TUBE, region=(0.5, 3.0, 1.0, 0.5), disturbance=(0.04, 0.02, 0.03),
-                certified=True)
+                tiers=Tiers(True, True))
     base.update(changes)
     return Tightening(**base)
 
@@ -64,7 +65,7 @@ def test_the_result_and_the_loop_buffer_take_their_arrays_from_log_fields():
     from tubekit.loop.closed_loop import _Log
 
     names = [f.name for f in LOG_FIELDS]
-    assert len(names) == len(set(names)) == 19 and {"backup_active", "backup_anchor"} <= set(names)
+    assert len(names) == len(set(names)) == 20 and {"backup_active", "backup_anchor", "candidate"} <= set(names)
     assert issubclass(SimulationResult, LogArrays) and issubclass(_Log, LogArrays)
     assert {f.name for f in dataclasses.fields(LogArrays)} == set(names)
     assert set(names) <= {f.name for f in dataclasses.fields(_Log)}
@@ -115,7 +116,7 @@ def test_a_tube_runs_metrics_carry_its_promises_and_bounds(stationary):
 
 
 def test_an_uncertified_run_has_no_rho_bound_and_a_zero_tube_is_an_infinite_ratio(stationary):
-    m = _run(stationary, tightening=_tight(certified=False, tube=np.zeros(3))).metrics
+    m = _run(stationary, tightening=_tight(tiers=Tiers(), tube=np.zeros(3))).metrics
     assert m["certified"] is False and m["rho_bound"] is None
     assert m["max_rho_ratio"] is None and m["promises_kept"] is False  # inf is null in strict JSON
 
@@ -133,3 +134,18 @@ def test_step_timings_in_the_metrics_come_from_the_logged_periods(stationary):
     m = _run(stationary).metrics
     assert m["steps"] == STEPS and m["step_ms_median"] == 2.0
     assert m["fhocp_max_violation"] == 2e-3 and math.isclose(m["wall_s"], 0.3)
+
+
+def test_a_dynamic_log_writes_the_water_current_after_the_hull(stationary):
+    """Issue 30: a dynamic run's CSV ends with the water current the plant applied (current_1..3, m/s), apart
+    from omega_1..3; NaN when the log holds none; a kinematic log has neither."""
+    body, thrust = np.zeros((ROWS, 4)), np.zeros((ROWS, 3))
+    current = np.tile([0.01, -0.02, 0.005], (ROWS, 1))
+    cols = _run(stationary, body=body, thrust=thrust, current=current, current_peak=(0.03, 0.01)).columns()
+    assert tuple(cols) == CSV_COLUMNS + DYNAMIC_COLUMNS
+    assert DYNAMIC_COLUMNS[-3:] == ("current_1", "current_2", "current_3")
+    np.testing.assert_array_equal(np.column_stack([cols["current_1"], cols["current_2"], cols["current_3"]]), current)
+    unlogged = _run(stationary, body=body, thrust=thrust).columns()
+    assert np.all(np.isnan(unlogged["current_1"]))
+    kinematic = _run(stationary)
+    assert kinematic.current is None and kinematic.current_peak is None and tuple(kinematic.columns()) == CSV_COLUMNS

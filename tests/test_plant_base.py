@@ -4,6 +4,7 @@ the Protocol with its parameters, and behave as it documents on a case worked ou
 from __future__ import annotations
 
 import inspect
+import math
 from dataclasses import replace
 
 import numpy as np
@@ -37,7 +38,8 @@ def missing_from(cls: type) -> list[str]:
 
 
 def test_the_protocol_names_what_the_loop_calls():
-    assert PROTOCOL_METHODS == ["current_at", "history", "omega_peak", "omega_series", "step", "step_tuple"]
+    assert PROTOCOL_METHODS == ["current_at", "current_peak", "current_series", "history", "omega_peak", "omega_series",
+                                "step", "step_tuple"]
 
 
 @pytest.mark.parametrize("cls", [Plant, DynamicPlant])
@@ -52,6 +54,8 @@ def test_the_structural_check_rejects_a_plant_that_lacks_a_method_or_renames_a_p
         def current_at(self, t): ...
         def omega_series(self, t, states, inputs): ...
         def omega_peak(self): ...
+        def current_series(self, t): ...
+        def current_peak(self): ...
 
     class Renamed(NoHistory):
         def history(self): ...
@@ -131,3 +135,19 @@ def test_omega_series_measures_the_water_at_rest_and_nan_without_an_input(kind):
     assert omega.shape == (ticks + 1, 3)
     assert omega[:ticks] == pytest.approx(np.tile(WATER, (ticks, 1)), abs=1e-12)
     assert np.all(np.isnan(omega[ticks]))
+
+
+@pytest.mark.parametrize("kind", ["kinematic", "dynamic"])
+def test_only_the_dynamic_plant_reports_the_water_current_apart(kind):
+    """The dynamic plant's ω holds the hull's sway and the loop error besides the water (issue 30): it reports
+    the water apart, at the ticks and over every stage (here the override: exactly WATER). The kinematic
+    plant's ω is what the certificate assumes, not split: None."""
+    plant = _plant(kind, override=lambda t: WATER)
+    plant.step_tuple(0.0, (0.0, 0.0, 0.0, 0.0), (0.3, 0.05, 0.2), 0.01, 5)
+    t = np.array([0.0, 0.05])
+    if kind == "kinematic":
+        assert plant.current_series(t) is None and plant.current_peak() is None
+        return
+    assert plant.current_series(t).shape == (2, 3) and np.all(plant.current_series(t) == WATER)
+    assert plant.current_peak() == (math.hypot(WATER[0], WATER[1]), abs(WATER[2]))
+    assert plant.omega_peak() != plant.current_peak()  # ω also holds the hull's sway and the loop error

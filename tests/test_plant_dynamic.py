@@ -16,7 +16,7 @@ from tubekit.model.kinematics import SwayModel
 from tubekit.plant.kinematic import Plant
 from tubekit.scenario import Disturbance
 from tubekit.model.vehicles import BLUEROV2_HEAVY, REMUS100, PlantSettings
-from verify.design import hull_sway_bound
+from verify.theorem.design import hull_sway_bound
 
 CALM = Disturbance(amplitude=(0.0, 0.0, 0.0), sway=SwayModel(gain=0.0, amplitude=0.0, bound=0.0))
 REMUS = REMUS100.nominal  # a point of the box: the default truth
@@ -225,3 +225,21 @@ def test_the_omega_peak_covers_every_tick_and_the_stages_between():
     peak_xy, peak_z = plant.omega_peak()
     assert peak_xy >= np.max(np.hypot(omega[:, 0], omega[:, 1])) - 1e-12
     assert peak_z >= np.max(np.abs(omega[:, 2])) - 1e-12
+
+
+def test_the_water_current_is_logged_apart_from_omega_at_the_ticks_and_every_stage():
+    """Issue 30: at the ticks the logged current is the scenario's current itself; over every RK4 stage its peak
+    covers the tick values and stays within the current's bound max(a_x, a_y), a_z (no constant here)."""
+    sc = paper_scenario().with_changes(plant=PlantSettings("dynamic"))
+    plant = DynamicPlant(sc)
+    assert plant.current_peak() == (0.0, 0.0)
+    _run(plant, _commands(30), 2)
+    t = np.arange(31) * 0.01
+    current = plant.current_series(t)
+    np.testing.assert_array_equal(current, Plant(sc.disturbance).current(t))
+    peak_xy, peak_z = plant.current_peak()
+    assert peak_xy >= np.max(np.hypot(current[:, 0], current[:, 1])) - 1e-15
+    assert peak_z >= np.max(np.abs(current[:, 2])) - 1e-15
+    amplitude = sc.disturbance.amplitude
+    assert sc.disturbance.constant == (0.0, 0.0, 0.0)
+    assert peak_xy <= max(amplitude[0], amplitude[1]) + 1e-12 and peak_z <= amplitude[2] + 1e-12

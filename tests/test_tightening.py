@@ -10,6 +10,7 @@ import pytest
 import verify
 from tubekit.exceptions import ConfigError
 from tubekit.scenario import load_scenario, paper_scenario
+from tubekit.tiers import Tiers
 from tubekit.tightening import MARGIN_COLUMNS, DisturbanceBound, RegionBounds, Tightening
 
 
@@ -24,7 +25,7 @@ def test_untightened_is_the_scenario():
     assert t.region == RegionBounds(epsilon=sc.epsilon, e_d_max=sc.region.e_d_max, e_z_max=sc.region.e_z_max,
                                     e_o_max=sc.region.e_o_max)
     assert np.all(t.tube == 0) and t.disturbance == DisturbanceBound(0.0, 0.0, 0.0) and t.margins.shape == (0, 4)
-    assert t.law is None and t.design_key is None and t.design_fields is None   # the baseline is not checked
+    assert t.law is None and t.design_key is None and t.design is None   # the baseline is not checked
 
 
 def test_untightened_does_not_share_the_limits_array():
@@ -40,7 +41,7 @@ def test_margin_columns():
 
 def test_horizon_arcs_is_the_number_of_margin_rows():
     t = Tightening(v_max=np.ones(3), e_d_min=0.5, e_o_max=0.4, e_z_max=0.9, e_d_max=2.9, obstacle_margin=0.1,
-                   rho_tilde=0.0, sigma=1.0, margins=np.zeros((5, 4)))
+                   sigma=1.0, margins=np.zeros((5, 4)))
     assert t.horizon_arcs == 5
 
 
@@ -61,7 +62,7 @@ def test_certified_tightening_is_the_pontryagin_difference():
 
 def _plain(**changes) -> Tightening:
     return Tightening(v_max=np.ones(3), e_d_min=0.5, e_o_max=0.4, e_z_max=0.9, e_d_max=2.9, obstacle_margin=0.1,
-                      rho_tilde=0.0, sigma=1.0, **changes)
+                      sigma=1.0, **changes)
 
 
 def test_region_and_disturbance_are_named_and_accept_numbers_in_order():
@@ -93,11 +94,11 @@ def test_only_a_certified_backup_imposes_the_terminal_condition():
 
     plan = BackupPlan(StationKeeping(0.2, 0.5, 0.05, 0.3, 0.04), SafeSet(0.75, 0.4, 0.08), (0.1, 0.05))
     base = Tightening.untightened(paper_scenario())
-    assert replace(base, backup=plan).terminal_backup is plan  # no tiers stated: enforced
-    assert replace(base, backup=plan, tiers={"safe": True, "tracking": False}).terminal_backup is plan
-    assert replace(base, backup=plan, tiers={"safe": False, "tracking": False}).terminal_backup is None
+    assert replace(base, backup=plan).terminal_backup is None  # no tier given (the baseline's): not enforced
+    assert replace(base, backup=plan, tiers=Tiers(True, False)).terminal_backup is plan
+    assert replace(base, backup=plan, tiers=Tiers(False, False)).terminal_backup is None
     assert base.terminal_backup is None
-    assert replace(base, backup=plan).terminal_rest and not base.terminal_rest
+    assert replace(base, backup=plan, tiers=Tiers(True, True)).terminal_rest and not base.terminal_rest
     ramped = BackupPlan(replace(plan.law, surge_fade=0.1, yaw_fade=0.1, ramp=1.0), plan.safe_set, plan.handover)
     assert not replace(base, backup=ramped).terminal_rest  # it blends from the last command instead
-    assert not replace(base, backup=plan, tiers={"safe": False, "tracking": False}).terminal_rest
+    assert not replace(base, backup=plan, tiers=Tiers(False, False)).terminal_rest

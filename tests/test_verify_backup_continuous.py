@@ -13,7 +13,7 @@ from tubekit.model.backup import SafeSet, StationKeeping
 from verify.backup import certify_backup
 from verify.backup.continuous import (_rate_upper, cone_angle, continuous_rate_bound, shape_enclosure,
                                       unstable_condition, yaw_shape_enclosure)
-from verify.intervals import lower, upper
+from verify.kernel.intervals import lower, upper
 
 LIMITS = (0.4, 0.3, 0.5)
 TICK = 0.01

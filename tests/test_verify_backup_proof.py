@@ -188,8 +188,11 @@ def test_the_smooth_certificate_round_trips_and_an_old_one_still_reads():
                           yaw_rate_error=0.01)
     assert BackupCertificate.from_dict(cert.to_dict()) == cert
     old = certify_backup(LAW, SAFE, omega_xy=0.12, omega_z=0.1, limits=LIMITS, tick=TICK).to_dict()
-    # an unfaded law at E_r = 0 writes the keys it wrote before issue 22, and reads back
-    assert set(old["law"]) == {"surge", "yaw_rate", "yaw_band", "heave", "heave_band"} and "yaw_rate_error" not in old
+    # an unfaded law at E_r = 0 writes the keys it wrote before issue 22, and its kind (issue 30)
+    assert set(old["law"]) == {"kind", "surge", "yaw_rate", "yaw_band", "heave", "heave_band"}
+    assert old["law"]["kind"] == "station_keeping" and "yaw_rate_error" not in old
+    assert BackupCertificate.from_dict(old).law == LAW
+    del old["law"]["kind"]  # a certificate written before issue 30 stored no kind: station keeping
     assert BackupCertificate.from_dict(old).law == LAW
 
 

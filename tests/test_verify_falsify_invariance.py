@@ -11,7 +11,7 @@ from hypothesis import given
 from tubekit.model.ancillary import LAWS
 from verify.falsify import strategies as vs
 from verify.falsify.invariance import TubeConfiguration, one_period_ratio, rho_dot_inner
-from verify.region import Region
+from verify.kernel.region import Region
 
 from .independent import fd_rho_dot_inner
 

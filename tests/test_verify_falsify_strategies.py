@@ -12,7 +12,7 @@ from hypothesis import strategies as st
 from tubekit.model.errors import error_coordinates
 from tubekit.exceptions import ConfigError
 from verify.falsify import strategies as vs
-from verify.region import Region
+from verify.kernel.region import Region
 
 REGION = Region(e_d=(0.2, 3.0), e_z=(-1.0, 1.0), e_o=(-0.8, 0.8), heading="both", pd_dot_max=(0.3, 0.2, 0.05),
                 pd_dot_xy_max=0.3, omega_bar=0.15, v_max=(0.4, 0.3, 0.5))

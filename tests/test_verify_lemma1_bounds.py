@@ -29,7 +29,7 @@ from tubekit.model.errors import numeric
 from tubekit.scenario import load_scenario, paper_scenario
 from verify.lemma1.bounds import compute_bounds
 from verify.lemma1.polar import A_V, B_V, ALPHA, BETA, E_D, E_O, law_gain, polar_model
-from verify.region import Region
+from verify.kernel.region import Region
 from verify import SCENARIOS_DIR
 
 GAP = 0.05

@@ -23,7 +23,7 @@ from tubekit.exceptions import ConfigError
 from tubekit.scenario import load_scenario, paper_scenario
 from verify import SCENARIOS_DIR
 from verify.lemma1 import ROUTE_BUDGET, PaperRoute, paper_route
-from verify.region import Region
+from verify.kernel.region import Region
 
 CURRENTS = load_scenario(SCENARIOS_DIR / "paper_currents.toml")
 SCENARIOS = {"paper_currents": CURRENTS, "paper": paper_scenario(),
@@ -98,7 +98,7 @@ def test_why_not_the_verdict_names_the_loop_that_runs():
     c = CURRENTS.controller
     assert "\n" not in line
     for part in ("reset", "ZOH", f"delta = {c.dt:g} s", f"h = {1 / c.ancillary_rate_hz:g} s",
-                 "(J(e) - J(e_i)) kappa_i", "verify.sampled"):
+                 "(J(e) - J(e_i)) kappa_i", "verify.theorem.sampled"):
         assert part in line
 
 

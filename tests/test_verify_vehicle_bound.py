@@ -15,7 +15,7 @@ from tubekit.model.vehicle_sets import BLUEROV2_HEAVY, REMUS100
 from tubekit.model.vehicles import PlantSettings
 from tubekit.plant.dynamic import DynamicPlant, body_forces
 from tubekit.scenario import Disturbance
-from verify.design import hull_sway_bound
+from verify.theorem.design import hull_sway_bound
 from verify.vehicle.bound import actuator_authority, loop_matrix, rate_authority_conditions, velocity_loop_bound
 
 CALM = Disturbance(amplitude=(0.0, 0.0, 0.0), sway=SwayModel(gain=0.0, amplitude=0.0, bound=0.0))

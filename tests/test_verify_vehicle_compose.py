@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from tubekit.tiers import Tiers
+
 import json
 import math
 
@@ -9,9 +11,9 @@ import numpy as np
 import pytest
 
 from tubekit.scenario import load_scenario, scenario_from_dict
-from verify.certificate import Certificate, certify
+from verify.certificate.certify import Certificate, certify
 from verify.vehicle.compose import PLAN_CHECK_TOLERANCE, plan_jumps
-from verify.recheck import recheck
+from verify.studies.recheck import recheck
 
 PAPER_CURRENTS = "verify/scenarios/paper_currents.toml"
 
@@ -45,7 +47,7 @@ def test_the_tolerance_is_the_plan_checks():
 def test_a_dynamic_scenario_without_a_rate_limit_is_refused_by_name():
     cert = certify(_dynamic())
     assert "limits_rate" in _failed(cert)
-    assert cert.tiers == {"safe": False, "tracking": False}
+    assert cert.tiers == Tiers(False, False)
     assert cert.velocity_loop is not None and cert.sigma.value == 0.0
 
 
@@ -56,7 +58,7 @@ def test_remus_fins_cannot_turn_or_heave_at_low_speed():
     assert {"loop_saturation[Z]", "loop_saturation[N]"} <= failed
     text = next(c for c in cert.plant_conditions if c.condition == "loop_saturation[N]")
     assert text.rhs == 0.0                                   # the smallest yaw moment over |u| <= u_max
-    assert not cert.tiers["safe"]
+    assert not cert.tiers.safe
 
 
 def test_a_kinematic_certificate_has_no_loop_part():
@@ -90,7 +92,7 @@ def test_an_edited_loop_bound_is_caught_by_recheck():
         loop["error"] = [0.0, 0.0, 0.0]
     else:
         loop["error"] = [x / 2 for x in loop["error"]]
-    from verify.certificate_json import checksum_of
+    from verify.certificate.jsonio import checksum_of
     data["checksum"] = checksum_of(data)
     result = recheck(data)
     assert not result.ok
@@ -110,7 +112,7 @@ def slow_cert():
 def test_the_slow_bluerov2_scenario_certifies_both_tiers_with_a_closed_fixed_point(slow_cert):
     """The fixed point closes: the derived E is below the assumed E_a in every channel, the backup that the gentle
     search chose is certified and its per-tick jumps are what the loop bound used."""
-    assert slow_cert.certified and slow_cert.tiers == {"safe": True, "tracking": True}
+    assert slow_cert.certified and slow_cert.tiers == Tiers(True, True)
     consistent = next(c for c in slow_cert.plant_conditions if c.condition == "loop_consistent")
     assert consistent.ok and consistent.lhs < 1.0
     loop, law = slow_cert.velocity_loop, slow_cert.backup.law
@@ -152,7 +154,7 @@ def test_a_forced_backup_from_a_moving_state_keeps_every_promise_and_tracking_re
                 raise SolverError("injected")
             return self.inner.solve(t, state, obstacles, v_last=v_last)
 
-    sc = load_scenario(SLOW).with_changes(duration=40.0)
+    sc = load_scenario(SLOW).with_changes(duration=40.0, **{"controller.candidate": False})  # the backup, not the candidate
     res = run_closed_loop(sc, tightening=slow_cert.tightening, solver_factory=_Failing, progress=False)
     m = res.metrics
     assert m["backup_engagements"] == 1 and m["backup_s"] > 10.0
@@ -162,3 +164,61 @@ def test_a_forced_backup_from_a_moving_state_keeps_every_promise_and_tracking_re
     assert np.linalg.norm(res.inputs[start - 1]) > 0.05  # the vehicle was moving
     broken = [p.name for p in tubekit.check_promises(res) if not p.ok and p.name != "recursive_feasibility"]
     assert broken == []
+
+
+# ---- the fixed point for a given backup law (issue 30) --------------------------------------------------------
+
+@pytest.fixture(scope="module")
+def slow_solution(slow_cert):
+    """solve_dynamic on the slow scenario, with the certificate's gains (the fixed point certify ran)."""
+    from verify.kernel.region import Region
+    from verify.vehicle.compose import solve_dynamic
+    sc = load_scenario(SLOW)
+    return sc, solve_dynamic(sc, Region.from_scenario(sc), slow_cert.gains, (0.0,))
+
+
+def test_the_loop_for_the_designed_law_is_the_last_round_number_for_number(slow_cert, slow_solution):
+    """loop_for_law (no design) on the law the fixed point designed, at its E_a, is its last round exactly: what
+    ``tubekit recheck`` evaluates on the stored law."""
+    from verify.vehicle.compose import loop_for_law
+    sc, sol = slow_solution
+    given = loop_for_law(sc, sol.backup.law, sol.backup.safe_set, sol.assumed, 0.0)
+    assert given.loop == sol.loop == slow_cert.velocity_loop
+    assert given.conditions == sol.conditions == slow_cert.plant_conditions
+    assert given.dist == sol.dist == slow_cert.disturbance and given.assumed == sol.assumed
+
+
+def test_a_faster_law_is_charged_its_own_command_rate(slow_solution):
+    """The same safe set with a heave band 100 times narrower: its heave command changes faster, the loop is charged
+    for it (per-tick heave jump up), and the fixed point no longer closes (``loop_consistent``)."""
+    import dataclasses
+    from verify.vehicle.compose import loop_for_law
+    sc, sol = slow_solution
+    fast = dataclasses.replace(sol.backup.law, heave_band=0.01 * sol.backup.law.heave_band)
+    given = loop_for_law(sc, fast, sol.backup.safe_set, sol.assumed, 0.0)
+    assert given.loop.jump_tick[1] > 10 * sol.loop.jump_tick[1]
+    assert given.loop.jump_tick[0] == sol.loop.jump_tick[0] and given.loop.jump_tick[2] == sol.loop.jump_tick[2]
+    consistent = next(c for c in given.conditions if c.condition == "loop_consistent")
+    assert consistent.ok is False
+
+
+def test_loop_for_law_refuses_a_bad_assumption(slow_solution):
+    from tubekit.exceptions import ConfigError
+    from verify.vehicle.compose import loop_for_law
+    sc, sol = slow_solution
+    with pytest.raises(ConfigError, match=r"assumed\[1\]"):
+        loop_for_law(sc, sol.backup.law, sol.backup.safe_set, (0.05, -1.0, 0.07), 0.0)
+    with pytest.raises(ConfigError, match="assumed"):
+        loop_for_law(sc, sol.backup.law, sol.backup.safe_set, (0.05, 0.07), 0.0)
+
+
+def test_the_last_round_compares_e_with_the_assumption_it_was_derived_with(monkeypatch):
+    """With one round allowed the slow scenario's fixed point does not close (it needs four): ``loop_consistent``
+    fails. Before issue 30 the last round raised E_a after deriving ω̄ with the old one, and compared E with the
+    raised bound: E/E_a = 1/1.05 < 1, a closed fixed point claimed and the certificate certified."""
+    import verify.vehicle.compose as compose
+    monkeypatch.setattr(compose, "FIXED_POINT_ROUNDS", 1)
+    cert = certify(load_scenario(SLOW))
+    consistent = next(c for c in cert.plant_conditions if c.condition == "loop_consistent")
+    assert consistent.ok is False and consistent.lhs >= 1.0
+    assert not cert.certified and not cert.tiers.safe

@@ -10,7 +10,7 @@ from tubekit.exceptions import ConfigError
 from tubekit.model.vehicle_params import VehicleParams
 from tubekit.model.vehicle_sets import BLUEROV2_HEAVY, REMUS100
 from tubekit.plant.dynamic import body_forces
-from verify.intervals import lower, upper
+from verify.kernel.intervals import lower, upper
 from verify.vehicle.model import (arb_body_forces, body_force_gradient, channel_forces, channel_gradient, channel_masses,
                                channel_mismatch, channel_mismatch_gradient, field_ball, hull_balls, nominal_balls,
                                point_time_constant, thrust_floor, velocity_box)

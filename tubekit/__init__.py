@@ -11,7 +11,8 @@ from __future__ import annotations
 
 from typing import Any
 
-from tubekit.api import simulate
+from tubekit.api import Certified, simulate
+from tubekit.design_inputs import DesignInputs
 from tubekit.exceptions import ConfigError, NotAvailableError, ShapeError, SolverError, TubekitError
 from tubekit.loop.promises import Promise, check_promises
 from tubekit.loop.result import SimulationResult
@@ -22,6 +23,7 @@ from tubekit.model.trajectory import Circle, Helix, Line, Trajectory, Waypoints
 from tubekit.scenario import (ControllerSettings, Disturbance, Obstacle, RegionSettings, Scenario,
                               load_scenario, paper_scenario, scenario_from_dict)
 from tubekit.tightening import Tightening
+from tubekit.tiers import Tiers
 from tubekit.version import __version__
 
 __all__ = [
@@ -33,7 +35,7 @@ __all__ = [
     "Trajectory", "Circle", "Helix", "Line", "Waypoints",
     "Obstacle", "Disturbance", "ControllerSettings", "RegionSettings", "Scenario",
     "paper_scenario", "load_scenario", "scenario_from_dict",
-    "Tightening",
+    "Tightening", "Tiers", "DesignInputs", "Certified",
     "simulate", "SimulationResult", "Promise", "check_promises",
 ]
 

@@ -13,10 +13,10 @@ says what to do when it is not certified. With no certificate the nominal MPC al
 
 from __future__ import annotations
 
-from typing import Any
+import warnings
+from typing import Protocol, runtime_checkable
 
-from tubekit.checks import check_run_inputs
-from tubekit.design_key import require_matching
+from tubekit.checks import check_run_inputs, unit_hints
 from tubekit.loop.closed_loop import run_closed_loop
 from tubekit.exceptions import ConfigError, TubekitError
 from tubekit.scenario import Scenario
@@ -24,10 +24,20 @@ from tubekit.loop.result import SimulationResult
 from tubekit.tightening import Tightening
 from tubekit.validation import duration_seconds
 
-__all__ = ["simulate"]
+__all__ = ["simulate", "Certified"]
 
 
-def _tightening_of(certificate: Any) -> Tightening:
+@runtime_checkable
+class Certified(Protocol):
+    """What a run needs of a certificate (``verify.Certificate`` has it): the tightening it hands out."""
+
+    @property
+    def tightening(self) -> Tightening:
+        """The certified tightening (raises when not even the safe tier is certified)."""
+        ...
+
+
+def _tightening_of(certificate: Certified | Tightening) -> Tightening:
     """The Tightening of a certificate (or a Tightening given directly)."""
     if isinstance(certificate, Tightening):
         return certificate
@@ -44,7 +54,7 @@ def _tightening_of(certificate: Any) -> Tightening:
     return tight
 
 
-def simulate(scenario: Scenario, certificate: Any = None, duration: float | None = None,
+def simulate(scenario: Scenario, certificate: Certified | Tightening | None = None, duration: float | None = None,
              progress: bool = True) -> SimulationResult:
     """Run the closed loop of ``scenario`` (the tube controller when a certificate is given).
 
@@ -70,8 +80,9 @@ def simulate(scenario: Scenario, certificate: Any = None, duration: float | None
     if duration is not None:
         scenario = scenario.with_changes(duration=duration_seconds("duration", duration))
     check_run_inputs(scenario)
+    for hint in unit_hints(scenario):
+        warnings.warn(hint, UserWarning, stacklevel=2)
     if certificate is None:
         return run_closed_loop(scenario, tube=False, progress=progress, label="baseline")
-    tightening = _tightening_of(certificate)
-    require_matching(scenario, tightening)  # a certificate of another design is refused before anything runs
+    tightening = _tightening_of(certificate)  # the loop refuses a certificate of another design before any tick
     return run_closed_loop(scenario, tightening, tube=True, progress=progress, label="tube")

@@ -24,6 +24,7 @@ the same rule with its tightened speed and clearance). "duration > 0" is
 
 from __future__ import annotations
 
+import math
 from typing import Any
 
 import numpy as np
@@ -33,7 +34,7 @@ from tubekit.exceptions import ConfigError
 from tubekit.scenario import ControllerSettings, Scenario, paper_scenario
 from tubekit.validation import duration_seconds, period_count
 
-__all__ = ["check_run_inputs", "check_start", "check_target", "TARGET_SAMPLES", "check_log_size",
+__all__ = ["unit_hints", "check_run_inputs", "check_start", "check_target", "TARGET_SAMPLES", "check_log_size",
            "check_horizon_and_limits", "log_bytes", "require_one_period", "horizon_reach", "workspace_fits",
            "workspace_rule", "MEMORY_BUDGET_BYTES", "LOG_BYTES_PER_TICK", "RUNS_PER_STUDY", "MAX_HORIZON_STEPS"]
 
@@ -178,6 +179,33 @@ def check_horizon_and_limits(scenario: Scenario) -> None:
         raise ConfigError("limits.u_max", f"a smaller speed: {rule}", u_max)
     extents = np.subtract(scenario.workspace[1], scenario.workspace[0])[:2]
     raise ConfigError("workspace", rule, f"x, y extents {extents[0]:.4g} m, {extents[1]:.4g} m")
+
+
+def _degrees(value: float, unit: str) -> str:
+    """``value`` read as degrees, in radians: ``30 deg/s = 0.5236 rad/s``."""
+    return f"{value:g} deg{unit} = {math.radians(value):.4g} rad{unit}"
+
+
+def unit_hints(scenario: Scenario) -> tuple[str, ...]:
+    """Values that look like degrees where radians are meant (a hint, not an error: each is still a valid number).
+
+    A yaw-rate limit above π rad/s (a half turn per second), a yaw-rate rate limit above 2π rad/s², or a heading
+    outside [−2π, 2π] is far outside what the vehicles here do and the usual sign of a value written in degrees.
+    """
+    hints = []
+    r_max = scenario.limits.r_max
+    if r_max > math.pi:
+        hints.append(f"limits.r_max = {r_max:g} rad/s is above pi rad/s; it is in rad/s, not deg/s "
+                     f"(if you meant {_degrees(r_max, '/s')})")
+    rate = scenario.limits.rate
+    if rate is not None and rate[2] > 2 * math.pi:
+        hints.append(f"limits.rate[2] = {rate[2]:g} rad/s^2 is above 2 pi rad/s^2; it is in rad/s^2 "
+                     f"(if you meant {_degrees(rate[2], '/s^2')})")
+    psi = scenario.initial_state[3]
+    if abs(psi) > 2 * math.pi:
+        hints.append(f"initial_state[3] (the heading) = {psi:g} rad is outside [-2 pi, 2 pi]; it is in rad "
+                     f"(if you meant {_degrees(psi, '')})")
+    return tuple(hints)
 
 
 def check_run_inputs(scenario: Scenario, duration: float | None = None) -> None:

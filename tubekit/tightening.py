@@ -14,9 +14,10 @@ Two layers of data:
   exactly along its arcs and by the run's promise checks;
 * the bounds it holds over, by name: :class:`RegionBounds` (R) and
   :class:`DisturbanceBound` (ω̄_xy, ω̄_z, γ̄);
-* what it was certified for: ``law``, ``design_key`` and ``design_fields``
-  (:mod:`tubekit.design_key`; :func:`tubekit.design_key.require_matching` refuses a run
-  of another design). The untightened baseline carries no key.
+* what it was certified for: ``design`` (:class:`tubekit.design_inputs.DesignInputs`, the design the
+  certificate's theorem read, σ included) and ``tiers`` (:class:`tubekit.tiers.Tiers`). The loop calls
+  :meth:`Tightening.require` once, before any tick: a run of another design — another start included —
+  is refused naming the first field that differs. The untightened baseline carries no design.
 """
 
 from __future__ import annotations
@@ -27,9 +28,11 @@ from typing import Any
 
 import numpy as np
 
+from tubekit.design_inputs import DesignInputs
 from tubekit.exceptions import ConfigError
 from tubekit.model.backup import BackupPlan
 from tubekit.scenario import Scenario
+from tubekit.tiers import Tiers
 
 __all__ = ["Tightening", "MARGIN_COLUMNS", "RegionBounds", "DisturbanceBound"]
 
@@ -104,8 +107,6 @@ class Tightening:
         Nominal |e_z| bound at the nodes (m).
     obstacle_margin : float
         Added to vehicle radius + obstacle radius for the nominal position at the nodes (m).
-    rho_tilde : float
-        Euclidean norm of the per-axis tube ``tube`` (plots); 0 for the baseline.
     sigma : float
         Ancillary gain (1/s); 0 disables the feedback.
     margins : array (N, 4)
@@ -120,20 +121,13 @@ class Tightening:
     disturbance : DisturbanceBound
         The certificate's ``omega_xy``, ``omega_z`` and ``sway`` bound γ̄ (m/s); zeros for the baseline
         (3 numbers in that order are accepted).
-    certified : bool
-        True only when it comes from a certificate whose safe tier is certified (``tiers`` says
-        whether tracking is too).
-    law : str or None
-        The ancillary law it was certified for (None: the baseline).
-    design_key : str or None
-        SHA-256 of the design (:func:`tubekit.design_key.design_key`); None: not checked.
-    design_fields : dict or None
-        The fields the key hashes, to name the first one that differs.
+    design : DesignInputs or None
+        The design it was certified for (σ included); None: the baseline, nothing to check.
     backup : BackupPlan or None
-        The backup law and safe set (certified when ``tiers["safe"]``; a best-effort tightening
+        The backup law and safe set (certified when ``tiers.safe``; a best-effort tightening
         carries the uncertified design). None: no backup (the untightened baseline).
-    tiers : dict or None
-        Which tier of promise the certificate gives, e.g. ``{"safe": True, "tracking": False}``.
+    tiers : Tiers
+        Which tiers of promise the certificate gives (none by default: the baseline or a best-effort run).
         A safe-only tightening (tracking False) has σ = 0, ``v_max`` = V, a zero tube and margins
         whose e-columns are zero (not enforced: only the position constraints are checked).
     velocity_loop : (3,) floats or None
@@ -148,22 +142,22 @@ class Tightening:
     e_z_max: float
     e_d_max: float
     obstacle_margin: float
-    rho_tilde: float
     sigma: float
     margins: np.ndarray = field(default_factory=lambda: np.zeros((0, 4)))
     rates: np.ndarray = field(default_factory=lambda: np.zeros(4))
     tube: np.ndarray = field(default_factory=lambda: np.zeros(3))
     region: RegionBounds = field(default_factory=RegionBounds)
     disturbance: DisturbanceBound = field(default_factory=DisturbanceBound)
-    certified: bool = False
-    law: str | None = None
-    design_key: str | None = None
-    design_fields: dict | None = None
+    design: DesignInputs | None = None
     backup: BackupPlan | None = None
-    tiers: dict | None = None
+    tiers: Tiers = field(default_factory=Tiers)
     velocity_loop: tuple[float, float, float] | None = None
 
     def __post_init__(self) -> None:
+        if not isinstance(self.tiers, Tiers):
+            raise ConfigError("tightening.tiers", "a tubekit.Tiers", type(self.tiers).__name__)
+        if self.design is not None and not isinstance(self.design, DesignInputs):
+            raise ConfigError("tightening.design", "a tubekit.DesignInputs or None", type(self.design).__name__)
         object.__setattr__(self, "region", RegionBounds.of(self.region))
         object.__setattr__(self, "disturbance", DisturbanceBound.of(self.disturbance))
         if self.velocity_loop is not None:
@@ -173,16 +167,64 @@ class Tightening:
             object.__setattr__(self, "velocity_loop", tuple(loop))
 
     @property
+    def certified(self) -> bool:
+        """True when the certificate gives the safe tier (``tiers`` says whether tracking too)."""
+        return self.tiers.safe
+
+    @property
+    def law(self) -> str | None:
+        """The ancillary law it was certified for (None: the baseline)."""
+        return None if self.design is None else self.design.law
+
+    @property
+    def design_key(self) -> str | None:
+        """SHA-256 of the design (:meth:`DesignInputs.key`); None for the baseline."""
+        return None if self.design is None else self.design.key()
+
+    @property
+    def rho_tilde(self) -> float:
+        """Euclidean norm of the per-axis tube ``tube`` (plots); 0 without a tube."""
+        return float(np.linalg.norm(np.asarray(self.tube, dtype=float)))
+
+    @property
     def terminal_backup(self) -> BackupPlan | None:
         """The backup whose safe set every accepted plan must end in (the terminal condition).
 
-        None without a backup, and None for a backup the certificate did not certify (``tiers`` says
-        ``safe: False``, e.g. a best-effort tightening): its law still replaces the zero input once a
+        None without a backup, and None for a backup the certificate did not certify (``tiers.safe``
+        False, e.g. a best-effort tightening): its law still replaces the zero input once a
         replayed plan is exhausted, but a safe set that is not proved cannot make plans wait for it.
         """
-        if self.backup is None or not (self.tiers or {}).get("safe", True):
-            return None
-        return self.backup
+        return self.backup if self.tiers.safe else None
+
+    def require(self, scenario: Scenario) -> None:
+        """Refuse a run of ``scenario`` this tightening was not certified for (nothing runs then).
+
+        The run's design is the scenario's (its start included) under its own law at this tightening's σ;
+        the certified design must cover it (:meth:`DesignInputs.covers`: a shorter run is covered). A σ the
+        scenario declares must be the certified one, unless the certificate gives the safe tier alone (which
+        runs at σ = 0). The baseline (no design) is not checked.
+
+        Raises
+        ------
+        ConfigError
+            ``design_key.<field>`` naming the first field that differs, with the scenario's and the
+            certificate's values.
+        """
+        stored = self.design
+        if stored is None:
+            return
+        declared = scenario.controller.sigma
+        if declared is not None and not self.tiers.safe_only and float(declared) != float(self.sigma):
+            raise ConfigError("design_key.sigma", f"the certificate's value {self.sigma!r} (it was issued for "
+                              "another design)", declared, "the scenario declares another sigma than the "
+                              "certificate's; certify this scenario (tubekit certify) and use that certificate")
+        diff = stored.uncovered(DesignInputs.of(scenario, sigma=self.sigma))
+        if diff is None:
+            return
+        name, here, there = diff
+        raise ConfigError(f"design_key.{name}", f"the certificate's value {there!r} (it was issued for another "
+                          "design)", here, "the scenario and law the run uses differ from those the certificate "
+                          "was issued for; certify this scenario (tubekit certify) and use that certificate")
 
     @property
     def terminal_rest(self) -> bool:
@@ -201,5 +243,5 @@ class Tightening:
         """The baseline's sets: V, e_d >= epsilon, region bounds, no margin, no feedback."""
         reg = scenario.region
         return cls(v_max=scenario.limits.vector.copy(), e_d_min=scenario.epsilon, e_o_max=reg.e_o_max,
-                   e_z_max=reg.e_z_max, e_d_max=reg.e_d_max, obstacle_margin=0.0, rho_tilde=0.0, sigma=0.0,
+                   e_z_max=reg.e_z_max, e_d_max=reg.e_d_max, obstacle_margin=0.0, sigma=0.0,
                    region=RegionBounds(scenario.epsilon, reg.e_d_max, reg.e_z_max, reg.e_o_max))

@@ -22,7 +22,7 @@
 # 2. **The tube of the loop that runs.** `tubekit.loop.closed_loop` resets the nominal to the
 #    measured state every δ = `controller.dt` and holds the ancillary input at its rate. The
 #    certificate (`verify.certify`) proves a *one-period* box tube for exactly that loop
-#    (`verify.sampled`). We compute it for a range of gains σ and see what σ buys and costs.
+#    (`verify.theorem.sampled`). We compute it for a range of gains σ and see what σ buys and costs.
 # 3. **Both side by side.** `verify.lemma1.paper_route` evaluates Lemma 1's formulas for σ and the
 #    tube radius on the certified bounds; we set it beside the certificate's sampled-data tube.
 #
@@ -42,10 +42,10 @@ import matplotlib.pyplot as plt
 import numpy as np
 
 import verify
-import verify.design
+import verify.theorem.design
 from tubekit import load_scenario, paper_scenario
 from verify.lemma1 import paper_route
-from verify.sampled import horizon_margins, one_period_tube
+from verify.theorem.sampled import horizon_margins, one_period_tube
 
 QUICK = os.environ.get("TUBEKIT_QUICK") == "1"
 FIGURES = (Path(os.environ["TUBEKIT_FIGURES"]) if "TUBEKIT_FIGURES" in os.environ
@@ -124,7 +124,7 @@ for eps, x in zip(eps_grid, xi_bar):
 # `Certificate`; its chosen design holds the **TubeProblem**: every input of the one-period
 # theorem as plain floats (ε, |e_o| bound, input limits, disturbance bounds ω̄_xy and ω̄_z,
 # target speed, σ, the tick h = 1/f and the number of ticks per period, and the law's gain
-# bounds over R from `verify.gains`).
+# bounds over R from `verify.theorem.gains`).
 
 # %%
 currents = load_scenario(verify.SCENARIOS_DIR / "paper_currents.toml")
@@ -170,7 +170,7 @@ print(f"  omega_xy*delta = {problem.omega_xy * d:.4g}, omega_z*delta = {problem.
 # %% [markdown]
 # ### Step 6: sweep σ
 # For each σ we replace it in the TubeProblem, compute the tube, the per-arc margins along the
-# horizon (tutorial 04) and the full verdict of that design (`verify.design.evaluate_design`,
+# horizon (tutorial 04) and the full verdict of that design (`verify.theorem.design.evaluate_design`,
 # the function `certify` calls for each σ it tries).
 
 # %%
@@ -181,7 +181,7 @@ for s in sigmas:  # about 10 ms per sigma
     p = dataclasses.replace(problem, sigma=float(s))
     t = one_period_tube(p)
     m = horizon_margins(p, t, currents.controller.horizon_steps) if t.certified else None
-    design = verify.design.evaluate_design(currents, cert.region, cert.gains, float(s), cert.disturbance)
+    design = verify.theorem.design.evaluate_design(currents, cert.region, cert.gains, float(s), cert.disturbance)
     rows.append(dict(sigma=s, ok=t.certified, rho=np.array(t.rho), kappa=np.array(t.kappa), psi=t.psi,
                      theta=t.theta, m_o=m.e_o[-1] if m else np.inf, certified=design.certified,
                      failed=[c.condition for c in design.failures]))

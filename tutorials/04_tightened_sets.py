@@ -41,7 +41,7 @@ import verify
 from tubekit import error_coordinates, load_scenario
 from tubekit.loop.plan_check import check_plan, plan_arcs
 from tubekit.tightening import MARGIN_COLUMNS, Tightening
-from verify.sampled import horizon_margins
+from verify.theorem.sampled import horizon_margins
 
 QUICK = os.environ.get("TUBEKIT_QUICK") == "1"
 FIGURES = (Path(os.environ["TUBEKIT_FIGURES"]) if "TUBEKIT_FIGURES" in os.environ
@@ -90,7 +90,7 @@ for j, (ax, unit, why) in enumerate((("u", "m/s", "target speed + omega_xy"), ("
 #
 #     M_0 = the one-period tube,   M_j = M_{j−1} + Δ(jδ).
 #
-# `verify.sampled.horizon_margins` computes them; `cert.margins` stores them.
+# `verify.theorem.sampled.horizon_margins` computes them; `cert.margins` stores them.
 
 # %%
 tube = cert.design.tube

@@ -15,7 +15,7 @@
 # 2. fix the ancillary gain `controller.sigma` yourself and see which values certify, and why;
 # 3. see how much current the design can take at each target speed (`verify.envelope`);
 # 4. write **your own ancillary law** and certify it (`verify.certify` bounds its gains with
-#    `verify.gains`);
+#    `verify.theorem.gains`);
 # 5. hand the certificate to someone else, who **re-checks** it from its JSON alone
 #    (`verify.recheck`, `tubekit recheck`).
 
@@ -37,10 +37,10 @@ import sympy as sp
 from matplotlib.colors import ListedColormap
 
 import verify
-import verify.gains
+import verify.theorem.gains
 from tubekit import AncillaryLaw, load_scenario, paper_scenario
 from tubekit.app.plots import envelope_figure
-from verify.recheck import recheck_file
+from verify import recheck_file
 
 QUICK = os.environ.get("TUBEKIT_QUICK") == "1"
 FIGURES = (Path(os.environ["TUBEKIT_FIGURES"]) if "TUBEKIT_FIGURES" in os.environ
@@ -144,7 +144,7 @@ print("wrote", FIGURES / "08_envelope.png")
 # %% [markdown]
 # ## Step 4: your own law, certified
 # A law is κ = −σ K(J) ρ. Give it the numeric gain *and* the same map on a sympy Matrix
-# (`symbolic_gain`). `verify.certify` registers it and `verify.gains.gain_bounds` substitutes the
+# (`symbolic_gain`). `verify.certify` registers it and `verify.theorem.gains.gain_bounds` substitutes the
 # derived J in polar form, J = [[c, 0, 0], [0, 1, 0], [−e_o c/e_d, 0, c]] with c = −sqrt(1 − e_o²)
 # toward the target, then bounds every entry of K and of G = J K over R (Arb branch-and-bound).
 # The tube only needs those entry bounds: sup|K_jl| (input use) and the range of G (contraction
@@ -168,7 +168,7 @@ laws = (("corrected", "corrected"), ("diag-inverse", mine), ("paper", "paper"))
 law_certs = {name: verify.certify(currents, law) for name, law in laws}          # sigma chosen by certify
 common = with_sigma(currents, 3.125)                                            # one sigma for all three
 at_common = {name: verify.certify(common, law) for name, law in laws}
-K_entries, G_entries = verify.gains.gain_entries("diag-inverse", -1)        # registered by certify
+K_entries, G_entries = verify.theorem.gains.gain_entries("diag-inverse", -1)        # registered by certify
 print("diag-inverse, toward the target: G = J K =")
 sp.pprint(sp.Matrix(3, 3, G_entries))
 for name, c in law_certs.items():
@@ -206,7 +206,7 @@ for name, c in law_certs.items():
 #
 # ## Step 5: re-check a certificate from its JSON
 # `cert.to_dict()` is strict JSON (what `tubekit certify FILE --json cert.json` writes). It holds
-# the scenario and every input of the theorem, so `verify.recheck.recheck_file` (`tubekit recheck`)
+# the scenario and every input of the theorem, so `verify.recheck_file` (`tubekit recheck`)
 # can confirm it without searching: it re-derives the disturbance bounds, verifies F(x) < x for the
 # stored tube, the margins and every condition, and spot-checks the gain bounds.
 

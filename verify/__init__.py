@@ -1,7 +1,7 @@
 """verify: certificates of the loop that runs, for tubekit scenarios.
 
 ``certify(scenario, law)`` returns a :class:`Certificate`: the sampled-data tube of one
-FHOCP period under the nominal reset (:mod:`verify.sampled`), the per-arc margins of the
+FHOCP period under the nominal reset (:mod:`verify.theorem.sampled`), the per-arc margins of the
 replayed plan, V̄, and every named condition with both sides' numbers, in Arb interval
 arithmetic and with budgets in work units (the same verdict on any machine). See
 ``docs/verify.md``. ``recheck`` re-derives a certificate from its JSON; ``envelope`` draws
@@ -20,8 +20,6 @@ matplotlib. ``import verify`` loads no sympy either: the names below are importe
 from __future__ import annotations
 
 import importlib
-import sys
-import types
 from pathlib import Path
 from typing import Any
 
@@ -33,14 +31,14 @@ SCENARIOS_DIR = Path(__file__).resolve().parent / "scenarios"
 
 #: Public name -> the module that defines it, imported on first access (PEP 562).
 _LAZY: dict[str, str] = {
-    "certify": "verify.certificate", "Certificate": "verify.certificate", "Condition": "verify.certificate",
-    "NotCertifiedError": "verify.certificate",
-    "Region": "verify.region",
+    "certify": "verify.certificate.certify", "Certificate": "verify.certificate.certify", "Condition": "verify.certificate.certify",
+    "NotCertifiedError": "verify.certificate.certify",
+    "Region": "verify.kernel.region",
     "compute_bounds": "verify.lemma1.bounds", "Bounds": "verify.lemma1.bounds",
     "BoundResult": "verify.lemma1.bounds", "BOUND_NAMES": "verify.lemma1.bounds",
-    "envelope": "verify.envelope", "EnvelopeResult": "verify.envelope",
-    "recheck": "verify.recheck", "recheck_file": "verify.recheck", "RecheckResult": "verify.recheck",
-    "search_region": "verify.region_search", "RegionSearchResult": "verify.region_search",
+    "envelope": "verify.studies.envelope", "EnvelopeResult": "verify.studies.envelope",
+    "recheck": "verify.studies.recheck", "recheck_file": "verify.studies.recheck", "RecheckResult": "verify.studies.recheck",
+    "search_region": "verify.studies.region_search", "RegionSearchResult": "verify.studies.region_search",
 }
 
 
@@ -66,19 +64,3 @@ def __getattr__(name: str) -> Any:
 
 def __dir__() -> list[str]:
     return sorted(set(globals()) | set(_LAZY))
-
-
-class _Package(types.ModuleType):
-    """``verify`` itself: keeps ``verify.envelope`` / ``verify.recheck`` the functions, not their modules.
-
-    Importing a submodule binds it on the package under its own name; for the two public functions
-    named like their modules, the function is bound instead (the module stays in ``sys.modules``).
-    """
-
-    def __setattr__(self, name: str, value: Any) -> None:
-        if isinstance(value, types.ModuleType) and _LAZY.get(name) == value.__name__:
-            value = getattr(value, name)
-        super().__setattr__(name, value)
-
-
-sys.modules[__name__].__class__ = _Package

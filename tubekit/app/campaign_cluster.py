@@ -47,7 +47,7 @@ def warm_scenario(scenario: Scenario) -> Scenario:
     dynamic certificate's fixed point and backup design can take seconds, paid twice; the kinematic copy
     imports and runs the same ``verify``, cvxpy and loop code."""
     warm = scenario.with_changes(duration=WARM_DURATION_S)
-    if warm.plant.kind == "dynamic":
+    if warm.plant.dynamic:
         warm = warm.with_changes(plant=dataclasses.replace(warm.plant, kind="kinematic"))
     return warm
 

@@ -49,13 +49,8 @@ from tubekit.exceptions import ConfigError, TubekitError
 from tubekit.scenario import Scenario, load_scenario, paper_scenario, read_toml, scenario_from_dict
 
 __all__ = ["Distribution", "CampaignSpec", "RunPlan", "load_spec", "spec_from_dict", "run_seed",
-           "certificate_key", "certificate_inputs", "spec_from_stored", "NOT_CERTIFICATE_INPUTS", "SPEC_KEYS",
+           "spec_from_stored", "SPEC_KEYS",
            "draw_cluster", "CLUSTER_KEYS"]
-
-#: Top-level keys of a spec.
-SPEC_KEYS = ("scenario", "runs", "seed", "duration", "sample", "falsify")
-#: Scenario keys ``verify.certify`` does not read (a test keeps this true): samples of these share a certificate.
-NOT_CERTIFICATE_INPUTS = ("name", "duration", "disturbance.period", "plant.truth")
 #: Upper bound on ``runs`` (a typo guard; 10^6 run files is already a lot).
 MAX_RUNS = 1_000_000
 #: Keys of an ``obstacles = { cluster = {...} }`` entry (``margin`` optional, m).
@@ -65,6 +60,9 @@ _HEX = ([(0.0, 0.0)] + [(math.cos(k * math.pi / 3), math.sin(k * math.pi / 3)) f
         + [(2 * math.cos(k * math.pi / 3), 2 * math.sin(k * math.pi / 3)) for k in range(6)]
         + [(math.sqrt(3) * math.cos(k * math.pi / 3 + math.pi / 6), math.sqrt(3) * math.sin(k * math.pi / 3 + math.pi / 6))
            for k in range(6)])
+
+#: Top-level keys of a spec.
+SPEC_KEYS = ("scenario", "runs", "seed", "duration", "sample", "falsify")
 
 
 @dataclass(frozen=True)
@@ -203,22 +201,6 @@ def run_seed(seed: int, run: int) -> int:
     """The integer seed of run ``run``: child ``run`` of ``SeedSequence(seed)``, one 63-bit word."""
     child = np.random.SeedSequence(seed, spawn_key=(run,))
     return int(child.generate_state(1, dtype=np.uint64)[0] >> np.uint64(1))
-
-
-def certificate_key(scenario: Scenario) -> str:
-    """What ``verify.certify`` reads of ``scenario``, as text: equal keys share one certificate."""
-    return json.dumps(certificate_inputs(scenario.to_dict()), sort_keys=True)
-
-
-def certificate_inputs(data: dict) -> dict:
-    """Scenario dict ``data`` without the keys of :data:`NOT_CERTIFICATE_INPUTS` (removed in place; returned)."""
-    for dotted in NOT_CERTIFICATE_INPUTS:
-        *parents, leaf = dotted.split(".")
-        table = data
-        for part in parents:
-            table = table.get(part, {})
-        table.pop(leaf, None)
-    return data
 
 
 def _set_dotted(data: dict, key: str, value: Any) -> None:

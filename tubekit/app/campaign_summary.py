@@ -1,20 +1,26 @@
 """The summary of a campaign (``summary.json``, the result line, throughput) and its figures.
 
-:func:`summarise` reads the run rows (``DIR/runs/*.json``): counts, the largest ``max_rho_ratio``
-beside the certified radius 1 (the tube's box norm), violations, the tiers' figures (issue 21),
-quantiles of each metric, the 10 worst runs and the throughput of this invocation (issue 23):
-simulated seconds per wall second and runs per minute. :func:`write_figures` draws
-``figures/ecdf.png`` and ``figures/worst_runs.png`` (matplotlib, imported here only).
+:func:`summarise` reads the run rows (``DIR/runs/*.json``): the runs per tier their certificate gives
+(``runs_by_tier``: both, safe only, none; issue 35: no run is called certified on the safe tier alone),
+the largest ``max_rho_ratio`` beside the certified radius 1 (the tube's box norm), violations, the tiers'
+figures (issue 21), quantiles of each metric, the 10 worst runs and the throughput of this invocation
+(issue 23): simulated seconds per wall second and runs per minute. :func:`write_figures` draws
+``figures/ecdf.png`` and ``figures/worst_runs.png`` (matplotlib, imported only to draw them), whatever the rows
+hold (no tube, no certified run), each written atomically.
 """
 
 from __future__ import annotations
 
+import io
+import os
+import uuid
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
 from tubekit.app.campaign_spec import CampaignSpec
+from tubekit.app.plots_campaign import TIERS, ecdf_figure, empty_reason, tier_counts, tier_of, worst_runs_figure
 from tubekit.tightening import Tightening
 
 __all__ = ["summarise", "summary_line", "throughput", "write_figures", "import_plotting", "METRIC_COLUMNS", "FIGURES"]
@@ -38,9 +44,10 @@ def _quantiles(rows: list[dict], key: str) -> dict[str, float | None]:
 
 def _worst(rows: list[dict], count: int = 10) -> list[dict]:
     ranked = sorted((r for r in rows if r.get("max_rho_ratio") is not None), key=lambda r: -r["max_rho_ratio"])
-    keep = ("run", "seed", "certified", "max_rho_ratio", "min_clearance", "violated", "broken", "worst_sequence")
+    keep = ("run", "seed", "certified", "safe_tier", "tracking_tier", "max_rho_ratio", "min_clearance", "violated",
+            "broken", "worst_sequence")
     values = [k for k in (ranked[0] if ranked else {}) if k not in keep and k not in METRIC_COLUMNS]
-    return [{**{k: r[k] for k in keep}, "values": {k: r[k] for k in values}} for r in ranked[:count]]
+    return [{**{k: r.get(k) for k in keep}, "values": {k: r[k] for k in values}} for r in ranked[:count]]
 
 
 def _tier_summary(rows: list[dict], seconds_per_run: float) -> dict[str, Any]:
@@ -94,24 +101,61 @@ def throughput(computed_runs: int, simulated_s_per_run: float, wall_s: float, ru
             "simulated_s_per_run_s": simulated / runs_wall_s if some and runs_wall_s > 0 else None}
 
 
+def _certificates_by_tier(certs: dict[str, Tightening]) -> tuple[dict[str, int], np.ndarray]:
+    """The distinct certificates per tier they give (:data:`TIERS`, read as a run's row reads them) and the
+    tubes of those giving the tracking tier (the tube is its promise; a safe-only design has none), shape (n, 3)."""
+    from tubekit.app.campaign_task import _tiers_of  # the row's safe_tier and tracking_tier
+
+    counts = dict.fromkeys(TIERS, 0)
+    tubes = []
+    for tightening in certs.values():
+        tier = tier_of(_tiers_of(tightening))
+        counts[tier] += 1
+        if tier == "both":
+            tubes.append(tightening.tube)
+    return counts, np.array(tubes, dtype=float).reshape(-1, 3)
+
+
 def summarise(rows: list[dict], spec: CampaignSpec, certs: dict[str, Tightening], facts: dict) -> dict[str, Any]:
-    """``summary.json``: the largest max_rho_ratio beside the certified radius (1 in the tube's box norm), counts."""
-    certified = [r for r in rows if r["certified"]]
-    tubes = np.array([t.tube for t in certs.values() if t.certified], dtype=float).reshape(-1, 3)
+    """``summary.json``: runs per tier, the largest max_rho_ratio beside the certified radius (1 in the tube's
+    box norm), violations, the tiers' figures, quantiles, the worst runs and the throughput.
+
+    Parameters
+    ----------
+    rows : list of dict
+        The campaign's rows (``runs/*.json``).
+    spec : CampaignSpec
+        The campaign's spec.
+    certs : dict
+        Its distinct certificates' tightenings, by input key.
+    facts : dict
+        ``computed_runs``, ``campaign_wall_s``, ``computed_runs_wall_s`` and whatever else the summary carries.
+
+    Returns
+    -------
+    dict
+        ``runs_by_tier`` counts each run once by the tiers its certificate gives (``both``, ``safe_only``,
+        ``none``); ``certificates_by_tier`` the distinct certificates alike. ``violations_certified`` counts
+        runs with a tier that broke one of its promises; ``largest_max_rho_ratio_certified`` and
+        ``certificate_tube_box`` are of the runs and certificates with the tracking tier (null: none).
+    """
+    given = [r for r in rows if tier_of(r) != "none"]  # a tier given: the safe tier at least
+    tracking = [r for r in rows if tier_of(r) == "both"]
+    by_certificate, tubes = _certificates_by_tier(certs)
     worst = _worst(rows)
-    largest_cert = _worst(certified, 1)
+    largest_cert = _worst(tracking, 1)
     return {
         "runs": len(rows), "planned_runs": spec.runs, "seed": spec.seed, "duration_s": spec.duration,
         "scenario": spec.scenario_source, "falsify_sequences": spec.falsify_sequences,
-        "certified_runs": len(certified), "distinct_certificates": len(certs),
-        "certified_certificates": int(sum(bool(t.certified) for t in certs.values())),
+        "runs_by_tier": tier_counts(rows), "distinct_certificates": len(certs),
+        "certificates_by_tier": by_certificate,
         "certificate_radius": 1.0,
         "certificate_tube_box": {"min": tubes.min(axis=0).tolist() if tubes.size else None,
                                  "max": tubes.max(axis=0).tolist() if tubes.size else None},
         "largest_max_rho_ratio": worst[0] if worst else None,
         "largest_max_rho_ratio_certified": largest_cert[0] if largest_cert else None,
         "violations": sum(bool(r["violated"]) for r in rows),
-        "violations_certified": sum(bool(r["violated"]) for r in certified),  # of a given tier, its premises held
+        "violations_certified": sum(bool(r["violated"]) for r in given),  # of a given tier, its premises held
         "premise_failures": sum(not r["premises_held"] for r in rows),
         "errors": sum(bool(r["error"]) for r in rows),
         **_tier_summary(rows, spec.duration),
@@ -125,12 +169,17 @@ def summarise(rows: list[dict], spec: CampaignSpec, certs: dict[str, Tightening]
 
 
 def summary_line(summary: dict, out: str | Path) -> str:
-    """The result line of ``tubekit campaign``: runs, the largest max_rho_ratio beside the radius, violations."""
-    top = summary["largest_max_rho_ratio"] or {}
-    return (f"{summary['runs']} runs ({summary['computed_runs']} computed), {summary['certified_runs']} certified; "
-            f"largest max_rho_ratio {top.get('max_rho_ratio')} (run {top.get('run')}, seed {top.get('seed')}) vs "
-            f"certified radius 1; violations {summary['violations']} ({summary['violations_certified']} of a "
-            f"certified run with its premises held); safety promises broken {summary['safety_broken_safe_tier']} "
+    """The result line of ``tubekit campaign``: runs per tier, the largest max_rho_ratio beside the radius
+    (or that no run has one), violations, safety, the backup and the throughput."""
+    tiers = summary["runs_by_tier"]
+    top = summary["largest_max_rho_ratio"]
+    radius = "vs certified radius 1" if tiers["both"] else "(no run has the tracking tier: no tube is promised)"
+    ratio = (f"largest max_rho_ratio {top.get('max_rho_ratio')} (run {top.get('run')}, seed {top.get('seed')}) "
+             f"{radius}" if top else "no tube ratio (no run has a tube)")
+    return (f"{summary['runs']} runs ({summary['computed_runs']} computed): {tiers['both']} with both tiers, "
+            f"{tiers['safe_only']} with the safe tier only, {tiers['none']} uncertified; {ratio}; "
+            f"violations {summary['violations']} ({summary['violations_certified']} of a tier a run's certificate "
+            f"gives, its premises held); safety promises broken {summary['safety_broken_safe_tier']} "
             f"(of {summary['safe_tier_runs']} runs with the safe tier); backup engaged in "
             f"{summary['backup']['runs_engaged']} runs, {summary['backup']['seconds_total']:.4g} s in all; "
             f"{_speed(summary['throughput'])}wrote {out}")
@@ -145,22 +194,34 @@ def _speed(rate: dict) -> str:
 
 
 def import_plotting() -> None:
-    """Import what the tables and :func:`write_figures` need (pyarrow's parquet writer, matplotlib's Figure
-    and Agg, ~0.6 s): called in a thread while the client waits for its workers, so the end does not pay it."""
+    """Import what the tables and :func:`write_figures` need (pyarrow's parquet writer, matplotlib's Figure,
+    ticker and Agg, ~0.6 s): called while the client waits for its workers, so the end does not pay it."""
     import matplotlib.backends.backend_agg  # noqa: F401
+    import matplotlib.figure  # noqa: F401
+    import matplotlib.ticker  # noqa: F401
     import pyarrow.parquet  # noqa: F401
 
-    import tubekit.app.plots_campaign  # noqa: F401  (matplotlib.figure, matplotlib.ticker)
+
+def _save(figure: Any, path: Path) -> Path:
+    """``figure`` as a PNG at ``path``, atomically (drawn in memory, then a temporary file renamed into place)."""
+    buffer = io.BytesIO()
+    figure.savefig(buffer, format="png", dpi=100)
+    temporary = path.with_name(f".{path.name}.{uuid.uuid4().hex}.tmp")
+    try:
+        temporary.write_bytes(buffer.getvalue())
+        os.replace(temporary, path)
+    except BaseException:
+        temporary.unlink(missing_ok=True)
+        raise
+    return path
 
 
 def write_figures(out: Path, rows: list[dict], epsilon: float) -> list[Path]:
     """``figures/ecdf.png`` and ``figures/worst_runs.png`` (:mod:`tubekit.app.plots_campaign`: units on every
-    axis; the worst runs as the margin 1 - ratio on a log axis)."""
-    from tubekit.app.plots_campaign import ecdf_figure, worst_runs_figure
-
+    axis; the worst runs as the margin 1 - ratio on a log axis; a panel saying why where there is nothing to
+    draw, e.g. no tube at σ = 0), each written atomically."""
     folder = out / "figures"
     folder.mkdir(exist_ok=True)
-    paths = [folder / FIGURES[0], folder / FIGURES[1]]
-    ecdf_figure(rows, epsilon).savefig(paths[0], dpi=100)
-    worst_runs_figure(_worst(rows, 15)).savefig(paths[1], dpi=100)
-    return paths
+    worst = _worst(rows, 15)
+    return [_save(ecdf_figure(rows, epsilon), folder / FIGURES[0]),
+            _save(worst_runs_figure(worst, "" if worst else empty_reason(rows, "max_rho_ratio")), folder / FIGURES[1])]

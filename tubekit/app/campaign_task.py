@@ -13,13 +13,16 @@ from __future__ import annotations
 
 import time
 from dataclasses import dataclass, replace
-from typing import Any, Callable
+from typing import TYPE_CHECKING, Any, Callable
 
 import numpy as np
 
 from tubekit.exceptions import TubekitError
 from tubekit.scenario import Scenario
 from tubekit.tightening import Tightening
+
+if TYPE_CHECKING:  # verify loads with the certificate task, not with this module
+    from tubekit.app.certified import IssuedCertificate
 
 __all__ = ["RunTask", "simulate_task", "simulate_all", "row_of"]
 
@@ -71,13 +74,10 @@ def _figures_of(sim: Any) -> dict[str, Any]:
 
 def _tiers_of(tightening: Tightening) -> dict[str, bool]:
     """``safe_tier`` and ``tracking_tier``: the tiers the run's certificate gives."""
-    from tubekit.loop.promises import tiers_given
-
-    given = tiers_given(tightening)
-    return {"safe_tier": bool(given.get("safe")), "tracking_tier": bool(given.get("tracking"))}
+    return {"safe_tier": tightening.tiers.safe, "tracking_tier": tightening.tiers.tracking}
 
 
-def simulate_task(task: RunTask, issued: Any = None) -> dict[str, Any]:
+def simulate_task(task: RunTask, issued: IssuedCertificate | None = None) -> dict[str, Any]:
     """Run ``task`` and return its row (without the sampled values); ``wall_s`` is the only timing.
 
     ``issued`` (a :class:`tubekit.app.certified.IssuedCertificate`, the result of the certificate task the

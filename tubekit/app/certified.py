@@ -7,15 +7,14 @@ once, in :attr:`Tightening.certified <tubekit.tightening.Tightening.certified>`;
 :class:`CertifiedDesign` only reads it. The runs themselves are :func:`tubekit.loop.pipeline.certified_run`.
 
 Campaigns certify on their workers (:func:`issue_certificate`) and keep each certificate by its
-input key (:func:`input_key`, the SHA-256 of what :func:`verify.certify` reads: the design key's fields
-plus the start, which the ``initial`` conditions read and the design key leaves out). A stored
-certificate is used only through :func:`load_certificate`: checksum, design key, the scenario it was
-issued for, then :func:`tubekit.design_key.require_matching` against the run's scenario.
+input key (:func:`input_key`: the key of :class:`tubekit.design_inputs.DesignInputs`, the one statement of
+what :func:`verify.certify` reads, the start included). A stored certificate is used only through
+:func:`load_certificate`: checksum, design key, then :meth:`tubekit.tightening.Tightening.require`
+against the run's scenario.
 """
 
 from __future__ import annotations
 
-import hashlib
 import json
 import logging
 import time
@@ -24,10 +23,12 @@ from pathlib import Path
 from typing import Any
 
 import verify
+from verify.certificate import Certificate
+from verify.certificate.jsonio import checksum_of
 
-from tubekit.design_key import design_key, require_matching
+from tubekit.design_inputs import DesignInputs
 from tubekit.exceptions import ConfigError
-from tubekit.jsonable import to_jsonable, write_json
+from tubekit.jsonable import write_json
 from tubekit.scenario import Scenario
 from tubekit.tightening import Tightening
 
@@ -41,7 +42,7 @@ LOGGER = logging.getLogger(__name__)
 class CertifiedDesign:
     """A certificate, the tightening the runs use and the time certifying took (s)."""
 
-    certificate: Any
+    certificate: Certificate
     tightening: Tightening
     certify_s: float
 
@@ -51,7 +52,7 @@ class CertifiedDesign:
         return bool(self.tightening.certified)
 
 
-def certify_design(scenario: Scenario, certificate: Any = None) -> CertifiedDesign:
+def certify_design(scenario: Scenario, certificate: Certificate | None = None) -> CertifiedDesign:
     """Certify ``scenario`` with its own law (unless ``certificate`` is given); its best-effort tightening.
 
     Parameters
@@ -82,18 +83,10 @@ class IssuedCertificate:
     tightening: Tightening
 
 
-def _input_text(data: dict) -> str:
-    """Canonical JSON of a scenario dict without the keys certify does not read
-    (:func:`tubekit.app.campaign_spec.certificate_inputs`)."""
-    from tubekit.app.campaign_spec import certificate_inputs
-
-    data = certificate_inputs(json.loads(json.dumps(to_jsonable(data))))
-    return json.dumps(data, sort_keys=True, separators=(",", ":"))
-
-
 def input_key(scenario: Scenario) -> str:
-    """SHA-256 (hex) of what :func:`verify.certify` reads of ``scenario``: equal keys share one certificate."""
-    return hashlib.sha256(_input_text(scenario.to_dict()).encode("utf-8")).hexdigest()
+    """SHA-256 (hex) of what :func:`verify.certify` reads of ``scenario`` (:meth:`DesignInputs.key`, the declared σ
+    included): equal keys share one certificate."""
+    return DesignInputs.of(scenario).key()
 
 
 def issue_certificate(scenario: Scenario) -> IssuedCertificate:
@@ -109,12 +102,9 @@ def load_certificate(data: Any, scenario: Scenario, where: str = "certificate") 
     ------
     ConfigError
         ``<where>.checksum`` (edited after issue), ``<where>.<key>`` (incomplete), ``<where>.design_key``
-        (the key is not that of its fields), ``<where>.scenario_data`` (issued for another scenario or
-        start), ``design_key.<field>`` (:func:`tubekit.design_key.require_matching`).
+        (the key is not that of its design), ``design_key.<field>`` (issued for another design or start:
+        :meth:`tubekit.tightening.Tightening.require`).
     """
-    from verify.certificate import Certificate
-    from verify.certificate_json import checksum_of
-
     started = time.perf_counter()
     if not isinstance(data, dict):
         raise ConfigError(where, "a certificate JSON object", type(data).__name__)
@@ -122,15 +112,10 @@ def load_certificate(data: Any, scenario: Scenario, where: str = "certificate") 
         raise ConfigError(f"{where}.checksum", f"the SHA-256 of the content ({checksum_of(data)[:16]}...)",
                           data.get("checksum"), "the certificate was edited after issue")
     certificate = Certificate.from_dict(data)
-    if design_key(certificate.design_fields) != data.get("design_key"):
-        raise ConfigError(f"{where}.design_key", "the key of its design_fields", data.get("design_key"))
-    stored = data.get("scenario_data")
-    if not isinstance(stored, dict) or _input_text(stored) != _input_text(scenario.to_dict()):
-        raise ConfigError(f"{where}.scenario_data", f"the certificate input of scenario {scenario.name!r} "
-                          f"(key {input_key(scenario)[:16]}...)", "another scenario or start",
-                          "it was issued for another design")
+    if certificate.design_key != data.get("design_key"):
+        raise ConfigError(f"{where}.design_key", "the key of its design inputs", data.get("design_key"))
     tightening: Tightening = certificate.best_effort_tightening()
-    require_matching(scenario, tightening)
+    tightening.require(scenario)
     return CertifiedDesign(certificate, tightening, time.perf_counter() - started)
 
 

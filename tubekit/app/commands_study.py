@@ -15,7 +15,7 @@ from tubekit.checks import check_run_inputs
 from tubekit.exceptions import ConfigError, NotAvailableError
 from tubekit.scenario import Scenario, load_scenario, paper_scenario
 from tubekit.validation import bounded_int
-from tubekit.app.commands_verify import add_law_option, checked_law
+from tubekit.app.commands_verify import add_law_option, checked_law, log_unit_hints
 from tubekit.app.exit_codes import EXIT_FAILURE, EXIT_OK, EXIT_PROMISE_BROKEN, extra_hint
 from tubekit.app.output import OutputLock, check_output_dir
 
@@ -68,6 +68,7 @@ def _study_scenario(scenario: Scenario, args: argparse.Namespace) -> Scenario:
     law = None if args.law is None else checked_law(args.law, scenario)
     scenario = apply_overrides(scenario, duration=args.duration, quick=args.quick, law=law)
     check_run_inputs(scenario)
+    log_unit_hints(scenario)
     return scenario
 
 

@@ -7,14 +7,17 @@ Each is a ``configure_*(parser)`` adding its options and a ``run_*(args) -> exit
 from __future__ import annotations
 
 import argparse
+import logging
 from pathlib import Path
 
-from tubekit.checks import check_log_size, check_run_inputs, require_one_period
+from tubekit.checks import check_log_size, check_run_inputs, require_one_period, unit_hints
 from tubekit.exceptions import ConfigError
 from tubekit.scenario import Scenario, load_scenario, paper_scenario
 from tubekit.validation import bounded_int, duration_seconds, gain, positive
 from tubekit.app.exit_codes import EXIT_NOT_CERTIFIED, EXIT_OK
 from tubekit.app.output import check_figure_target, check_file_target, emit_json, write_json_creating_dirs
+
+LOGGER = logging.getLogger(__name__)
 
 __all__ = ["configure_audit", "run_audit", "configure_certify", "run_certify", "configure_envelope", "run_envelope",
            "configure_recheck", "run_recheck", "configure_falsify", "run_falsify", "add_law_option", "checked_law",
@@ -51,10 +54,17 @@ def checked_law(law: str | None, scenario: Scenario) -> str:
 
 def load_checked(config: str | None, duration: float | None = None) -> Scenario:
     """The scenario of CONFIG (default: the paper's) after every pre-run check of
-    :func:`tubekit.checks.check_run_inputs`, the same for every command."""
+    :func:`tubekit.checks.check_run_inputs`, the same for every command; unit hints logged."""
     scenario = paper_scenario() if config is None else load_scenario(config)
     check_run_inputs(scenario, duration)
+    log_unit_hints(scenario)
     return scenario
+
+
+def log_unit_hints(scenario: Scenario) -> None:
+    """Log each :func:`tubekit.checks.unit_hints` of ``scenario`` as one warning line on stderr."""
+    for hint in unit_hints(scenario):
+        LOGGER.warning("hint: %s", hint)
 
 
 def _verify_options(parser: argparse.ArgumentParser) -> None:
@@ -116,7 +126,7 @@ def run_certify(args: argparse.Namespace) -> int:
     ``-q`` prints no summary; ``-v`` adds every sigma tried with its failed conditions.
     """
     from verify import certify
-    from verify.report import tried_lines
+    from verify.certificate.report import tried_lines
 
     scenario = load_checked(args.config)
     law = checked_law(args.law, scenario)
@@ -124,7 +134,7 @@ def run_certify(args: argparse.Namespace) -> int:
     bounded_int("--max-boxes", args.max_boxes, 1, MAX_BOXES)
     show = not args.quiet and args.json != "-"
     if args.search_region:
-        from verify.region_search import search_region
+        from verify.studies.region_search import search_region
 
         found = search_region(scenario, law)
         if show:
@@ -188,7 +198,7 @@ def configure_recheck(parser: argparse.ArgumentParser) -> None:
 
 def run_recheck(args: argparse.Namespace) -> int:
     """0 when the certificate is confirmed, 3 when it is not certified or the recheck disagrees."""
-    from verify.recheck import recheck_file
+    from verify.studies.recheck import recheck_file
 
     if args.json:
         check_file_target("--json", args.json)

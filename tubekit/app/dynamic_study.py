@@ -44,7 +44,7 @@ DYNAMIC_RATE = (0.3, 0.3, 1.0)
 def _dynamic_scenario(scenario: Scenario) -> Scenario:
     """``scenario`` on the 4-DOF plant: unchanged when it is dynamic already; else the BlueROV2 Heavy with
     rate-limited plans (:data:`DYNAMIC_VEHICLE`, :data:`DYNAMIC_RATE`)."""
-    if scenario.plant.kind == "dynamic":
+    if scenario.plant.dynamic:
         return scenario
     limits = scenario.limits if scenario.limits.rate is not None else replace(scenario.limits, rate=DYNAMIC_RATE)
     return scenario.with_changes(plant=replace(scenario.plant, kind="dynamic", vehicle=DYNAMIC_VEHICLE),

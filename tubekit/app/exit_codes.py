@@ -9,7 +9,7 @@ code   meaning
        or the machine failing a write (:data:`ENVIRONMENT_ERRNOS`: a full disk, a quota, an I/O
        error; the line gives the path) -- the input was fine, so it is not exit 2
 2      bad input (:class:`ConfigError`, :class:`ShapeError`, any other file-system error naming the file)
-3      not certified (:class:`verify.certificate.NotCertifiedError`) or a counterexample found
+3      not certified (:class:`verify.certificate.certify.NotCertifiedError`) or a counterexample found
 4      a certified promise broken in a run (``simulate``, ``reproduce``, ``campaign``)
 130    interrupted (``KeyboardInterrupt``)
 =====  ==========================================================================================
@@ -112,9 +112,9 @@ def _environment_error(exc: BaseException) -> str:
 
 
 def _not_certified_error() -> type[BaseException] | None:
-    """:class:`verify.certificate.NotCertifiedError` (None where verify cannot be imported)."""
+    """:class:`verify.certificate.certify.NotCertifiedError` (None where verify cannot be imported)."""
     try:
-        from verify.certificate import NotCertifiedError
+        from verify.certificate.certify import NotCertifiedError
     except ImportError:
         return None
     return NotCertifiedError

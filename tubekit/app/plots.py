@@ -20,6 +20,7 @@ from matplotlib.ticker import MaxNLocator
 from tubekit.exceptions import ConfigError
 from tubekit.loop.metrics import clearance
 from tubekit.loop.result import SimulationResult
+from tubekit.tiers import Tiers
 from tubekit.scenario import Scenario
 from tubekit.tightening import Tightening
 from tubekit.app.plots_obstacle import draw_obstacle_side_view
@@ -92,16 +93,24 @@ def title_lines(head: str, tiers: str | None, width: int = 110) -> str:
     return f"{head}\n{wrapped}" if head else wrapped
 
 
-def tier_title(tiers: Mapping[str, bool] | None, failures: Mapping[str, Sequence[str]] | None = None) -> str:
-    """The title line of the tiers: ``safe: certified; tracking: not certified (keep_up, yaw_budget)``."""
+def tier_title(tiers: Tiers | Mapping[str, bool] | None, failures: Mapping[str, Sequence[str]] | None = None,
+               outcomes: Mapping[str, str] | None = None) -> str:
+    """The title line of the tiers: ``safe: certified, kept; tracking: not certified (keep_up, yaw_budget)``.
+
+    ``outcomes`` (per tier, :func:`tubekit.loop.promises.tier_outcomes` of a run) replaces "certified" by what
+    happened on the run ("certified, kept", "certified, not in force (recursive_feasibility failed)", ...).
+    """
     if tiers is None:
         return "no certificate (baseline only): nothing is promised"
+    if isinstance(tiers, Tiers):
+        tiers = tiers.to_dict()
     parts = []
     for name in ("safe", "tracking"):
         ok = bool(tiers.get(name, False))
         failed = list((failures or {}).get(name, ()))
         reason = f" ({', '.join(failed)})" if failed and not ok else ""
-        parts.append(f"{name}: {'certified' if ok else 'not certified'}{reason}")
+        said = (outcomes or {}).get(name) if ok else None
+        parts.append(f"{name}: {said or ('certified' if ok else 'not certified')}{reason}")
     return "; ".join(parts)
 
 

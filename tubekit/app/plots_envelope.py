@@ -1,4 +1,4 @@
-"""The design-envelope figure of ``tubekit envelope --plot`` (:func:`verify.envelope`).
+"""The design-envelope figure of ``tubekit envelope --plot`` (:func:`verify.studies.envelope`).
 
 Uses matplotlib's object API (:class:`matplotlib.figure.Figure`, Agg canvas): no pyplot state, no window.
 """
@@ -14,7 +14,7 @@ from matplotlib.figure import Figure
 from tubekit.exceptions import ConfigError
 
 if TYPE_CHECKING:  # verify is imported for its type only; plotting needs no certificate code
-    from verify.envelope import EnvelopeResult
+    from verify.studies.envelope import EnvelopeResult
 
 __all__ = ["envelope_figure", "plot_envelope"]
 
@@ -22,9 +22,9 @@ __all__ = ["envelope_figure", "plot_envelope"]
 def envelope_figure(result: EnvelopeResult) -> Figure:
     """omega_bar_xy against target speed at one epsilon: the certified frontier (region under it shaded)
     beside the physical-necessity frontier min(u_max - s, r_max epsilon), with the reference operating
-    points (:data:`verify.envelope.REFERENCE_POINTS`) marked: green inside the certified region, red outside,
+    points (:data:`verify.studies.envelope.REFERENCE_POINTS`) marked: green inside the certified region, red outside,
     white when the point's epsilon is not this envelope's."""
-    from verify.envelope import REFERENCE_POINTS  # data only: verify imports no plotting library
+    from verify.studies.envelope import REFERENCE_POINTS  # data only: verify imports no plotting library
 
     u_max, r_max = result.limits[0], result.limits[2]
     fig = Figure(figsize=(7.6, 5.4), layout="constrained")

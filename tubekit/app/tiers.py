@@ -12,6 +12,8 @@ from __future__ import annotations
 
 from typing import Any, Mapping
 
+from verify.certificate.record import CertificateRecord
+
 from tubekit.app.plots import tier_title
 
 __all__ = ["TIER_MEANING", "tier_report", "tier_lines", "activity_line", "report_title"]
@@ -23,8 +25,9 @@ TIER_MEANING: dict[str, str] = {
 }
 
 
-def tier_report(certificate: Any, metrics: Mapping[str, Any]) -> dict[str, dict[str, Any]]:
-    """Per tier: ``certified``, ``failed_conditions``, ``promises`` (names) and ``depends_on`` (premises).
+def tier_report(certificate: CertificateRecord, metrics: Mapping[str, Any]) -> dict[str, dict[str, Any]]:
+    """Per tier: ``certified``, ``failed_conditions``, ``promises`` (names), ``depends_on`` (premises) and the run's
+    ``outcome`` (kept, BROKEN, not in force: :func:`tubekit.loop.promises.tier_outcomes`; None without a run).
 
     Parameters
     ----------
@@ -33,21 +36,22 @@ def tier_report(certificate: Any, metrics: Mapping[str, Any]) -> dict[str, dict[
     metrics : mapping
         A tube run's metrics (:func:`tubekit.loop.metrics.run_metrics`): its ``promises``.
     """
-    tiers, failures = dict(certificate.tiers), dict(certificate.tier_failures)
+    tiers, failures = certificate.tiers.to_dict(), dict(certificate.tier_failures)
     out: dict[str, dict[str, Any]] = {}
     for name in ("safe", "tracking"):
         mine = [p for p in metrics.get("promises", []) if p.get("tier") == name]
         depends = sorted({d for p in mine for d in p.get("depends_on", [])})
         out[name] = {"certified": bool(tiers.get(name, False)), "promises": [p["name"] for p in mine],
                      "depends_on": depends, "failed_conditions": list(failures.get(name, ())),
-                     "meaning": TIER_MEANING[name]}
+                     "meaning": TIER_MEANING[name], "outcome": (metrics.get("outcome") or {}).get(name)}
     return out
 
 
 def report_title(report: Mapping[str, Mapping[str, Any]]) -> str:
     """The one-line verdict of :func:`tier_report` (the figures' title line)."""
     return tier_title({k: v["certified"] for k, v in report.items()},
-                      {k: v["failed_conditions"] for k, v in report.items()})
+                      {k: v["failed_conditions"] for k, v in report.items()},
+                      {k: v["outcome"] for k, v in report.items() if v.get("outcome")})
 
 
 def tier_lines(report: Mapping[str, Mapping[str, Any]]) -> list[str]:

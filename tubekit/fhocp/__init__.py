@@ -7,11 +7,13 @@ Modules, from the contract outwards:
 * :mod:`~tubekit.fhocp.nlp` — the discretised nonlinear program (:class:`FhocpNlp`):
   exact step, rollout, linearisations, obstacle selection, evaluation;
 * :mod:`~tubekit.fhocp.convex` — the DPP cvxpy subproblem of one SCP iteration;
-* :mod:`~tubekit.fhocp.fastpath` — the compiled parameter-to-data map + persistent Clarabel;
+* :mod:`~tubekit.fhocp.fastpath` — the compiled parameter-to-data map, solved by a QP backend;
+* :mod:`~tubekit.fhocp.qp` — the QP backends (Clarabel, PIQP through the relaxation wrapper) by name;
 * :mod:`~tubekit.fhocp.options` — :class:`ScpOptions`, the SCP solver's validated options;
 * :mod:`~tubekit.fhocp.scp` — :class:`FHOCP`: SCP loop, trust region, fallback;
 * :mod:`~tubekit.fhocp.ipopt` — :class:`IpoptFHOCP`, the CasADi + IPOPT peer (optional);
-* :mod:`~tubekit.fhocp.registry` — the backends by name (``"scp"``, ``"ipopt"``): :func:`make_solver`.
+* :mod:`~tubekit.fhocp.registry` — the FHOCP backends by name (``"scp"``, ``"ipopt"``, ``"scp-piqp"``):
+  :func:`make_solver`.
 """
 
 from __future__ import annotations

@@ -29,8 +29,8 @@
 
 The problem is built once; :meth:`ConvexSubproblem.linearise` writes every parameter
 into one vector, which the fast path (:class:`tubekit.fhocp.fastpath.CompiledConeProgram`)
-maps straight to Clarabel's data, and :meth:`ConvexSubproblem.push_parameters` copies
-into the cvxpy Parameters for ``problem.solve``.
+maps straight to its QP backend's data (:mod:`tubekit.fhocp.qp`), and
+:meth:`ConvexSubproblem.push_parameters` copies into the cvxpy Parameters for ``problem.solve``.
 """
 
 from __future__ import annotations
@@ -42,8 +42,11 @@ import cvxpy as cp
 import numpy as np
 import scipy.sparse as sp
 
-from tubekit.fhocp.fastpath import CompiledConeProgram, ConeSolution
+from tubekit.exceptions import ConfigError
+from tubekit.fhocp.fastpath import CompiledConeProgram
 from tubekit.fhocp.nlp import FhocpNlp, eo_linearisation, rollout, step_linearisation
+from tubekit.fhocp.qp.base import ConeSolution, QpBackend
+from tubekit.fhocp.qp.registry import DEFAULT_QP_BACKEND, make_qp_backend
 from tubekit.fhocp.result import Status, status_from
 
 __all__ = ["ConvexSubproblem", "DEFAULT_CLARABEL_SETTINGS", "CVXPY_STATUS"]
@@ -90,10 +93,15 @@ class ConvexSubproblem:
     trust_radius : float
         Trust radius (fraction of V-bar) of that first linearisation.
     fast_path : bool
-        Re-solve through the compiled map + persistent Clarabel; False uses
+        Re-solve through the compiled map + a persistent QP backend (``qp_backend``); False uses
         ``problem.solve(solver=cp.CLARABEL)``.
     clarabel_settings : dict, optional
-        Overrides of :data:`DEFAULT_CLARABEL_SETTINGS`.
+        Overrides of :data:`DEFAULT_CLARABEL_SETTINGS` (for Clarabel on either path, including as the
+        cone fallback of a QP backend without cones).
+    qp_backend : str or QpBackend
+        The fast path's backend (:mod:`tubekit.fhocp.qp`): a registered name (default ``"clarabel"``;
+        ``"piqp"`` is wrapped in the relaxation wrapper since it takes no cones) or an instance, through
+        :func:`tubekit.fhocp.qp.registry.make_qp_backend`. Only ``"clarabel"`` without the fast path.
 
     Attributes
     ----------
@@ -107,7 +115,10 @@ class ConvexSubproblem:
 
     def __init__(self, nlp: FhocpNlp, max_obstacles: int, neutral_state: np.ndarray,
                  neutral_reference: np.ndarray, trust_radius: float, *, fast_path: bool = True,
-                 clarabel_settings: dict | None = None) -> None:
+                 clarabel_settings: dict | None = None, qp_backend: str | QpBackend = DEFAULT_QP_BACKEND) -> None:
+        if not fast_path and qp_backend != DEFAULT_QP_BACKEND:
+            raise ConfigError("qp_backend", f"{DEFAULT_QP_BACKEND!r} when fast_path=False (the QP backends read "
+                              "the compiled data)", qp_backend)
         self.nlp = nlp
         self.max_obstacles = max_obstacles
         N = nlp.n
@@ -118,7 +129,8 @@ class ConvexSubproblem:
         self.clarabel_settings = {**DEFAULT_CLARABEL_SETTINGS, **(clarabel_settings or {})}
         self.compiled: CompiledConeProgram | None = None
         if fast_path:
-            self.compiled = CompiledConeProgram(self.problem, self.clarabel_settings)
+            backend = make_qp_backend(qp_backend, {"clarabel": self.clarabel_settings})
+            self.compiled = CompiledConeProgram(self.problem, backend=backend)
         self._layout()
         self.linearise(neutral_state, rollout(neutral_state, np.zeros((N, 3)), nlp.dt), np.zeros((N, 3)),
                        neutral_reference, np.zeros((0, 4)), trust_radius)

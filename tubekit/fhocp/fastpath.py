@@ -1,18 +1,18 @@
-"""Re-solving a DPP cvxpy problem without cvxpy's solve path: compiled map + persistent Clarabel.
+"""Re-solving a DPP cvxpy problem without cvxpy's solve path: the compiled map + a persistent QP backend.
 
 cvxpy compiles a DPP problem once into an affine map from the parameter vector
 to the solver's data (``ParamConeProg``). :class:`CompiledConeProgram` takes
-that map (``problem.get_problem_data(cp.CLARABEL)``, called once), keeps the
-parameter vector as one numpy array whose slices are writeable views per
-parameter, and on each solve
+that map (``problem.get_problem_data(cp.CLARABEL)``, called once: the cone program
+Ax + s = b, s in K of Clarabel's standard form), keeps the parameter vector as one
+numpy array whose slices are writeable views per parameter, and on each solve
 
 1. multiplies the reduced parameter-to-data tensors by that vector (three
    sparse mat-vecs; the sparsity pattern is structural, hence fixed),
-2. hands the new values of q, A, b (and P, if parametric) to a persistent
-   ``clarabel.DefaultSolver`` through ``solver.update`` (no re-allocation,
-   no new symbolic factorisation; presolve and chordal decomposition are
-   off because they forbid data updates),
-3. splits Clarabel's x into the problem's variables by their column offsets.
+2. hands the new values of q, A, b (and P, if parametric) to its QP backend as a
+   :class:`~tubekit.fhocp.qp.base.ConeProgramData` (default: Clarabel, which keeps one
+   solver and updates it in place, :mod:`tubekit.fhocp.qp.clarabel`),
+3. returns the backend's :class:`~tubekit.fhocp.qp.base.ConeSolution`; :meth:`CompiledConeProgram.value`
+   splits its x into the problem's variables by their column offsets.
 
 No cvxpy reduction runs after construction. :meth:`CompiledConeProgram.verify`
 compares the data with cvxpy's own ``ParamConeProg.apply_parameters``.
@@ -20,113 +20,70 @@ compares the data with cvxpy's own ``ParamConeProg.apply_parameters``.
 
 from __future__ import annotations
 
-import math
 import time
-from dataclasses import dataclass
 from typing import Any
 
-import clarabel
 import cvxpy as cp
 import numpy as np
 import scipy.sparse as sp
 from cvxpy.lin_ops.lin_op import CONSTANT_ID
 
-from tubekit.exceptions import SolverError
-from tubekit.fhocp.result import Status, status_from
+from tubekit.exceptions import ConfigError, SolverError
+from tubekit.fhocp.qp.base import ConeDims, ConeProgramData, ConeSolution, QpBackend
+from tubekit.fhocp.qp.registry import make_qp_backend
 
-__all__ = ["CompiledConeProgram", "ConeSolution", "clarabel_settings", "CLARABEL_STATUS"]
-
-#: Clarabel's status (``str(clarabel.SolverStatus.X)``) -> :class:`Status`; any other is SOLVER_ERROR
-CLARABEL_STATUS: dict[str, Status] = {
-    "Solved": Status.OPTIMAL,
-    "AlmostSolved": Status.OPTIMAL_INACCURATE,
-    "PrimalInfeasible": Status.INFEASIBLE,
-    "AlmostPrimalInfeasible": Status.INFEASIBLE_INACCURATE,
-    "DualInfeasible": Status.UNBOUNDED,
-    "AlmostDualInfeasible": Status.UNBOUNDED_INACCURATE,
-    "MaxIterations": Status.USER_LIMIT,
-    "MaxTime": Status.USER_LIMIT,
-    "CallbackTerminated": Status.USER_LIMIT,
-    "NumericalError": Status.SOLVER_ERROR,
-    "InsufficientProgress": Status.SOLVER_ERROR,
-    "Unsolved": Status.SOLVER_ERROR,
-}
+__all__ = ["CompiledConeProgram", "cone_dims"]
 
 
-def clarabel_settings(overrides: dict | None = None) -> clarabel.DefaultSettings:
-    """Clarabel settings that allow data updates (presolve/chordal off), quiet, plus ``overrides``."""
-    st = clarabel.DefaultSettings()
-    st.verbose = False
-    st.presolve_enable = False
-    st.chordal_decomposition_enable = False
-    st.input_sparse_dropzeros = False
-    for key, value in (overrides or {}).items():
-        setattr(st, key, value)
-    return st
+def cone_dims(dims: Any) -> ConeDims:
+    """:class:`ConeDims` of cvxpy's cone dimensions (zero, nonnegative, second-order only).
 
-
-def _clarabel_cones(dims: Any) -> list:
-    """Clarabel's cone list for cvxpy's cone dimensions (zero, nonnegative, second-order only)."""
-    cones: list = []
-    if dims.zero:
-        cones.append(clarabel.ZeroConeT(dims.zero))
-    if dims.nonneg:
-        cones.append(clarabel.NonnegativeConeT(dims.nonneg))
-    for d in dims.soc:
-        cones.append(clarabel.SecondOrderConeT(d))
+    Raises
+    ------
+    SolverError
+        Another cone (exponential, PSD, power).
+    """
     if dims.exp or dims.psd or dims.p3d or getattr(dims, "pnd", []):
         raise SolverError("only zero, nonnegative and second-order cones are supported")
-    return cones
-
-
-@dataclass(frozen=True)
-class ConeSolution:
-    """One Clarabel solve mapped back to the problem's variables.
-
-    Attributes
-    ----------
-    status : Status
-        Mapped status (:data:`CLARABEL_STATUS`), e.g. ``Status.OPTIMAL``.
-    raw_status : str
-        Clarabel's own status string.
-    x : array or None
-        Clarabel's primal solution (None without a usable solution); see
-        :meth:`CompiledConeProgram.value` for one variable's value.
-    objective : float
-        Objective value including cvxpy's constant offset (nan without a solution).
-    solver_time_s : float
-        Wall time of Clarabel's ``solve()`` call alone (s): the floor of a re-solve.
-    iterations : int
-        Interior-point iterations.
-    """
-
-    status: Status
-    raw_status: str
-    x: np.ndarray | None
-    objective: float
-    solver_time_s: float
-    iterations: int
+    return ConeDims(int(dims.zero), int(dims.nonneg), tuple(int(d) for d in dims.soc))
 
 
 class CompiledConeProgram:
-    """A DPP ``cvxpy.Problem`` compiled once for Clarabel, re-solved by data updates.
+    """A DPP ``cvxpy.Problem`` compiled once, re-solved by data updates through a QP backend.
 
     Parameters
     ----------
     problem : cvxpy.Problem
         Must satisfy ``problem.is_dcp(dpp=True)``.
     settings : dict, optional
-        Clarabel setting overrides.
+        Clarabel setting overrides of the default backend (only without ``backend``).
+    backend : QpBackend, optional
+        The backend that solves the compiled cone program (it must take second-order cones when the
+        problem has some: wrap a QP solver in :class:`~tubekit.fhocp.qp.relaxed.RelaxedQpBackend`, as
+        :func:`~tubekit.fhocp.qp.registry.make_qp_backend` does); default Clarabel with ``settings``.
+
+    Attributes
+    ----------
+    backend : QpBackend
+        The backend every :meth:`solve` goes through.
+    dims : ConeDims
+        The cone of the compiled program.
+    n, m : int
+        Variables and rows of the compiled program.
     """
 
-    def __init__(self, problem: cp.Problem, settings: dict | None = None) -> None:
+    def __init__(self, problem: cp.Problem, settings: dict | None = None, *,
+                 backend: QpBackend | None = None) -> None:
         if not problem.is_dcp(dpp=True):
             raise SolverError("the problem is not DPP; it cannot be compiled once")
+        if backend is not None and settings is not None:
+            raise ConfigError("settings", "None when a backend is given (the backend holds its settings)", settings)
+        if backend is not None and not isinstance(backend, QpBackend):
+            raise ConfigError("backend", "a tubekit.fhocp.qp.base.QpBackend", backend)
         t0 = time.perf_counter()
         data, _chain, _inv = problem.get_problem_data(cp.CLARABEL)
         pp = data[cp.settings.PARAM_PROB]
         self._pp = pp
-        self._settings_overrides = dict(settings or {})
         self.n = int(pp.x.size)
         # the parameter vector (F-order values of each parameter at its column, then 1)
         self.param_vector = np.zeros(pp.total_param_size + 1)
@@ -158,12 +115,15 @@ class CompiledConeProgram:
         # q (with the offset d as its last entry)
         self._q_map = sp.csr_matrix(pp.q)
         self._compile_quadratic(pp)
-        self.cones = _clarabel_cones(data[cp.reductions.solvers.conic_solvers.conic_solver.ConicSolver.DIMS])
+        self.dims = cone_dims(data[cp.reductions.solvers.conic_solvers.conic_solver.ConicSolver.DIMS])
         self.var_id_to_col = dict(pp.var_id_to_col)
-        self._solver: clarabel.DefaultSolver | None = None
+        if backend is None:
+            backend = make_qp_backend("clarabel", {"clarabel": settings})
+        if self.dims.soc and not backend.takes_cones:
+            raise ConfigError("backend", "a QpBackend that takes second-order cones (or a RelaxedQpBackend)",
+                              backend.name)
+        self.backend = backend
         self.compile_time_s = time.perf_counter() - t0
-        self.rebuilds = 0
-        self.updates = 0
 
     def _compile_quadratic(self, pp: Any) -> None:
         """P: the reduced tensor restricted to the upper triangle (a constant when no parameter enters)."""
@@ -217,12 +177,8 @@ class CompiledConeProgram:
 
     def data(self) -> tuple[sp.csc_matrix, np.ndarray, sp.csc_matrix, np.ndarray, float]:
         """(P upper triangle, q, A, b, d) for the current parameter vector; Clarabel's Ax + s = b."""
-        _, b, q, d = self._vectors()
-        p_data = self._p_data()
-        A = sp.csc_matrix((self._a_data.copy(), self._A_indices, self._A_indptr), shape=(self.m, self.n))
-        P = sp.csc_matrix((p_data, self._P_indices, self._P_indptr), shape=(self.n, self.n)) \
-            if p_data is not None else sp.csc_matrix((self.n, self.n))
-        return P, q, A, b, d
+        prog = self.program()
+        return prog.P(), prog.q, prog.A(), prog.b, prog.offset
 
     def _p_data(self) -> np.ndarray | None:
         if self._P_const is not None:
@@ -249,37 +205,18 @@ class CompiledConeProgram:
         return float(max(errs))
 
     # ----------------------------------------------------------------- solve
+    def program(self) -> ConeProgramData:
+        """The cone program at the current parameter vector, as the backend gets it (views of the buffers)."""
+        _, b, q, d = self._vectors()
+        return ConeProgramData(self._p_data(), self._P_indices, self._P_indptr, q, self._a_data, self._A_indices,
+                               self._A_indptr, b, self.dims, d, self._a_par, self._P_map is not None)
+
     def solve(self) -> ConeSolution:
-        """Update (or, the first time, build) the Clarabel solver and solve."""
-        a_par, b, q, d = self._vectors()
-        if self._solver is None:
-            self._build(b, q)
-        else:
-            kw = {"q": q, "A": (self._a_par, a_par), "b": b}
-            if self._P_map is not None:
-                kw["P"] = self._P_map @ self.param_vector
-            try:
-                self._solver.update(**kw)
-                self.updates += 1
-            except Exception:  # pattern/dimension mismatch: rebuild (should not happen)
-                self._build(b, q)
-        t0 = time.perf_counter()
-        sol = self._solver.solve()
-        wall = time.perf_counter() - t0
-        raw = str(sol.status)
-        status = status_from(CLARABEL_STATUS, raw)
-        x: np.ndarray | None = None
-        objective = math.nan
-        if status.solved:
-            x = np.asarray(sol.x, dtype=float)
-            objective = float(sol.obj_val) + d
-            if x.size != self.n or not (np.isfinite(x).all() and math.isfinite(objective)):
-                x, objective, status = None, math.nan, Status.SOLVER_ERROR
-        return ConeSolution(status=status, raw_status=raw, x=x, objective=objective,
-                            solver_time_s=wall, iterations=int(sol.iterations))
+        """Solve the cone program at the current parameter vector with :attr:`backend`."""
+        return self.backend.solve(self.program())
 
     def columns_of(self, variable: cp.Variable) -> np.ndarray:
-        """Indices of ``variable``'s entries (F order) in Clarabel's x."""
+        """Indices of ``variable``'s entries (F order) in the backend's x."""
         col = self.var_id_to_col[variable.id]
         return np.arange(col, col + variable.size)
 
@@ -289,14 +226,16 @@ class CompiledConeProgram:
             return None
         return solution.x[self.columns_of(variable)].reshape(variable.shape, order="F")
 
-    def _build(self, b: np.ndarray, q: np.ndarray) -> None:
-        A = sp.csc_matrix((self._a_data.copy(), self._A_indices, self._A_indptr), shape=(self.m, self.n))
-        p_data = self._p_data()
-        P = sp.csc_matrix((p_data, self._P_indices, self._P_indptr), shape=(self.n, self.n)) \
-            if p_data is not None else sp.csc_matrix((self.n, self.n))
-        self._solver = clarabel.DefaultSolver(P, q, A, b, self.cones, clarabel_settings(self._settings_overrides))
-        self.rebuilds += 1
+    @property
+    def updates(self) -> int:
+        """In-place data updates of the backend's solver so far."""
+        return self.backend.updates
+
+    @property
+    def rebuilds(self) -> int:
+        """Set-ups of the backend's solver so far (the first one included)."""
+        return self.backend.setups
 
     def reset_solver(self) -> None:
-        """Drop the persistent Clarabel solver (the next solve rebuilds it)."""
-        self._solver = None
+        """Drop the backend's persistent solver (the next solve sets one up)."""
+        self.backend.reset()

@@ -13,13 +13,11 @@ from types import MappingProxyType
 from typing import Any, Mapping
 
 from tubekit.exceptions import ConfigError
+from tubekit.fhocp.qp.registry import DEFAULT_QP_BACKEND, qp_backend_names
 from tubekit.scenario import TerminalMode
 from tubekit.validation import choice, nonnegative, positive
 
-__all__ = ["ScpOptions", "DEFAULT_RATE_PENALTY", "QP_SOLVERS"]
-
-#: The subproblem solvers by name (:attr:`ScpOptions.qp_solver`).
-QP_SOLVERS = ("clarabel", "piqp")
+__all__ = ["ScpOptions", "DEFAULT_RATE_PENALTY"]
 
 #: The rate penalty's default weight lambda (s): damps the real-time SCP's alternating plans (issue 24 item 8),
 #: measured by the ``sign_flips_per_s`` metric of :mod:`tubekit.loop.metrics`.
@@ -64,7 +62,7 @@ class ScpOptions:
     extrapolate : bool
         Converged mode: stretch accurately predicted steps by a merit line search.
     fast_path : bool
-        Re-solve through the compiled map + persistent Clarabel; False uses
+        Re-solve through the compiled map + a persistent QP backend (``qp_solver``); False uses
         ``problem.solve(solver=cp.CLARABEL)`` (same problem, slower).
     clarabel_settings : mapping or None
         Overrides of :data:`tubekit.fhocp.convex.DEFAULT_CLARABEL_SETTINGS` / Clarabel's settings
@@ -74,9 +72,11 @@ class ScpOptions:
         v_last,c)^2) in the cost (:mod:`tubekit.fhocp.rows`); default :data:`DEFAULT_RATE_PENALTY`,
         0 switches it off (the cost of the paper's FHOCP).
     qp_solver : str
-        :data:`QP_SOLVERS`: ``"clarabel"`` (default) solves every subproblem with Clarabel; ``"piqp"``
-        (opt-in, needs the fast path and ``pip install piqp``) tries PIQP on the QP relaxation first and
-        keeps its answer only where it meets the cones (:mod:`tubekit.fhocp.qp_relaxed`), else Clarabel.
+        The subproblems' QP backend, a name of :func:`tubekit.fhocp.qp.registry.qp_backend_names`:
+        ``"clarabel"`` (default) solves every subproblem with Clarabel; ``"piqp"`` (opt-in, needs the fast
+        path and ``pip install piqp``) takes no cones, so it solves the QP relaxation first and its answer
+        is kept only where it meets the cones, else Clarabel's (:mod:`tubekit.fhocp.qp.relaxed`). A name
+        whose package is missing is a :class:`~tubekit.exceptions.NotAvailableError` when the solver is built.
     """
 
     max_obstacles: int | None = None
@@ -91,7 +91,7 @@ class ScpOptions:
     fast_path: bool = True
     clarabel_settings: Mapping[str, Any] | None = None
     rate_penalty: float = DEFAULT_RATE_PENALTY
-    qp_solver: str = "clarabel"
+    qp_solver: str = DEFAULT_QP_BACKEND
 
     def __post_init__(self) -> None:
         if self.max_obstacles is not None:
@@ -106,11 +106,12 @@ class ScpOptions:
         object.__setattr__(self, "tolerance", positive("tolerance", self.tolerance))
         object.__setattr__(self, "trust_radius", positive("trust_radius", self.trust_radius))
         object.__setattr__(self, "rate_penalty", nonnegative("rate_penalty", self.rate_penalty))
-        if self.qp_solver not in QP_SOLVERS:
-            raise ConfigError("qp_solver", f"one of {QP_SOLVERS}", self.qp_solver)
-        if self.qp_solver != "clarabel" and not self.fast_path:
-            raise ConfigError("qp_solver", "'clarabel' when fast_path=False (the QP path reads the compiled data)",
-                              self.qp_solver)
+        names = qp_backend_names()
+        if not isinstance(self.qp_solver, str) or self.qp_solver not in names:
+            raise ConfigError("qp_solver", f"one of the QP backends {names}", self.qp_solver)
+        if self.qp_solver != DEFAULT_QP_BACKEND and not self.fast_path:
+            raise ConfigError("qp_solver", f"{DEFAULT_QP_BACKEND!r} when fast_path=False (the QP backends read "
+                              "the compiled data)", self.qp_solver)
         for name in ("extrapolate", "fast_path"):
             if not isinstance(getattr(self, name), bool):
                 raise ConfigError(name, "True or False", getattr(self, name))

@@ -7,7 +7,7 @@ Built in:
 * ``"ipopt"`` — :class:`tubekit.fhocp.ipopt.IpoptFHOCP`, the CasADi + IPOPT peer (optional:
   without CasADi, :class:`~tubekit.exceptions.NotAvailableError` with the install hint);
 * ``"scp-piqp"`` — the SCP solver with ``ScpOptions(qp_solver="piqp")``: PIQP on the QP relaxation,
-  checked against the cones, else Clarabel (:mod:`tubekit.fhocp.qp_relaxed`; opt-in, needs PIQP).
+  checked against the cones, else Clarabel (:mod:`tubekit.fhocp.qp.relaxed`; opt-in, needs PIQP).
 
 The closed loop builds its solver with :func:`make_solver` from
 ``scenario.controller.fhocp_backend``; :func:`register_backend` adds a backend.
@@ -19,6 +19,8 @@ from typing import TYPE_CHECKING
 
 from tubekit.exceptions import ConfigError
 from tubekit.fhocp.ipopt import IpoptFHOCP, import_casadi
+from tubekit.fhocp.options import ScpOptions
+from tubekit.fhocp.qp.registry import get_qp_backend
 from tubekit.fhocp.result import FhocpSolver, SolverFactory
 from tubekit.fhocp.scp import FHOCP, obstacle_slots
 
@@ -46,9 +48,7 @@ def _ipopt(scenario: Scenario, tightening: Tightening) -> FhocpSolver:
 
 def _scp_piqp(scenario: Scenario, tightening: Tightening) -> FhocpSolver:
     """The SCP solver whose subproblems try PIQP on the QP relaxation first (same answers as ``scp``)."""
-    from tubekit.fhocp.options import ScpOptions
-    from tubekit.fhocp.qp_relaxed import import_piqp
-    import_piqp()  # NotAvailableError with the install hint before anything is built
+    get_qp_backend("piqp", "backend")  # NotAvailableError with the install hint before anything is built
     return FHOCP(scenario, tightening, options=ScpOptions(qp_solver="piqp"))
 
 

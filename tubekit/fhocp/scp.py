@@ -4,8 +4,9 @@ The nonlinear program is :class:`tubekit.fhocp.nlp.FhocpNlp` (exact
 zero-order-hold discretisation, diagonal Q/R/P, exact-penalty slacks). Each
 SCP iteration solves one convex subproblem
 (:class:`tubekit.fhocp.convex.ConvexSubproblem`: built **once** in cvxpy with
-Parameters (DPP) and re-solved by Clarabel data updates through
-:class:`tubekit.fhocp.fastpath.CompiledConeProgram`).
+Parameters (DPP) and re-solved by data updates through
+:class:`tubekit.fhocp.fastpath.CompiledConeProgram` and its QP backend, Clarabel unless
+``ScpOptions.qp_solver`` names another (:mod:`tubekit.fhocp.qp`)).
 
 Modes: ``"realtime"`` does one convex solve per control step from the shifted
 previous plan (real-time iteration); ``"converged"`` iterates with a
@@ -191,10 +192,8 @@ class FHOCP:
         s0 = np.asarray(scenario.initial_state, dtype=float)
         self.subproblem = ConvexSubproblem(self.nlp, self.max_obstacles, s0,
                                            self.nlp.reference(scenario.trajectory, 0.0), self.trust_radius,
-                                           fast_path=self.fast_path, clarabel_settings=opts.clarabel_overrides())
-        if opts.qp_solver == "piqp":  # opt-in: PIQP on the QP relaxation, checked against the cones
-            from tubekit.fhocp.qp_relaxed import RelaxedQpProgram
-            self.subproblem.compiled = RelaxedQpProgram(self.subproblem.compiled)
+                                           fast_path=self.fast_path, clarabel_settings=opts.clarabel_overrides(),
+                                           qp_backend=opts.qp_solver)
         self.build_time_s = time.perf_counter() - t0
 
     def _check_workspace(self) -> None:
@@ -234,7 +233,7 @@ class FHOCP:
         self.subproblem.push_parameters()
 
     def _solve_subproblem(self) -> tuple[Status, np.ndarray | None, float, float]:
-        """Solve the convex subproblem: (status, inputs (N, 3) or None, model objective, Clarabel time (s))."""
+        """Solve the convex subproblem: (status, inputs (N, 3) or None, model objective, solver time (s))."""
         return self.subproblem.solve()
 
     # ----------------------------------------------------------- warm start

@@ -31,7 +31,8 @@ Fallbacks: a FHOCP result flagged ``fallback`` is used (its first input) and
 counted; a result whose first input is not finite, a :class:`SolverError` or a plan
 the arc check (with the terminal condition) rejects is replaced by the last accepted
 plan shifted by the steps elapsed and counted as ``replaced``. Once that plan is exhausted the backup
-law (:func:`tubekit.model.backup.station_keeping_input`, held over each tick, no κ) runs about the anchor
+law (``tightening.backup.law.command``, a :class:`tubekit.model.backup.BackupLaw`, held over each tick, no κ) runs
+about the anchor
 p* = the nominal end of the last accepted plan (:class:`tubekit.loop.memory.PlanMemory`), logged as
 ``backup_active``, until a plan is accepted again; only a tightening without a backup keeps the zero
 input (logged as a warning). A non-finite κ (J singular) is replaced by zero and counted. Nothing
@@ -51,25 +52,22 @@ applied at that tick uses the reset nominal (ρ = 0).
 
 from __future__ import annotations
 
-import enum
-import inspect
 import logging
 import math
-import sys
 import time
 import warnings
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
 import numpy as np
 
-from tubekit.design_key import require_matching
-from tubekit.checks import require_one_period
-from tubekit.model.ancillary import AncillaryLaw, get_law
+from tubekit.model.ancillary import AncillaryLaw
 from tubekit.exceptions import ConfigError, SolverError
+from tubekit.loop.candidate import candidate_plan
 from tubekit.loop.memory import ZERO_INPUT, PlanMemory
 from tubekit.loop.plan_check import PlanCheck, check_plan, check_rates
-from tubekit.model.backup import station_keeping_input
+from tubekit.loop.setup import (Clock, build_solver, progress_bar, saturate, silence_fallback_warnings, status_text,
+                                takes_v_last, validate_inputs)
 from tubekit.plant.base import OmegaOverride, PlantModel
 from tubekit.plant.factory import make_plant
 from tubekit.plant.kinematic import nominal_arc
@@ -91,120 +89,9 @@ __all__ = [
 
 
 _ZERO_INPUT = ZERO_INPUT
+#: Where the candidate's completion aims e_d: this fraction of the way from the nominal's e_d bound up (m / m).
+CANDIDATE_GOAL = 0.1
 _LOG = logging.getLogger(__name__)
-
-
-# ---- setup ------------------------------------------------------------------------------
-
-def validate_inputs(scenario: Scenario, tightening: Tightening | None, tube: bool,
-                    plant_substeps: int) -> tuple[Tightening, AncillaryLaw, float]:
-    """Check the arguments of :func:`run_closed_loop`; return (tightening, the scenario's law, σ in 1/s).
-
-    Raises
-    ------
-    ConfigError
-        Bad ``plant_substeps``, a duration shorter than one period, a tube run
-        without tightening, a tightening of another design, or a σ that is not finite and >= 0.
-    """
-    if not isinstance(scenario, Scenario):
-        raise ConfigError("scenario", "a tubekit.Scenario", type(scenario).__name__)
-    if not isinstance(plant_substeps, int) or isinstance(plant_substeps, bool) or plant_substeps < 1:
-        raise ConfigError("plant_substeps", "an integer >= 1", plant_substeps)
-    require_one_period("duration", scenario.duration, scenario.controller.dt)
-    if tightening is None:
-        if tube:
-            raise ConfigError("tightening", "a Tightening (e.g. verify.certify(...).tightening) for the tube run",
-                              None)
-        tightening = Tightening.untightened(scenario)
-    law_obj = get_law(scenario.controller.law)
-    if not tube:
-        return tightening, law_obj, 0.0
-    require_matching(scenario, tightening)
-    sig = float(tightening.sigma)
-    if not math.isfinite(sig) or sig < 0:
-        raise ConfigError("sigma", "a finite number >= 0", sig)
-    return tightening, law_obj, sig
-
-
-def build_solver(scenario: Scenario, tightening: Tightening, solver_factory: SolverFactory | None) -> FhocpSolver:
-    """``solver_factory(scenario, tightening)``, or the scenario's backend from the registry.
-
-    The default is :func:`tubekit.fhocp.registry.make_solver`: backend
-    ``scenario.controller.fhocp_backend`` (``"scp"``: :class:`tubekit.fhocp.FHOCP` in
-    ``scenario.controller.fhocp_mode``).
-    """
-    if solver_factory is not None:
-        return solver_factory(scenario, tightening)
-    from tubekit.fhocp.registry import make_solver  # imported lazily: cvxpy loads only when a solver is built
-    return make_solver(scenario, tightening)
-
-
-def _takes_v_last(solver: FhocpSolver) -> bool:
-    """True when ``solver.solve`` accepts the keyword ``v_last`` (the built-in backends do)."""
-    try:
-        params = inspect.signature(solver.solve).parameters
-    except (TypeError, ValueError):  # pragma: no cover - a builtin without a signature
-        return False
-    return "v_last" in params or any(p.kind is inspect.Parameter.VAR_KEYWORD for p in params.values())
-
-
-def _silence_fallback_warnings() -> None:
-    try:
-        from tubekit.fhocp import FallbackWarning
-    except ImportError:  # pragma: no cover - a stand-in solver without the real module
-        return
-    warnings.simplefilter("ignore", FallbackWarning)
-
-
-def _progress(total: int, enabled: bool, label: str) -> Any:
-    if not enabled or not sys.stderr.isatty():
-        return None
-    try:
-        from tqdm import tqdm
-    except ImportError:  # pragma: no cover
-        return None
-    return tqdm(total=total, desc=label, unit="step", leave=False, dynamic_ncols=True)
-
-
-@dataclass(frozen=True)
-class _Clock:
-    """The time grid: ``steps`` periods of ``ticks`` ticks of ``h`` s, ``substeps`` RK4 steps per tick."""
-
-    steps: int
-    ticks: int
-    h: float
-    substeps: int
-    t: np.ndarray  # (K + 1,) tick times (s), K = steps * ticks
-    tau: np.ndarray  # (ticks + 1,) times within a period (s)
-
-    @classmethod
-    def of(cls, scenario: Scenario, substeps: int) -> _Clock:
-        dt = scenario.controller.dt
-        m = int(round(scenario.controller.ancillary_rate_hz * dt))
-        h = dt / m
-        k_total = scenario.steps * m
-        return cls(steps=scenario.steps, ticks=m, h=h, substeps=substeps,
-                   t=np.round(np.arange(k_total + 1) * h, 9), tau=np.arange(m + 1) * h)
-
-    @property
-    def plant_step(self) -> float:
-        """RK4 step (s)."""
-        return self.h / self.substeps
-
-
-# ---- the "never pass NaN on" rule -----------------------------------------------------
-
-def saturate(v: tuple[float, float, float],
-             limits: tuple[float, float, float]) -> tuple[tuple[float, float, float], bool]:
-    """Clip ``v`` to the box |v_i| <= limits_i (m/s, m/s, rad/s); return (v, whether it was clipped)."""
-    if abs(v[0]) <= limits[0] and abs(v[1]) <= limits[1] and abs(v[2]) <= limits[2]:
-        return v, False
-    return tuple(min(max(vi, -li), li) for vi, li in zip(v, limits)), True
-
-
-def _status_text(status: Any) -> str:
-    """A result status (a str-valued enum member or a str) as plain text."""
-    return str(status.value) if isinstance(status, enum.Enum) else str(status)
 
 
 # ---- the log ----------------------------------------------------------------------------
@@ -217,7 +104,7 @@ class _Log(LogArrays):
     kappa_failures: int = 0
 
     @classmethod
-    def allocate(cls, clock: _Clock) -> _Log:
+    def allocate(cls, clock: Clock) -> _Log:
         return cls(**allocate_log(len(clock.t), clock.steps))
 
     def record_solve(self, k: int, i0: int, result: FhocpResult | None, elapsed_s: float) -> None:
@@ -226,7 +113,7 @@ class _Log(LogArrays):
             self.statuses.append("exception")
             self.solve_ms[i0] = 1e3 * elapsed_s
             return
-        self.statuses.append(_status_text(result.status))
+        self.statuses.append(status_text(result.status))
         self.iterations[k] = float(result.iterations)
         self.max_violation[k] = float(result.max_violation)
         self.solve_ms[i0] = 1e3 * float(result.solve_time_s)
@@ -249,17 +136,18 @@ class _Period:
 class _ClosedLoop:
     """One run's fixed context (scenario, sets, clock, solver, law, plant, map) and its log."""
 
-    def __init__(self, scenario: Scenario, tightening: Tightening, clock: _Clock, solver: FhocpSolver,
+    def __init__(self, scenario: Scenario, tightening: Tightening, clock: Clock, solver: FhocpSolver,
                  law: AncillaryLaw, sigma: float, plant: PlantModel, obstacle_map: ObstacleMap) -> None:
         self.scenario, self.tightening, self.clock, self.solver = scenario, tightening, clock, solver
         self.law, self.sigma, self.plant, self.map = law, sigma, plant, obstacle_map
         self.desired = np.asarray(scenario.trajectory.position(clock.t), dtype=float)
         self.limits = tuple(float(c) for c in scenario.limits.vector)
+        self.v_bar = np.asarray(tightening.v_max, dtype=float)  # V̄: the plans' box (V for the baseline)
         self.memory = PlanMemory()
         self.log = _Log.allocate(clock)
         self.sign = HEMISPHERE_SIGN[scenario.region.heading]
         self.v_last = None if scenario.limits.rate is None else np.zeros(3)  # the last tick's command (at rest)
-        self.passes_v_last = _takes_v_last(solver)
+        self.passes_v_last = takes_v_last(solver)
         self.t_h, self.v_h = 0.0, (0.0, 0.0, 0.0)  # the last hand-over to the backup: time (s), applied command
 
     def sense(self, xk: np.ndarray) -> tuple[Obstacle, ...]:
@@ -271,25 +159,68 @@ class _ClosedLoop:
         """Solve the FHOCP at ``tk`` and decide v̂; never pass NaN on. Returns (v̂, fallback, replaced)."""
         c0 = time.perf_counter()
         result: FhocpResult | None = None
+        plan: np.ndarray | None = None
         try:
             if self.passes_v_last:
                 result = self.solver.solve(tk, xk.copy(), known, v_last=self.v_last)
             else:
                 result = self.solver.solve(tk, xk.copy(), known)
-            first = np.asarray(result.first_input, dtype=float).reshape(3)
-            usable = bool(np.all(np.isfinite(first)))
-        except SolverError:
-            first, usable = _ZERO_INPUT, False
+            plan = self.plan_of(result)
+        except SolverError as exc:
+            _LOG.debug("period %d: solver result refused: %s", k, exc)
         self.log.record_solve(k, k * self.clock.ticks, result, time.perf_counter() - c0)
-        check = self.accept(k, tk, xk, result, known) if usable else None
-        if check is not None and check.ok:
+        check = self.accept(k, tk, xk, plan, known) if plan is not None else None
+        if result is not None and plan is not None and check is not None and check.ok:
             checked = self.tightening.horizon_arcs > 0
-            flagged = self.memory.remember(result, accepted=checked, end=check.end)
+            flagged = self.memory.remember(plan, bool(result.fallback), accepted=checked, end=check.end)
             self.log.plan_age[k] = self.memory.age
-            return first, flagged, False
+            return plan[0].copy(), flagged, False
+        shifted = self.candidate(tk, xk, known)
+        if shifted is not None:
+            self.log.candidate[k] = True
+            return shifted, True, True
         v_hat = self.memory.replacement()
         self.log.plan_age[k] = self.memory.age
         return v_hat, True, True
+
+    def candidate(self, tk: float, xk: np.ndarray, known: tuple[Obstacle, ...]) -> np.ndarray | None:
+        """v̂ of the shifted candidate (:mod:`tubekit.loop.candidate`) when it passes the exact check (then it is the
+        accepted plan), else None (the old plan is replayed). Only where plans are checked (a certificate's margins)."""
+        memory, tight = self.memory, self.tightening
+        if not self.scenario.controller.candidate or tight.horizon_arcs == 0 or memory.plan is None \
+                or memory.exhausted:
+            return None
+        goal = tight.e_d_min + CANDIDATE_GOAL * (tight.e_d_max - tight.e_d_min)
+        plan = candidate_plan(self.scenario, memory.plan, memory.age, xk, tk, self.v_bar,
+                              self.scenario.limits.jump(self.scenario.controller.dt), goal)
+        if plan is None:
+            return None
+        check = check_plan(self.scenario, tight, tk, xk, plan, known, self.sign, v_last=self.v_last)
+        if not check.ok:
+            return None
+        memory.remember(plan, False, accepted=True, end=check.end)
+        return plan[0].copy()
+
+    def plan_of(self, result: FhocpResult) -> np.ndarray:
+        """The plan the loop may use: exactly N finite rows, the first equal to ``first_input``, projected onto V̄.
+
+        The projection (each input clipped to |v_i| <= V̄_i) removes the solver's tolerance: the plan check
+        then verifies, against V̄ exactly, the inputs that run (module doc).
+
+        Raises
+        ------
+        SolverError
+            A result with another number of rows than N, a non-finite input, or a ``first_input`` that is not
+            its first row (handled like any failed solve: the previous plan is replayed).
+        """
+        n = self.scenario.controller.horizon_steps
+        inputs = np.asarray(result.inputs, dtype=float)
+        if inputs.shape != (n, 3) or not np.all(np.isfinite(inputs)):
+            raise SolverError(f"a plan of exactly {n} finite rows of 3 inputs expected, got shape {inputs.shape}")
+        first = np.asarray(result.first_input, dtype=float).reshape(-1)
+        if first.shape != (3,) or not np.array_equal(first, inputs[0]):
+            raise SolverError(f"first_input {first.tolist()} differs from the plan's first row {inputs[0].tolist()}")
+        return np.clip(inputs, -self.v_bar, self.v_bar)
 
     def backup_anchor(self, k: int, xk: np.ndarray) -> np.ndarray | None:
         """p* (3,) for period ``k`` when the replayed plan is exhausted and a backup exists, else None.
@@ -309,19 +240,18 @@ class _ClosedLoop:
             self.memory.anchor = np.asarray(xk, dtype=float)[:3].copy()
         return self.memory.anchor
 
-    def accept(self, k: int, tk: float, xk: np.ndarray, result: FhocpResult,
+    def accept(self, k: int, tk: float, xk: np.ndarray, plan: np.ndarray,
                known: tuple[Obstacle, ...]) -> PlanCheck:
-        """Exact arc check of the plan against the certificate's margins (ok, with no end, without margins).
+        """Exact arc check of the plan (N, 3) against the certificate's margins (ok, with no end, without margins).
 
         The check's ``end`` is the accepted plan's nominal end: the backup's anchor.
         """
         if self.tightening.horizon_arcs == 0:
             if self.scenario.limits.rate is None:
                 return PlanCheck(True, math.inf, "no margins")
-            check = check_rates(self.scenario, self.tightening, result.inputs, self.v_last)
+            check = check_rates(self.scenario, self.tightening, plan, self.v_last)
         else:
-            check = check_plan(self.scenario, self.tightening, tk, xk, result.inputs, known, self.sign,
-                               v_last=self.v_last)
+            check = check_plan(self.scenario, self.tightening, tk, xk, plan, known, self.sign, v_last=self.v_last)
         self.log.plan_slack[k] = check.slack
         self.log.rejected[k] = not check.ok
         if not check.ok:
@@ -345,6 +275,7 @@ class _ClosedLoop:
         i0, h = k * clock.ticks, clock.plant_step
         vh = tuple(float(c) for c in period.v_hat)
         law_s = 0.0
+        backup = None if self.tightening.backup is None else self.tightening.backup.law
         if period.anchor is not None and not (i0 and log.backup_active[i0 - 1]):
             self.t_h = clock.t[i0]  # the hand-over: the backup starts this period, from the last applied command
             self.v_h = tuple(float(c) for c in log.inputs[i0 - 1]) if i0 else (0.0, 0.0, 0.0)
@@ -353,8 +284,7 @@ class _ClosedLoop:
             xs = np.asarray(x)
             log.states[i] = xs
             if period.anchor is not None:
-                v = station_keeping_input(self.tightening.backup.law, x, period.anchor, float(clock.t[i] - self.t_h),
-                                          self.v_h)
+                v = backup.command(x, period.anchor, float(clock.t[i] - self.t_h), self.v_h)
                 log.kappa[i] = 0.0
                 log.v_hat[i] = v
             elif self.sigma > 0.0:
@@ -456,14 +386,14 @@ def run_closed_loop(scenario: Scenario, tightening: Tightening | None = None, *,
     wall0 = time.perf_counter()
     tightening, law_obj, sig = validate_inputs(scenario, tightening, tube, plant_substeps)
     solver = build_solver(scenario, tightening, solver_factory)
-    clock = _Clock.of(scenario, plant_substeps)
+    clock = Clock.of(scenario, plant_substeps)
     loop = _ClosedLoop(scenario, tightening, clock, solver, law_obj, sig, make_plant(scenario, disturbance),
                        ObstacleMap(scenario.obstacles, scenario.sensing_range, remember=remember_obstacles))
     x = tuple(float(c) for c in scenario.initial_state)
     nominal_end = np.asarray(x)
-    bar = _progress(clock.steps, progress, label or ("tube" if tube else "baseline"))
+    bar = progress_bar(clock.steps, progress, label or ("tube" if tube else "baseline"))
     with warnings.catch_warnings():
-        _silence_fallback_warnings()  # fallbacks are counted; one warning each would flood the terminal
+        silence_fallback_warnings()  # fallbacks are counted; one warning each would flood the terminal
         try:
             for k in range(clock.steps):
                 x, nominal_end = loop.run_period(k, x, nominal_end, wall0)
@@ -495,6 +425,7 @@ def _result(loop: _ClosedLoop, tube: bool, wall0: float, overridden: bool) -> Si
         replaced=log.replaced, n_detected=log.n_detected, solve_ms=log.solve_ms, step_ms=log.step_ms,
         wall=log.wall, statuses=log.statuses, iterations=log.iterations, max_violation=log.max_violation,
         kappa_failures=log.kappa_failures, wall_s=wall_s, rejected=log.rejected, plan_age=log.plan_age,
+        candidate=log.candidate,
         plan_slack=log.plan_slack, backup_active=log.backup_active, backup_anchor=log.backup_anchor,
-        omega_overridden=overridden, body=body,
-        thrust=thrust, omega_peak=loop.plant.omega_peak())
+        omega_overridden=overridden, body=body, current=loop.plant.current_series(clock.t),
+        thrust=thrust, omega_peak=loop.plant.omega_peak(), current_peak=loop.plant.current_peak())

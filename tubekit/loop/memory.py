@@ -10,12 +10,7 @@ anchor p* = the nominal end position of that plan; (4) a new accepted plan resum
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
-
 import numpy as np
-
-if TYPE_CHECKING:  # the solver package (cvxpy) is loaded only when a solver is built
-    from tubekit.fhocp.result import FhocpResult
 
 __all__ = ["PlanMemory", "ZERO_INPUT"]
 
@@ -42,21 +37,20 @@ class PlanMemory:
     age: int = 0
     anchor: np.ndarray | None = None
 
-    def remember(self, result: FhocpResult, accepted: bool = False, end: np.ndarray | None = None) -> bool:
-        """Keep the plan of a usable result when it is a good one; return its ``fallback`` flag.
+    def remember(self, plan: np.ndarray, fallback: bool, accepted: bool = False, end: np.ndarray | None = None) -> bool:
+        """Keep ``plan`` (N, 3) of a usable result when it is a good one; return the result's ``fallback`` flag.
 
         ``accepted`` (it passed :func:`tubekit.loop.plan_check.check_plan`) makes any finite plan a good
         one; ``end`` (its nominal end state, m and rad) then becomes the backup's anchor.
         """
-        is_fallback = bool(result.fallback)
-        plan = np.asarray(result.inputs, dtype=float)
-        if (accepted or not is_fallback) and plan.ndim == 2 and np.all(np.isfinite(plan)):
+        plan = np.asarray(plan, dtype=float)
+        if (accepted or not fallback) and plan.ndim == 2 and np.all(np.isfinite(plan)):
             self.plan, self.age = plan, 0
             if accepted and end is not None:
                 self.anchor = np.asarray(end, dtype=float)[:3].copy()
         else:
             self.age += 1
-        return is_fallback
+        return bool(fallback)
 
     @property
     def exhausted(self) -> bool:

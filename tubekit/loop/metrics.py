@@ -60,7 +60,7 @@ from typing import Any, Mapping, Sequence
 import numpy as np
 
 from tubekit.jsonable import json_number
-from tubekit.loop.promises import Promise, RunLog, broken_promises, check_promises, tiers_given
+from tubekit.loop.promises import Promise, RunLog, broken_promises, check_promises, tier_outcomes
 from tubekit.plant.kinematic import Plant
 from tubekit.scenario import Obstacle, Scenario
 from tubekit.model.trajectory import Circle
@@ -102,7 +102,7 @@ METRIC_KEYS: tuple[str, ...] = (
 #: Keys :func:`run_metrics` adds to :func:`compute_metrics` (every run has them; the baseline's promises are empty).
 RUN_KEYS: tuple[str, ...] = ("tube", "law", "sigma", "kappa_failures", "checks", "certified", "rho_tilde_used",
                              "tube_box", "promises", "promises_kept", "promises_broken", "max_rho_ratio",
-                             "tiers")
+                             "tiers", "outcome")
 
 
 def clearance(positions: np.ndarray, obstacles: Sequence[Obstacle | Mapping[str, Any]],
@@ -413,7 +413,8 @@ def run_metrics(run: RunLog, promises: Sequence[Promise] | None = None) -> dict[
         promises = check_promises(run, uncertified=True)
     m = compute_metrics(run.columns(), run.scenario, rho_bound=float(tight.rho_tilde) if certified else None,
                         sway_bound=float(tight.disturbance.sway) if run.tube else None, extra=run.facts)
-    m.update(certified=certified, rho_tilde_used=float(tight.rho_tilde), tiers=tiers_given(tight),
+    m.update(certified=certified, rho_tilde_used=float(tight.rho_tilde), tiers=tight.tiers.to_dict(),
+             outcome=tier_outcomes(promises, tight.tiers) if run.tube else None,
              tube_box=[float(x) for x in np.asarray(tight.tube, dtype=float)], **promise_figures(promises))
     return m
 

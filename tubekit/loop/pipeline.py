@@ -16,10 +16,11 @@ from typing import Any
 
 from tubekit.loop.closed_loop import run_closed_loop
 from tubekit.loop.metrics import run_metrics
-from tubekit.loop.promises import PREMISES, Promise, broken_promises, check_promises, tiers_given
+from tubekit.loop.promises import PREMISES, Promise, broken_promises, check_promises, tier_outcomes
 from tubekit.loop.result import SimulationResult
 from tubekit.plant.base import OmegaOverride
 from tubekit.scenario import Scenario
+from tubekit.tiers import Tiers
 from tubekit.tightening import Tightening
 
 __all__ = ["CertifiedRun", "certified_run"]
@@ -66,9 +67,15 @@ class CertifiedRun:
         return broken_promises(self.promises)
 
     @property
-    def tiers(self) -> dict[str, bool]:
-        """Which tiers of promise the run's certificate gives (``{"safe": ..., "tracking": ...}``)."""
-        return tiers_given(self.run.tightening)
+    def tiers(self) -> Tiers:
+        """Which tiers of promise the run's certificate gives."""
+        return self.run.tightening.tiers
+
+    @property
+    def outcome(self) -> dict[str, str]:
+        """Per tier, what happened on the run next to what the certificate gives
+        (:func:`tubekit.loop.promises.tier_outcomes`: kept, BROKEN, not in force, not certified)."""
+        return tier_outcomes(self.promises, self.tiers)
 
     @property
     def ratio(self) -> float:
@@ -87,8 +94,7 @@ class CertifiedRun:
         if not self.run.tube:
             verdict = "no certificate"
         elif self.certified:
-            verdict = "certified: " + ", ".join(f"{tier} {'given' if ok else 'not given'}"
-                                                 for tier, ok in self.tiers.items())
+            verdict = "; ".join(f"{tier}: {outcome}" for tier, outcome in self.outcome.items())
         else:
             verdict = "not certified"
         line = (f"{kind} run of {self.run.scenario.name!r} ({verdict}): min clearance "

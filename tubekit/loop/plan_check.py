@@ -6,7 +6,8 @@ certificate does not rely on that: a plan is *accepted* only when
 (the unicycle arcs of :func:`tubekit.plant.kinematic.nominal_arc`, the same the loop
 follows), that
 
-* v̂_j is in V̄;
+* the plan has exactly N rows and v̂_j is in V̄ (compared exactly: the loop projects a solver's plan onto
+  V̄ first, so no tolerance stands outside the proof);
 * with a rate limit (``scenario.limits.rate``, J = rate · dt per component), the rate rows
   (:func:`check_rates`): |v̂_{j+1} − v̂_j| <= J, |v̂_0 − v_last| <= J (v_last the command applied in the
   last tick before the plan, when given) and, when the tightening gates plans by a certified backup that
@@ -26,8 +27,8 @@ rate · spacing / 2 with the certificate's bound on its rate along an arc
 (:attr:`Tightening.rates`), so the check covers the whole arc, not only its
 samples. A plan that fails is replaced by the previous accepted plan, replayed.
 
-When ``tightening.tiers`` says tracking is not certified (``{"tracking": False}``: the safe-only
-design), only the position constraints are checked (V̄, obstacles, workspace, terminal condition,
+When ``tightening.tiers`` does not give tracking (the safe-only design, or a best-effort run), only the
+position constraints are checked (V̄, obstacles, workspace, terminal condition,
 sensing), not e ∈ R nor the hemisphere.
 """
 
@@ -39,6 +40,7 @@ from typing import Sequence
 
 import numpy as np
 
+from tubekit.design_inputs import RATE_TOLERANCE
 from tubekit.model.errors import error_coordinates, heading_cosine
 from tubekit.model.kinematics import sinc, unicycle_step
 from tubekit.plant.kinematic import nominal_arc
@@ -51,9 +53,6 @@ __all__ = ["PlanCheck", "check_plan", "check_rates", "rate_slacks", "plan_arcs",
 
 #: Points per arc of the check (plus the arc's end).
 SAMPLES_PER_ARC = 10
-#: Absolute tolerance (m/s, rad/s) of the rate rows: round-off only; the FHOCP imposes J (1 - 1e-4), so a
-#: plan it returns meets J with room, and the theorem's jump bound is J + RATE_TOLERANCE at most.
-RATE_TOLERANCE = 1e-9
 
 
 @dataclass(frozen=True)
@@ -162,8 +161,8 @@ def _position_slacks(scenario: Scenario, pos: np.ndarray, margin: np.ndarray,
 
 
 def tracking_checked(tight: Tightening) -> bool:
-    """False when ``tight.tiers`` says tracking is not certified (then e ∈ R is not checked)."""
-    return not (isinstance(tight.tiers, dict) and tight.tiers.get("tracking") is False)
+    """True when ``tight.tiers`` gives tracking (otherwise e ∈ R is not checked, only the positions)."""
+    return tight.tiers.tracking
 
 
 def _terminal_slack(scenario: Scenario, tight: Tightening, x0: np.ndarray, end: np.ndarray,
@@ -183,11 +182,10 @@ def check_plan(scenario: Scenario, tight: Tightening, t0: float, x0: np.ndarray,
     ``v_last`` (3,) the command before the plan (rate row (b); None: not checked)."""
     inputs = np.asarray(inputs, dtype=float)
     n = tight.horizon_arcs
-    if inputs.ndim != 2 or inputs.shape[1] != 3 or inputs.shape[0] < n or not np.all(np.isfinite(inputs)):
+    if inputs.ndim != 2 or inputs.shape[1] != 3 or inputs.shape[0] != n or not np.all(np.isfinite(inputs)):
         return PlanCheck(False, -math.inf, "plan shape or values")
-    inputs = inputs[:n]
     over = np.max(np.abs(inputs) - np.asarray(tight.v_max)[None, :])
-    if over > 1e-9:
+    if over > 0.0:
         return PlanCheck(False, -float(over), "input outside V_bar")
     rates = check_rates(scenario, tight, inputs, v_last)
     if not rates.ok:

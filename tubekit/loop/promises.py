@@ -13,20 +13,33 @@ Each :class:`Promise` compares an observed figure with the certificate's bound:
 * ``velocity_loop`` (dynamic plant with a certified loop bound) — max |u_b - u|, |w_b - w|, |r_b - r|
   at the ticks within the certificate's derived bound ``tightening.velocity_loop`` (observed = the
   largest ratio, <= 1);
-* the premises: ``disturbance`` (‖ω_xy‖ <= ω̄_xy, |ω_z| <= ω̄_z over every evaluation of ω the
-  plant's integrator made, between ticks included, and at the logged ticks) and
-  ``recursive_feasibility`` (a plan accepted at t = 0, and the replayed candidate never older than
-  N - 1 periods).
+* the premises, what the certificate assumes and the run can break without breaking a promise:
+
+  - ``disturbance``: on the kinematic plant ω = current + the sway model, both assumed, so
+    ‖ω_xy‖ <= ω̄_xy and |ω_z| <= ω̄_z; on the dynamic plant ω = current + hull sway + loop error, of
+    which only the water current is assumed (γ̄ and E are derived: promises ``sway`` and
+    ``velocity_loop``), so ‖δ_xy‖ <= max(a_x, a_y) + ‖c_xy‖ and |δ_z| <= a_z + |c_z|
+    (:func:`current_bound` of the certified design's current). Either over every evaluation the
+    plant's integrator made (between ticks included) and at the logged ticks;
+  - ``recursive_feasibility``: a plan accepted at t = 0, and the replayed candidate never older than
+    N - 1 periods;
+  - ``plant_in_box`` (dynamic plant only; absent on the kinematic plant, which has no coefficients):
+    every coefficient of the vehicle as simulated (``scenario.plant.truth_params``) lies in the
+    coefficient box the certificate covers (the vehicle of the tightening's design; the run's own
+    vehicle for a tightening without one); it names the first coefficient outside.
 
 Tiers (:data:`TIER_OF`). The *safe* promises (``clearance``, ``workspace``, ``inputs``, ``sway``,
 ``velocity_loop``) hold for all time with only the ``disturbance`` premise when the tightening has a
 backup (without one, they also need ``recursive_feasibility``, the old theorem). The *tracking*
 promises (``tube``, ``region``, ``epsilon``) are measured only while a plan is followed (not while the
-backup law runs, column ``backup_active``) and depend on both premises. Each :class:`Promise` carries
+backup law runs, column ``backup_active``) and depend on both premises. On the dynamic plant (a log
+with the hull's ``body``) both tiers also depend on ``plant_in_box`` (:func:`premises_of`). Each
+:class:`Promise` carries
 its ``tier``, ``depends_on`` and whether the certificate ``given`` its tier (``tightening.tiers``;
 None: every tier of a certified tightening). :func:`broken_promises` names the promises a run broke:
-only those of a given tier whose premises held; a premise failure is never a broken promise. An
-uncertified run reports the same figures and claims nothing.
+only those of a given tier whose premises held; a premise failure is never a broken promise, and a
+breach of a bound the certificate derived (γ̄, E on the dynamic plant) is a broken promise, never a
+failed premise. An uncertified run reports the same figures and claims nothing.
 """
 
 from __future__ import annotations
@@ -41,18 +54,21 @@ from tubekit.exceptions import ConfigError
 from tubekit.model.errors import heading_cosine
 from tubekit.plant.kinematic import Plant
 from tubekit.scenario import HEMISPHERE_SIGN, Scenario
+from tubekit.tiers import Tiers
 from tubekit.tightening import Tightening
 
-__all__ = ["Promise", "check_promises", "RunLog", "PREMISES", "TIER_OF", "premises_of", "tiers_given",
-           "broken_promises"]
+__all__ = ["Promise", "check_promises", "RunLog", "PREMISES", "TIER_OF", "premises_of", "tier_outcomes",
+           "broken_promises", "current_bound"]
 
-#: Promises that are premises of the theorem: a run breaking one claims nothing of the tiers resting on it.
-PREMISES: tuple[str, ...] = ("disturbance", "recursive_feasibility")
+#: Promises that are premises of the theorem: a run breaking one claims nothing of the tiers resting on it
+#: (``plant_in_box`` is measured on the dynamic plant only).
+PREMISES: tuple[str, ...] = ("disturbance", "recursive_feasibility", "plant_in_box")
 
 #: The tier of every promise ("premise" for the premises).
 TIER_OF: dict[str, str] = {"clearance": "safe", "workspace": "safe", "inputs": "safe", "sway": "safe",
                            "velocity_loop": "safe", "tube": "tracking", "region": "tracking",
-                           "epsilon": "tracking", "disturbance": "premise", "recursive_feasibility": "premise"}
+                           "epsilon": "tracking", "disturbance": "premise", "recursive_feasibility": "premise",
+                           "plant_in_box": "premise"}
 
 
 class RunLog(Protocol):
@@ -74,6 +90,8 @@ class RunLog(Protocol):
     plan_age: np.ndarray
     omega_overridden: bool
     body: np.ndarray | None
+    current: np.ndarray | None
+    current_peak: tuple[float, float] | None
 
     @property
     def errors(self) -> np.ndarray: ...
@@ -182,32 +200,97 @@ def _geometry(run: RunLog) -> list[Promise]:
     return out
 
 
-def _disturbance(run: RunLog) -> list[Promise]:
-    bound = run.tightening.disturbance
-    wxy, wz, gamma = bound.omega_xy, bound.omega_z, bound.sway
-    om = run.omega[:-1]
-    tol = 1e-12
+#: Tolerance of the disturbance and sway comparisons (m/s): rounding of the logged figures.
+_TOL = 1e-12
+
+
+def _peaks(ticks: np.ndarray, stages: tuple[float, float] | None) -> tuple[float, float]:
+    """Largest ‖x_xy‖ and |x_z| (m/s) of a series (n, 3) at the ticks (NaN rows skipped) and, when
+    given, of the plant's peaks over every integrator stage (between ticks too)."""
+    peak_xy = float(np.nanmax(np.hypot(ticks[:, 0], ticks[:, 1]), initial=0.0))
+    peak_z = float(np.nanmax(np.abs(ticks[:, 2]), initial=0.0))
+    if stages is not None:
+        peak_xy, peak_z = max(peak_xy, float(stages[0])), max(peak_z, float(stages[1]))
+    return peak_xy, peak_z
+
+
+def _sway(run: RunLog) -> Promise:
+    """The sway the plant applied against γ̄: the hull's |v_b| (dynamic plant) or the sway model's |v_s|."""
+    gamma = run.tightening.disturbance.sway
     if run.body is not None:
         vb = np.abs(run.body[:, 1])
-        sway_promise = _at_most("sway", float(np.nanmax(vb)) if len(vb) else 0.0, gamma + tol,
-                                "max |v_b| of the 4-DOF hull (m/s) vs gamma_bar (ISS bound of the sway dynamics)")
-    elif run.omega_overridden:
-        sway_promise = Promise("sway", math.nan, gamma, True, "not applicable: the disturbance is overridden, "
-                                                              "so the sway cannot be separated from it")
-    else:
-        plant = Plant.of(run.scenario)
-        sway = [abs(plant.sway_velocity(float(t), x, v))
-                for t, x, v in zip(run.t[:-1], run.states[:-1], run.inputs[:-1])]
-        sway_promise = _at_most("sway", max(sway, default=0.0), gamma + tol, "max |v_s| applied (m/s) vs gamma_bar")
-    peak_xy = float(np.nanmax(np.hypot(om[:, 0], om[:, 1]), initial=0.0))
-    peak_z = float(np.nanmax(np.abs(om[:, 2]), initial=0.0))
-    stages = getattr(run, "omega_peak", None)
-    if stages is not None:  # every RK4 stage of the plant: the disturbance it received between ticks too
-        peak_xy, peak_z = max(peak_xy, float(stages[0])), max(peak_z, float(stages[1]))
-    return [sway_promise,
-            _at_most("disturbance", max(peak_xy - wxy - tol, peak_z - wz - tol), 0.0,
-                     f"premise: max over the whole run (every integrator stage) of ||omega_xy|| - omega_bar_xy "
-                     f"and |omega_z| - omega_bar_z; peaks {peak_xy:.4g}, {peak_z:.4g} m/s")]
+        return _at_most("sway", float(np.nanmax(vb)) if len(vb) else 0.0, gamma + _TOL,
+                        "max |v_b| of the 4-DOF hull (m/s) vs gamma_bar (ISS bound of the sway dynamics)")
+    if run.omega_overridden:
+        return Promise("sway", math.nan, gamma, True, "not applicable: the disturbance is overridden, "
+                                                      "so the sway cannot be separated from it")
+    plant = Plant.of(run.scenario)
+    sway = [abs(plant.sway_velocity(float(t), x, v)) for t, x, v in zip(run.t[:-1], run.states[:-1], run.inputs[:-1])]
+    return _at_most("sway", max(sway, default=0.0), gamma + _TOL, "max |v_s| applied (m/s) vs gamma_bar")
+
+
+def current_bound(scenario: Scenario) -> tuple[float, float]:
+    """The bound on the water current δ a certificate assumes (m/s): ‖δ_xy‖ <= max(a_x, a_y) + ‖c_xy‖ and
+    |δ_z| <= a_z + |c_z| for ``scenario.disturbance`` (amplitude a, constant c), the current's terms of
+    ω̄_xy and ω̄_z (``verify.theorem.design.disturbance_bounds``)."""
+    a, c = scenario.disturbance.amplitude, scenario.disturbance.constant
+    return max(a[0], a[1]) + math.hypot(c[0], c[1]), a[2] + abs(c[2])
+
+
+def _certified_scenario(run: RunLog) -> Scenario:
+    """The scenario the certificate read (its current, its coefficient box): the tightening's design, or the
+    run's own scenario for a tightening without one (its design is then the run's)."""
+    design = run.tightening.design
+    return run.scenario if design is None else design.scenario
+
+
+def _water_current(run: RunLog) -> np.ndarray:
+    """The water current δ (m/s, (K + 1, 3)) of a dynamic-plant run: the logged ``current``, or for a log
+    without it (built by hand) ω minus the hull's part: δ_xy = ω_xy − R(ψ)(u_b − u, v_b), δ_z = ω_z − (w_b − w)."""
+    if run.current is not None:
+        return np.asarray(run.current, dtype=float)
+    body, v, psi = run.body, run.inputs, run.states[:, 3]
+    du, vb, cp, sp = body[:, 0] - v[:, 0], body[:, 1], np.cos(psi), np.sin(psi)
+    return run.omega - np.column_stack([du * cp - vb * sp, du * sp + vb * cp, body[:, 2] - v[:, 1]])
+
+
+def _disturbance(run: RunLog) -> Promise:
+    """The premise on what the certificate assumes of the disturbance (module doc): ω on the kinematic plant,
+    the water current alone on the dynamic plant."""
+    bound = run.tightening.disturbance
+    total_xy, total_z = _peaks(run.omega[:-1], run.omega_peak)
+    if run.body is None:
+        return _at_most("disturbance", max(total_xy - bound.omega_xy - _TOL, total_z - bound.omega_z - _TOL), 0.0,
+                        f"premise: max over the whole run (every integrator stage) of ||omega_xy|| - omega_bar_xy "
+                        f"and |omega_z| - omega_bar_z; peaks {total_xy:.4g}, {total_z:.4g} m/s")
+    cur_xy, cur_z = _peaks(_water_current(run), run.current_peak)
+    bound_xy, bound_z = current_bound(_certified_scenario(run))
+    return _at_most("disturbance", max(cur_xy - bound_xy - _TOL, cur_z - bound_z - _TOL), 0.0,
+                    f"premise: max over the whole run (every integrator stage) of ||current_xy|| - {bound_xy:.4g} "
+                    f"and |current_z| - {bound_z:.4g} (the water current against the bound the certificate assumes); "
+                    f"peaks {cur_xy:.4g}, {cur_z:.4g} m/s. Not a premise: the total omega (current + hull sway + "
+                    f"loop error, derived) peaks {total_xy:.4g}, {total_z:.4g} m/s vs omega_bar "
+                    f"{bound.omega_xy:.4g}, {bound.omega_z:.4g}")
+
+
+def _plant_in_box(run: RunLog) -> list[Promise]:
+    """Dynamic plant: every coefficient of the vehicle as simulated inside the certified coefficient box."""
+    if run.body is None:
+        return []
+    box = _certified_scenario(run).plant.params
+    simulated = run.scenario.plant.truth_params
+    outside: list[str] = []
+    for name in box.to_dict():
+        if name == "actuation":
+            if simulated.actuation != box.actuation:
+                outside.append(f"actuation = {simulated.actuation!r}, certified {box.actuation!r}")
+            continue
+        (lo, hi), value = box.interval(name), simulated.interval(name)[0]
+        if not lo <= value <= hi:
+            outside.append(f"{name} = {value:.6g} outside [{lo:.6g}, {hi:.6g}]")
+    detail = ("premise (dynamic plant): the vehicle as simulated lies in the certified coefficient box; "
+              + (f"{len(outside)} coefficients outside, first {outside[0]}" if outside else "every coefficient inside"))
+    return [Promise("plant_in_box", float(len(outside)), 0.0, not outside, detail)]
 
 
 def _velocity_loop(run: RunLog) -> list[Promise]:
@@ -237,22 +320,18 @@ def _feasibility(run: RunLog) -> Promise:
                    f"accepted at t = 0: {first_ok}")
 
 
-def premises_of(tier: str, tightening: Tightening) -> tuple[str, ...]:
+def premises_of(tier: str, tightening: Tightening, *, dynamic: bool = False) -> tuple[str, ...]:
     """The premises a promise of ``tier`` rests on: the safe tier needs only the disturbance bound when
-    the tightening has a backup; tracking (and safety without a backup) also needs recursive feasibility."""
+    the tightening has a backup; tracking (and safety without a backup) also needs recursive feasibility.
+    On the dynamic plant (``dynamic``) both also rest on ``plant_in_box``: every bound the certificate
+    derived from the vehicle (γ̄, E, hence ω̄) holds for the coefficients of its box only."""
     if tier == "premise":
         return ()
     if tier == "safe" and tightening.backup is not None:
-        return ("disturbance",)
-    return PREMISES
-
-
-def tiers_given(tightening: Tightening) -> dict[str, bool]:
-    """Which tiers the certificate gives: ``tightening.tiers`` or, when None, every tier iff certified."""
-    given = {"safe": bool(tightening.certified), "tracking": bool(tightening.certified)}
-    if isinstance(tightening.tiers, dict):
-        given.update({k: bool(v) and bool(tightening.certified) for k, v in tightening.tiers.items()})
-    return given
+        base: tuple[str, ...] = ("disturbance",)
+    else:
+        base = ("disturbance", "recursive_feasibility")
+    return (*base, "plant_in_box") if dynamic else base
 
 
 def broken_promises(promises: Sequence[Promise]) -> tuple[str, ...]:
@@ -264,11 +343,35 @@ def broken_promises(promises: Sequence[Promise]) -> tuple[str, ...]:
                  and all(held.get(name, True) for name in p.depends_on))
 
 
-def _annotate(promise: Promise, tightening: Tightening, given: dict[str, bool]) -> Promise:
-    """``promise`` with its tier, the premises it depends on and whether its tier was given."""
+def tier_outcomes(promises: Sequence[Promise], tiers: Tiers) -> dict[str, str]:
+    """What happened to each tier on the run, next to whether the certificate gives it (issue 31):
+
+    ``"not certified"``; ``"certified, kept"``; ``"certified, BROKEN (<promises>)"`` (a promise of the tier
+    broken with its premises held: exit 4); ``"certified, not in force (<premise> failed)"`` (a premise the
+    tier rests on failed, so the run claims nothing of it). A certified tier is never reported without one of
+    these, so a run in which its promise was not in force is never presented as "certified" alone.
+    """
+    broken = set(broken_promises(promises))
+    failed = {p.name for p in promises if p.tier == "premise" and not p.ok}
+    out = {}
+    for tier in ("safe", "tracking"):
+        mine = [p for p in promises if p.tier == tier]
+        if not getattr(tiers, tier):
+            out[tier] = "not certified"
+            continue
+        hit = sorted(p.name for p in mine if p.name in broken)
+        lapsed = sorted({name for p in mine for name in p.depends_on if name in failed})
+        out[tier] = (f"certified, BROKEN ({', '.join(hit)})" if hit
+                     else f"certified, not in force ({', '.join(lapsed)} failed)" if lapsed else "certified, kept")
+    return out
+
+
+def _annotate(promise: Promise, tightening: Tightening, *, dynamic: bool) -> Promise:
+    """``promise`` with its tier, the premises it depends on (``dynamic``: a run on the dynamic plant) and
+    whether its tier was given."""
     tier = TIER_OF.get(promise.name, "safe")
-    return replace(promise, tier=tier, depends_on=premises_of(tier, tightening),
-                   given=given.get(tier, True) if tier != "premise" else True)
+    return replace(promise, tier=tier, depends_on=premises_of(tier, tightening, dynamic=dynamic),
+                   given=getattr(tightening.tiers, tier) if tier != "premise" else True)
 
 
 def check_promises(run: RunLog, *, uncertified: bool = False) -> list[Promise]:
@@ -297,7 +400,6 @@ def check_promises(run: RunLog, *, uncertified: bool = False) -> list[Promise]:
         raise ConfigError("run.tightening", "a certified tightening (tubekit.simulate(scenario, certificate) with "
                           "certificate.certified)", f"a best-effort tightening, tube = {tube}",
                           "nothing is promised; check_promises(run, uncertified=True) measures the figures anyway")
-    raw = [_tube(run), *_region(run), _inputs(run), *_geometry(run), *_disturbance(run), *_velocity_loop(run),
-           _feasibility(run)]
-    given = tiers_given(run.tightening)
-    return [_annotate(p, run.tightening, given) for p in raw]
+    raw = [_tube(run), *_region(run), _inputs(run), *_geometry(run), _sway(run), _disturbance(run),
+           *_velocity_loop(run), _feasibility(run), *_plant_in_box(run)]
+    return [_annotate(p, run.tightening, dynamic=run.body is not None) for p in raw]

@@ -74,6 +74,8 @@ LOG_FIELDS: tuple[LogField, ...] = (
              "largest constraint violation of the returned plan"),
     LogField("rejected", "period", 0, bool, False, (), "the plan failed the arc check"),
     LogField("plan_age", "period", 0, int, 0, (), "periods since the plan in use was computed"),
+    LogField("candidate", "period", 0, bool, False, (),
+             "the shifted candidate (tubekit.loop.candidate) was accepted in place of the solver's plan"),
     LogField("plan_slack", "period", 0, float, np.nan, (), "smallest slack of the arc check"),
 )
 
@@ -113,8 +115,10 @@ _CSV_SOURCES: tuple[tuple[str, tuple[str, ...]], ...] = tuple(
 CSV_COLUMNS: tuple[str, ...] = tuple(name for _, names in _CSV_SOURCES for name in names)
 
 #: Columns appended to ``trajectory.csv`` by a dynamic-plant run (absent for the kinematic plant):
-#: body velocities reached (m/s, m/s, m/s, rad/s) and thrusts (N, N, N m) at the start of each tick.
-DYNAMIC_COLUMNS: tuple[str, ...] = ("u_b", "v_b", "w_b", "r_b", "X", "Z", "N")
+#: body velocities reached (m/s, m/s, m/s, rad/s) and thrusts (N, N, N m) at the start of each tick, then
+#: the water current the plant applied there (m/s, inertial x, y, z; NaN when not logged): the part of
+#: ``omega_1..3`` the certificate assumes (the rest is the hull's sway and the loop error).
+DYNAMIC_COLUMNS: tuple[str, ...] = ("u_b", "v_b", "w_b", "r_b", "X", "Z", "N", "current_1", "current_2", "current_3")
 
 
 @dataclass
@@ -126,6 +130,10 @@ class SimulationResult(LogArrays):
     ``body`` (u_b, v_b, w_b, r_b) and ``thrust`` (X, Z, N) are set by the dynamic plant only.
     ``omega_peak`` is the largest ‖ω_xy‖ and |ω_z| (m/s) over every evaluation of ω the plant's
     integrator made (every RK4 stage, between ticks included): the disturbance the plant received.
+    ``current`` (K + 1, 3) and ``current_peak`` are the water current alone (m/s), at the ticks and
+    over every evaluation, set by a plant whose ω holds more than the current (the dynamic plant:
+    ω = current + hull sway + loop error); None on the kinematic plant, whose ω is what the certificate
+    assumes.
     """
 
     scenario: Scenario
@@ -146,6 +154,8 @@ class SimulationResult(LogArrays):
     body: np.ndarray | None = None
     thrust: np.ndarray | None = None
     omega_peak: tuple[float, float] | None = None
+    current: np.ndarray | None = None
+    current_peak: tuple[float, float] | None = None
 
     # ---- derived -------------------------------------------------------------------
     @property
@@ -238,7 +248,8 @@ class SimulationResult(LogArrays):
             for i, name in enumerate(names):
                 c[name] = np.asarray(values[:, i] if values.ndim == 2 else values)
         if self.body is not None and self.thrust is not None:
-            dynamic = np.column_stack([self.body, self.thrust])
+            current = np.full((len(self.t), 3), np.nan) if self.current is None else self.current
+            dynamic = np.column_stack([self.body, self.thrust, current])
             c.update({name: dynamic[:, i] for i, name in enumerate(DYNAMIC_COLUMNS)})
         return c
 

@@ -165,7 +165,7 @@ LAWS: dict[str, AncillaryLaw] = {
                               closed_form=generated.corrected_kappa),
 }
 
-#: The built-in laws, whose certificate objectives ship compiled (``verify.compiled``).
+#: The built-in laws, whose certificate objectives ship compiled (``verify.kernel.compiled``).
 BUILTIN_LAWS: tuple[str, ...] = tuple(LAWS)
 _BUILTIN: dict[str, AncillaryLaw] = dict(LAWS)
 

@@ -37,6 +37,15 @@ a rises on [0, χ_p], χ_p = :data:`SHAPE_PLATEAU` χ_u (``StationKeeping.platea
 falls on [χ_u, π).
 
 Every input stays in V when u_b <= ū, w_b <= w̄ and k <= r̄, so the law never saturates.
+
+**The backup-law protocol.** The loop, the terminal condition and the velocity loop's bound read a backup
+law only through :class:`BackupLaw`: its ``kind`` (the registry key of :data:`BACKUP_LAWS` and of its proof
+in ``verify.backup``), ``command(state, anchor, elapsed, start)``, ``bounds`` (the largest |u|, |w|, |r| it
+commands), ``within(V)``, ``blends`` and ``to_dict``. A new backup law is one module beside this one,
+registered with :func:`register_backup_law`, and one proof beside :mod:`verify.backup.proof`;
+:class:`StationKeeping` is the first implementation. The safe set's footprint for the terminal condition
+is :meth:`BackupPlan.footprint`.
+
 :func:`verify.backup.certify_backup` proves that the set
 S = {d + β(1 − cos χ) <= c, |z − z*| <= Z} is invariant under the law held at the ancillary rate
 for every current within the certified bound; this module only evaluates the law.
@@ -45,15 +54,47 @@ for every current within the certified bound; this module only evaluates the law
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import asdict, dataclass
+from typing import Any, ClassVar, Protocol, runtime_checkable
 
 import numpy as np
 
 from tubekit.exceptions import ConfigError
 from tubekit.validation import nonnegative, positive
 
-__all__ = ["StationKeeping", "SafeSet", "BackupPlan", "line_of_sight_angle", "axis_angle", "station_keeping_input",
-           "yaw_shape", "axis_shape", "YAW_LAWS", "SHAPE_PLATEAU"]
+__all__ = ["BackupLaw", "BACKUP_LAWS", "register_backup_law", "backup_law_from_dict", "StationKeeping", "SafeSet",
+           "BackupPlan", "line_of_sight_angle", "axis_angle", "station_keeping_input", "yaw_shape", "axis_shape",
+           "YAW_LAWS", "SHAPE_PLATEAU"]
+
+
+@runtime_checkable
+class BackupLaw(Protocol):
+    """What the loop, the terminal condition and the velocity loop's bound read of a backup law (module doc)."""
+
+    kind: ClassVar[str]
+
+    @property
+    def blends(self) -> bool:
+        """True when the command applied at the hand-over fades out (the command is continuous there)."""
+        ...
+
+    @property
+    def bounds(self) -> tuple[float, float, float]:
+        """The largest |u|, |w|, |r| the law commands after its ramp (m/s, m/s, rad/s)."""
+        ...
+
+    def within(self, u_max: float, w_max: float, r_max: float) -> bool:
+        """True when every command of the law lies in V."""
+        ...
+
+    def command(self, state: tuple[float, float, float, float], anchor: tuple[float, float, float],
+                elapsed: float, start: tuple[float, float, float]) -> tuple[float, float, float]:
+        """(u, w, r) at ``state`` about ``anchor``, ``elapsed`` s after the hand-over, ``start`` the command then."""
+        ...
+
+    def to_dict(self) -> dict[str, Any]:
+        """The law's parameters as JSON, with its ``kind``."""
+        ...
 
 #: The yaw laws: "ridge" (r = −k sat(χ/χ_0), the default) and "continuous" (r = −k ρ(φ)).
 YAW_LAWS = ("ridge", "continuous")
@@ -112,6 +153,8 @@ class StationKeeping:
         χ_u (rad), the continuous law's unstable axis angle, in (0, π/2); 0 with the ridge law.
     """
 
+    kind: ClassVar[str] = "station_keeping"
+
     surge: float
     yaw_rate: float
     yaw_band: float
@@ -152,6 +195,27 @@ class StationKeeping:
     def within(self, u_max: float, w_max: float, r_max: float) -> bool:
         """True when every input of the law lies in V = {|u| <= u_max, |w| <= w_max, |r| <= r_max}."""
         return self.surge <= u_max and self.heave <= w_max and self.yaw_rate <= r_max
+
+    @property
+    def bounds(self) -> tuple[float, float, float]:
+        """(u_b, w_b, k): the largest |u|, |w|, |r| the law commands after its ramp (m/s, m/s, rad/s)."""
+        return self.surge, self.heave, self.yaw_rate
+
+    def command(self, state: tuple[float, float, float, float], anchor: tuple[float, float, float],
+                elapsed: float = math.inf, start: tuple[float, float, float] = (0.0, 0.0, 0.0)
+                ) -> tuple[float, float, float]:
+        """:func:`station_keeping_input` of this law (float tuples: the loop's inner loop)."""
+        return station_keeping_input(self, state, anchor, elapsed, start)
+
+    def to_dict(self) -> dict[str, Any]:
+        """The gains with ``kind``; the fades, the ramp and the yaw law only when set (0 / "ridge": off)."""
+        out: dict[str, Any] = {"kind": self.kind}
+        for name, value in asdict(self).items():
+            if (name in ("surge_fade", "yaw_fade", "ramp", "unstable") and value == 0.0) or \
+                    (name == "yaw_law" and value == "ridge"):
+                continue
+            out[name] = value
+        return out
 
     @property
     def blends(self) -> bool:
@@ -262,8 +326,8 @@ class BackupPlan:
 
     Attributes
     ----------
-    law : StationKeeping
-        The station-keeping law.
+    law : BackupLaw
+        The backup law (station keeping, the first :class:`BackupLaw`).
     safe_set : SafeSet
         Its invariant set about the anchor (the end of the last accepted plan).
     handover : (float, float)
@@ -271,7 +335,7 @@ class BackupPlan:
         (the replayed plan's last position and depth margins).
     """
 
-    law: StationKeeping
+    law: BackupLaw
     safe_set: SafeSet
     handover: tuple[float, float] = (0.0, 0.0)
 
@@ -279,3 +343,37 @@ class BackupPlan:
         """(horizontal radius, half height) (m) of the safe set inflated by the vehicle ball."""
         return self.safe_set.radius + vehicle_radius, self.safe_set.depth + vehicle_radius
 
+
+#: Backup laws by ``kind`` (their JSON tag); :func:`register_backup_law` adds one.
+BACKUP_LAWS: dict[str, type] = {StationKeeping.kind: StationKeeping}
+
+
+def register_backup_law(cls: type) -> type:
+    """Register a backup-law class under its ``kind`` (usable as a class decorator); ConfigError when the class does
+    not state a ``kind`` or the kind is taken by another class."""
+    kind = getattr(cls, "kind", None)
+    if not isinstance(kind, str) or not kind:
+        raise ConfigError("backup.kind", "a class with a non-empty str 'kind'", cls)
+    if BACKUP_LAWS.get(kind, cls) is not cls:
+        raise ConfigError("backup.kind", f"a kind not yet registered (taken: {sorted(BACKUP_LAWS)})", kind)
+    BACKUP_LAWS[kind] = cls
+    return cls
+
+
+def backup_law_from_dict(d: Any, where: str = "backup.law") -> BackupLaw:
+    """The backup law of a :meth:`BackupLaw.to_dict` dict (``kind`` absent: station keeping); ConfigError naming
+    ``where.<key>`` when the kind is unknown or a parameter is missing, unknown or out of range."""
+    if not isinstance(d, dict):
+        raise ConfigError(where, "a table of the law's parameters", d)
+    params = dict(d)
+    kind = params.pop("kind", StationKeeping.kind)
+    if kind not in BACKUP_LAWS:
+        raise ConfigError(f"{where}.kind", f"one of {sorted(BACKUP_LAWS)}", kind)
+    cls = BACKUP_LAWS[kind]
+    try:
+        return cls(**params)
+    except TypeError as exc:
+        raise ConfigError(where, f"the parameters of a {kind} law", sorted(params), str(exc)) from None
+    except ConfigError as exc:
+        name = exc.field.split(".", 1)[1] if exc.field.startswith("backup.") else exc.field
+        raise ConfigError(f"{where}.{name}", exc.expected, exc.received) from None

@@ -1,9 +1,12 @@
 """What the closed loop needs from a plant: :class:`PlantModel`.
 
 A plant integrates the simulated vehicle over one ancillary tick with the applied command held,
-reports the current it applies and, afterwards, the total disturbance ω = ẋ − f(x) v it saw. The
-kinematic plant of eq. (11) and the 4-DOF dynamic vehicle both satisfy it; the loop never asks which
-one it has.
+reports the current it applies and, afterwards, the total disturbance ω = ẋ − f(x) v it saw. A plant
+whose ω holds more than the certificate assumes (the dynamic vehicle: current + hull sway + loop
+error) also reports the water current apart (:meth:`PlantModel.current_series`,
+:meth:`PlantModel.current_peak`); the kinematic plant returns None there, its ω (current + the sway
+model) being what the certificate assumes. The kinematic plant of eq. (11) and the 4-DOF dynamic
+vehicle both satisfy it; the loop never asks which one it has.
 """
 
 from __future__ import annotations
@@ -41,6 +44,14 @@ class PlantModel(Protocol):
 
     def omega_peak(self) -> tuple[float, float]:
         """Largest ‖ω_xy‖ and |ω_z| (m/s) over every evaluation of ω the integrator made so far."""
+        ...
+
+    def current_series(self, t: np.ndarray) -> np.ndarray | None:
+        """The water current (len(t), 3), m/s, applied at the times ``t`` (s); None when ω is not split."""
+        ...
+
+    def current_peak(self) -> tuple[float, float] | None:
+        """Largest ‖δ_xy‖ and |δ_z| (m/s) of the water current over every evaluation so far; None when not split."""
         ...
 
     def history(self) -> tuple[np.ndarray | None, np.ndarray | None]:

@@ -80,7 +80,9 @@ class DynamicPlant:
     and integrators are internal state, initialised on the first step to the
     trimmed start ν = (u_c, 0, w_c, r_c), τ = sat(n̂(ν)) (the vehicle already
     moving at the first command, as the kinematic plant assumes). Each call of
-    :meth:`step_tuple` (one tick) logs ν and τ at its start (:meth:`history`).
+    :meth:`step_tuple` (one tick) logs ν and τ at its start (:meth:`history`). The water current it
+    applies is reported apart from the total ω = current + hull sway + loop error (:meth:`omega_series`,
+    :meth:`omega_peak`): :meth:`current_series` at the ticks and :meth:`current_peak` over every stage.
 
     Parameters
     ----------
@@ -115,7 +117,8 @@ class DynamicPlant:
         self._limits = self.params.thrust_limits if self.params.actuation == "thrusters" else None
         self.state: tuple[float, ...] | None = None  # (u, v, w, r, X, Z, N, I_u, I_w, I_r)
         self._log: list[tuple[float, ...]] = []
-        self._peak = [0.0, 0.0]  # largest ||omega_xy||, |omega_z| over every evaluation (m/s)
+        # largest ||omega_xy||, |omega_z|, then ||delta_xy||, |delta_z| of the current, over every evaluation (m/s)
+        self._peak = [0.0, 0.0, 0.0, 0.0]
 
     # ---- the model ---------------------------------------------------------------------
     def current_at(self, t: float) -> tuple[float, float, float]:
@@ -150,21 +153,32 @@ class DynamicPlant:
         err = (command[0] - u, command[1] - w, command[2] - r)
         # conditional integration: hold the integral while its channel saturates in the error's direction
         integ = tuple(0.0 if s and c * e > 0.0 else e for s, c, e in zip(saturated, cmd, err))
-        self._record_omega(c1 - err[0] * cp - v * sp, c2 - err[0] * sp + v * cp, c3 - err[1])
+        self._record(c1 - err[0] * cp - v * sp, c2 - err[0] * sp + v * cp, c3 - err[1], c1, c2, c3)
         return (u * cp - v * sp + c1, u * sp + v * cp + c2, w + c3, r, *acc,
                 *((ci - ti) * self._tau_inv for ci, ti in zip(cmd, tau)), *integ)
 
-    def _record_omega(self, o1: float, o2: float, o3: float) -> None:
-        """Keep the largest ‖ω_xy‖, |ω_z| (m/s) of ω = ẋ − f(x) v seen by the integrator."""
-        oxy = math.hypot(o1, o2)
-        if oxy > self._peak[0]:
-            self._peak[0] = oxy
-        if abs(o3) > self._peak[1]:
-            self._peak[1] = abs(o3)
+    def _record(self, o1: float, o2: float, o3: float, c1: float, c2: float, c3: float) -> None:
+        """Keep the largest ‖ω_xy‖, |ω_z| of ω = ẋ − f(x) v and ‖δ_xy‖, |δ_z| of the current δ (m/s) seen by
+        the integrator (one call per stage: the hot loop pays one call for both)."""
+        peak = self._peak
+        oxy, cxy = math.hypot(o1, o2), math.hypot(c1, c2)
+        if oxy > peak[0]:
+            peak[0] = oxy
+        if abs(o3) > peak[1]:
+            peak[1] = abs(o3)
+        if cxy > peak[2]:
+            peak[2] = cxy
+        if abs(c3) > peak[3]:
+            peak[3] = abs(c3)
 
     def omega_peak(self) -> tuple[float, float]:
         """Largest ‖ω_xy‖ and |ω_z| (m/s) over every evaluation the integrator made (every RK4 stage)."""
         return self._peak[0], self._peak[1]
+
+    def current_peak(self) -> tuple[float, float]:
+        """Largest ‖δ_xy‖ and |δ_z| (m/s) of the water current the plant applied (the override, if any), over
+        every evaluation the integrator made (every RK4 stage): the part of ω the certificate assumes."""
+        return self._peak[2], self._peak[3]
 
     def _start(self, command: Sequence[float]) -> tuple[float, ...]:
         nu = (float(command[0]), 0.0, float(command[1]), float(command[2]))
@@ -190,6 +204,11 @@ class DynamicPlant:
         rows = [*self._log, self.state[:7]] if self.state is not None else []
         data = np.asarray(rows, dtype=float).reshape(-1, 7)
         return data[:, :4], data[:, 4:7]
+
+    def current_series(self, t: np.ndarray) -> np.ndarray:
+        """The water current δ (m/s) the plant applied at the times ``t`` (s), shape (len(t), 3): the override or
+        the scenario's current (computed after the run, nothing in the integrator)."""
+        return np.array([self.current_at(float(ti)) for ti in np.asarray(t, dtype=float)], dtype=float).reshape(-1, 3)
 
     def omega_series(self, t: np.ndarray, states: np.ndarray, inputs: np.ndarray) -> np.ndarray:
         """ω = ẋ − f(x) v at every tick (K + 1, 3), m/s: δ + R(ψ)(u_b − u_c, v_b), δ_z + w_b − w_c."""

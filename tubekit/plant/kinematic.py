@@ -218,6 +218,14 @@ class Plant:
         """No body velocities or thrusts: the kinematic plant has no hull."""
         return None, None
 
+    def current_series(self, t: np.ndarray) -> None:
+        """None: ω (current + the sway model, or the override) is what the certificate assumes, not split."""
+        return None
+
+    def current_peak(self) -> None:
+        """None: the run's premise reads the total ω (:meth:`omega_peak`), not the current apart."""
+        return None
+
 
 def rk4_tuple(f: Callable, t: float, y: tuple, v: Sequence[float], h: float, n: int) -> tuple:
     """``n`` classical RK4 steps of ``h`` (s) of ``y' = f(t, y, v)`` on float tuples, ``v`` held (both plants)."""

@@ -31,8 +31,8 @@ import numpy as np
 from flint import arb, ctx
 
 from tubekit.model.backup import SafeSet, StationKeeping
-from verify.design import Condition
-from verify.intervals import bisect_sup, enclose, lower, upper
+from verify.theorem.design import Condition
+from verify.kernel.intervals import bisect_sup, enclose, lower, upper
 
 __all__ = ["continuous_rate_bound", "continuous_rate_sampled", "continuous_rate_sampled_shapes", "unstable_condition", "cone_angle",
            "shape_enclosure", "yaw_shape_enclosure"]

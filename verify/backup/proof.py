@@ -38,12 +38,14 @@ matters has s >= t_r, where the blend is over. The command's rate is bounded in 
 (:func:`tubekit.model.backup.axis_shape`), the rate bound is :func:`verify.backup.continuous.continuous_rate_bound`
 over the whole axis circle, and the condition ``backup_ridge`` is replaced by ``backup_unstable``
 (0 < χ_u < χ_c); every other condition is the same.
+
+This module is the ``certify`` step of the station-keeping proof (:mod:`verify.backup.station_keeping`, registered
+for :class:`verify.backup.protocol.BackupProof`); the :class:`BackupCertificate` it returns is the protocol's.
 """
 
 from __future__ import annotations
 
 import math
-from dataclasses import asdict, dataclass
 
 import numpy as np
 from flint import arb
@@ -51,10 +53,10 @@ from flint import arb
 from tubekit.exceptions import ConfigError
 from tubekit.model.backup import SafeSet, StationKeeping
 from tubekit.validation import nonnegative, positive
-from verify.design import Condition
-from verify.intervals import bisect_sup, enclose, lower, upper
-from verify.parts import block, bound, integer, item, number, numbers
+from verify.theorem.design import Condition
+from verify.kernel.intervals import bisect_sup, enclose, lower, upper
 from verify.backup.continuous import continuous_rate_bound, continuous_rate_sampled, unstable_condition
+from verify.backup.protocol import BackupCertificate
 from verify.backup.rate import backup_command_rate, backup_tick_change
 
 __all__ = ["BackupCertificate", "planar_rate_bound", "certify_backup", "ramp_window", "tick_distance", "rate_sampled",
@@ -63,100 +65,6 @@ __all__ = ["BackupCertificate", "planar_rate_bound", "certify_backup", "ramp_win
 #: Bisection budget of :func:`planar_rate_bound` (intervals of χ examined): a work unit, not seconds.
 BACKUP_MAX_BOXES = 4096
 _HALF_PI_UP = math.nextafter(math.pi / 2, math.inf)
-
-
-@dataclass(frozen=True)
-class BackupCertificate:
-    """The backup law, its safe set, the disturbance it holds against and every checked condition."""
-
-    law: StationKeeping
-    safe_set: SafeSet
-    omega_xy: float
-    omega_z: float
-    tick: float
-    rate_bound: float
-    rate_sampled: float
-    boxes: int
-    conditions: tuple[Condition, ...]
-    handover: tuple[float, float] = (0.0, 0.0)
-    yaw_rate_error: float = 0.0
-
-    @property
-    def certified(self) -> bool:
-        """True when every condition holds."""
-        return all(c.ok for c in self.conditions)
-
-    @property
-    def failures(self) -> tuple[Condition, ...]:
-        """The conditions that do not hold."""
-        return tuple(c for c in self.conditions if not c.ok)
-
-    def to_dict(self) -> dict:
-        """Plain JSON-able data (floats, strings, booleans)."""
-        law = {k: v for k, v in asdict(self.law).items()
-               if not (k in _SMOOTH_KEYS and v == 0.0) and not (k == "yaw_law" and v == "ridge")}
-        out = {"law": law, "safe_set": asdict(self.safe_set), "omega_xy": self.omega_xy,
-               "omega_z": self.omega_z, "tick": self.tick, "rate_bound": self.rate_bound,
-               "rate_sampled": self.rate_sampled, "boxes": self.boxes, "certified": self.certified,
-               "handover": list(self.handover), "conditions": [c.to_dict() for c in self.conditions]}
-        if self.yaw_rate_error:  # issue 22's keys appear only when on: older certificates keep their JSON
-            out["yaw_rate_error"] = self.yaw_rate_error
-        return out
-
-    @classmethod
-    def from_dict(cls, d: dict, where: str = "certificate.backup") -> "BackupCertificate":
-        """Inverse of :meth:`to_dict` (``certified`` is recomputed; ConfigError naming the key)."""
-        raw = block(d, "law", where)
-        law_ = _typed(StationKeeping, raw, f"{where}.law", ("surge", "yaw_rate", "yaw_band", "heave", "heave_band"),
-                      _SMOOTH_KEYS, {"yaw_law": raw["yaw_law"]} if "yaw_law" in raw else {})
-        safe_ = _typed(SafeSet, block(d, "safe_set", where), f"{where}.safe_set", ("level", "shape", "depth"))
-        conds = item(d, "conditions", where)
-        if not isinstance(conds, list):
-            raise ConfigError(f"{where}.conditions", "a list of conditions", type(conds).__name__)
-        return cls(law=law_, safe_set=safe_, omega_xy=number(d, "omega_xy", where),
-                   omega_z=number(d, "omega_z", where), tick=number(d, "tick", where),
-                   rate_bound=bound(d, "rate_bound", where), rate_sampled=number(d, "rate_sampled", where),
-                   boxes=integer(d, "boxes", where),
-                   conditions=tuple(Condition.from_dict(c, f"{where}.conditions[{i}]") for i, c in enumerate(conds)),
-                   handover=numbers(d, "handover", where, 2),
-                   yaw_rate_error=number(d, "yaw_rate_error", where) if "yaw_rate_error" in d else 0.0)
-
-    def summary_lines(self) -> list[str]:
-        """Human-readable lines for a certificate's text."""
-        s, law = self.safe_set, self.law
-        head = "certified" if self.certified else "NOT certified: " + ", ".join(c.condition for c in self.failures)
-        return [f"backup (station keeping): {head}",
-                f"  safe set: horizontal radius {s.radius:.3f} m, depth band ±{s.depth:.3f} m; hand-over within "
-                f"{s.handover_radius:.3f} m of the anchor (any heading)",
-                f"  law: u_b {law.surge:g} m/s, k {law.yaw_rate:g} rad/s, w_b {law.heave:g} m/s; against "
-                f"ω̄_xy {self.omega_xy:.4g} m/s, ω̄_z {self.omega_z:.4g} m/s",
-                f"  sup V̇ on the level set <= {self.rate_bound:.4g} m/s (sampled {self.rate_sampled:.4g}, "
-                f"{self.boxes} intervals)"] + self._smooth_lines()
-
-    def _smooth_lines(self) -> list[str]:
-        law = self.law
-        if not (law.surge_fade or law.yaw_fade or law.ramp or self.yaw_rate_error):
-            return []
-        yaw = ([f"  continuous yaw law: unstable axis angle χ_u {law.unstable:.4g} rad, "
-                f"band χ_0 {law.yaw_band:.4g} rad"]
-               if law.yaw_law == "continuous" else [])
-        return [f"  fades d_0 {law.surge_fade:.4g} m, d_1 {law.yaw_fade:.4g} m, ramp t_r {law.ramp:.4g} s; "
-                f"yaw-rate error E_r {self.yaw_rate_error:.4g} rad/s"] + yaw
-
-
-#: Optional keys of a stored law (issue 22; 0 = off, so older certificates read unchanged).
-_SMOOTH_KEYS = ("surge_fade", "yaw_fade", "ramp", "unstable")
-
-
-def _typed(cls: type, d: dict, where: str, keys: tuple[str, ...], optional: tuple[str, ...] = (),
-           extra: dict | None = None):
-    """``cls(**numbers, **extra)`` from ``d``, a ConfigError naming ``where.key`` when a value is refused."""
-    try:
-        return cls(**{k: number(d, k, where) for k in keys + tuple(k for k in optional if k in d)}, **(extra or {}))
-    except ConfigError as exc:
-        if exc.field.startswith(where):
-            raise
-        raise ConfigError(f"{where}.{exc.field.split('.')[-1]}", exc.expected, exc.received) from None
 
 
 def tick_distance(law: StationKeeping, safe: SafeSet, omega_xy: float, tick: float) -> float:

@@ -58,7 +58,7 @@ from flint import arb
 from tubekit.exceptions import ConfigError
 from tubekit.model.backup import SafeSet, StationKeeping
 from tubekit.validation import nonnegative, positive
-from verify.intervals import upper
+from verify.kernel.intervals import upper
 
 __all__ = ["backup_command_rate", "backup_tick_change"]
 

@@ -23,7 +23,6 @@ from __future__ import annotations
 
 import dataclasses
 import math
-from typing import Callable
 
 import numpy as np
 from flint import arb
@@ -31,9 +30,9 @@ from flint import arb
 from tubekit.model.backup import SafeSet, StationKeeping
 from tubekit.validation import nonnegative, positive
 from verify.backup.continuous import cone_angle, continuous_rate_sampled_shapes
-from verify.backup.proof import BACKUP_MAX_BOXES, BackupCertificate, certify_backup, ramp_window, rate_sampled, \
-    tick_distance
-from verify.intervals import lower, upper
+from verify.backup.proof import BACKUP_MAX_BOXES, certify_backup, ramp_window, rate_sampled, tick_distance
+from verify.backup.protocol import BackupCertificate, Fits
+from verify.kernel.intervals import lower, upper
 
 __all__ = ["design_backup", "UNSTABLE_FRACTION", "SMOOTH_BAND_FRACTIONS", "NARROW_YAW_BAND", "SMOOTH_SEARCH_BOXES",
            "GENTLE_LEVEL_STEP", "GENTLE_MAX_LEVEL", "Fits"]
@@ -52,9 +51,6 @@ GENTLE_MAX_LEVEL = 12.0
 
 #: The smallest shape β (m) of the grid: the gentlest command at a level (the longest fades and ramp).
 MIN_SHAPE = 0.05
-
-#: ``fits(law, safe)``: the ratio (dimensionless) of the loop error the candidate causes to the error assumed.
-Fits = Callable[[StationKeeping, SafeSet], float]
 
 
 def _candidates(limits: tuple[float, float, float], omega_xy: float) -> list[tuple[float, float]]:

@@ -24,10 +24,11 @@ from __future__ import annotations
 import contextlib
 import math
 from dataclasses import dataclass, field, replace
-from typing import Any, Callable, Iterator
+from typing import TYPE_CHECKING, Callable, Iterator
 
 import numpy as np
 
+from tubekit.design_inputs import DesignInputs
 from tubekit.model.ancillary import LAWS, AncillaryLaw, get_law
 from tubekit.model.errors import error_coordinates, numeric
 from tubekit.exceptions import ConfigError
@@ -39,6 +40,9 @@ from tubekit.tightening import Tightening
 from tubekit.validation import duration_seconds
 
 from verify.falsify.strategies import state_from_error
+
+if TYPE_CHECKING:
+    from verify.certificate.artefact import Certificate
 
 __all__ = ["LoopRun", "ClosedLoopResult", "falsify_closed_loop", "start_state", "greedy_disturbance",
            "piecewise_disturbance", "PREMISE_NAMES", "GREEDY_AXES"]
@@ -271,16 +275,27 @@ class _Attack:
         """Simulate from ``start`` under ``disturbance`` (:func:`certified_run`) and measure the promises."""
         sc = self.scenario.with_changes(initial_state=start)
         with _tapped(self.law, tap):
-            done = certified_run(sc, self.tightening, disturbance=disturbance)
-        by_name = {p.name: p for p in done.promises}
+            done = certified_run(sc, self.tightening_at(sc), disturbance=disturbance)
         axes = np.nanmax(np.abs(np.asarray(done.run.rho)) / np.asarray(self.tightening.tube), axis=0)
-        return LoopRun(strategy, tuple(float(x) for x in start), float(by_name["tube"].observed), done.broken,
+        ratio = float(np.max(axes)) if np.all(np.isfinite(axes)) else math.inf  # against the attacked tube
+        return LoopRun(strategy, tuple(float(x) for x in start), ratio, done.broken,
                        not done.premises_held, done.promises, sequence, tuple(float(a) for a in axes))
 
 
-def _setup(scenario: Scenario, law: str | None, duration: float, certificate: Any,
-           tightening: Tightening | None) -> tuple[_Attack, Any]:
-    from verify.certificate import certify
+    def tightening_at(self, scenario: Scenario) -> Tightening:
+        """The tightening of a run of ``scenario``: the attacked one from its own start; from another start, the
+        same design at the same σ certified for that start (the start is part of the design, so a certificate
+        covers its own start only). A start the design does not cover gives a best-effort tightening: its runs
+        claim nothing."""
+        if self.tightening.design is None or scenario.initial_state == self.scenario.initial_state:
+            return self.tightening
+        from verify.certificate.certify import certify
+        return certify(DesignInputs.of(scenario, sigma=self.tightening.sigma)).best_effort_tightening()
+
+
+def _setup(scenario: Scenario, law: str | None, duration: float, certificate: Certificate | None,
+           tightening: Tightening | None) -> tuple[_Attack, Certificate]:
+    from verify.certificate.certify import certify
 
     name = scenario.controller.law if law is None else law
     law_obj = get_law(name)
@@ -297,7 +312,7 @@ def _setup(scenario: Scenario, law: str | None, duration: float, certificate: An
 
 
 def falsify_closed_loop(scenario: Scenario, law: str | None = None, *, budget: int = 20, seed: int = 0,
-                        duration: float = 3.0, certificate: Any = None,
+                        duration: float = 3.0, certificate: Certificate | None = None,
                         tightening: Tightening | None = None) -> ClosedLoopResult:
     """Search disturbance sequences and boundary starts for a run that breaks the certificate.
 

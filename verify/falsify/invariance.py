@@ -10,7 +10,7 @@ always with the *derived* dynamics (:mod:`tubekit.model.derivation`). The tube i
 invariant at a configuration on its boundary (||rho|| = rho-tilde) when this is <= 0.
 
 That pointwise sign is no longer what the certificate claims (the sampled-data
-theorem, :mod:`verify.sampled`): :func:`one_period_ratio` runs one FHOCP period of
+theorem, :mod:`verify.theorem.sampled`): :func:`one_period_ratio` runs one FHOCP period of
 the loop as it runs — reset ê(t_k) = e(t_k) (so ``real`` = ``nominal``), v̂ held,
 κ held over each tick, the plant of :mod:`tubekit.plant.kinematic` under a constant ω and a
 target moving at p_d_dot — and returns max_j |e_j - ê_j| / tube_j over the period,

@@ -1,6 +1,6 @@
 """The falsifiers: one sampled-data period (pointwise) and whole closed-loop runs.
 
-The certificate (:mod:`verify.sampled`) claims: from any state with ρ = 0 at a
+The certificate (:mod:`verify.theorem.sampled`) claims: from any state with ρ = 0 at a
 sample (the nominal reset), one period of the sampled-data loop keeps
 max_j |e_j - ê_j| / tube_j <= 1. :func:`falsify` searches the starts of one period
 (e in Ē, v̂ in V̄, constant ω with ‖ω_xy‖ <= ω̄_xy and |ω_z| <= ω̄_z, p_d_dot in P)
@@ -32,7 +32,7 @@ from tubekit.scenario import Scenario
 
 from verify.falsify.closed_loop import ClosedLoopResult, LoopRun, falsify_closed_loop
 from verify.falsify.invariance import TubeConfiguration, one_period_ratio
-from verify.region import Region
+from verify.kernel.region import Region
 from verify.falsify.strategies import PERIOD_DIM, period_configuration_from_unit, period_configurations
 
 __all__ = ["FalsifyResult", "SearchSpace", "search_space", "falsify", "VIOLATION_TOL", "falsify_closed_loop",
@@ -77,7 +77,7 @@ def search_space(scenario: Scenario, law: str | None = None, *, sigma: float | N
 
     ``sigma`` overrides the gain attacked (the tube stays the certificate's).
     """
-    from verify.certificate import certify
+    from verify.certificate.certify import certify
 
     law = scenario.controller.law if law is None else law
     get_law(law)

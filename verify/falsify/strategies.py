@@ -34,7 +34,7 @@ from tubekit.model.trajectory import Circle, Helix, Line, Trajectory, Waypoints
 
 from verify.falsify import scenarios as families
 from verify.falsify.invariance import TubeConfiguration
-from verify.region import Region
+from verify.kernel.region import Region
 
 __all__ = [
     "regions",
@@ -92,7 +92,7 @@ def state_from_error(e_d: float, e_z: float, e_o: float, bearing: float, sign: i
 # ------------------------------------------------------------------ regions and states
 @st.composite
 def regions(draw, heading: str | None = None, max_e_o: float = 0.95) -> Region:
-    """Valid :class:`verify.region.Region` values (optionally with a fixed heading)."""
+    """Valid :class:`verify.kernel.region.Region` values (optionally with a fixed heading)."""
     lo = draw(st.floats(0.05, 2.0))
     hi = lo + draw(st.floats(0.2, 5.0))
     ez = draw(st.floats(0.1, 2.0))

@@ -1,7 +1,7 @@
 """The paper's continuous-time Lemma 1: L1, L2, J_lower, ξ̄ and the σ and tube radius they give (a reference).
 
 The names below are imported on first use (PEP 562): the polar model is sympy, the bounds and the route
-of the built-in laws are not (:mod:`verify.compiled`).
+of the built-in laws are not (:mod:`verify.kernel.compiled`).
 """
 
 from __future__ import annotations

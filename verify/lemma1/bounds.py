@@ -9,11 +9,11 @@ extreme points: vertices of boxes, the circle a = h cos(gamma), b = h sin(gamma)
 of the disc. omega enters xi linearly, so sup over the ball is
 omega_bar * ||d xi / d omega||_2.
 
-Objectives are enclosed in Arb (:mod:`verify.intervals`): a matrix 2-norm as
+Objectives are enclosed in Arb (:mod:`verify.kernel.intervals`): a matrix 2-norm as
 sqrt(lambda_max(A^T A)) of the symbolically simplified Gram matrix, lambda_min of
-a symmetric matrix via :func:`verify.intervals.sym_eig_bounds`. The objectives (one matrix per case)
+a symmetric matrix via :func:`verify.kernel.intervals.sym_eig_bounds`. The objectives (one matrix per case)
 are built and compiled by :mod:`verify.lemma1.objectives` (sympy); for the built-in laws they ship
-compiled (:mod:`verify.compiled`), so a certificate's route needs no sympy.
+compiled (:mod:`verify.kernel.compiled`), so a certificate's route needs no sympy.
 """
 
 from __future__ import annotations
@@ -29,10 +29,10 @@ from flint import arb
 from tubekit.model.ancillary import LAWS
 from tubekit.exceptions import ConfigError
 
-from verify.compiled import LAW_BOUNDS, Objective, route_objectives
-from verify.compiled import linear_in_speed as shipped_linear_in_speed
-from verify.intervals import Case, MaxResult, maximise, point, sym_eig_bounds, upper
-from verify.region import Region
+from verify.kernel.compiled import LAW_BOUNDS, Objective, route_objectives
+from verify.kernel.compiled import linear_in_speed as shipped_linear_in_speed
+from verify.kernel.intervals import Case, MaxResult, maximise, point, sym_eig_bounds, upper
+from verify.kernel.region import Region
 
 __all__ = [
     "BoundResult",

@@ -15,9 +15,9 @@ import sympy as sp
 
 from tubekit.jsonable import write_text
 
-from verify import compiled
+from verify.kernel import compiled
 from verify.lemma1 import bounds, forms, objectives, polar
-from verify.region import Region
+from verify.kernel.region import Region
 
 __all__ = ["generated_source", "GENERATED_PATH", "GENERATED_LAWS"]
 
@@ -40,7 +40,7 @@ def _clear_caches() -> None:
 
 def _derive_all() -> tuple[dict[int, dict[str, object]], dict[str, str]]:
     """(polar fields per hemisphere as srepr, the recorded simplifications), with the shipped forms unused
-    (and the compiled objectives of :mod:`verify.compiled`, which would skip the simplifications)."""
+    (and the compiled objectives of :mod:`verify.kernel.compiled`, which would skip the simplifications)."""
     forms.recording(True)
     was = compiled.use(False)
     _clear_caches()

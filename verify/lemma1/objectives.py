@@ -4,8 +4,8 @@
 of a matrix of the polar model (:mod:`verify.lemma1.polar`) at each extreme point of the bound's
 linear parameters (:func:`case_matrices`). This module builds those matrices and compiles them:
 the Arb enclosure reads the simplified Gram matrix AᵀA (or (A + Aᵀ)/2, :func:`arb_entries`), the
-sampled value A itself. For the built-in laws the same functions ship compiled (:mod:`verify.compiled`,
-printed from :func:`case_matrices` by :mod:`verify.generate_compiled`), so this module is imported only
+sampled value A itself. For the built-in laws the same functions ship compiled (:mod:`verify.kernel.compiled`,
+printed from :func:`case_matrices` by :mod:`verify.studies.generate_compiled`), so this module is imported only
 for another law, when the shipped code is stale, or by the generators.
 """
 
@@ -20,8 +20,8 @@ import sympy as sp
 from tubekit.model.derivation import symbols
 from tubekit.exceptions import ConfigError, TubekitError
 
-from verify.compiled import Objective
-from verify.intervals import compile_arb, compile_numpy
+from verify.kernel.compiled import Objective
+from verify.kernel.intervals import compile_arb, compile_numpy
 from verify.lemma1.forms import simplified
 from verify.lemma1.polar import A_V, B_V, E_D, E_O, E_Z, GAMMA, H_XY, P_Z, R_M, THETA, U_M, W_M, law_gain, polar_model
 

@@ -10,7 +10,7 @@ with ‖h(e, v̂) − h(ê, v̂)‖ <= L1‖ρ‖, ‖ζ(e) − ζ(ê)‖ <= L2�
 (each with its sampled value and gap) and evaluates these two formulas in Arb, rounded in the
 safe direction (σ_min up, ρ̃ up). When J_lower's certified bound is not positive the formula
 gives no σ and no tube, and the route says why. The route is reported beside the certificate's
-sampled-data tube (:mod:`verify.sampled`), which is the verdict: :attr:`PaperRoute.why_not_the_verdict`.
+sampled-data tube (:mod:`verify.theorem.sampled`), which is the verdict: :attr:`PaperRoute.why_not_the_verdict`.
 """
 
 from __future__ import annotations
@@ -25,10 +25,10 @@ from tubekit.exceptions import ConfigError
 from tubekit.model.ancillary import LAWS
 from tubekit.scenario import Scenario
 
-from verify.intervals import upper
+from verify.kernel.intervals import upper
 from verify.lemma1.bounds import BoundResult, compute_bounds
-from verify.parts import bound, flag, integer, item, number, text
-from verify.region import Region
+from verify.kernel.parts import bound, flag, integer, item, number, text
+from verify.kernel.region import Region
 
 __all__ = ["PaperRoute", "RouteQuantity", "paper_route", "ROUTE_NAMES", "ROUTE_BUDGET", "ROUTE_GAP"]
 
@@ -250,7 +250,7 @@ def _why_line(scenario: Scenario) -> str:
             f"delta = {c.dt:g} s and holds kappa_i = -sigma K(e_i)(e_i - e_hat_i) for h = {h:g} s ticks (ZOH), so "
             f"rho moves by (I - sigma h J K) rho_i plus the inter-tick drift (J(e) - J(e_i)) kappa_i, which Lemma 1 "
             f"omits (its rho_tilde -> 0 as sigma -> inf, while a held tick contracts only while |1 - sigma h g| < 1 "
-            f"on the diagonal g of J K); the one-period box tube of verify.sampled bounds that loop (F(x) < x in "
+            f"on the diagonal g of J K); the one-period box tube of verify.theorem.sampled bounds that loop (F(x) < x in "
             f"Arb, docs/verify.md section 3).")
 
 

@@ -20,7 +20,7 @@ the inputs Ẇ and w_n (L1), and the free response from x(0) (peak).
 
 **Theorem (first exit).** Let (E, Â, Ẑ, Ŷ) be assumed bounds of (|e|, |a|, |z|, |ẏ|) per channel.
 While they hold on [0, t): ν lies in the box |y_c| <= V_c + E_c, |v| <= γ̄ (hull ISS bound,
-:func:`verify.design.hull_sway_bound`); no channel saturates (``loop_saturation``), so the model
+:func:`verify.theorem.design.hull_sway_bound`); no channel saturates (``loop_saturation``), so the model
 above holds; the inputs obey the bounds of :func:`input_bounds`; so :func:`computed_bounds`
 bounds (|e|, |a|, |z|, |ẏ|) on [0, t] (a jump at t included). If every computed bound is strictly
 below the assumed one (``loop_fixed_point``), let t* be the first time an assumed bound is reached:
@@ -40,8 +40,8 @@ from flint import arb, ctx
 
 from tubekit.exceptions import ConfigError
 from tubekit.validation import finite, nonnegative, positive
-from verify.design import Condition, hull_sway_bound
-from verify.intervals import lower, upper
+from verify.theorem.design import Condition, hull_sway_bound
+from verify.kernel.intervals import lower, upper
 from verify.vehicle.result import LoopBound
 from verify.vehicle.model import (arb_body_forces, channel_forces, channel_gradient, channel_masses, channel_mismatch,
                                channel_mismatch_gradient, hull_balls, nominal_balls, nominal_params,
@@ -103,7 +103,7 @@ class Inputs:
 class _Loop:
     """The vehicle's fixed data for the fixed point: balls, gains, slopes λ_c, the response sums per channel."""
 
-    def __init__(self, params: Any, v_max: Sequence[float], tick: float, ticks: int) -> None:
+    def __init__(self, params: VehicleParams, v_max: Sequence[float], tick: float, ticks: int) -> None:
         self.params, self.v_max, self.tick = params, tuple(v_max), tick
         self.nominal, self.hull = nominal_balls(params), hull_balls(params)
         nom = nominal_params(params)
@@ -135,12 +135,12 @@ class _Loop:
 
 
 @functools.lru_cache(maxsize=8)
-def _cached_loop(params: Any, v_max: tuple, tick: float, ticks: int, prec: int) -> _Loop:
+def _cached_loop(params: VehicleParams, v_max: tuple, tick: float, ticks: int, prec: int) -> _Loop:
     """:class:`_Loop` memoised on its inputs and the working precision ``prec`` (bits) it is built at."""
     return _Loop(params, v_max, tick, ticks)
 
 
-def _loop_of(params: Any, v_max: tuple, tick: float, ticks: int) -> _Loop:
+def _loop_of(params: VehicleParams, v_max: tuple, tick: float, ticks: int) -> _Loop:
     """The :class:`_Loop` (its impulse-response sums) of a vehicle, V and h, built once per (hashable) vehicle: it
     does not depend on the jump bounds, which the fixed point of :mod:`verify.vehicle.compose` changes each round."""
     try:
@@ -218,7 +218,7 @@ def _thrust_peaks(loop: _Loop, box: tuple[float, float, float], gamma: float,
     return [upper(abs(forces[c]) + loop.m_hat[c] * arb(a_bound[c])) for c in range(3)]
 
 
-def actuator_authority(params: Any, v_max: Sequence[float]) -> tuple[float, float, float]:
+def actuator_authority(params: VehicleParams, v_max: Sequence[float]) -> tuple[float, float, float]:
     """(a_u, a_w, a_r): a lower bound of the acceleration each channel delivers against drag in V.
 
     a_c = (smallest limit over |u| <= V_u and Θ − sup|n_c| over V (sway |v| <= γ̄(V)) and Θ) / sup m_c
@@ -253,7 +253,7 @@ def _triple(name: str, value: Any, strict: bool = False) -> tuple[float, float, 
     return tuple(check(f"{name}[{i}]", finite(f"{name}[{i}]", x)) for i, x in enumerate(value))
 
 
-def _validate(params: Any, v_max: Any, tick: Any, period: Any, jump_tick: Any, jump_period: Any,
+def _validate(params: VehicleParams, v_max: Any, tick: Any, period: Any, jump_tick: Any, jump_period: Any,
               rate: Any, max_iterations: Any) -> tuple:
     if not hasattr(params, "loop_bandwidth") or not hasattr(params, "interval"):
         raise ConfigError("params", "a VehicleParams", type(params).__name__)
@@ -274,7 +274,7 @@ def _validate(params: Any, v_max: Any, tick: Any, period: Any, jump_tick: Any, j
     return v, h, d, int(ticks), jt, jp, rho
 
 
-def velocity_loop_bound(params: Any, *, v_max: Sequence[float], tick: float, period: float,
+def velocity_loop_bound(params: VehicleParams, *, v_max: Sequence[float], tick: float, period: float,
                         jump_tick: Sequence[float], jump_period: Sequence[float],
                         rate: Sequence[float] | None = None,
                         max_iterations: int = LOOP_MAX_ITERATIONS) -> LoopBound:
@@ -316,7 +316,7 @@ def velocity_loop_bound(params: Any, *, v_max: Sequence[float], tick: float, per
                    found, rho)
 
 
-def _saturation(loop: _Loop, params: Any, v: Sequence[float], assumed: list) -> list[Condition]:
+def _saturation(loop: _Loop, params: VehicleParams, v: Sequence[float], assumed: list) -> list[Condition]:
     """``loop_saturation[X|Z|N]``: sup|n̂_c| + m̂_c Â_c < the smallest limit over |u| <= V_u + E_u and Θ."""
     box, sway = loop.box([r[0] for r in assumed])
     a_assumed = [r[1] for r in assumed]
@@ -335,7 +335,7 @@ def _saturation(loop: _Loop, params: Any, v: Sequence[float], assumed: list) -> 
     return conds
 
 
-def _result(loop: _Loop, params: Any, given: tuple, assumed: list, computed: list, inputs: Inputs | None,
+def _result(loop: _Loop, params: VehicleParams, given: tuple, assumed: list, computed: list, inputs: Inputs | None,
             authority: tuple, iterations: tuple[int, int], found: bool, rho: tuple | None) -> LoopBound:
     """The :class:`LoopBound` with every condition of the theorem (bounds +inf when not certified)."""
     v, h, d, jt, jp = given

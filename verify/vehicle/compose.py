@@ -8,11 +8,12 @@ jumps; the command jumps
   checked by the plan check: between nodes and against the last applied command, 0 at t = 0); not at the
   hand-over, where the ramped backup starts from the last applied command (a backup without a ramp makes
   plans end at rest instead, ``Tightening.terminal_rest``), and
-* at every tick during the backup by at most :func:`verify.backup.backup_tick_change` (the backup law's
-  command rate × h, :func:`verify.backup.backup_command_rate`, finite because the law is faded near its
-  anchor, ramped after the hand-over and, with the continuous yaw law, free of the ridge's jump).
+* at every tick during the backup by at most the law's proof's ``tick_change`` (station keeping:
+  :func:`verify.backup.backup_tick_change`, the command rate × h of :func:`verify.backup.backup_command_rate`,
+  finite because the law is faded near its anchor, ramped after the hand-over and, with the continuous yaw law,
+  free of the ridge's jump).
 
-E in turn enters ω̄ (:func:`verify.design.disturbance_bounds`), the tube, the hand-over margins and the
+E in turn enters ω̄ (:func:`verify.theorem.design.disturbance_bounds`), the tube, the hand-over margins and the
 backup's proof, which fix the backup's command rate. :func:`solve_dynamic` closes this loop as a checked
 fixed point: it *assumes* a bound E_a, derives everything from it (the backup designed so that its command
 rate keeps E below E_a when it can: ``fits``, the gentle search of :mod:`verify.backup.search`), computes E
@@ -21,33 +22,43 @@ from the resulting jump bounds, and certifies only when E < E_a component-wise (
 monotone in E_a, so the derived statements hold with E_a in place of E (first exit: the loop error is
 continuous between jumps and the L1 bound covers the jumps).
 
+The backup law enters only through its proof (:func:`verify.backup.proof_for`, keyed by the law's ``kind``):
+its command's change per tick is :meth:`verify.backup.BackupProof.tick_change`. :func:`loop_for_law` evaluates
+the loop bound and the plant's conditions for a *given* law and safe set at a given E_a (no design): the last
+round of :func:`solve_dynamic` is that evaluation, and ``tubekit recheck`` runs it on the stored law
+(:mod:`verify.studies.rederive`).
+
 On the dynamic plant the ancillary feedback is off (σ = 0, κ ≡ 0): κ changes at every tick by an amount
 the loop bound would have to absorb; a scenario asking for σ > 0 fails ``loop_kappa``.
 """
 
 from __future__ import annotations
 
+import json
 import math
 from dataclasses import dataclass
 
 from flint import arb
 
-from tubekit.model.backup import SafeSet, StationKeeping
+from tubekit.model.backup import BackupLaw, SafeSet
+from tubekit.design_inputs import RATE_TOLERANCE
+from tubekit.exceptions import ConfigError
 from tubekit.scenario import Scenario
+from tubekit.validation import nonnegative
 
-from verify.backup import BackupCertificate, backup_tick_change
-from verify.design import Condition, Design, DisturbanceBounds, disturbance_bounds
-from verify.gains import GainBounds
-from verify.intervals import upper
-from verify.region import Region
-from verify.tiers import solve_tiers
+from verify.backup import BackupCertificate, Fits, proof_for
+from verify.theorem.design import Condition, Design, DisturbanceBounds, disturbance_bounds
+from verify.theorem.gains import GainBounds
+from verify.kernel.intervals import upper
+from verify.kernel.region import Region
+from verify.theorem.tiers import solve_tiers
 from verify.vehicle.bound import LoopBound, rate_authority_conditions, velocity_loop_bound
 
-__all__ = ["DynamicSolution", "solve_dynamic", "plan_jumps", "FIXED_POINT_ROUNDS", "PLAN_CHECK_TOLERANCE"]
+__all__ = ["DynamicSolution", "LawLoop", "solve_dynamic", "loop_for_law", "plan_jumps", "FIXED_POINT_ROUNDS",
+           "PLAN_CHECK_TOLERANCE"]
 
-#: Absolute tolerance of the plan check's rate rows (``tubekit.loop.plan_check.RATE_TOLERANCE``; verify may not
-#: import the loop, a test keeps the two equal): an accepted plan jumps by at most ρ δ + this.
-PLAN_CHECK_TOLERANCE = 1e-9
+#: The plan check's rate tolerance, carried by the proof (one number: :data:`tubekit.design_inputs.RATE_TOLERANCE`).
+PLAN_CHECK_TOLERANCE = RATE_TOLERANCE
 #: Rounds of the fixed point E_a -> E (a work unit: the verdict is the same on any machine).
 FIXED_POINT_ROUNDS = 10
 #: The first round's assumed bound over the plans-only one.
@@ -70,7 +81,7 @@ class DynamicSolution:
     dist : DisturbanceBounds
         ω̄ with E_a.
     designs, best, safe, backup
-        As :func:`verify.certificate.certify` computes them, with ``dist``.
+        As :func:`verify.certificate.certify.certify` computes them, with ``dist``.
     conditions : tuple of Condition
         The loop's conditions, ``loop_consistent``, ``rate_authority[*]``, ``loop_kappa``.
     """
@@ -124,12 +135,12 @@ def _ratio(error: tuple[float, ...], assumed: tuple[float, float, float]) -> flo
     return max((e / a if a > 0 else (math.inf if e > 0 else 0.0)) for e, a in zip(error, assumed))
 
 
-def _fits(scenario: Scenario, dist: DisturbanceBounds, assumed: tuple[float, float, float]):
+def _fits(scenario: Scenario, dist: DisturbanceBounds, assumed: tuple[float, float, float]) -> Fits:
     """``fits(law, safe)`` for :func:`verify.backup.design_backup`: E / E_a of the loop bound the candidate's
     command rate gives (inf when the loop bound fails). The scenario's part is read once, not per candidate."""
     fixed = _LoopInputs.of(scenario)
 
-    def ratio(law: StationKeeping, safe: SafeSet) -> float:
+    def ratio(law: BackupLaw, safe: SafeSet) -> float:
         loop = fixed.loop(law, safe, dist, assumed)
         return _ratio(loop.error, assumed) if loop.certified else math.inf
     return ratio
@@ -151,17 +162,18 @@ class _LoopInputs:
                    tick=1.0 / float(scenario.controller.ancillary_rate_hz), period=float(scenario.controller.dt),
                    plans=plan_jumps(scenario))
 
-    def loop(self, law: StationKeeping, safe: SafeSet, dist: DisturbanceBounds,
+    def loop(self, law: BackupLaw, safe: SafeSet, dist: DisturbanceBounds,
              assumed: tuple[float, float, float]) -> LoopBound:
-        """The loop bound for the jump bounds that ``assumed`` implies (plans: J; backup: its rate × h)."""
-        per_tick = backup_tick_change(law, safe, omega_xy=dist.omega_xy, omega_z=dist.omega_z,
-                                      limits=self.v_max, loop_error=assumed, tick=self.tick)
+        """The loop bound for the jump bounds that ``assumed`` implies (plans: J; backup: its proof's
+        :meth:`~verify.backup.BackupProof.tick_change`, the command's rate × h)."""
+        per_tick = proof_for(law).tick_change(law, safe, omega_xy=dist.omega_xy, omega_z=dist.omega_z,
+                                              limits=self.v_max, loop_error=assumed, tick=self.tick)
         per_period = tuple(max(j, t) for j, t in zip(self.plans, per_tick))
         return velocity_loop_bound(self.params, v_max=self.v_max, tick=self.tick, period=self.period,
                                    jump_tick=per_tick, jump_period=per_period)
 
 
-def _loop_at(scenario: Scenario, law: StationKeeping, safe: SafeSet, dist: DisturbanceBounds,
+def _loop_at(scenario: Scenario, law: BackupLaw, safe: SafeSet, dist: DisturbanceBounds,
              assumed: tuple[float, float, float]) -> LoopBound:
     """The loop bound for ``law`` (:meth:`_LoopInputs.loop`)."""
     return _LoopInputs.of(scenario).loop(law, safe, dist, assumed)
@@ -175,37 +187,135 @@ def _consistent(loop: LoopBound, assumed: tuple[float, float, float]) -> Conditi
                      f"E = {[round(x, 6) for x in loop.error]}, assumed {[round(x, 6) for x in assumed]}")
 
 
+def _plans_only(scenario: Scenario) -> LoopBound:
+    """The loop bound for the plans' jumps alone (no backup): the fixed point's start."""
+    return velocity_loop_bound(scenario.plant.params, v_max=tuple(float(x) for x in scenario.limits.vector),
+                               tick=1.0 / float(scenario.controller.ancillary_rate_hz),
+                               period=float(scenario.controller.dt), jump_tick=(0.0, 0.0, 0.0),
+                               jump_period=plan_jumps(scenario))
+
+
+def _first_assumption(first: LoopBound) -> tuple[float, float, float] | None:
+    """E_a of the first round (:data:`_INFLATE` × the plans-only E), None when the plans' jumps alone break the
+    loop (no finite E: no round is run and the plans-only bound is reported)."""
+    assumed = tuple(_INFLATE * e if math.isfinite(e) else math.inf for e in first.error)
+    return assumed if all(math.isfinite(a) for a in assumed) else None
+
+
+def _plant_conditions(scenario: Scenario, loop: LoopBound, assumed: tuple[float, float, float],
+                      sigma: float) -> tuple[Condition, ...]:
+    """The loop's conditions, ``loop_consistent``, ``limits_rate`` / ``rate_authority[c]`` and ``loop_kappa``."""
+    return (*loop.conditions, _consistent(loop, assumed), *_rate_conditions(scenario, loop), _kappa_condition(sigma))
+
+
+@dataclass(frozen=True)
+class LawLoop:
+    """The velocity loop evaluated for one backup law at one assumed bound (:func:`loop_for_law`).
+
+    Attributes
+    ----------
+    assumed : (3,) floats
+        E_a (m/s, m/s, rad/s): the bound ω̄ is derived with.
+    dist : DisturbanceBounds
+        ω̄ with E_a.
+    loop : LoopBound
+        The loop bound for the plans' jumps and the law's per-tick jumps (the plans-only bound when the plans'
+        jumps alone break the loop).
+    conditions : tuple of Condition
+        The plant's conditions, as :attr:`DynamicSolution.conditions`.
+    """
+
+    assumed: tuple[float, float, float]
+    dist: DisturbanceBounds
+    loop: LoopBound
+    conditions: tuple[Condition, ...]
+
+
+def loop_for_law(scenario: Scenario, law: BackupLaw, safe: SafeSet, assumed: tuple[float, float, float],
+                 sigma: float) -> LawLoop:
+    """The fixed point's check for a *given* backup law and safe set at the assumed E_a (no design).
+
+    ω̄ = :func:`verify.theorem.design.disturbance_bounds` with E_a; the backup's per-tick jumps from the law's
+    proof (:meth:`verify.backup.BackupProof.tick_change`: its ramp, fades, bands and their command rate); the loop
+    bound E for them and the plans' jumps; ``loop_consistent`` (E < E_a), the rate conditions and ``loop_kappa``
+    at σ (1/s). When the plans' jumps alone break the loop, the plans-only bound is reported, as
+    :func:`solve_dynamic` does. For the law :func:`solve_dynamic` designed at its E_a this is its last round,
+    number for number.
+
+    Parameters
+    ----------
+    scenario : Scenario
+        A scenario on the dynamic plant.
+    law, safe : BackupLaw, SafeSet
+        The backup law (any registered kind) and its safe set.
+    assumed : (float, float, float)
+        E_a (m/s, m/s, rad/s), finite and >= 0.
+    sigma : float
+        σ (1/s) of the design (the dynamic plant requires 0).
+    """
+    if len(tuple(assumed)) != 3:
+        raise ConfigError("assumed", "three loop-error bounds (E_u, E_w, E_r)", assumed)
+    e_a = tuple(nonnegative(f"assumed[{i}]", a) for i, a in enumerate(assumed))
+    dist = disturbance_bounds(scenario, loop_error=e_a)
+    first = _plans_only(scenario)
+    loop = first if _first_assumption(first) is None else _LoopInputs.of(scenario).loop(law, safe, dist, e_a)
+    return LawLoop(assumed=e_a, dist=dist, loop=loop, conditions=_plant_conditions(scenario, loop, e_a, sigma))
+
+
+#: The last fixed points solved in this process, by their inputs (:func:`solve_dynamic` is a pure function of them;
+#: a re-check and the certificate it re-checks, or a table of edits of one certificate, solve it once).
+_SOLVED: dict[str, DynamicSolution] = {}
+_SOLVED_KEEP = 4
+
+
+def _solved_key(scenario: Scenario, region: Region, gains: GainBounds, sigmas: tuple[float, ...]) -> str:
+    """A canonical text of everything :func:`solve_dynamic` reads (the round limit included)."""
+    return json.dumps([scenario.to_dict(), region.to_dict(), gains.to_dict(), [float(s) for s in sigmas],
+                       FIXED_POINT_ROUNDS], sort_keys=True, default=str)
+
+
 def solve_dynamic(scenario: Scenario, region: Region, gains: GainBounds,
                   sigmas: tuple[float, ...]) -> DynamicSolution:
-    """The checked fixed point E_a -> (ω̄, tube, backup) -> jumps -> E (module doc).
+    """The checked fixed point E_a -> (ω̄, tube, backup) -> jumps -> E (module doc); memoised on its inputs.
+
+    Each round designs the backup for E_a (``fits``) and evaluates the loop bound for it; the rounds stop when
+    E < E_a, when the loop bound fails or after :data:`FIXED_POINT_ROUNDS`, and the E_a returned is always the
+    one ω̄, the tube and the backup were derived with (``loop_consistent`` compares E with it).
 
     Parameters
     ----------
     scenario : Scenario
         A scenario on the dynamic plant.
     region, gains : Region, GainBounds
-        As :func:`verify.certificate.certify` computes them.
+        As :func:`verify.certificate.certify.certify` computes them.
     sigmas : tuple of float
         σ values to try (1/s); the dynamic plant requires 0.
     """
-    v_max = tuple(float(x) for x in scenario.limits.vector)
-    tick = 1.0 / float(scenario.controller.ancillary_rate_hz)
-    first = velocity_loop_bound(scenario.plant.params, v_max=v_max, tick=tick,
-                                period=float(scenario.controller.dt), jump_tick=(0.0, 0.0, 0.0),
-                                jump_period=plan_jumps(scenario))
-    assumed = tuple(_INFLATE * e if math.isfinite(e) else math.inf for e in first.error)
-    rounds, loop = 0, first
-    while rounds < FIXED_POINT_ROUNDS and all(math.isfinite(a) for a in assumed):
-        rounds += 1
+    key = _solved_key(scenario, region, gains, sigmas)
+    if key not in _SOLVED:
+        if len(_SOLVED) >= _SOLVED_KEEP:
+            _SOLVED.pop(next(iter(_SOLVED)))
+        _SOLVED[key] = _solve_dynamic(scenario, region, gains, sigmas)
+    return _SOLVED[key]
+
+
+def _solve_dynamic(scenario: Scenario, region: Region, gains: GainBounds,
+                   sigmas: tuple[float, ...]) -> DynamicSolution:
+    """:func:`solve_dynamic` without the memo."""
+    first = _plans_only(scenario)
+    assumed = _first_assumption(first)
+    if assumed is None:  # the plans' jumps alone already break the loop: report with a finite stand-in
+        v_max = tuple(float(x) for x in scenario.limits.vector)
+        assumed = tuple(e if math.isfinite(e) else x for e, x in zip(first.error, v_max))
         dist, designs, best, safe, backup = _tiers_at(scenario, region, gains, sigmas, assumed)
-        loop = _loop_at(scenario, backup.law, backup.safe_set, dist, assumed)
-        if not loop.certified or all(e < a for e, a in zip(loop.error, assumed)):
-            break
+        return DynamicSolution(loop=first, assumed=assumed, dist=dist, designs=designs, best=best, safe=safe,
+                               backup=backup, conditions=_plant_conditions(scenario, first, assumed, best.sigma))
+    fixed = _LoopInputs.of(scenario)
+    for rounds in range(1, FIXED_POINT_ROUNDS + 1):
+        dist, designs, best, safe, backup = _tiers_at(scenario, region, gains, sigmas, assumed)
+        loop = fixed.loop(backup.law, backup.safe_set, dist, assumed)
+        if not loop.certified or all(e < a for e, a in zip(loop.error, assumed)) or rounds == FIXED_POINT_ROUNDS:
+            break  # the last round keeps its E_a: raising it now would compare E with a bound ω̄ never used
         assumed = tuple(max(a, _STEP * e) for a, e in zip(assumed, loop.error))
-    if rounds == 0:  # the plans' jumps alone already break the loop: report with a finite stand-in
-        assumed = tuple(e if math.isfinite(e) else float(x) for e, x in zip(first.error, v_max))
-        dist, designs, best, safe, backup = _tiers_at(scenario, region, gains, sigmas, assumed)
-    conds = (*loop.conditions, _consistent(loop, assumed), *_rate_conditions(scenario, loop),
-             _kappa_condition(best.sigma))
     return DynamicSolution(loop=loop, assumed=assumed, dist=dist, designs=designs, best=best, safe=safe,
-                           backup=backup, conditions=conds)
+                           backup=backup, conditions=_plant_conditions(scenario, loop, assumed, best.sigma))

@@ -19,7 +19,7 @@ from typing import Any, Mapping, Sequence
 from flint import arb
 
 from tubekit.exceptions import ConfigError
-from verify.intervals import _abs, enclose, point, upper
+from verify.kernel.intervals import _abs, enclose, point, upper
 
 __all__ = ["COEFFICIENTS", "MASS_FIELDS", "field_ball", "nominal_params", "hull_balls", "nominal_balls",
            "arb_body_forces", "body_force_gradient", "channel_forces", "channel_gradient", "channel_masses",
@@ -33,12 +33,12 @@ MASS_FIELDS = ("m", "I_zz", "x_g", "X_udot", "Y_vdot", "Z_wdot", "N_rdot", "Y_rd
 _ROUND = 2.0 ** -50   # relative: covers the float rounding of a point vehicle's mass entries
 
 
-def field_ball(params: Any, name: str) -> arb:
+def field_ball(params: VehicleParams, name: str) -> arb:
     """The ball of field ``name``: ``params.interval(name)`` (lo == hi for a point)."""
     return enclose(*params.interval(name))
 
 
-def nominal_params(params: Any) -> Any:
+def nominal_params(params: VehicleParams) -> VehicleParams:
     """The controller's point vehicle: ``params.nominal`` (every interval at its midpoint)."""
     return params.nominal
 
@@ -51,13 +51,13 @@ def _mass_balls(f: Mapping[str, arb]) -> dict[str, arb]:
     return {k: v + arb(0, upper(abs(v)) * _ROUND) for k, v in raw.items()}
 
 
-def hull_balls(params: Any) -> dict[str, arb]:
+def hull_balls(params: VehicleParams) -> dict[str, arb]:
     """Balls of every coefficient and mass entry over the vehicle's box Θ (the true plant)."""
     f = {name: field_ball(params, name) for name in COEFFICIENTS + MASS_FIELDS}
     return {**{k: f[k] for k in COEFFICIENTS}, **_mass_balls(f)}
 
 
-def nominal_balls(params: Any) -> dict[str, arb]:
+def nominal_balls(params: VehicleParams) -> dict[str, arb]:
     """Exact points of the nominal vehicle (the feedforward n̂, m̂ the plant's controller uses)."""
     nom = nominal_params(params)
     out = {k: point(getattr(nom, k)) for k in COEFFICIENTS}
@@ -140,14 +140,14 @@ def velocity_box(u: float, v: float, w: float, r: float) -> tuple[arb, arb, arb,
     return tuple(enclose(-x, x) for x in (u, v, w, r))
 
 
-def thrust_floor(params: Any, u_abs_max: float) -> tuple[float, float, float]:
+def thrust_floor(params: VehicleParams, u_abs_max: float) -> tuple[float, float, float]:
     """Smallest (X, Z, N) limit over |u| <= ``u_abs_max`` and Θ: ``params.thrust_limit_floor`` or the limits."""
     floor = getattr(params, "thrust_limit_floor", None)
     limits = floor(u_abs_max) if callable(floor) else params.thrust_limits
     return tuple(float(x) for x in limits)
 
 
-def point_time_constant(params: Any) -> float:
+def point_time_constant(params: VehicleParams) -> float:
     """T_thr (s); a thruster lag given as an interval is refused (the loop's matrix A needs a point)."""
     ball = field_ball(params, "thruster_time_constant")
     if ball.rad() != 0:

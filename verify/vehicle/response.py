@@ -26,7 +26,7 @@ from typing import Sequence
 
 from flint import arb, arb_mat, ctx
 
-from verify.intervals import upper
+from verify.kernel.intervals import upper
 
 __all__ = ["ResponseSums", "impulse_sums", "RESPONSE_PREC", "INTRA_TICK_PIECES"]
 

@@ -11,9 +11,9 @@ from dataclasses import dataclass
 from typing import Any
 
 from tubekit.exceptions import ConfigError
-from verify.design import Condition
+from verify.theorem.design import Condition
 from verify.vehicle.response import ResponseSums
-from verify.parts import block, bound, integer, item, number, numbers, text
+from verify.kernel.parts import block, bound, integer, item, number, numbers, text
 
 __all__ = ["LoopBound"]
 

@@ -1,0 +1,92 @@
+"""What safety costs the mission: time without a plan, tracking error and laps, with and without the candidate.
+
+Usage::
+
+    python benchmarks/mission.py [--duration S] [--json FILE] [--only NAME ...]
+
+For each scenario (the paper's Section VI, ``verify/scenarios/paper_currents.toml`` and its variants with a
+faster current (period 3 s) and a steady one, the two-rock transit of issue 31) the certificate is computed
+(:func:`verify.certify`), then the tube run is simulated twice under the scenario's own current: with the
+shifted candidate (:mod:`tubekit.loop.candidate`, the default) and without it (``controller.candidate =
+false``), beside the baseline (the nominal MPC alone). Printed per run: the tiers, the seconds the backup law
+ran (no plan followed), the periods the candidate was accepted, the tracking RMSE (m), its ratio to the
+baseline's, the laps about the circle's centre where there is one, and the promises broken. Everything is
+measured on the run; nothing here is timed.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import sys
+from pathlib import Path
+
+import verify
+from tubekit import paper_scenario, simulate
+from tubekit.loop.pipeline import certified_run
+from tubekit.model.trajectory import Line
+from tubekit.scenario import Obstacle, Scenario, load_scenario
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def transit() -> Scenario:
+    """The transit of issue 31: a line at 0.24 m/s, a 0.12 m/s cross current, two rocks 0.9 m off the path."""
+    base = load_scenario(verify.SCENARIOS_DIR / "paper_currents.toml")
+    return base.with_changes(
+        name="transit", trajectory=Line(start=(-12.0, 0.0, 0.0), direction_velocity=(0.24, 0.0, 0.0)),
+        initial_state=(-12.8, 0.0, 0.2, 0.0), obstacles=(Obstacle((-4.0, 0.9, 0.0), 0.4), Obstacle((4.0, -0.9, 0.0), 0.4)),
+        epsilon=0.5, workspace=((-20.0, -10.0, -5.0), (30.0, 10.0, 5.0)),
+        **{"disturbance.amplitude": (0.0, 0.0, 0.0), "disturbance.constant": (0.0, 0.12, 0.0)})
+
+
+def scenarios() -> dict[str, Scenario]:
+    """The scenarios of the module doc, by name."""
+    pc = load_scenario(verify.SCENARIOS_DIR / "paper_currents.toml")
+    steady = pc.with_changes(**{"disturbance.amplitude": (0.0, 0.0, 0.0),
+                                "disturbance.constant": tuple(pc.disturbance.amplitude)})
+    return {"section_vi": paper_scenario(), "paper_currents": pc,
+            "paper_currents_fast": pc.with_changes(**{"disturbance.period": 3.0}),
+            "paper_currents_steady": steady, "transit": transit()}
+
+
+def measure(name: str, scenario: Scenario, duration: float) -> dict:
+    """The certificate's tiers and, for the tube run with and without the candidate and the baseline, the figures."""
+    scenario = scenario.with_changes(duration=duration)
+    cert = verify.certify(scenario)
+    tight = cert.best_effort_tightening()
+    base = simulate(scenario, None, progress=False)
+    out = {"scenario": name, "tiers": cert.tiers.to_dict(), "baseline_rmse": base.metrics["tracking_rmse"]}
+    for label, on in (("candidate", True), ("replay_only", False)):
+        sc = scenario.with_changes(**{"controller.candidate": on})
+        done = certified_run(sc, tight, progress=False)
+        m = done.metrics
+        out[label] = {"backup_s": m["backup_s"], "candidate_periods": int(done.run.candidate.sum()),
+                      "tracking_rmse": m["tracking_rmse"],
+                      "rmse_ratio": m["tracking_rmse"] / out["baseline_rmse"] if out["baseline_rmse"] else math.nan,
+                      "encirclements": m.get("encirclements"), "broken": list(done.broken),
+                      "premises_failed": [p.name for p in done.promises if p.tier == "premise" and not p.ok]}
+    return out
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--duration", type=float, default=100.0, help="simulated seconds per run (default 100)")
+    parser.add_argument("--only", nargs="*", help="scenario names to run (default all)")
+    parser.add_argument("--json", type=Path, help="also write the rows as JSON")
+    args = parser.parse_args(argv)
+    rows = []
+    for name, sc in scenarios().items():
+        if args.only and name not in args.only:
+            continue
+        row = measure(name, sc, args.duration)
+        rows.append(row)
+        print(json.dumps(row), flush=True)
+    if args.json:
+        args.json.write_text(json.dumps(rows, indent=1))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

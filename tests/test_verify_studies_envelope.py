@@ -1,0 +1,89 @@
+"""The envelope: the certified frontier agrees with direct certification and never exceeds physical necessity."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+import verify
+from tubekit.app.plots import plot_envelope
+from tubekit.exceptions import ConfigError
+from tubekit.scenario import load_scenario
+from verify.studies.envelope import necessary_omega, scenario_at
+
+PAPER_CURRENTS = verify.SCENARIOS_DIR / "paper_currents.toml"
+
+
+@pytest.fixture(scope="module")
+def scenario():
+    return load_scenario(PAPER_CURRENTS)
+
+
+@pytest.fixture(scope="module")
+def env(scenario):
+    return verify.envelope(scenario, "corrected", speeds=[0.1, 0.19, 0.3], quick=True)
+
+
+def test_contains_paper_currents_point(env):
+    """paper_currents' own point (0.19 m/s, omega_bar_xy = 0.1 current + 0.02 sway) is certified."""
+    assert env.epsilon == 0.5
+    assert env.certifies(0.19, 0.12)
+    i = int(np.flatnonzero(np.isclose(env.speeds, 0.19))[0])
+    assert env.certified_omega[i] >= 0.12
+
+
+def test_certified_below_necessity(env):
+    assert env.check() == []
+    ok = np.isfinite(env.certified_omega)
+    assert ok.any()
+    assert np.all(env.certified_omega[ok] <= env.necessary_omega[ok] + 1e-9)
+    assert 0 < env.ratio_min <= env.ratio_median <= 1.0 + 1e-9
+
+
+def test_necessity_formula():
+    assert necessary_omega(0.19, 0.5, 0.4, 0.5) == pytest.approx(0.21)   # keep-up binds
+    assert necessary_omega(0.1, 0.3, 0.4, 0.5) == pytest.approx(0.15)    # yaw budget binds
+
+
+def test_bisection_brackets_certify(env, scenario):
+    """certify holds at the returned amplitude and fails at the refuted one (value * (1 + tol))."""
+    i = int(np.flatnonzero(np.isclose(env.speeds, 0.3))[0])
+    lo, hi = env.certified_amplitude[i], env.refuted_amplitude[i]
+    assert math.isfinite(lo) and math.isfinite(hi) and lo < hi
+    assert (hi - lo) / hi < 0.01
+    assert verify.certify(scenario_at(scenario, speed=0.3, amplitude_xy=lo, epsilon=0.5), "corrected").certified
+    assert not verify.certify(scenario_at(scenario, speed=0.3, amplitude_xy=hi, epsilon=0.5), "corrected").certified
+
+
+def test_plot_summary_json(env, tmp_path):
+    path = plot_envelope(env, tmp_path / "env.png")
+    assert path.stat().st_size > 10_000
+    assert "ratio certified / necessary" in env.summary()
+    d = env.to_dict()
+    assert d["epsilon"] == 0.5 and len(d["certified_omega"]) == 3 and d["problems"] == []
+
+
+def test_paper_scenario_speed_is_physically_out_of_reach():
+    """At the paper's 0.377 m/s only 0.023 m/s of horizontal disturbance is physically admissible (< gamma)."""
+    env = verify.envelope(verify.certifiable_scenario(), "corrected", speeds=[0.377], quick=True)
+    assert env.necessary_omega[0] == pytest.approx(0.023)
+    assert env.check() == []
+
+
+@pytest.mark.parametrize("kwargs, field", [
+    (dict(eps=-0.1), "eps"),
+    (dict(eps=5.0), "eps"),
+    (dict(speeds=[0.5]), "speeds"),
+    (dict(speeds=["fast"]), "speeds"),
+    (dict(speeds=[]), "speeds"),
+])
+def test_bad_inputs(scenario, kwargs, field):
+    with pytest.raises(ConfigError, match=field):
+        verify.envelope(scenario, **kwargs)
+
+
+def test_bad_law():
+    with pytest.raises(ConfigError, match="law"):
+        verify.envelope(verify.certifiable_scenario(), "pid")

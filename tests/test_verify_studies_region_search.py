@@ -1,0 +1,52 @@
+"""Region search: every grid point is certified or reported with its first failure."""
+
+from __future__ import annotations
+
+import pytest
+
+import verify
+from tubekit import paper_scenario
+from tubekit.app.cli import main
+from tubekit.exceptions import ConfigError
+from tubekit.scenario import load_scenario
+from verify.studies.region_search import search_region
+
+PAPER_CURRENTS = str(verify.SCENARIOS_DIR / "paper_currents.toml")
+
+
+def test_paper_scenario_reports_what_it_tried():
+    res = search_region(paper_scenario(), e_o_max=(0.3, 0.6), e_d_max=(1.5, 3.0))
+    assert len(res.tried) == 4 and res.best is None
+    assert all(not t.certified and t.first_failure for t in res.tried)
+    text = res.summary()
+    assert "none certifies" in text and "tried 4" in text
+    assert res.to_dict()["any_certified"] is False
+
+
+def test_best_is_widest_certified():
+    res = search_region(load_scenario(PAPER_CURRENTS), e_o_max=(0.3, 0.5), e_d_max=(2.0, 3.0))
+    assert res.best is not None and res.best.certified
+    assert (res.best.e_o_max, res.best.e_d_max) == max((t.e_o_max, t.e_d_max) for t in res.certified)
+
+
+def test_small_e_d_max_is_skipped():
+    res = search_region(load_scenario(PAPER_CURRENTS), e_o_max=(0.5,), e_d_max=(0.4, 3.0))
+    assert res.tried[0].first_failure.startswith("skipped")
+
+
+@pytest.mark.parametrize("kwargs, field", [
+    (dict(e_o_max=(1.2,)), "e_o_max"),
+    (dict(e_o_max=()), "e_o_max"),
+    (dict(e_d_max=(-1.0,)), "e_d_max"),
+    (dict(e_d_max=("far",)), "e_d_max"),
+])
+def test_bad_grids(kwargs, field):
+    with pytest.raises(ConfigError, match=field):
+        search_region(paper_scenario(), **kwargs)
+
+
+def test_cli_search_region_exit_codes(capsys):
+    assert main(["certify", PAPER_CURRENTS, "--search-region"]) == 0
+    assert "best: e_o_max = 0.9" in capsys.readouterr().out
+    assert main(["certify", "--search-region"]) == 3
+    assert "none certifies" in capsys.readouterr().out

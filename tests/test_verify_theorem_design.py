@@ -1,0 +1,202 @@
+"""Tests of verify.theorem.design: disturbance bounds, the theorem's inputs, V_bar and the named conditions.
+
+Expected numbers are recomputed here from the scenario's data (closed forms written in the tests) or by
+sampling the disturbance model directly; nothing is copied from the code under test.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import replace
+
+import numpy as np
+import pytest
+from hypothesis import given
+from hypothesis import strategies as st
+
+import verify
+from tubekit.model.kinematics import InputLimits, SwayModel
+from tubekit.scenario import Disturbance, load_scenario
+from verify.theorem.design import (Condition, Design, arc_rates, disturbance_bounds, evaluate_design, tube_problem)
+from verify.theorem.gains import gain_bounds
+from verify.kernel.region import Region
+
+
+@pytest.fixture(scope="module")
+def pc():
+    """paper_currents: scenario, region, corrected-law gains, disturbance bounds."""
+    sc = load_scenario(verify.SCENARIOS_DIR / "paper_currents.toml")
+    reg = Region.from_scenario(sc)
+    return sc, reg, gain_bounds("corrected", reg), disturbance_bounds(sc)
+
+
+@pytest.fixture(scope="module")
+def design(pc):
+    sc, reg, g, dist = pc
+    return evaluate_design(sc, reg, g, 3.125, dist)
+
+
+def _cond(d: Design, name: str) -> Condition:
+    found = [c for c in d.conditions if c.condition == name]
+    assert len(found) == 1, [c.condition for c in d.conditions]
+    return found[0]
+
+
+# --------------------------------------------------------------------------- disturbance
+@given(amp=st.tuples(*[st.floats(0.0, 0.3)] * 3), const=st.tuples(*[st.floats(-0.2, 0.2)] * 3),
+       gain=st.floats(0.0, 0.5), samp=st.floats(0.0, 0.05), t=st.floats(0.0, 200.0),
+       u=st.floats(-1, 1), r=st.floats(-1, 1), psi=st.floats(-math.pi, math.pi))
+def test_disturbance_bounds_cover_the_model(amp, const, gain, samp, t, u, r, psi):
+    """Property: the bounds are the closed forms max(a_x, a_y) + ||c_xy|| + gamma, a_z + |c_z|,
+    gamma = gain u_max r_max + amplitude, and they cover the current + sway evaluated here (eq. 2)."""
+    sc = verify.certifiable_scenario()
+    lim = sc.limits
+    dist = Disturbance(amplitude=amp, period=15.0, constant=const,
+                       sway=SwayModel(gain=gain, amplitude=samp, period=10.0, bound=1.0))
+    b = disturbance_bounds(sc.with_changes(disturbance=dist))
+    gamma = gain * lim.u_max * lim.r_max + samp
+    assert b.gamma == pytest.approx(gamma, rel=1e-12, abs=1e-15) and b.gamma >= gamma * (1 - 1e-15)
+    assert b.omega_xy == pytest.approx(max(amp[0], amp[1]) + math.hypot(const[0], const[1]) + gamma, rel=1e-12,
+                                       abs=1e-15)
+    assert b.omega_z == pytest.approx(amp[2] + abs(const[2]), rel=1e-12, abs=1e-15)
+    assert b.declared_sway == 1.0
+    a = 2 * math.pi * t / 15.0
+    vs = gain * (u * lim.u_max) * (r * lim.r_max) + samp * math.sin(2 * math.pi * t / 10.0)
+    om = (amp[0] * math.sin(a) + const[0] - vs * math.sin(psi),
+          amp[1] * math.cos(a) + const[1] + vs * math.cos(psi),
+          amp[2] * math.sin(a) + const[2])
+    assert math.hypot(om[0], om[1]) <= b.omega_xy * (1 + 1e-12) + 1e-15
+    assert abs(om[2]) <= b.omega_z * (1 + 1e-12) + 1e-15
+
+
+def test_disturbance_bounds_of_paper_currents(pc):
+    *_, dist = pc
+    assert dist.omega_xy == pytest.approx(0.1 + 0.1 * 0.4 * 0.5) and dist.omega_z == pytest.approx(0.1)
+    assert dist.gamma == pytest.approx(0.02) and dist.declared_sway == 0.02
+    assert dist.to_dict() == {"omega_xy": dist.omega_xy, "omega_z": dist.omega_z, "gamma": dist.gamma,
+                              "declared_sway": 0.02, "yaw_rate_error": 0.0}  # kinematic plant: psi_dot = r
+
+
+# --------------------------------------------------------------------------- the theorem's inputs
+def test_tube_problem_is_the_scenario(pc):
+    sc, reg, g, dist = pc
+    p = tube_problem(sc, reg, g, 3.125, dist)
+    assert p.ticks == 10 and p.tick == pytest.approx(0.01) and p.period == pytest.approx(0.1)
+    assert (p.eps, p.e_o_max, p.u_max, p.w_max, p.r_max) == (0.5, 0.5, 0.4, 0.3, 0.5)
+    assert p.pd_xy == pytest.approx(3.0 * math.pi / 50) and p.pd_z == 0.0
+    assert p.omega_xy == dist.omega_xy and p.sigma == 3.125 and p.k_abs == g.k_abs
+
+
+def test_arc_rates_are_the_closed_forms(pc):
+    """Along a nominal arc: |e_d'| <= u + P, |e_z'| <= w + |zdot_d|, |e_o'| <= r + (u + P) / eps, ||p'|| <= ||(u, w)||."""
+    sc, reg, g, dist = pc
+    rates = arc_rates(tube_problem(sc, reg, g, 3.125, dist))
+    P = 3.0 * math.pi / 50
+    want = (0.4 + P, 0.3, 0.5 + (0.4 + P) / 0.5, math.hypot(0.4, 0.3))
+    for got, w in zip(rates, want):
+        assert w <= got <= w * (1 + 1e-12)
+
+
+# --------------------------------------------------------------------------- conditions
+def test_every_condition_of_a_finite_tube_has_both_numbers(design):
+    assert design.certified and design.tube.certified and design.failures == []
+    for c in design.conditions:
+        if c.condition == "tube":
+            continue   # see test_verify_certificate.test_the_tube_condition_has_both_numbers
+        assert c.lhs is not None and c.rhs is not None and math.isfinite(c.lhs) and math.isfinite(c.rhs), c
+        assert c.ok is True and c.inequality
+
+
+def test_input_tightening_numbers(design, pc):
+    sc, reg, g, dist = pc
+    kap = design.tube.kappa
+    for i, ax in enumerate("uwr"):
+        c = _cond(design, f"v_bar[{ax}]")
+        assert c.lhs == pytest.approx(reg.v_max[i] - kap[i], rel=1e-12) and c.rhs == 0.0
+        assert design.v_bar[i] <= reg.v_max[i] - kap[i] + 1e-15
+    ku = _cond(design, "keep_up[u]")
+    assert ku.lhs == pytest.approx(0.4 - kap[0]) and ku.rhs == pytest.approx(3 * math.pi / 50 + dist.omega_xy)
+    kw = _cond(design, "keep_up[w]")
+    assert kw.lhs == pytest.approx(0.3 - kap[1]) and kw.rhs == pytest.approx(dist.omega_z)
+    yb = _cond(design, "yaw_budget")
+    assert yb.lhs == pytest.approx(0.5 - kap[2]) and yb.rhs == pytest.approx(dist.omega_xy / 0.5)
+
+
+def test_state_condition_numbers(design, pc):
+    sc, reg, *_ = pc
+    m = design.margins
+    ed = _cond(design, "e_bar[e_d]")
+    assert ed.lhs == pytest.approx(0.5 + m.e_d[-1]) and ed.rhs == pytest.approx(3.0 - m.e_d[-1])
+    eo = _cond(design, "e_bar[e_o]")
+    assert eo.lhs == m.e_o[-1] and eo.rhs == 0.5
+    sens = _cond(design, "sensing")
+    reach = 0.8 * math.hypot(design.v_bar[0], design.v_bar[1]) + m.position[-1] + 0.2
+    assert sens.lhs == pytest.approx(reach, rel=1e-12) and sens.rhs == 1.5
+    ob = _cond(design, "obstacles[0,1]")
+    assert ob.lhs == pytest.approx(6.0) and ob.rhs == pytest.approx(2 * (0.2 + m.position[-1]) + 0.8)
+
+
+@pytest.mark.parametrize("state, why", [
+    ((-0.51, 3.0, 0.2, 0.0), "e_d below epsilon + M_0"),
+    ((-0.8, 3.0, 0.2, math.pi), "away from the target (heading 'toward' certified)"),
+    ((-0.8, 3.0, 0.2, 0.6), "|e_o| = sin 0.6 above e_o_max - M_0"),
+])
+def test_initial_condition_fails_outside(pc, state, why):
+    sc, reg, g, dist = pc
+    d = evaluate_design(sc.with_changes(initial_state=state), reg, g, 3.125, dist)
+    c = _cond(d, "initial")
+    assert c.ok is False and not d.certified, why
+    assert "e(0) = " in c.detail
+
+
+def test_initial_condition_numbers(design):
+    """e(0) of paper_currents: vehicle at (-0.8, 3), target at (0, 3): e = (0.8, 0.2, 0); the worst
+    violation is the largest of the box slacks and minus the obstacle clearance (negative = inside)."""
+    c = _cond(design, "initial")
+    m = design.margins
+    slack = max(0.5 + m.e_d[0] - 0.8, 0.8 - 3.0 + m.e_d[0], 0.2 - (1.0 - m.e_z[0]), -1.0 - 0.2 + m.e_z[0],
+                0.0 - (0.5 - m.e_o[0]), -0.5 + m.e_o[0])
+    assert c.ok and c.lhs == pytest.approx(slack, abs=1e-9) and c.rhs == 0.0
+
+
+def test_sway_condition(pc):
+    sc, reg, g, _ = pc
+    low = replace(sc.disturbance, sway=replace(sc.disturbance.sway, bound=0.005))
+    sc_low = sc.with_changes(disturbance=low)
+    d = evaluate_design(sc_low, reg, g, 3.125, disturbance_bounds(sc_low))
+    c = _cond(d, "sway_bound")
+    assert c.ok is False and c.lhs == 0.005 and c.rhs == pytest.approx(0.1 * 0.4 * 0.5)
+
+
+def test_a_diverging_tube_stops_the_pipeline(pc):
+    sc, reg, g, dist = pc
+    d = evaluate_design(sc, reg, g, 1e4, dist)
+    assert [c.condition for c in d.conditions] == ["sway_bound", "tube"]
+    assert _cond(d, "tube").ok is False and "diverge" in _cond(d, "tube").detail
+    assert d.margins is None and d.v_bar is None and d.score == -math.inf and not d.certified
+    assert [c.condition for c in d.failures] == ["tube"]
+
+
+def test_condition_to_dict_drops_non_finite():
+    c = Condition("x", "a < b", math.inf, float("nan"), False, "d")
+    assert c.to_dict() == {"condition": "x", "inequality": "a < b", "lhs": None, "rhs": None, "ok": False,
+                           "detail": "d"}
+    assert Condition("y", "", 1, None, None).to_dict()["lhs"] == 1.0
+
+
+def test_score_is_the_smallest_normalised_slack(design, pc):
+    """score = min(V_bar_i / V_i, 1 - 2 M_j / width_j) over inputs and error axes (last arc)."""
+    sc, reg, *_ = pc
+    m = design.margins
+    want = min(min(v / vm for v, vm in zip(design.v_bar, reg.v_max)),
+               1 - 2 * m.e_d[-1] / 2.5, 1 - 2 * m.e_z[-1] / 2.0, 1 - 2 * m.e_o[-1] / 1.0)
+    assert design.score == pytest.approx(want, rel=1e-12)
+
+
+def test_limits_enter_v_bar(pc):
+    sc, reg, g, dist = pc
+    sc2 = sc.with_changes(limits=InputLimits(0.3, 0.3, 0.5))
+    reg2 = Region.from_scenario(sc2)
+    d = evaluate_design(sc2, reg2, g, 3.125, disturbance_bounds(sc2))
+    assert _cond(d, "keep_up[u]").ok is False    # 0.3 - kappa_u < 0.188 + 0.115
+    assert np.isclose(_cond(d, "keep_up[u]").rhs, 3 * math.pi / 50 + 0.1 + 0.1 * 0.3 * 0.5)

@@ -1,0 +1,125 @@
+"""verify.theorem.tiers: the safe and tracking tiers, the safe-only design at sigma = 0 and the certificate's backup.
+
+Numbers are recomputed by hand from the scenarios: the paper's current 0.1 m/s per axis plus the sway bound
+0.1 * 0.4 * 0.5 = 0.02 gives omega_xy = 0.12 m/s, omega_z = 0.1 m/s; delta = 0.1 s.
+"""
+
+from __future__ import annotations
+
+from tubekit.tiers import Tiers
+
+import math
+
+import pytest
+
+from tubekit.model.backup import SafeSet, StationKeeping
+from tubekit.scenario import Obstacle, paper_scenario
+from tubekit.design_inputs import handed_sigma
+from verify.theorem.tiers import SAFE_PREFIX, initial_backup, is_safe_condition, position_tube, tiers_of
+
+
+def test_paper_currents_certifies_both_tiers_with_a_backup(pc_cert):
+    c = pc_cert
+    assert c.tiers == Tiers(True, True) and c.certified and c.safe_design is None
+    b = c.backup
+    assert b.certified and b.omega_xy == c.disturbance.omega_xy and b.omega_z == c.disturbance.omega_z
+    assert b.tick == pytest.approx(0.01)                                      # 100 Hz
+    m = c.margins
+    assert b.handover == (m.position[-1], m.e_z[-1])                          # the last arc's margins
+    assert b.safe_set.handover_radius >= m.position[-1] and b.safe_set.depth >= m.e_z[-1]
+    names = [x.condition for x in b.conditions]
+    assert {"backup_level_set", "backup_handover", "backup_initial"} <= set(names)
+    assert all(n.startswith("backup") for n in names)
+    safe = {x.condition for x in c.tier_conditions["safe"]}
+    tracking = {x.condition for x in c.tier_conditions["tracking"]}
+    assert safe < tracking                                                    # tracking needs everything safety does
+    assert {"sensing", "tube", "v_bar[u]", "sway_bound", "obstacles[0,1]", "backup_level_set"} <= safe
+    assert not {"keep_up[u]", "yaw_budget", "e_bar[e_o]", "initial", "target_in_workspace"} & safe
+
+
+def test_the_paper_scenario_certifies_the_safe_tier_only(paper_cert):
+    c = paper_cert
+    assert c.tiers == Tiers(True, False) and not c.certified
+    assert {"keep_up[u]", "yaw_budget"} <= set(c.tier_failures["tracking"])
+    s = c.safe_design
+    assert s.sigma == 0.0 and all(x.condition.startswith(SAFE_PREFIX) for x in s.conditions)
+    # sigma = 0: ||dp_xy|| <= omega_xy delta = 0.012 m, |dz| <= omega_z delta = 0.01 m per period; the replay's
+    # position margin grows by hypot(0.012, 0.01) per arc (no heading error on the kinematic plant)
+    assert s.tube.p_xy == pytest.approx(0.012) and s.tube.p_z == pytest.approx(0.01) and s.tube.psi == 0.0
+    step = math.hypot(0.012, 0.01)
+    assert s.margins.position == pytest.approx([step * (j + 1) for j in range(8)])
+    assert s.v_bar == (0.4, 0.3, 0.5)                                         # no feedback: V_bar = V
+    assert c.backup.certified and c.backup.handover == (s.margins.position[-1], s.margins.e_z[-1])
+    assert "safe: certified; tracking: not certified (keep_up[u], yaw_budget" in c.summary()
+    assert c.inputs.sigma == 0.0
+
+
+def test_the_position_tube_at_sigma_zero_is_the_disturbance_times_the_period(paper_cert):
+    p = paper_cert.safe_design.problem
+    t = position_tube(p)
+    assert t.certified and t.kappa == (0.0, 0.0, 0.0)
+    assert t.rho[0] == t.p_xy and t.rho[1] == t.p_z
+    assert t.theta == pytest.approx(math.asin(0.012 / 0.1))                   # the angle at the target, eps = 0.1
+
+
+@pytest.mark.parametrize("name, safe", [("sensing", True), ("tube", True), ("v_bar[r]", True),
+                                        ("obstacles[0,3]", True), ("sway_bound", True),
+                                        ("safe_only.sensing", True), ("keep_up[u]", False), ("yaw_budget", False),
+                                        ("e_bar[e_d]", False), ("initial", False), ("initial_workspace", False),
+                                        ("target_in_workspace", False), ("tube_extra", False)])
+def test_which_design_conditions_the_safe_tier_reads(name, safe):
+    assert is_safe_condition(name) is safe
+
+
+LAW = StationKeeping(surge=0.2, yaw_rate=0.5, yaw_band=0.05, heave=0.3, heave_band=0.04)
+SAFE = SafeSet(level=0.75, shape=0.4, depth=0.08)
+
+
+def test_the_backup_at_the_start_is_checked_against_obstacles():
+    """An obstacle 1.5 m from the start at its depth, radius 0.4: slack 1.5 - (0.75 + 0.2) - 0.4 = 0.15 m."""
+    sc = paper_scenario()
+    x0, y0, z0 = sc.initial_state[:3]
+    near = sc.with_changes(obstacles=(Obstacle((x0 + 1.5, y0, z0), 0.4),))
+    c = initial_backup(near, LAW, SAFE)
+    assert c.ok is True and c.lhs == pytest.approx(0.15)
+    closer = sc.with_changes(obstacles=(Obstacle((x0 + 1.2, y0, z0), 0.4),))
+    c = initial_backup(closer, LAW, SAFE)
+    assert c.ok is False and c.lhs == pytest.approx(-0.15)
+
+
+def test_the_backup_at_the_start_is_checked_against_the_workspace():
+    """Start 0.5 m below the top of the box: the cylinder's half height 0.08 + 0.2 fits (slack 0.22 m)."""
+    sc = paper_scenario().with_changes(initial_state=(0.0, 6.0, 4.5, 0.0), obstacles=())
+    c = initial_backup(sc, LAW, SAFE)
+    assert c.ok is True and c.lhs == pytest.approx(0.5 - 0.28)
+    c = initial_backup(sc.with_changes(initial_state=(0.0, 6.0, 4.8, 0.0)), LAW, SAFE)
+    assert c.ok is False and c.lhs == pytest.approx(0.2 - 0.28)
+
+
+def test_an_obstacle_over_the_start_breaks_the_safe_tier():
+    import verify
+    sc = paper_scenario()
+    x0, y0, z0 = sc.initial_state[:3]
+    c = verify.certify(sc.with_changes(obstacles=sc.obstacles + (Obstacle((x0 + 1.0, y0, z0), 0.3),)))
+    assert c.tiers.safe is False and "backup_initial" in c.tier_failures["safe"]
+
+
+def test_the_key_sigma_is_zero_only_for_a_safe_only_design(paper_cert):
+    """certifiable.toml declares sigma = 100 and certifies both tiers: its key holds 100."""
+    import verify
+    ok = verify.certify(verify.certifiable_scenario())
+    assert ok.tiers == Tiers(True, True)
+    assert handed_sigma(tiers_of(ok.design, ok.safe_design, ok.backup), ok.design.sigma) == 100.0 == ok.inputs.sigma
+    assert handed_sigma(tiers_of(paper_cert.design, paper_cert.safe_design, paper_cert.backup), paper_cert.design.sigma) == 0.0
+
+
+def test_the_backup_is_designed_and_re_proved_through_the_registry(pc_cert):
+    """backup_of designs station keeping by default (the certificate's backup, number for number); recertify_backup
+    proves the stored law by its kind; a kind without a proof is refused by name (issue 30)."""
+    from tubekit.exceptions import ConfigError
+    from verify.theorem.tiers import backup_of, recertify_backup
+    sc, dist, margins = pc_cert.inputs.scenario, pc_cert.disturbance, pc_cert.design.margins
+    assert backup_of(sc, dist, margins) == pc_cert.backup
+    assert recertify_backup(sc, pc_cert.backup.law, pc_cert.backup.safe_set, dist, margins) == pc_cert.backup
+    with pytest.raises(ConfigError, match=r"backup\.kind"):
+        backup_of(sc, dist, margins, kind="hover")

@@ -1,0 +1,75 @@
+"""The shifted candidate: the last accepted plan, shifted by the periods elapsed and completed at its end.
+
+Tube MPC keeps a plan available by the *candidate* (Chisci et al. 2001): the previous plan shifted by
+one period, completed by a terminal input. The loop tries it whenever the solver's plan is refused or
+rejected (:meth:`tubekit.loop.closed_loop._ClosedLoop.solve`): the candidate goes through the same exact
+check as any plan (:func:`tubekit.loop.plan_check.check_plan`) and, if it passes, it is accepted — a new
+plan, followed from now on — instead of replaying the old one towards its end and the backup.
+
+Why the shifted part passes. A plan accepted at t_k satisfies every constraint of arc j + 1 with the
+margin M_{j+1} (``verify.theorem.sampled.horizon_margins``). At t_{k+1} the measured state lies within
+the one-period tube of the plan's first node, and the same inputs from there deviate from the old arcs
+by at most M_{j+1} − M_j (the start offset plus the heading offset times the distance run), so the
+shifted arc j meets its constraint with the margin M_j the check asks for. What the theorem does not
+give yet is the completion: the terminal input below is a pursuit of the target, clipped to V̄ and to
+the rate rows, and the check decides (no tolerance is added: a candidate that fails is not used).
+
+:func:`candidate_plan` builds it; :func:`pursuit_input` is the completion law.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from tubekit.loop.plan_check import plan_arcs
+from tubekit.scenario import Scenario
+
+__all__ = ["candidate_plan", "pursuit_input", "PURSUIT_GAIN"]
+
+#: Gain (1/s) of the completion law on the distance and depth errors (a period's worth of correction at δ = 0.1 s
+#: over about four periods).
+PURSUIT_GAIN = 2.5
+
+
+def pursuit_input(scenario: Scenario, state: np.ndarray, t: float, v_max: np.ndarray, e_d_goal: float
+                  ) -> np.ndarray:
+    """The completion law at the nominal ``state`` [x, y, z, ψ] and time ``t`` (s): turn onto the line of sight
+    within one period, surge to bring e_d to ``e_d_goal`` (m) on top of the target's speed along the line of
+    sight, heave to the target's depth; clipped to ``v_max`` (3,) = V̄ (m/s, m/s, rad/s)."""
+    dt = scenario.controller.dt
+    p = np.asarray(scenario.trajectory.position(t), dtype=float).reshape(3)
+    pd_dot = np.asarray(scenario.trajectory.velocity(t), dtype=float).reshape(3)
+    dx, dy = p[0] - state[0], p[1] - state[1]
+    e_d = math.hypot(dx, dy)
+    los = math.atan2(dy, dx)
+    alpha = math.atan2(math.sin(los - state[3]), math.cos(los - state[3]))
+    r = alpha / dt
+    along = (pd_dot[0] * dx + pd_dot[1] * dy) / e_d if e_d > 0.0 else 0.0
+    facing = math.cos(alpha)
+    u = (along + PURSUIT_GAIN * (e_d - e_d_goal)) / facing if facing > 0.1 else 0.0
+    w = pd_dot[2] + PURSUIT_GAIN * (p[2] - state[2])
+    return np.clip(np.array([u, w, r]), -np.asarray(v_max, dtype=float), np.asarray(v_max, dtype=float))
+
+
+def candidate_plan(scenario: Scenario, plan: np.ndarray, age: int, x0: np.ndarray, t0: float, v_max: np.ndarray,
+                   jump: np.ndarray | None, e_d_goal: float) -> np.ndarray | None:
+    """The candidate at ``t0`` (s) from the measured ``x0`` (4,): rows ``age + 1 ..`` of the last accepted
+    ``plan`` (N, 3), ``age`` periods old, completed with :func:`pursuit_input` (each completion row within
+    ``jump`` (3,) of the row before it, when the plans are rate-limited). None when nothing of the plan is left
+    to shift (the candidate would be the completion alone)."""
+    plan = np.asarray(plan, dtype=float)
+    n = len(plan)
+    kept = plan[age + 1:]
+    if len(kept) == 0:
+        return None
+    rows = [row for row in kept]
+    dt = scenario.controller.dt
+    for _ in range(n - len(kept)):
+        end = plan_arcs(x0, np.asarray(rows), dt, 1)[-1, -1]
+        v = pursuit_input(scenario, end, t0 + dt * len(rows), v_max, e_d_goal)
+        if jump is not None:
+            v = np.clip(v, rows[-1] - jump, rows[-1] + jump)
+        rows.append(v)
+    return np.asarray(rows, dtype=float)

@@ -1,0 +1,310 @@
+"""The certified frontier of a scenario beside the physical-necessity frontier, at one epsilon.
+
+For each target speed s (m/s) the search builds a variant of the scenario whose
+trajectory moves at horizontal speed s (a circle's or helix's rate scaled to
+s / radius, a line's horizontal velocity scaled to s) and whose horizontal current
+amplitude is a (m/s: ``disturbance.amplitude`` x and y both set to a; the vertical
+amplitude, the constant current and the sway model are kept as they are), and asks
+:func:`verify.certify` for a verdict. Two frontiers, both in
+
+    omega_bar_xy = a + ||c_xy|| + gamma_bar,   gamma_bar = sway gain u_max r_max + sway amplitude
+
+(the certificate's horizontal disturbance bound, :func:`verify.theorem.design.disturbance_bounds`:
+current amplitude plus constant current plus the sway the model produces over V):
+
+* **certified**: the largest omega_bar_xy that certifies, found by bisection on the
+  amplitude a with a fixed number of steps (a work unit: the result is the same on any
+  machine). The certificate is monotone in the disturbance (every bound grows with it),
+  so the bracket [certified, refuted] holds the edge;
+* **necessary** (any controller, any tube): keep-up needs u_max >= s + omega_bar_xy,
+  and holding e_o at e_d = epsilon needs the bearing rate omega_bar_xy / epsilon <= r_max,
+  so omega_bar_xy <= min(u_max - s, r_max epsilon).
+
+The ratio certified / necessary per speed (1 = the certificate loses nothing to
+physics) and its min and median summarise the conservatism. The plot is drawn by
+the application layer (:func:`tubekit.app.plots.plot_envelope`).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from tubekit.exceptions import ConfigError
+from tubekit.jsonable import to_jsonable
+from tubekit.scenario import Scenario
+from tubekit.model.trajectory import Circle, Line, Trajectory
+from tubekit.validation import finite, positive
+
+from verify.certificate.certify import certify, resolve_law
+from verify.theorem.design import disturbance_bounds
+
+__all__ = ["EnvelopeResult", "envelope", "necessary_omega", "scenario_at", "REFERENCE_POINTS",
+           "BISECTION_STEPS"]
+
+#: Bisection steps on the current amplitude (full, quick): the bracket is top / 2**steps wide.
+BISECTION_STEPS: dict[bool, int] = {False: 14, True: 9}
+
+#: Operating points marked on the plot: (label, target speed m/s, omega_bar_xy m/s, epsilon m).
+REFERENCE_POINTS: tuple[tuple[str, float, float, float], ...] = (
+    ("paper Section VI", 0.377, 0.12, 0.1),
+    ("paper_currents", 0.19, 0.12, 0.5),
+)
+
+
+@dataclass(frozen=True)
+class EnvelopeResult:
+    """Outcome of :func:`envelope` (units: m, m/s, rad/s).
+
+    Attributes
+    ----------
+    scenario_name, law : str
+        What was searched.
+    epsilon : float
+        Lower bound of e_d used for every point (m).
+    speeds : array (k,)
+        Horizontal target speeds (m/s).
+    certified_omega : array (k,)
+        Largest certified omega_bar_xy per speed (m/s); NaN when not even a = 0 certifies.
+    certified_amplitude, refuted_amplitude : array (k,)
+        The bisection bracket on the horizontal current amplitude a (m/s): certify holds at the first,
+        fails at the second (NaN: none certifies / the top of the search certified).
+    necessary_omega : array (k,)
+        min(u_max - s, r_max epsilon) (m/s): the physical-necessity frontier.
+    first_failure : list of str
+        The first failed condition at the refuted amplitude (or at a = 0 when none certifies).
+    sigma_at_edge : array (k,)
+        sigma (1/s) of the certified design at the certified amplitude (NaN: none certifies).
+    gamma, current_offset : float
+        gamma_bar (sway) and ||c_xy|| (constant current), both in omega_bar_xy (m/s).
+    amplitude_z : float
+        The vertical current amplitude kept for every point (m/s).
+    limits : (3,)
+        u_max, w_max, r_max.
+    bisection_steps : int
+        Steps per speed (the work unit).
+    """
+
+    scenario_name: str
+    law: str
+    epsilon: float
+    speeds: np.ndarray
+    certified_omega: np.ndarray
+    certified_amplitude: np.ndarray
+    refuted_amplitude: np.ndarray
+    necessary_omega: np.ndarray
+    first_failure: list = field(default_factory=list)
+    sigma_at_edge: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    gamma: float = 0.0
+    current_offset: float = 0.0
+    amplitude_z: float = 0.0
+    limits: tuple[float, float, float] = (0.4, 0.3, 0.5)
+    bisection_steps: int = 14
+
+    @property
+    def ratio(self) -> np.ndarray:
+        """certified / necessary per speed (0 where none certifies, NaN where nothing is necessary-feasible)."""
+        cert = np.nan_to_num(self.certified_omega, nan=0.0)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            return np.where(self.necessary_omega > 0, cert / self.necessary_omega, np.nan)
+
+    @property
+    def ratio_min(self) -> float | None:
+        """Smallest ratio over the speeds (None: no speed is physically feasible)."""
+        r = self.ratio[np.isfinite(self.ratio)]
+        return float(r.min()) if r.size else None
+
+    @property
+    def ratio_median(self) -> float | None:
+        """Median ratio over the speeds (None: no speed is physically feasible)."""
+        r = self.ratio[np.isfinite(self.ratio)]
+        return float(np.median(r)) if r.size else None
+
+    def certifies(self, speed: float, omega_xy: float) -> bool:
+        """True if (speed, omega_xy) lies under the certified frontier at a searched speed (exact match, 1e-9)."""
+        hit = np.flatnonzero(np.abs(self.speeds - speed) <= 1e-9)
+        return bool(hit.size) and bool(omega_xy <= np.nan_to_num(self.certified_omega[hit[0]], nan=-1.0))
+
+    def check(self) -> list[str]:
+        """Sanity problems (empty list: none): a certified value above the necessity frontier is unsound."""
+        problems = []
+        for s, c, n in zip(self.speeds, self.certified_omega, self.necessary_omega):
+            if math.isfinite(c) and c > n + 1e-9:
+                problems.append(f"speed {s:.4g} m/s: certified omega_bar_xy {c:.6g} > necessary {n:.6g} m/s")
+        for s, lo, hi in zip(self.speeds, self.certified_amplitude, self.refuted_amplitude):
+            if math.isfinite(lo) and math.isfinite(hi) and not lo < hi:
+                problems.append(f"speed {s:.4g} m/s: bracket [{lo:.6g}, {hi:.6g}] is empty")
+        return problems
+
+    def to_dict(self) -> dict:
+        """Strict-JSON-ready dict (NaN as None)."""
+        return to_jsonable({
+            "scenario": self.scenario_name, "law": self.law, "epsilon": self.epsilon,
+            "omega_bar_xy": "current amplitude a + ||c_xy|| + gamma_bar (sway: gain u_max r_max + amplitude)",
+            "gamma": self.gamma, "current_offset": self.current_offset, "amplitude_z": self.amplitude_z,
+            "limits": list(self.limits), "speeds": self.speeds, "certified_omega": self.certified_omega,
+            "certified_amplitude": self.certified_amplitude, "refuted_amplitude": self.refuted_amplitude,
+            "necessary_omega": self.necessary_omega, "ratio": self.ratio, "ratio_min": self.ratio_min,
+            "ratio_median": self.ratio_median, "first_failure": list(self.first_failure),
+            "sigma_at_edge": self.sigma_at_edge,
+            "bisection_steps": self.bisection_steps, "problems": self.check(),
+        })
+
+    def summary(self) -> str:
+        """The frontier table and the ratio."""
+        def num(x: float) -> str:
+            return f"{x:.4f}" if math.isfinite(x) else "none"
+
+        lines = [f"tubekit envelope: scenario '{self.scenario_name}', law '{self.law}', epsilon = {self.epsilon:g} m",
+                 f"  omega_bar_xy = horizontal current amplitude + {self.current_offset:.4g} (constant) + "
+                 f"gamma_bar {self.gamma:.4g} (sway); vertical amplitude kept at {self.amplitude_z:.4g} m/s",
+                 f"  necessary: omega_bar_xy <= min(u_max - speed, r_max epsilon) = min({self.limits[0]:g} - speed, "
+                 f"{self.limits[2] * self.epsilon:.4g})",
+                 "  speed [m/s] | certified omega_bar_xy [m/s] | necessary [m/s] | ratio | sigma [1/s] | first failure above",
+                 ]
+        sigmas = self.sigma_at_edge if len(self.sigma_at_edge) else np.full(len(self.speeds), np.nan)
+        for s, c, n, r, sg, f in zip(self.speeds, self.certified_omega, self.necessary_omega, self.ratio, sigmas,
+                                     self.first_failure):
+            sig = f"{sg:.4g}" if math.isfinite(sg) else "-"
+            lines.append(f"  {s:11.4f} | {num(c):>28s} | {num(n):>15s} | {num(r):>5s} | {sig:>11s} | {f or '-'}")
+        rmin, rmed = self.ratio_min, self.ratio_median
+        lines.append("  ratio certified / necessary: " + ("none (no speed is feasible)" if rmin is None else
+                                                          f"min {rmin:.4f}, median {rmed:.4f}"))
+        lines.append(f"  bisection: {self.bisection_steps} steps per speed on the amplitude (bracket in the JSON)")
+        problems = self.check()
+        if problems:
+            lines.append("  SANITY PROBLEMS: " + "; ".join(problems))
+        return "\n".join(lines)
+
+
+def necessary_omega(speed: float, epsilon: float, u_max: float, r_max: float) -> float:
+    """Largest omega_bar_xy (m/s) physics admits: min(u_max - speed, r_max epsilon) (may be negative)."""
+    return min(u_max - speed, r_max * epsilon)
+
+
+def _trajectory_at_speed(trajectory: Trajectory, speed: float) -> Trajectory:
+    """``trajectory`` moving at horizontal speed ``speed`` (m/s): a circle's rate, a line's xy velocity."""
+    if isinstance(trajectory, Circle):  # Helix too: only the horizontal rate changes
+        sign = -1.0 if trajectory.rate < 0 else 1.0
+        return dataclasses.replace(trajectory, rate=sign * speed / trajectory.radius)
+    if isinstance(trajectory, Line):
+        v = np.asarray(trajectory.direction_velocity, dtype=float)
+        norm = math.hypot(v[0], v[1])
+        if norm == 0:
+            raise ConfigError("trajectory.velocity", "a line with a horizontal velocity (to scale)", list(v))
+        k = speed / norm
+        return dataclasses.replace(trajectory, direction_velocity=(k * v[0], k * v[1], v[2]))
+    raise ConfigError("trajectory.kind", "circle, helix or line (the envelope scales their speed)",
+                      getattr(trajectory, "kind", type(trajectory).__name__))
+
+
+def scenario_at(scenario: Scenario, *, speed: float, amplitude_xy: float, epsilon: float) -> Scenario:
+    """The variant at horizontal target speed ``speed``, current amplitude ``amplitude_xy`` on x and y
+    (z kept), and ``epsilon`` (m/s, m/s, m)."""
+    d = scenario.disturbance
+    dist = dataclasses.replace(d, amplitude=(amplitude_xy, amplitude_xy, d.amplitude[2]))
+    return scenario.with_changes(trajectory=_trajectory_at_speed(scenario.trajectory, speed), disturbance=dist,
+                                 epsilon=epsilon)
+
+
+def _check_inputs(scenario: Scenario, eps: float | None, speeds) -> tuple[float, np.ndarray]:
+    """Validated epsilon (m) and speed grid (m/s); the default grid spans (0, u_max) plus the scenario's speed."""
+    if not isinstance(scenario, Scenario):
+        raise ConfigError("scenario", "a tubekit.scenario.Scenario", type(scenario).__name__)
+    if scenario.plant.dynamic:
+        raise ConfigError("plant.kind", "\"kinematic\" (the envelope sweeps the kinematic theorem; a dynamic "
+                          "scenario's bounds come from its vehicle: use tubekit certify)", scenario.plant.kind)
+    eps = scenario.epsilon if eps is None else positive("eps", eps)
+    if eps >= scenario.region.e_d_max:
+        raise ConfigError("eps", f"a number < region.e_d_max = {scenario.region.e_d_max}", eps)
+    u_max = scenario.limits.u_max
+    if speeds is None:
+        return eps, np.array([])
+    try:
+        grid = np.asarray([finite("speeds", s) for s in np.ravel(np.asarray(speeds, dtype=float))])
+    except (TypeError, ValueError):
+        raise ConfigError("speeds", "a list of numbers in [0, u_max)", speeds) from None
+    if grid.size == 0 or np.any(grid < 0) or np.any(grid >= u_max):
+        raise ConfigError("speeds", f"a non-empty list of speeds in [0, u_max = {u_max:g}) m/s", list(grid))
+    return eps, np.unique(grid)
+
+
+def _default_speeds(scenario: Scenario, quick: bool) -> np.ndarray:
+    """Evenly spaced in [0, u_max) (quick 5, full 16 points) plus the scenario's own speed (m/s)."""
+    u_max = scenario.limits.u_max
+    n = 5 if quick else 16
+    own = scenario.trajectory.horizontal_speed_bound()
+    grid = np.linspace(0.0, u_max, n + 1)[:-1]
+    return np.unique(np.round(np.append(grid, [own] if own < u_max else []), 12))
+
+
+def _frontier_at(scenario: Scenario, law: str, speed: float, eps: float, top: float,
+                 steps: int) -> tuple[float, float, str, float]:
+    """Bisection on the amplitude in [0, top] (m/s): certified a (NaN: none), refuted a (NaN: top certifies),
+    the first failure at the refuted a, and the sigma (1/s) of the certified design at the certified a."""
+    def verdict(a: float) -> tuple[bool, str, float]:
+        cert = certify(scenario_at(scenario, speed=speed, amplitude_xy=a, epsilon=eps), law)
+        return cert.certified, (cert.failures[0].condition if cert.failures else ""), cert.design.sigma
+
+    ok, fail, sigma = verdict(0.0)
+    if not ok:
+        return math.nan, 0.0, fail, math.nan
+    top = max(top, 0.0)
+    ok_top, fail_top, sigma_top = verdict(top)
+    if ok_top or top == 0.0:
+        return top, math.nan, "", sigma_top if ok_top else sigma
+    lo, hi, fail = 0.0, top, fail_top
+    for _ in range(steps):
+        mid = 0.5 * (lo + hi)
+        ok, why, sig = verdict(mid)
+        if ok:
+            lo, sigma = mid, sig
+        else:
+            hi, fail = mid, why
+    return lo, hi, fail, sigma
+
+
+def envelope(scenario: Scenario, law: str | None = None, *, eps: float | None = None, speeds=None,
+             quick: bool = False) -> EnvelopeResult:
+    """Certified and physical-necessity frontiers of ``scenario`` at one epsilon (module doc).
+
+    Parameters
+    ----------
+    scenario : Scenario
+        Base scenario (circle, helix or line trajectory).
+    law : str, optional
+        Ancillary law; default the scenario's.
+    eps : float, optional
+        Lower bound of e_d (m); default the scenario's epsilon.
+    speeds : sequence of float, optional
+        Horizontal target speeds in [0, u_max) (m/s); default an even grid plus the scenario's speed.
+    quick : bool
+        Fewer speeds (5 + the scenario's) and bisection steps (9 instead of 14).
+
+    Returns
+    -------
+    EnvelopeResult
+    """
+    eps, grid = _check_inputs(scenario, eps, speeds)
+    law = resolve_law(scenario.controller.law if law is None else law)
+    grid = grid if grid.size else _default_speeds(scenario, quick)
+    steps = BISECTION_STEPS[bool(quick)]
+    lim = scenario.limits
+    dist = disturbance_bounds(scenario_at(scenario, speed=float(grid[0]), amplitude_xy=0.0, epsilon=eps))
+    offset = max(dist.omega_xy - dist.gamma, 0.0)  # ||c_xy|| rounded outward, as the certificate sees it
+    rows = []
+    for s in grid:
+        need = necessary_omega(float(s), eps, lim.u_max, lim.r_max)
+        rows.append((need, *_frontier_at(scenario, law, float(s), eps, need - dist.gamma - offset, steps)))
+    need, lo, hi, fails, sigmas = (list(x) for x in zip(*rows))
+    lo_arr = np.asarray(lo, dtype=float)
+    return EnvelopeResult(
+        scenario_name=scenario.name, law=law, epsilon=eps, speeds=grid,
+        certified_omega=np.where(np.isfinite(lo_arr), lo_arr + offset + dist.gamma, np.nan),
+        certified_amplitude=lo_arr, refuted_amplitude=np.asarray(hi, dtype=float),
+        necessary_omega=np.asarray(need, dtype=float), first_failure=fails, gamma=dist.gamma,
+        sigma_at_edge=np.asarray(sigmas, dtype=float), current_offset=offset, amplitude_z=scenario.disturbance.amplitude[2],
+        limits=tuple(lim.vector), bisection_steps=steps)

@@ -1,0 +1,140 @@
+"""Search the verification region: which (e_o_max, e_d_max) certify a scenario.
+
+:func:`search_region` certifies the scenario with ``region.e_o_max`` and ``region.e_d_max``
+replaced by every point of a fixed grid (default e_o_max in 0.3 .. 0.9, e_d_max in
+1.5 .. 6 m; points with e_d_max <= epsilon are skipped and reported as such) and keeps
+every verdict with its first failed condition. The best certified point is the one
+with the largest e_o_max, then the largest e_d_max (the widest region that certifies).
+The grid is fixed, so the search is deterministic and its cost is a number of
+certificates, never seconds.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from tubekit.exceptions import ConfigError
+from tubekit.jsonable import to_jsonable
+from tubekit.scenario import Scenario
+
+from verify.certificate.certify import certify, resolve_law
+
+__all__ = ["RegionTrial", "RegionSearchResult", "search_region", "E_O_MAX_GRID", "E_D_MAX_GRID"]
+
+#: Default grid of region.e_o_max (dimensionless, |e_o| = |sin(psi - theta)|).
+E_O_MAX_GRID: tuple[float, ...] = (0.3, 0.4, 0.5, 0.6, 0.7, 0.8, 0.9)
+#: Default grid of region.e_d_max (m).
+E_D_MAX_GRID: tuple[float, ...] = (1.5, 2.0, 3.0, 4.0, 5.0, 6.0)
+
+
+@dataclass(frozen=True)
+class RegionTrial:
+    """One grid point: its verdict and the first failed condition ('' when certified)."""
+
+    e_o_max: float
+    e_d_max: float
+    certified: bool
+    first_failure: str
+
+    def to_dict(self) -> dict:
+        """JSON-ready copy."""
+        return dataclasses.asdict(self)
+
+
+@dataclass(frozen=True)
+class RegionSearchResult:
+    """Outcome of :func:`search_region`: every trial, in grid order (e_o_max outer, e_d_max inner)."""
+
+    scenario_name: str
+    law: str
+    epsilon: float
+    tried: tuple[RegionTrial, ...]
+
+    @property
+    def certified(self) -> list[RegionTrial]:
+        """The trials that certify."""
+        return [t for t in self.tried if t.certified]
+
+    @property
+    def best(self) -> RegionTrial | None:
+        """Largest e_o_max, then largest e_d_max, among the certified (None: none certifies)."""
+        return max(self.certified, key=lambda t: (t.e_o_max, t.e_d_max), default=None)
+
+    def to_dict(self) -> dict:
+        """Strict-JSON-ready dict."""
+        best = self.best
+        return to_jsonable({"scenario": self.scenario_name, "law": self.law, "epsilon": self.epsilon,
+                            "any_certified": best is not None, "best": None if best is None else best.to_dict(),
+                            "certified": [t.to_dict() for t in self.certified],
+                            "tried": [t.to_dict() for t in self.tried]})
+
+    def summary(self) -> str:
+        """A table of verdicts (e_o_max rows, e_d_max columns) with the first failures, then the best point."""
+        eds = sorted({t.e_d_max for t in self.tried})
+        lines = [f"tubekit certify --search-region: scenario '{self.scenario_name}', law '{self.law}', "
+                 f"epsilon = {self.epsilon:g} m",
+                 "  e_o_max \\ e_d_max [m] | " + " | ".join(f"{e:>14g}" for e in eds)]
+        for eo in sorted({t.e_o_max for t in self.tried}):
+            row = {t.e_d_max: t for t in self.tried if t.e_o_max == eo}
+            cells = [("certified" if row[e].certified else row[e].first_failure)[:14] if e in row else "-"
+                     for e in eds]
+            lines.append(f"  {eo:21g} | " + " | ".join(f"{c:>14s}" for c in cells))
+        best = self.best
+        lines.append(f"  tried {len(self.tried)}, certified {len(self.certified)}")
+        lines.append("  best: " + ("none certifies" if best is None else
+                                   f"e_o_max = {best.e_o_max:g}, e_d_max = {best.e_d_max:g} m"))
+        return "\n".join(lines)
+
+
+def _grid(field: str, values, upper: float | None) -> tuple[float, ...]:
+    """Validated grid: finite numbers > 0 (and < ``upper`` when given)."""
+    try:
+        grid = tuple(float(v) for v in values)
+    except (TypeError, ValueError):
+        raise ConfigError(field, "a list of numbers", values) from None
+    bad = [v for v in grid if not math.isfinite(v) or v <= 0 or (upper is not None and v >= upper)]
+    if not grid or bad:
+        limit = f" and < {upper:g}" if upper is not None else ""
+        raise ConfigError(field, f"a non-empty list of numbers > 0{limit}", list(values))
+    return tuple(np.unique(grid))
+
+
+def search_region(scenario: Scenario, law: str | None = None, *, e_o_max=E_O_MAX_GRID,
+                  e_d_max=E_D_MAX_GRID) -> RegionSearchResult:
+    """Certify ``scenario`` on every (e_o_max, e_d_max) of the grid (module doc).
+
+    Parameters
+    ----------
+    scenario : Scenario
+        Base scenario; every other field is kept.
+    law : str, optional
+        Ancillary law; default the scenario's.
+    e_o_max : sequence of float
+        Values of region.e_o_max, each in (0, 1).
+    e_d_max : sequence of float
+        Values of region.e_d_max (m), each > 0; those <= epsilon are skipped.
+
+    Returns
+    -------
+    RegionSearchResult
+    """
+    if not isinstance(scenario, Scenario):
+        raise ConfigError("scenario", "a tubekit.scenario.Scenario", type(scenario).__name__)
+    law = resolve_law(scenario.controller.law if law is None else law)
+    eo_grid = _grid("e_o_max", e_o_max, 1.0)
+    ed_grid = _grid("e_d_max", e_d_max, None)
+    tried = []
+    for eo in eo_grid:
+        for ed in ed_grid:
+            if ed <= scenario.epsilon:
+                tried.append(RegionTrial(eo, ed, False, f"skipped: e_d_max <= epsilon = {scenario.epsilon:g}"))
+                continue
+            region = dataclasses.replace(scenario.region, e_o_max=eo, e_d_max=ed)
+            cert = certify(scenario.with_changes(region=region), law)
+            first = cert.failures[0].condition if cert.failures else ""
+            tried.append(RegionTrial(eo, ed, cert.certified, first))
+    return RegionSearchResult(scenario_name=scenario.name, law=law, epsilon=scenario.epsilon, tried=tuple(tried))

@@ -6,9 +6,10 @@ Usage::
 
 For each scenario (the paper's Section VI, ``verify/scenarios/paper_currents.toml`` and its variants with a
 faster current (period 3 s) and a steady one, the two-rock transit of issue 31) the certificate is computed
-(:func:`verify.certify`), then the tube run is simulated twice under the scenario's own current: with the
-shifted candidate (:mod:`tubekit.loop.candidate`, the default) and without it (``controller.candidate =
-false``), beside the baseline (the nominal MPC alone). Printed per run: the tiers, the seconds the backup law
+(:func:`verify.certify`), then the tube run is simulated under the scenario's own current three ways: as shipped
+(the shifted candidate, :mod:`tubekit.loop.candidate`, and recovery plans, ``Tightening.recovers``), without
+recovery plans (``controller.recovery = false``) and with neither (``controller.candidate = false`` too: the
+replay, then the backup), beside the baseline (the nominal MPC alone). Printed per run: the tiers, the seconds the backup law
 ran (no plan followed), the periods the candidate was accepted, the tracking RMSE (m), its ratio to the
 baseline's, the laps about the circle's centre where there is one, and the promises broken. Everything is
 measured on the run; nothing here is timed.
@@ -58,11 +59,14 @@ def measure(name: str, scenario: Scenario, duration: float) -> dict:
     tight = cert.best_effort_tightening()
     base = simulate(scenario, None, progress=False)
     out = {"scenario": name, "tiers": cert.tiers.to_dict(), "baseline_rmse": base.metrics["tracking_rmse"]}
-    for label, on in (("candidate", True), ("replay_only", False)):
-        sc = scenario.with_changes(**{"controller.candidate": on})
+    for label, candidate, recovery in (("shipped", True, True), ("no_recovery", True, False),
+                                       ("replay_only", False, False)):
+        sc = scenario.with_changes(**{"controller.candidate": candidate, "controller.recovery": recovery})
         done = certified_run(sc, tight, progress=False)
         m = done.metrics
-        out[label] = {"backup_s": m["backup_s"], "candidate_periods": int(done.run.candidate.sum()),
+        recovering = float(done.run.recovery[:-1].sum()) * float(done.run.t[1] - done.run.t[0])
+        out[label] = {"backup_s": m["backup_s"], "recovery_s": round(recovering, 3),
+                      "candidate_periods": int(done.run.candidate.sum()),
                       "tracking_rmse": m["tracking_rmse"],
                       "rmse_ratio": m["tracking_rmse"] / out["baseline_rmse"] if out["baseline_rmse"] else math.nan,
                       "encirclements": m.get("encirclements"), "broken": list(done.broken),

@@ -54,7 +54,7 @@ def _run(stationary, **changes) -> SimulationResult:
         max_violation=np.array([0.0, 1e-3, 2e-3]), rejected=np.zeros(STEPS, dtype=bool),
         plan_age=np.zeros(STEPS, dtype=int), plan_slack=np.zeros(STEPS),
         backup_active=np.zeros(ROWS, dtype=bool),
-        backup_anchor=np.full((ROWS, 3), np.nan))
+        backup_anchor=np.full((ROWS, 3), np.nan), recovery=np.zeros(ROWS, dtype=bool))
     fields.update(changes)
     return SimulationResult(**fields)
 
@@ -65,7 +65,7 @@ def test_the_result_and_the_loop_buffer_take_their_arrays_from_log_fields():
     from tubekit.loop.closed_loop import _Log
 
     names = [f.name for f in LOG_FIELDS]
-    assert len(names) == len(set(names)) == 20 and {"backup_active", "backup_anchor", "candidate"} <= set(names)
+    assert len(names) == len(set(names)) == 21 and {"backup_active", "backup_anchor", "candidate", "recovery"} <= set(names)
     assert issubclass(SimulationResult, LogArrays) and issubclass(_Log, LogArrays)
     assert {f.name for f in dataclasses.fields(LogArrays)} == set(names)
     assert set(names) <= {f.name for f in dataclasses.fields(_Log)}

@@ -175,7 +175,7 @@ class Scenario:
             "controller": {k: (list(v) if isinstance(v, tuple) else str(v) if isinstance(v, str) else v)
                            for k, v in asdict(self.controller).items()
                            if v is not None and not (k == "fhocp_backend" and v == "scp")
-                           and not (k == "candidate" and v is True)},
+                           and not (k in ("candidate", "recovery") and v is True)},
             "region": {k: (str(v) if isinstance(v, str) else v) for k, v in asdict(self.region).items()},
         }
         if self.limits.rate is not None:  # only when set: a scenario without it keeps its dict

@@ -145,6 +145,11 @@ class ControllerSettings:
         shifted, completed by a pursuit input: :mod:`tubekit.loop.candidate`) through the same exact check
         before replaying the old plan. Not read by the certificate (any plan that passes the check is
         covered). Left out of :meth:`Scenario.to_dict` when True.
+    recovery : bool
+        When no tracking plan is left to follow, accept a plan that meets the safe part of the check only (its
+        error may leave R: a recovery plan, tracking not in force while it is followed) instead of holding the
+        backup; only under a certificate that allows it (``Tightening.recovers``: σ = 0). Not a certificate
+        input. Left out of :meth:`Scenario.to_dict` when True.
     """
 
     dt: float = 0.1
@@ -160,11 +165,13 @@ class ControllerSettings:
     terminal_mode: TerminalMode = TerminalMode.SOFT
     fhocp_backend: str = "scp"
     candidate: bool = True
+    recovery: bool = True
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "dt", positive("controller.dt", self.dt))
-        if not isinstance(self.candidate, bool):
-            raise ConfigError("controller.candidate", "true or false", self.candidate)
+        for name in ("candidate", "recovery"):
+            if not isinstance(getattr(self, name), bool):
+                raise ConfigError(f"controller.{name}", "true or false", getattr(self, name))
         if not isinstance(self.horizon_steps, int) or isinstance(self.horizon_steps, bool) or self.horizon_steps < 1:
             raise ConfigError("controller.horizon_steps", "an integer >= 1", self.horizon_steps)
         for name in ("Q", "R", "P"):

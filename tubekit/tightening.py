@@ -227,6 +227,14 @@ class Tightening:
                           "was issued for; certify this scenario (tubekit certify) and use that certificate")
 
     @property
+    def recovers(self) -> bool:
+        """True when a plan whose error leaves R may still be followed for safety (a *recovery* plan, tracking not
+        in force while it is): the certificate gives the safe tier and runs at σ = 0, so κ = 0 and the position
+        margins, V̄ and the backup's hand-over, all derived from (ω̄, δ, the heading error) alone, hold whatever e
+        is; a plan then only needs the safe part of the check (``docs/verify.md``, phase 2b)."""
+        return self.tiers.safe and self.sigma == 0.0 and self.horizon_arcs > 0
+
+    @property
     def terminal_rest(self) -> bool:
         """True when a plan must end at rest, |v̂_{N−1}| <= J: a terminal backup that starts from 0 instead of
         blending from the last applied command (:attr:`tubekit.model.backup.StationKeeping.blends`)."""

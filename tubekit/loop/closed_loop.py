@@ -143,6 +143,7 @@ class _ClosedLoop:
         self.desired = np.asarray(scenario.trajectory.position(clock.t), dtype=float)
         self.limits = tuple(float(c) for c in scenario.limits.vector)
         self.v_bar = np.asarray(tightening.v_max, dtype=float)  # V̄: the plans' box (V for the baseline)
+        self.recovers = tightening.recovers and scenario.controller.recovery
         self.memory = PlanMemory()
         self.log = _Log.allocate(clock)
         self.sign = HEMISPHERE_SIGN[scenario.region.heading]
@@ -156,7 +157,35 @@ class _ClosedLoop:
 
     def solve(self, k: int, tk: float, xk: np.ndarray,
               known: tuple[Obstacle, ...]) -> tuple[np.ndarray, bool, bool]:
-        """Solve the FHOCP at ``tk`` and decide v̂; never pass NaN on. Returns (v̂, fallback, replaced)."""
+        """Solve the FHOCP at ``tk`` and decide v̂; never pass NaN on. Returns (v̂, fallback, replaced).
+
+        In order: the solver's plan passing the check; the shifted candidate passing it; the replay of the last
+        tracking plan while it lasts; with :attr:`Tightening.recovers`, the solver's plan or the candidate
+        passing the safe part of the check (a recovery plan: tracking not in force); the replay; the backup.
+        """
+        result, plan, check = self.ask(k, tk, xk, known)
+        if result is not None and plan is not None and check is not None and check.ok:
+            fallback = bool(result.fallback)
+            return self.follow(k, plan, fallback, check, tracking=True), fallback, False
+        shifted = self.candidate(k, tk, xk, known, recovery=False)
+        if shifted is not None:
+            return shifted, True, True
+        memory = self.memory
+        if self.recovers and (memory.exhausted or not memory.tracking):
+            if result is not None and plan is not None and check is not None and check.safe:
+                return self.follow(k, plan, bool(result.fallback), check, tracking=False), bool(result.fallback), \
+                    False
+            shifted = self.candidate(k, tk, xk, known, recovery=True)
+            if shifted is not None:
+                return shifted, True, True
+        v_hat = memory.replacement()
+        self.log.plan_age[k] = memory.age
+        return v_hat, True, True
+
+    def ask(self, k: int, tk: float, xk: np.ndarray, known: tuple[Obstacle, ...]
+            ) -> tuple[FhocpResult | None, np.ndarray | None, PlanCheck | None]:
+        """The solver's result at ``tk``, the plan the loop may use of it (:meth:`plan_of`) and its check (None
+        where the solver failed or its result was refused)."""
         c0 = time.perf_counter()
         result: FhocpResult | None = None
         plan: np.ndarray | None = None
@@ -169,23 +198,20 @@ class _ClosedLoop:
         except SolverError as exc:
             _LOG.debug("period %d: solver result refused: %s", k, exc)
         self.log.record_solve(k, k * self.clock.ticks, result, time.perf_counter() - c0)
-        check = self.accept(k, tk, xk, plan, known) if plan is not None else None
-        if result is not None and plan is not None and check is not None and check.ok:
-            checked = self.tightening.horizon_arcs > 0
-            flagged = self.memory.remember(plan, bool(result.fallback), accepted=checked, end=check.end)
-            self.log.plan_age[k] = self.memory.age
-            return plan[0].copy(), flagged, False
-        shifted = self.candidate(tk, xk, known)
-        if shifted is not None:
-            self.log.candidate[k] = True
-            return shifted, True, True
-        v_hat = self.memory.replacement()
-        self.log.plan_age[k] = self.memory.age
-        return v_hat, True, True
+        return result, plan, self.accept(k, tk, xk, plan, known) if plan is not None else None
 
-    def candidate(self, tk: float, xk: np.ndarray, known: tuple[Obstacle, ...]) -> np.ndarray | None:
-        """v̂ of the shifted candidate (:mod:`tubekit.loop.candidate`) when it passes the exact check (then it is the
-        accepted plan), else None (the old plan is replayed). Only where plans are checked (a certificate's margins)."""
+    def follow(self, k: int, plan: np.ndarray, fallback: bool, check: PlanCheck, tracking: bool) -> np.ndarray:
+        """Accept ``plan`` (N, 3): remember it (its nominal end is the backup's anchor) and return its first input;
+        ``tracking`` False: a recovery plan (followed for safety, tracking not in force)."""
+        checked = self.tightening.horizon_arcs > 0
+        self.memory.remember(plan, fallback, accepted=checked, end=check.end, tracking=tracking)
+        self.log.plan_age[k] = self.memory.age
+        return plan[0].copy()
+
+    def candidate(self, k: int, tk: float, xk: np.ndarray, known: tuple[Obstacle, ...],
+                  recovery: bool) -> np.ndarray | None:
+        """v̂ of the shifted candidate (:mod:`tubekit.loop.candidate`) when it passes the exact check (with
+        ``recovery``: its safe part) — it is then the accepted plan — else None. Only where plans are checked."""
         memory, tight = self.memory, self.tightening
         if not self.scenario.controller.candidate or tight.horizon_arcs == 0 or memory.plan is None \
                 or memory.exhausted:
@@ -196,10 +222,10 @@ class _ClosedLoop:
         if plan is None:
             return None
         check = check_plan(self.scenario, tight, tk, xk, plan, known, self.sign, v_last=self.v_last)
-        if not check.ok:
+        if not (check.ok or (recovery and check.safe)):
             return None
-        memory.remember(plan, False, accepted=True, end=check.end)
-        return plan[0].copy()
+        self.log.candidate[k] = True
+        return self.follow(k, plan, False, check, tracking=check.ok)
 
     def plan_of(self, result: FhocpResult) -> np.ndarray:
         """The plan the loop may use: exactly N finite rows, the first equal to ``first_input``, projected onto V̄.
@@ -327,6 +353,7 @@ class _ClosedLoop:
         known = self.sense(xk)
         v_hat, flagged, replaced = self.solve(k, float(self.clock.t[i0]), xk, known)
         anchor = self.backup_anchor(k, xk) if replaced else None
+        self.log.recovery[i0:i0 + m] = anchor is None and not self.memory.tracking
         if anchor is None:
             period = _Period(v_hat, flagged, replaced, nominal_arc(xk, v_hat, self.clock.tau))
         else:  # phase 3: no nominal is followed while the backup law runs
@@ -405,6 +432,7 @@ def run_closed_loop(scenario: Scenario, tightening: Tightening | None = None, *,
     loop.log.states[-1] = np.asarray(x)
     loop.log.nominal[-1] = nominal_end
     loop.log.backup_active[-1] = loop.log.backup_active[-2]  # the final state is reached under the last period's law
+    loop.log.recovery[-1] = loop.log.recovery[-2]
     loop.log.backup_anchor[-1] = loop.log.backup_anchor[-2]
     return _result(loop, tube, wall0, disturbance is not None)
 
@@ -425,7 +453,7 @@ def _result(loop: _ClosedLoop, tube: bool, wall0: float, overridden: bool) -> Si
         replaced=log.replaced, n_detected=log.n_detected, solve_ms=log.solve_ms, step_ms=log.step_ms,
         wall=log.wall, statuses=log.statuses, iterations=log.iterations, max_violation=log.max_violation,
         kappa_failures=log.kappa_failures, wall_s=wall_s, rejected=log.rejected, plan_age=log.plan_age,
-        candidate=log.candidate,
+        candidate=log.candidate, recovery=log.recovery,
         plan_slack=log.plan_slack, backup_active=log.backup_active, backup_anchor=log.backup_anchor,
         omega_overridden=overridden, body=body, current=loop.plant.current_series(clock.t),
         thrust=thrust, omega_peak=loop.plant.omega_peak(), current_peak=loop.plant.current_peak())

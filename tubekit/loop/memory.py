@@ -31,21 +31,26 @@ class PlanMemory:
         Sampling periods elapsed since ``plan`` was computed.
     anchor : array (3,) or None
         p*: the nominal end position (m) of the last *accepted* plan (None before the first).
+    tracking : bool
+        False while ``plan`` is a recovery plan (accepted for safety alone: tracking not in force).
     """
 
     plan: np.ndarray | None = None
     age: int = 0
     anchor: np.ndarray | None = None
+    tracking: bool = True
 
-    def remember(self, plan: np.ndarray, fallback: bool, accepted: bool = False, end: np.ndarray | None = None) -> bool:
+    def remember(self, plan: np.ndarray, fallback: bool, accepted: bool = False, end: np.ndarray | None = None,
+                 tracking: bool = True) -> bool:
         """Keep ``plan`` (N, 3) of a usable result when it is a good one; return the result's ``fallback`` flag.
 
         ``accepted`` (it passed :func:`tubekit.loop.plan_check.check_plan`) makes any finite plan a good
-        one; ``end`` (its nominal end state, m and rad) then becomes the backup's anchor.
+        one; ``end`` (its nominal end state, m and rad) then becomes the backup's anchor; ``tracking`` False
+        marks a recovery plan.
         """
         plan = np.asarray(plan, dtype=float)
         if (accepted or not fallback) and plan.ndim == 2 and np.all(np.isfinite(plan)):
-            self.plan, self.age = plan, 0
+            self.plan, self.age, self.tracking = plan, 0, bool(tracking)
             if accepted and end is not None:
                 self.anchor = np.asarray(end, dtype=float)[:3].copy()
         else:

@@ -58,12 +58,17 @@ SAMPLES_PER_ARC = 10
 @dataclass(frozen=True)
 class PlanCheck:
     """Outcome of :func:`check_plan`: ``ok``, the smallest slack (error units or m), where it is, and
-    the plan's nominal end state ``end`` (4,) over the certified horizon (None when not rolled out)."""
+    the plan's nominal end state ``end`` (4,) over the certified horizon (None when not rolled out).
+
+    ``safe`` says whether every constraint the safe tier rests on holds (V̄, the rate rows, the
+    positions, the terminal condition, the sensed region): a plan that is not ``ok`` only because its
+    error leaves R is still ``safe`` (what a recovery plan needs, :attr:`Tightening.recovers`)."""
 
     ok: bool
     slack: float
     where: str
     end: np.ndarray | None = None
+    safe: bool = False
 
 
 def plan_arcs(x0: np.ndarray, inputs: np.ndarray, dt: float, samples: int) -> np.ndarray:
@@ -198,9 +203,18 @@ def check_plan(scenario: Scenario, tight: Tightening, t0: float, x0: np.ndarray,
     cos_rel = heading_cosine(arcs, desired)
     pad = 0.5 * (dt / samples) * np.asarray(tight.rates, dtype=float)
     m = np.asarray(tight.margins, dtype=float)
+    safety = _terminal_slack(scenario, tight, x0, arcs[-1, -1], obstacles)
+    safety.update(_position_slacks(scenario, arcs[..., :3], m[:, 3:4] + pad[3], obstacles))
+    safe_name, safe_worst = _worst(safety)
     slacks = _error_slacks(tight, e, cos_rel, m, pad, sign) if tracking_checked(tight) else {}
-    slacks.update(_terminal_slack(scenario, tight, x0, arcs[-1, -1], obstacles))
-    slacks.update(_position_slacks(scenario, arcs[..., :3], m[:, 3:4] + pad[3], obstacles))
-    worst_name, worst = min(((k, float(np.min(v))) for k, v in slacks.items()), key=lambda kv: kv[1],
-                            default=("nothing to check", math.inf))
-    return PlanCheck(ok=worst >= 0.0 and not math.isnan(worst), slack=worst, where=worst_name, end=arcs[-1, -1])
+    worst_name, worst = _worst(slacks)
+    if safe_worst < worst or math.isnan(safe_worst):
+        worst_name, worst = safe_name, safe_worst
+    return PlanCheck(ok=worst >= 0.0 and not math.isnan(worst), slack=worst, where=worst_name, end=arcs[-1, -1],
+                     safe=safe_worst >= 0.0 and not math.isnan(safe_worst))
+
+
+def _worst(slacks: dict[str, np.ndarray]) -> tuple[str, float]:
+    """The name and value of the smallest slack ("nothing to check", inf without any)."""
+    return min(((k, float(np.min(v))) for k, v in slacks.items()), key=lambda kv: kv[1],
+               default=("nothing to check", math.inf))

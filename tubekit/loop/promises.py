@@ -84,6 +84,7 @@ class RunLog(Protocol):
     omega: np.ndarray
     saturated: np.ndarray
     backup_active: np.ndarray
+    recovery: np.ndarray
     omega_peak: tuple[float, float] | None
     replaced: np.ndarray
     rejected: np.ndarray
@@ -139,11 +140,13 @@ def _at_least(name: str, observed: float, bound: float, detail: str) -> Promise:
 
 
 def _following(run: RunLog) -> np.ndarray:
-    """Boolean mask of the ticks at which a plan is followed (the backup law is not running)."""
-    active = getattr(run, "backup_active", None)
-    if active is None or len(active) != len(run.t):
-        return np.ones(len(run.t), dtype=bool)
-    return ~np.asarray(active, dtype=bool)
+    """Boolean mask of the ticks at which a tracking plan is followed (neither the backup law nor a recovery plan)."""
+    mask = np.ones(len(run.t), dtype=bool)
+    for name in ("backup_active", "recovery"):
+        flags = getattr(run, name, None)
+        if flags is not None and len(flags) == len(run.t):
+            mask &= ~np.asarray(flags, dtype=bool)
+    return mask
 
 
 def _tube(run: RunLog) -> Promise:
@@ -313,10 +316,13 @@ def _feasibility(run: RunLog) -> Promise:
     age = np.asarray(run.plan_age, dtype=int)
     first_ok = len(age) > 0 and age[0] == 0 and not bool(run.replaced[0])
     oldest = int(age.max()) if len(age) else 0
+    flags = getattr(run, "recovery", None)
+    recovering = float(np.sum(flags[:-1])) * float(run.t[1] - run.t[0]) if flags is not None and len(run.t) > 1 \
+        else 0.0
     return Promise("recursive_feasibility", float(oldest), float(max(n - 1, 0)),
-                   bool(first_ok and oldest <= max(n - 1, 0)),
+                   bool(first_ok and oldest <= max(n - 1, 0) and recovering == 0.0),
                    f"premise (of tracking; of safety too without a backup): oldest replayed plan (periods); "
-                   f"rejected plans = {int(np.sum(run.rejected))}; "
+                   f"rejected plans = {int(np.sum(run.rejected))}; recovery plans followed {recovering:.4g} s; "
                    f"accepted at t = 0: {first_ok}")
 
 

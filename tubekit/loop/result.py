@@ -63,6 +63,8 @@ LOG_FIELDS: tuple[LogField, ...] = (
     LogField("replaced", "tick", 0, bool, False, ("replaced",), "the period's FHOCP input was replaced"),
     LogField("backup_active", "tick", 0, bool, False, ("backup_active",),
              "the backup law ran at this tick (the replayed plan was exhausted)"),
+    LogField("recovery", "tick", 0, bool, False, ("recovery",),
+             "a recovery plan is followed (accepted for safety alone, its error left R: tracking not in force)"),
     LogField("backup_anchor", "tick", 3, float, np.nan, ("anchor_x", "anchor_y", "anchor_z"),
              "the backup's anchor p* (m) while it runs, NaN otherwise"),
     LogField("n_detected", "tick", 0, int, 0, ("n_detected",), "obstacles known to the map"),

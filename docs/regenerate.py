@@ -44,8 +44,8 @@ REPRODUCE_FIGURES = {"fig2_top_view.png": "docs/reproduce_top_view.png", "fig3_e
 ENVELOPE_FIGURE = "docs/envelope.png"
 CAMPAIGN_FIGURE = "docs/campaign_ecdf.png"
 #: The drawing code whose change makes every committed figure stale.
-DRAWING_CODE = ("tubekit/app/plots.py", "tubekit/app/plots_obstacle.py", "tubekit/app/plots_envelope.py",
-                "tubekit/app/plots_campaign.py")
+DRAWING_CODE = ("tubekit/app/plots.py", "tubekit/app/plots_envelope.py", "tubekit/app/plots_campaign.py",
+                *sorted(p.relative_to(ROOT).as_posix() for p in (ROOT / "tubekit" / "plotting").glob("*.py")))
 #: (name, scenario file relative to ROOT or "paper" for tubekit.paper_scenario(), law or None for the file's own).
 CERTIFICATES = (("paper", "paper", None), ("paper_currents", "verify/scenarios/paper_currents.toml", None),
                 ("paper_currents/paper-law", "verify/scenarios/paper_currents.toml", "paper"),

@@ -61,8 +61,10 @@ def _group(pgid: int) -> list[str]:
 
 
 def test_ctrl_c_stops_the_workers_and_exits_130_in_one_line(tmp_path):
+    """Ctrl-C after the first finished run: 60 runs, so the campaign is still running when the signal arrives on a
+    loaded machine too (the interrupt, not the campaign's end, must decide the exit code)."""
     spec = tmp_path / "spec.toml"
-    spec.write_text(f'scenario = "{SCENARIO.as_posix()}"\nruns = 12\nseed = 3\nduration = 6.0\n', encoding="utf-8")
+    spec.write_text(f'scenario = "{SCENARIO.as_posix()}"\nruns = 60\nseed = 3\nduration = 6.0\n', encoding="utf-8")
     out = tmp_path / "out"
     proc = subprocess.Popen([sys.executable, "-m", "tubekit.app.cli", "campaign", str(spec), "--out", str(out),
                              "--workers", "2", "--no-progress"], stdout=subprocess.PIPE, stderr=subprocess.PIPE,

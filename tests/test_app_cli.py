@@ -72,11 +72,13 @@ def _fake_certify(scenario, law=None):
         disturbance = SimpleNamespace(gamma=0.02)  # read by the dynamic-plant part of reproduce
         tiers = Tiers(False, False)
         tier_failures = {"safe": ("fake",), "tracking": ("fake",)}
+        inputs, law, sigma_source = SimpleNamespace(sigma=0.5), "corrected", "fake"
+        tried, tube = (SimpleNamespace(sigma=0.5),), SimpleNamespace(certified=False, rho=(0.03, 0.0, 0.0))
 
         def to_dict(self):
             return {"certified": False, "fake": True}
 
-        def summary(self):
+        def summary(self, verbose=False):
             return "fake certificate"
 
         def best_effort_tightening(self, min_input_fraction=0.5):

@@ -127,6 +127,19 @@ def test_certify_verbose_lists_every_sigma_tried_with_its_failures(capsys):
     assert main(["certify"]) == 3 and "Designs tried" not in capsys.readouterr().out
 
 
+def test_certify_prints_the_short_certificate_and_v_the_full_one(capsys):
+    """Issue 35 item 6: the short certificate says what to change; -v prints every condition and assumption."""
+    assert main(["certify"]) == 3
+    short = capsys.readouterr().out
+    assert len(short.splitlines()) <= 25 and "— set limits.u_max >= 0.503 m/s" in short
+    assert "Assumptions" not in short and "[ok  ]" not in short
+    assert main(["certify", "-v"]) == 3
+    full = capsys.readouterr().out
+    cert = certify(paper_scenario())
+    assert full.startswith(cert.summary(verbose=True).split("\nElapsed:")[0])
+    assert "Assumptions (outside the model):" in full and "Designs tried" in full
+
+
 def test_certify_quiet_prints_no_summary(capsys):
     assert main(["certify", "-q"]) == 3
     assert capsys.readouterr().out == ""

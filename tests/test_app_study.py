@@ -35,11 +35,13 @@ class FakeCertificate:
         self.disturbance = SimpleNamespace(gamma=0.02)  # what the dynamic part of reproduce reads
         self.tiers = Tiers(certified, certified)
         self.tier_failures = {"safe": () if certified else ("fake",), "tracking": () if certified else ("fake",)}
+        self.inputs, self.law, self.sigma_source = SimpleNamespace(sigma=0.5), "corrected", "fake"
+        self.tried, self.tube = (SimpleNamespace(sigma=0.5),), SimpleNamespace(certified=True, rho=(0.03, 0.0, 0.0))
 
     def to_dict(self):
         return {"certified": self.certified, "fake": True, "rho": 0.03}
 
-    def summary(self):
+    def summary(self, verbose=False):
         return "fake certificate for tests"
 
     def best_effort_tightening(self, min_input_fraction=0.5):

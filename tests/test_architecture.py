@@ -5,7 +5,9 @@ The layers, from the ground up: ``tubekit.exceptions`` / ``validation`` / ``vers
 ``design_key``), then the run (``tubekit.plant`` and ``tubekit.fhocp``, then ``tubekit.loop``);
 ``verify`` needs the model and the configuration, and only ``verify.falsify`` runs the loop;
 ``tubekit.app`` (with the ``python -m tubekit`` shim) sits on top and is the only layer that
-parses arguments, plots, or joins tubekit and verify.
+parses arguments or joins tubekit and verify; it and ``tubekit.plotting`` (the figures of a run, beside the
+solver and the plant: it imports only the configuration, the model and the ground) are the only code that
+imports matplotlib.
 
 Every module of ``tubekit/`` and ``verify/`` is parsed with :mod:`ast` (no import
 is executed); its imports are every ``import`` / ``from ... import`` statement
@@ -33,7 +35,13 @@ PACKAGES = ("tubekit", "verify")
 APP = "tubekit.app"
 #: The app layer: tubekit.app and the ``python -m tubekit`` shim that hands over to its CLI.
 APP_LAYER = (APP, "tubekit.__main__")
-GUI_AND_CLI = ("argparse", "matplotlib", "mpl_toolkits")
+CLI = ("argparse",)
+GUI = ("matplotlib", "mpl_toolkits")
+GUI_AND_CLI = (*CLI, *GUI)
+#: The plotting role: the only code outside the app layer that imports matplotlib; it draws a run from its
+#: columns, so it imports none of these (``SimulationResult.plot()`` imports it lazily: no cycle).
+PLOTTING = "tubekit.plotting"
+PLOTTING_MAY_NOT_IMPORT = ("tubekit.loop", "tubekit.fhocp", "tubekit.plant", APP, "verify")
 MODEL = "tubekit.model"
 MODEL_MAY_IMPORT = (MODEL, "tubekit.exceptions", "tubekit.validation", "tubekit.version")
 CONFIGURATION = ("tubekit.settings", "tubekit.scenario", "tubekit.tightening", "tubekit.checks", "tubekit.design_inputs",
@@ -245,8 +253,15 @@ def verify_studies_reach_the_falsifiers(mod: str, target: str) -> bool:
 
 
 def gui_or_cli_outside_the_app(mod: str, target: str) -> bool:
-    """argparse, matplotlib and mpl_toolkits are imported only in the app layer."""
-    return not _is_app(mod) and _within_any(target, GUI_AND_CLI)
+    """argparse is imported only in the app layer; matplotlib and mpl_toolkits only there and in tubekit.plotting."""
+    if _is_app(mod):
+        return False
+    return _within_any(target, CLI) or (_within_any(target, GUI) and not _within(mod, PLOTTING))
+
+
+def plotting_reaches_the_run(mod: str, target: str) -> bool:
+    """tubekit.plotting imports no tubekit.loop, tubekit.fhocp, tubekit.plant, tubekit.app or verify."""
+    return _within(mod, PLOTTING) and _within_any(target, PLOTTING_MAY_NOT_IMPORT)
 
 
 def _owning_module(target: str) -> str | None:
@@ -357,9 +372,15 @@ def test_verify_roles_import_only_downwards(rule):
     assert not offenders, _report(rule.__doc__, offenders)
 
 
-def test_argparse_and_matplotlib_only_in_the_app_layer():
+def test_argparse_only_in_the_app_layer_and_matplotlib_there_and_in_plotting():
     offenders = _offenders(gui_or_cli_outside_the_app)
-    assert not offenders, _report(f"{', '.join(GUI_AND_CLI)} may be imported only under tubekit/app/", offenders)
+    assert not offenders, _report(f"{', '.join(CLI)} may be imported only under tubekit/app/, {', '.join(GUI)} "
+                                  f"only there and under tubekit/plotting/", offenders)
+
+
+def test_plotting_imports_only_the_configuration_and_the_model():
+    offenders = _offenders(plotting_reaches_the_run)
+    assert not offenders, _report(f"{PLOTTING} must not import {', '.join(PLOTTING_MAY_NOT_IMPORT)}", offenders)
 
 
 def test_no_import_cycles():
@@ -394,7 +415,8 @@ def test_importing_the_packages_loads_no_matplotlib_and_no_sympy():
     run = subprocess.run([sys.executable, "-c", code], cwd=ROOT, capture_output=True, text=True, timeout=300)
     assert run.returncode == 0, f"`python -c {code!r}` failed:\n{run.stderr}"
     assert run.stdout.strip() == "[]", (f"`import tubekit, verify` loads {run.stdout.strip()}: plotting belongs "
-                                        f"in tubekit/app/, the sympy derivation is imported only on use")
+                                        f"in tubekit/app/ and tubekit/plotting/ (imported on use), the sympy "
+                                        f"derivation is imported only on use")
 
 
 # --------------------------------------------------------------------------- the checker itself
@@ -471,6 +493,14 @@ def test_the_layer_rules_flag_only_what_they_name():
     core = _fake("tubekit.loop.promises", "def f():\n    import matplotlib.pyplot as plt\n    import verify\n")
     assert _offenders(gui_or_cli_outside_the_app, among=[core]) == ["tubekit/loop/promises.py:2 -> matplotlib.pyplot"]
     assert _offenders(core_imports_verify, among=[core]) == ["tubekit/loop/promises.py:3 -> verify"]
+    plotting = _fake("tubekit.plotting.top_view", "import argparse\nfrom matplotlib.figure import Figure\n"
+                     "from tubekit.scenario import Scenario\nfrom tubekit.model.errors import numeric\n"
+                     "from tubekit.loop.result import SimulationResult\nfrom tubekit.app.plots import plot_all\n"
+                     "def f():\n    import tubekit.plant.dynamic\n    import verify\n")
+    assert _offenders(gui_or_cli_outside_the_app, among=[plotting]) == ["tubekit/plotting/top_view.py:1 -> argparse"]
+    assert _offenders(plotting_reaches_the_run, among=[plotting]) == [
+        "tubekit/plotting/top_view.py:5 -> tubekit.loop.result", "tubekit/plotting/top_view.py:6 -> tubekit.app.plots",
+        "tubekit/plotting/top_view.py:8 -> tubekit.plant.dynamic", "tubekit/plotting/top_view.py:9 -> verify"]
 
 
 def test_the_function_limit_counts_methods_and_stops_at_the_limit():

@@ -1,5 +1,6 @@
 """tubekit.loop.result: one field list (LOG_FIELDS) behind the loop's buffer, the result and the CSV; the run's
-metrics in the one convention; no plotting in the core.
+metrics in the one convention; ``plot()`` hands the run to the plotting role (``import tubekit`` loads no
+matplotlib: tests/test_architecture.py).
 
 The run is hand-built (as in test_loop_promises): a parked vehicle 2 m from a stationary target, 3 periods of
 10 ticks, so every column has a value known here.
@@ -95,8 +96,31 @@ def test_every_csv_column_of_a_log_field_holds_that_field(stationary):
     assert np.allclose(cols["e_d"], 2.0) and np.allclose(cols["rho_norm"], 0.0)
 
 
-def test_the_core_result_does_not_plot():
-    assert not hasattr(SimulationResult, "plot")
+def test_plot_is_a_figure_with_the_verdict_in_its_title(stationary):
+    """Issue 35 item 3: ``run.plot()`` returns a matplotlib figure (no pyplot state) titled with the run's tiers and
+    what happened to them (``run.metrics["outcome"]``); an unknown kind is refused by name."""
+    from matplotlib.figure import Figure
+
+    run = _run(stationary)
+    fig = run.plot()
+    assert isinstance(fig, Figure) and fig.canvas.manager is None  # not a pyplot figure
+    outcome = run.metrics["outcome"]
+    assert f"safe: {outcome['safe']}; tracking: {outcome['tracking']}" in fig.get_suptitle()
+    view = next(ax for ax in fig.axes if ax.get_title() == "top view")
+    assert any(ln.get_label().startswith("target at t = ") for ln in view.get_lines())
+    baseline = _run(stationary, tube=False, sigma=0.0, tightening=Tightening.untightened(stationary)).plot()
+    assert baseline.get_suptitle().endswith("baseline: nothing is promised")
+    with pytest.raises(ConfigError, match="^kind: expected one of summary"):
+        run.plot(kind="bode")
+
+
+def test_a_dynamic_runs_plot_has_the_thrust_panel(stationary):
+    dynamic = stationary.with_changes(plant=dataclasses.replace(stationary.plant, kind="dynamic",
+                                                                vehicle="bluerov2_heavy"))
+    body, thrust = np.zeros((ROWS, 4)), np.tile([10.0, 0.0, -1.0], (ROWS, 1))
+    fig = _run(dynamic, body=body, thrust=thrust).plot()
+    assert "thrust / limit" in [ax.get_ylabel() for ax in fig.axes]
+    assert "thrust / limit" not in [ax.get_ylabel() for ax in _run(stationary).plot().axes]
 
 
 # ---- the run's metrics: one convention --------------------------------------------------------------------

@@ -76,3 +76,10 @@ def test_every_module_the_tests_import_is_installed_by_the_test_command():
                if module not in sys.stdlib_module_names and not _is_local(module)
                and _name(DISTRIBUTION_OF.get(module, module)) not in installed}
     assert not missing, f"imported by the tests, installed by neither the dependencies nor [test]: {missing}"
+
+
+def test_the_plugins_the_suite_is_configured_with_are_in_the_test_extra():
+    """``addopts`` runs the suite on every core (``-n auto``: pytest-xdist), so the ``test`` extra installs it."""
+    addopts = PYPROJECT["tool"]["pytest"]["ini_options"]["addopts"].split()
+    extra = {_name(r) for r in PYPROJECT["project"]["optional-dependencies"]["test"]}
+    assert "-n" in addopts and "pytest-xdist" in extra

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import math
 
 import numpy as np
@@ -11,7 +12,7 @@ import verify
 from tubekit.app.plots import plot_envelope
 from tubekit.exceptions import ConfigError
 from tubekit.scenario import load_scenario
-from verify.studies.envelope import necessary_omega, scenario_at
+from verify.studies.envelope import EnvelopeResult, necessary_omega, scenario_at
 
 PAPER_CURRENTS = verify.SCENARIOS_DIR / "paper_currents.toml"
 
@@ -63,6 +64,54 @@ def test_plot_summary_json(env, tmp_path):
     assert "ratio certified / necessary" in env.summary()
     d = env.to_dict()
     assert d["epsilon"] == 0.5 and len(d["certified_omega"]) == 3 and d["problems"] == []
+
+
+def test_the_scenarios_own_point_and_verdict(env, scenario):
+    """The result carries the scenario's own speed, omega_bar_xy and verdict (certify of the scenario as it is)."""
+    assert env.own_speed == pytest.approx(3.0 * math.pi / 50)          # radius 3 m, rate pi/50
+    assert env.own_omega == pytest.approx(0.12)                        # 0.1 current + 0.02 sway
+    assert env.own_current == pytest.approx(0.1) and env.own_epsilon == 0.5
+    assert env.own_certified is True and env.own_safe is True and env.own_failure == ""
+    assert env.own_certified == verify.certify(scenario, "corrected").certified
+    assert env.own_verdict() == "certified"
+    point = env.to_dict()["scenario_point"]
+    assert point == {"speed": pytest.approx(env.own_speed), "omega_bar_xy": pytest.approx(0.12),
+                     "current": pytest.approx(0.1), "epsilon": 0.5, "certified": True, "safe": True,
+                     "first_failure": ""}
+    assert "your scenario: target 0.1885 m/s, current 0.1 m/s (omega_bar_xy 0.12) at epsilon 0.5 m: certified" \
+        in env.summary()
+
+
+def test_the_own_verdict_is_at_the_envelopes_epsilon(scenario):
+    """With eps given, the scenario's point is judged at that epsilon; its own epsilon is kept beside it."""
+    env = verify.envelope(scenario, "corrected", eps=0.3, speeds=[0.1], quick=True)
+    direct = verify.certify(scenario.with_changes(epsilon=0.3), "corrected")
+    assert env.epsilon == 0.3 and env.own_epsilon == 0.5
+    assert env.own_certified == direct.certified and env.own_safe == direct.tiers.safe
+    assert env.own_failure == (direct.failures[0].condition if direct.failures else "")
+
+
+def test_a_constant_current_enters_the_own_point():
+    """A 0.12 m/s constant cross current (no oscillation): omega_bar_xy = 0.12 + gamma, the verdict certify's."""
+    base = verify.certifiable_scenario()
+    dist = dataclasses.replace(base.disturbance, amplitude=(0.0, 0.0, 0.0), constant=(0.0, 0.12, 0.0))
+    sc = base.with_changes(disturbance=dist)
+    env = verify.envelope(sc, "corrected", speeds=[0.1], quick=True)
+    direct = verify.certify(sc, "corrected")
+    assert env.own_current == pytest.approx(0.12) and env.current_offset == pytest.approx(0.12)
+    assert env.own_omega == pytest.approx(0.12 + env.gamma)
+    assert env.own_certified == direct.certified
+    assert env.own_failure == (direct.failures[0].condition if direct.failures else "")
+    assert env.to_dict()["scenario_point"]["current"] == pytest.approx(0.12)
+
+
+def test_a_result_without_its_own_point_says_so():
+    result = EnvelopeResult(
+        scenario_name="hand", law="corrected", epsilon=0.5, speeds=np.array([0.1]), certified_omega=np.array([0.2]),
+        certified_amplitude=np.array([0.18]), refuted_amplitude=np.array([0.19]), necessary_omega=np.array([0.25]))
+    assert result.own_certified is None and result.own_verdict() == "not recorded"
+    assert result.to_dict()["scenario_point"]["speed"] is None
+    assert "your scenario" not in result.summary()
 
 
 def test_paper_scenario_speed_is_physically_out_of_reach():

@@ -73,7 +73,7 @@ def simulate(scenario: Scenario, certificate: Certified | Tightening | None = No
     -------
     SimulationResult
         With ``metrics`` and ``to_csv(path)``; :func:`tubekit.check_promises` measures a tube run;
-        its figure is ``tubekit.app.plots.plot_run(run)``.
+        its figure is ``run.plot()`` (:meth:`SimulationResult.plot`).
     """
     if not isinstance(scenario, Scenario):
         raise ConfigError("scenario", "a tubekit.Scenario", type(scenario).__name__)

@@ -87,6 +87,11 @@ print(f"target speed {speed:.4f} m/s; nominal surge bound V-bar_u = {tight.v_max
 # `solve(t, state, obstacles)` method. We use it to wrap the default `FHOCP` and keep, per
 # constraint family, the largest violation of the nonlinear constraints its plans had
 # (`FhocpResult.violations`) — the closed loop itself only logs the overall maximum.
+# The wrapper passes on the keyword `v_last` (the command applied just before the plan): the loop
+# gives it to any `solve` that takes it, and the FHOCP's rate penalty starts from it. A wrapper
+# without it plans from its own warm start instead, and its runs differ from `tubekit reproduce`'s
+# (an earlier version of this tutorial reported RMSE 1.886 m against reproduce's 1.869 m for that
+# reason); with it, these runs are reproduce's own.
 
 # %%
 class RecordingFHOCP:
@@ -96,8 +101,8 @@ class RecordingFHOCP:
         self.inner = FHOCP(scenario, tightening)
         self.worst = {}
 
-    def solve(self, t, state, obstacles):
-        res = self.inner.solve(t, state, obstacles)
+    def solve(self, t, state, obstacles, v_last=None):
+        res = self.inner.solve(t, state, obstacles, v_last=v_last)
         for family, value in res.violations.items():
             if value > self.worst.get(family, (0.0, None))[0]:
                 self.worst[family] = (value, t)

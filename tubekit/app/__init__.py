@@ -9,7 +9,7 @@
   (certify → tube run + baseline with :func:`tubekit.loop.pipeline.certified_run` → files; a
   :class:`~tubekit.app.study.StudyResult`), :mod:`tubekit.app.dynamic_study` its dynamic-plant part,
   :mod:`tubekit.app.campaign` many runs on dask;
-* :mod:`tubekit.app.plots` — every figure (a run's: :func:`~tubekit.app.plots.plot_run`; an envelope's);
+* :mod:`tubekit.app.plots` — every figure file (a run's are drawn by :mod:`tubekit.plotting`, ``run.plot()``; an envelope's);
 * :mod:`tubekit.app.animate` — the animated top view (``--animate``).
 
 Nothing here is imported by ``import tubekit``; import the submodule you need.

@@ -1,7 +1,7 @@
 """The top-view animation of ``--animate`` (``tubekit reproduce`` / ``tubekit simulate``).
 
 Frames are drawn on one matplotlib :class:`~matplotlib.figure.Figure` (Agg, no
-window): the static scene of :func:`tubekit.app.plots.draw_scene_xy` is rendered
+window): the static scene of :func:`tubekit.plotting.top_view.draw_scene_xy` is rendered
 once (layout fixed, background kept), then per frame only the moving artists are
 drawn over it (blitting): each run's path so far, its vehicle ball, the sensing
 circle R̄, the target p_d(t) and the clock. The frames are written as a GIF
@@ -23,7 +23,9 @@ from matplotlib.figure import Figure
 from matplotlib.patches import Circle as CirclePatch
 
 from tubekit.scenario import Scenario
-from tubekit.app.plots import Run, draw_scene_xy, fit_canvas, run_style
+from tubekit.plotting.run import Run
+from tubekit.plotting.style import run_style
+from tubekit.plotting.top_view import draw_scene_xy, fit_canvas
 
 __all__ = ["animate_top_view", "ANIMATION_GIF", "ANIMATION_MP4", "frame_rows"]
 

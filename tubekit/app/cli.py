@@ -12,10 +12,10 @@ Exit codes (:mod:`tubekit.app.exit_codes`, one table by error type): 0 success /
 (one message, no traceback), 3 not certified / counterexample found, 4 a certified promise
 broken in a run (simulate, reproduce, campaign), 130 interrupted (Ctrl-C).
 
-Every command takes ``-v`` (debug diagnostics; ``certify -v`` also prints every sigma tried with
-its failed conditions) and ``-q`` (warnings and errors only; ``certify -q`` prints no summary
-either): diagnostics go through :mod:`logging` to stderr; results are printed on stdout. Every
-file-system error (an unreadable or binary CONFIG, an ``--out`` naming a file or an unwritable
+Every command takes ``-v`` (debug diagnostics; ``certify -v`` also prints the full certificate instead of
+the short one, and every sigma tried with its failed conditions) and ``-q`` (warnings and errors only;
+``certify -q`` prints no summary either): diagnostics go through :mod:`logging` to stderr; results are
+printed on stdout. Every file-system error (an unreadable or binary CONFIG, an ``--out`` naming a file or an unwritable
 place, an ``--out`` another run holds) is one line naming the option, exit 2; a full disk is the
 machine's fault, not the input's: one line with the path, exit 1.
 
@@ -77,7 +77,8 @@ SUBCOMMANDS: dict[str, Subcommand] = {
 
 #: ``-v`` / ``-q`` help where a subcommand does more than the logging level.
 VERBOSITY_HELP: dict[str, tuple[str, str]] = {
-    "certify": ("debug diagnostics on stderr, and every sigma tried with its failed conditions on stdout",
+    "certify": ("the full certificate (every number, condition, premise and assumption) and every sigma tried with "
+                "its failed conditions on stdout, debug diagnostics on stderr",
                 "warnings and errors only on stderr, and no summary on stdout"),
 }
 

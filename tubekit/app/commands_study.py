@@ -14,7 +14,7 @@ from typing import TYPE_CHECKING
 from tubekit.checks import check_run_inputs
 from tubekit.exceptions import ConfigError, NotAvailableError
 from tubekit.scenario import Scenario, load_scenario, paper_scenario
-from tubekit.validation import bounded_int
+from tubekit.validation import bounded_int, gain
 from tubekit.app.commands_verify import add_law_option, checked_law, log_unit_hints
 from tubekit.app.exit_codes import EXIT_FAILURE, EXIT_OK, EXIT_PROMISE_BROKEN, extra_hint
 from tubekit.app.output import OutputLock, check_output_dir
@@ -41,6 +41,9 @@ def study_options(parser: argparse.ArgumentParser, default_out: str | None) -> N
     length.add_argument("--quick", action="store_true",
                         help=f"a faster, shorter run (smoke test): --duration {QUICK_DURATION_S:g}")
     add_law_option(parser)
+    parser.add_argument("--sigma", type=float, metavar="S", default=None,
+                        help="ancillary gain sigma (1/s) to certify and run (default: the scenario's, else the "
+                             "verifier's choice)")
     parser.add_argument("--no-progress", action="store_true", help="no progress bar")
     parser.add_argument("--animate", action="store_true",
                         help="also write top_view.gif (and top_view.mp4 where ffmpeg exists)")
@@ -67,6 +70,8 @@ def _study_scenario(scenario: Scenario, args: argparse.Namespace) -> Scenario:
 
     law = None if args.law is None else checked_law(args.law, scenario)
     scenario = apply_overrides(scenario, duration=args.duration, quick=args.quick, law=law)
+    if getattr(args, "sigma", None) is not None:
+        scenario = scenario.with_changes(**{"controller.sigma": gain("--sigma", args.sigma)})
     check_run_inputs(scenario)
     log_unit_hints(scenario)
     return scenario

@@ -123,7 +123,9 @@ def configure_certify(parser: argparse.ArgumentParser) -> None:
 def run_certify(args: argparse.Namespace) -> int:
     """Certify; print the summary; 0 certified, 3 not certified (``--search-region``: any point of the grid).
 
-    ``-q`` prints no summary; ``-v`` adds every sigma tried with its failed conditions.
+    The summary is the short certificate (the verdict, each failed condition with the field and value that would
+    make it hold, the tube, the backup, the design key); ``-v`` prints the full one (every number, condition,
+    premise and assumption) and every sigma tried with its failed conditions; ``-q`` prints no summary.
     """
     from verify import certify
     from verify.certificate.report import tried_lines
@@ -144,7 +146,7 @@ def run_certify(args: argparse.Namespace) -> int:
         return EXIT_OK if found.best is not None else EXIT_NOT_CERTIFIED
     cert = certify(scenario, law, max_boxes=args.max_boxes)
     if show:
-        print(cert.summary())
+        print(cert.summary(verbose=args.verbose))
         if args.verbose:
             print("\n".join(tried_lines(cert)))
     if args.json is not None:

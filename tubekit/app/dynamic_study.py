@@ -6,7 +6,8 @@ sway enter ω; usually not certified, and then the best-effort sets are used and
 controller on the dynamic plant under
 the same current with :func:`tubekit.loop.pipeline.certified_run` (metrics and promises in the
 one convention), and writes ``dynamic_trajectory.csv``,
-``dynamic_certificate.txt`` and ``dynamic_vs_kinematic.png``.
+``dynamic_certificate.txt``, ``dynamic_vs_kinematic.png`` and the dynamic run's panel set ``dynamic_plant.png``
+(:func:`tubekit.plotting.dynamic.dynamic_figure`).
 """
 
 from __future__ import annotations
@@ -15,22 +16,26 @@ from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
-import numpy as np
 from matplotlib.figure import Figure
-from matplotlib.patches import Circle as CirclePatch
 
 from tubekit.jsonable import write_text
 from tubekit.loop.pipeline import CertifiedRun, certified_run
 from tubekit.loop.result import SimulationResult
 from tubekit.scenario import Scenario
+from tubekit.tightening import Tightening
+from tubekit.plotting.dynamic import draw_sway, draw_thrust, dynamic_figure
+from tubekit.plotting.style import backup_stretches, shade_backup
+from tubekit.plotting.titles import title_lines
+from tubekit.plotting.top_view import draw_scene_xy
 from tubekit.app.certified import certify_design
-from tubekit.app.plots import backup_stretches, shade_backup, title_lines
+from tubekit.app.plots import DYNAMIC_FIGURE, save_figure
 from tubekit.app.tiers import report_title, tier_report
 
 __all__ = ["run_dynamic", "comparison_figure", "DYNAMIC_FILES", "DYNAMIC_VEHICLE", "DYNAMIC_RATE"]
 
 #: Files the dynamic part writes.
-DYNAMIC_FILES: tuple[str, ...] = ("dynamic_trajectory.csv", "dynamic_certificate.txt", "dynamic_vs_kinematic.png")
+DYNAMIC_FILES: tuple[str, ...] = ("dynamic_trajectory.csv", "dynamic_certificate.txt", "dynamic_vs_kinematic.png",
+                                   DYNAMIC_FIGURE)
 
 
 #: The vehicle of ``reproduce``'s dynamic run: actuated in surge, heave and yaw at any speed, as the paper
@@ -52,46 +57,34 @@ def _dynamic_scenario(scenario: Scenario) -> Scenario:
 
 
 def comparison_figure(scenario: Scenario, kinematic: SimulationResult, dynamic: SimulationResult,
-                      gamma: float, tiers: str | None = None) -> Figure:
-    """Path, e_d, sway against γ̄ and thrust against its limits: kinematic and dynamic tube runs.
+                      tightening: Tightening, tiers: str | None = None) -> Figure:
+    """Path and e_d of the kinematic and the dynamic tube runs; the dynamic run's sway against γ̄ and thrust
+    against its limits (:mod:`tubekit.plotting.dynamic`, whose bounds are ``tightening``'s).
 
-    ``tiers`` (the dynamic certificate's, :func:`tubekit.app.plots.tier_title`) is a title line; the
+    ``tiers`` (the dynamic certificate's, :func:`tubekit.plotting.titles.tier_title`) is a title line; the
     dynamic run's backup-active stretches are shaded on its time axes.
     """
     fig = Figure(figsize=(12, 8.5), layout="constrained")
     ax = fig.subplots(2, 2)
     runs = (("kinematic plant", kinematic, "tab:blue"), (f"dynamic plant ({scenario.plant.vehicle})", dynamic, "tab:purple"))
+    draw_scene_xy(ax[0, 0], scenario, float(kinematic.t[-1]), start_target=False)
     for label, run, colour in runs:
         ax[0, 0].plot(run.states[:, 0], run.states[:, 1], color=colour, lw=1.2, label=label)
         ax[0, 1].plot(run.t, run.errors[:, 0], color=colour, lw=1.2, label=label)
-    pd = scenario.trajectory.position(np.linspace(0.0, kinematic.t[-1], 800))
-    ax[0, 0].plot(pd[:, 0], pd[:, 1], "--", color="tab:green", lw=1.0, label="desired")
-    for o in scenario.obstacles:
-        ax[0, 0].add_patch(CirclePatch(o.center[:2], o.radius, color="0.45"))
-    ax[0, 0].set(aspect="equal", xlabel="x (m)", ylabel="y (m)", title="path")
+    ax[0, 0].set(aspect="equal", title="path")
     ax[0, 1].axhline(scenario.epsilon, color="tab:red", ls="--", lw=1.0, label=f"ε = {scenario.epsilon:g} m")
     ax[0, 1].set(yscale="log", xlabel="t (s)", ylabel="e_d (m)", title="distance error")
-    sway = dynamic.body[:, 1] if dynamic.body is not None else np.full(len(dynamic.t), np.nan)
-    ax[1, 0].plot(dynamic.t, sway, color="tab:purple", lw=1.0, label="sway v_b (dynamic plant)")
-    for s in (gamma, -gamma):
-        ax[1, 0].axhline(s, color="tab:red", ls="--", lw=1.0, label="±γ̄ (certificate)" if s > 0 else None)
-    ax[1, 0].set(xlabel="t (s)", ylabel="m/s", title="sway against its bound")
-    truth = scenario.plant.truth_params  # the plant as simulated; fins: limits ∝ u² (docs/plant.md)
-    limits = np.array([truth.thrust_limits_at(u) for u in dynamic.body[:, 0]]) if dynamic.body is not None else None
-    if dynamic.thrust is not None:
-        for k, (name, colour) in enumerate((("X / X_max", "tab:blue"), ("Z / Z_max", "tab:orange"),
-                                             ("N / N_max", "tab:green"))):
-            ratio = np.divide(dynamic.thrust[:, k], limits[:, k], out=np.zeros(len(limits)), where=limits[:, k] > 0)
-            ax[1, 1].plot(dynamic.t, ratio, color=colour, lw=0.9, label=name)
-    ax[1, 1].axhline(1.0, color="tab:red", ls="--", lw=1.0, label="limit")
-    ax[1, 1].axhline(-1.0, color="tab:red", ls="--", lw=1.0)
-    ax[1, 1].set(xlabel="t (s)", ylabel="thrust / limit", title="thrust against its limits")
-    stretches = backup_stretches(dynamic.columns())
+    columns = dynamic.columns()
+    draw_sway(ax[1, 0], columns, tightening)
+    draw_thrust(ax[1, 1], scenario, columns)
+    stretches = backup_stretches(columns)
     for n, a in enumerate((ax[0, 1], ax[1, 0], ax[1, 1])):
         shade_backup(a, stretches, label=n == 0)
     for a in ax.flat:
         a.grid(alpha=0.3)
         a.legend(fontsize=9, loc="best")
+    for a in ax[1]:
+        a.set_xlabel("t (s)")
     head = f"{scenario.name}: tube controller, kinematic vs dynamic plant"
     fig.suptitle(title_lines(head, tiers, width=140), fontsize=11)
     return fig
@@ -107,7 +100,7 @@ def run_dynamic(scenario: Scenario, staging: Path, kinematic: SimulationResult,
     """
     scd = _dynamic_scenario(scenario)
     design = certify_design(scd)
-    write_text(staging / "dynamic_certificate.txt", design.certificate.summary() + "\n")
+    write_text(staging / "dynamic_certificate.txt", design.certificate.summary(verbose=True) + "\n")
     dyn = certified_run(scd, design.tightening, progress=progress, label="dynamic")
     dyn.run.write_csv(staging / "dynamic_trajectory.csv")
     metrics = dyn.to_dict()
@@ -115,7 +108,9 @@ def run_dynamic(scenario: Scenario, staging: Path, kinematic: SimulationResult,
     metrics.update(failures=[f.condition for f in design.certificate.failures], vehicle=scd.plant.vehicle,
                    velocity_loop=None if loop is None else list(loop))
     metrics["tiers_report"] = tier_report(design.certificate, metrics)
-    gamma = float(design.tightening.disturbance.sway)
-    figure = comparison_figure(scd, kinematic, dyn.run, gamma, tiers=report_title(metrics["tiers_report"]))
+    title = report_title(metrics["tiers_report"])
+    figure = comparison_figure(scd, kinematic, dyn.run, design.tightening, tiers=title)
     figure.savefig(staging / "dynamic_vs_kinematic.png", dpi=100)
+    panels = dynamic_figure(scd, ("tube", dyn.run.columns()), design.tightening)
+    save_figure(panels, staging / DYNAMIC_FIGURE, tiers=title, dpi=100)
     return dyn, metrics

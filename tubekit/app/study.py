@@ -47,6 +47,7 @@ from tubekit.app import QUICK_S
 from tubekit.app.certified import CertifiedDesign, certify_design
 from tubekit.app.output import StagedOutput, check_output_dir
 from tubekit.app.plots import plot_all
+from tubekit.app.sigma_story import sigma_story
 from tubekit.app.tiers import activity_line, report_title, tier_lines, tier_report
 
 __all__ = [
@@ -146,8 +147,10 @@ def acceptance(metrics: dict[str, Any], total_wall_s: float) -> dict[str, Any]:
 def certify_and_write(scenario: Scenario, out: Path) -> CertifiedDesign:
     """Certify (:func:`tubekit.app.certified.certify_design`); write ``certificate.json`` and ``certificate.txt``."""
     design = certify_design(scenario)
+    for line in sigma_story(scenario, design.certificate):
+        LOGGER.info("%s", line)
     write_json(out / "certificate.json", design.certificate.to_dict())
-    write_text(out / "certificate.txt", str(design.certificate.summary()) + "\n")
+    write_text(out / "certificate.txt", str(design.certificate.summary(verbose=True)) + "\n")
     return design
 
 
@@ -184,8 +187,8 @@ def write_runs(out: Path, scenario: Scenario, design: CertifiedDesign, tube: Cer
     tight = design.tightening
     metrics = tube.to_dict()
     metrics["tiers_report"] = tier_report(design.certificate, metrics)
-    plot_all(out, scenario, [("tube", tube_cols), ("baseline", base_cols)], rho_tilde=float(tight.rho_tilde),
-             certified=design.certified, tightening=tight, tiers=report_title(metrics["tiers_report"]))
+    plot_all(out, scenario, [("tube", tube_cols), ("baseline", base_cols)], tightening=tight,
+             tiers=report_title(metrics["tiers_report"]))
     metrics["baseline"] = base.to_dict()
     metrics["e_d_peaks"] = e_d_peaks(tube_cols["e_d"], tube_cols["t"])
     metrics["certify_s"] = design.certify_s

@@ -6,13 +6,16 @@ from dataclasses import dataclass, make_dataclass
 from dataclasses import field as dc_field
 from functools import partial
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from tubekit.model.errors import error_coordinates
 from tubekit.scenario import Scenario
 from tubekit.tightening import Tightening
+
+if TYPE_CHECKING:  # matplotlib's Figure, named through the plotting role (imported by plot() on use only)
+    from tubekit.plotting.summary import Figure
 
 __all__ = [
     "SimulationResult",
@@ -272,6 +275,30 @@ class SimulationResult(LogArrays):
         """The run's metrics, exactly as ``metrics.json`` holds them (:func:`tubekit.loop.metrics.run_metrics`)."""
         from tubekit.loop.metrics import run_metrics
         return run_metrics(self)
+
+    def plot(self, kind: str = "summary") -> Figure:
+        """The run's figure, the verdict (its tiers and their outcome on the run) in its title.
+
+        Parameters
+        ----------
+        kind : str
+            ``"summary"`` (default): the top view with the target's end marked, the errors, the inputs and, on
+            the dynamic plant, the thrust against its limits; or one figure: ``"top_view"``, ``"errors"``,
+            ``"inputs"``, ``"deviation"``, ``"clearance"``, ``"view_3d"``, ``"dynamic"``
+            (:data:`tubekit.plotting.summary.KINDS`).
+
+        Returns
+        -------
+        matplotlib.figure.Figure
+            No pyplot state, nothing shown: ``run.plot().savefig("run.png")``.
+
+        Raises
+        ------
+        ConfigError
+            An unknown ``kind`` (or ``"dynamic"`` on the kinematic plant).
+        """
+        from tubekit.plotting.summary import plot_run  # matplotlib is loaded here, never by `import tubekit`
+        return plot_run(self, kind)
 
     def summary(self) -> str:
         """A few lines for the terminal."""

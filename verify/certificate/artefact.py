@@ -2,9 +2,9 @@
 
 :class:`Certificate` is :class:`verify.certificate.record.CertificateRecord` plus the methods that use its
 views: :meth:`Certificate.to_dict` / :meth:`Certificate.from_dict` (:mod:`verify.certificate.jsonio`,
-exact inverses), :meth:`Certificate.summary` (:mod:`verify.certificate.report`) and the tightening a run
-uses (:mod:`verify.certificate.handoff`). The views import the record, never this module, so the
-package has no import cycle and no untyped certificate.
+exact inverses), :meth:`Certificate.summary` (:mod:`verify.certificate.report`: short, or full with
+``verbose``) and the tightening a run uses (:mod:`verify.certificate.handoff`). The views import the record,
+never this module, so the package has no import cycle and no untyped certificate.
 """
 
 from __future__ import annotations
@@ -18,7 +18,7 @@ from tubekit.tightening import Tightening
 from verify.certificate.handoff import tightening_of
 from verify.certificate.jsonio import certificate_from_dict, certificate_to_dict
 from verify.certificate.record import CertificateRecord
-from verify.certificate.report import certificate_text
+from verify.certificate.report import certificate_text, summary_text
 
 __all__ = ["Certificate", "NotCertifiedError"]
 
@@ -49,9 +49,11 @@ class Certificate(CertificateRecord):
         """The certificate of a :meth:`to_dict` dict (ConfigError naming the key when one is missing or mistyped)."""
         return certificate_from_dict(cls, d)
 
-    def summary(self) -> str:
-        """Human-readable certificate."""
-        return certificate_text(self)
+    def summary(self, verbose: bool = False) -> str:
+        """Human-readable certificate: the short one (at most about 25 lines: the verdict, each failed condition
+        with the field and value that would make it hold, the tube, the backup, the design key), or with
+        ``verbose`` the full text (every number, condition, premise and assumption)."""
+        return certificate_text(self) if verbose else summary_text(self)
 
     # ------------------------------------------------------------------ hand-off to the FHOCP
     @property

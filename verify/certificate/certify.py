@@ -32,7 +32,7 @@ from tubekit.scenario import Scenario
 
 from verify.backup import BackupCertificate
 from verify.certificate.artefact import Certificate, NotCertifiedError
-from verify.certificate.record import ASSUMPTIONS, PREMISES, THEOREM
+from verify.certificate.record import ASSUMPTIONS, EXACT_SENSING, PREMISES, THEOREM
 from verify.kernel.parts import SigmaTrial
 from verify.kernel.region import Region
 from verify.theorem.design import Condition, Design, DisturbanceBounds, disturbance_bounds
@@ -43,8 +43,8 @@ if TYPE_CHECKING:  # loaded only when a dynamic scenario or the paper's route is
     from verify.lemma1.route import PaperRoute
     from verify.vehicle.bound import LoopBound
 
-__all__ = ["certify", "resolve_law", "paper_route_of", "Certificate", "NotCertifiedError", "Condition", "ASSUMPTIONS", "PREMISES",
-           "THEOREM"]
+__all__ = ["certify", "resolve_law", "paper_route_of", "assumptions_of", "Certificate", "NotCertifiedError",
+           "Condition", "ASSUMPTIONS", "PREMISES", "THEOREM"]
 
 
 # --------------------------------------------------------------------------- certify
@@ -78,14 +78,24 @@ def _design_of(scenario: Scenario | DesignInputs, law: str | AncillaryLaw | None
 
 
 def _dynamic_assumptions(dist: DisturbanceBounds) -> tuple[str, ...]:
-    """What the certificate takes from the dynamic plant's model (docs/plant.md)."""
+    """What the certificate takes from the dynamic plant's model (docs/plant.md): the whole list, eq. (11) not
+    among it."""
     return ("Dynamic plant: the 4-DOF model of docs/plant.md (surge, sway, heave, yaw; no roll or pitch; the "
             "current's own acceleration neglected in the relative-velocity dynamics) with every hydrodynamic "
             "coefficient anywhere in its interval; the controller's feedforward uses the midpoints. The velocity "
             "loop's error and the hull's sway are derived from it (verify.vehicle.bound, "
             f"gamma_bar = {dist.gamma:.4g} m/s), not assumed.",
             "Dynamic plant: the run starts trimmed (body velocities equal to the first command, thrust equal to "
-            "the feedforward).")
+            "the feedforward).",
+            "The simulator integrates the 4-DOF model with RK4 at a fixed step; the certificate bounds the exact "
+            "solution, not the integration error.",
+            EXACT_SENSING)
+
+
+def assumptions_of(dynamic: bool, dist: DisturbanceBounds) -> tuple[str, ...]:
+    """The assumptions outside the model a certificate states, by plant: :data:`ASSUMPTIONS` on the kinematic
+    plant, the 4-DOF model's on the dynamic one (the one definition ``certify`` and ``recheck`` use)."""
+    return _dynamic_assumptions(dist) if dynamic else ASSUMPTIONS
 
 
 def _solve(scenario: Scenario, region: Region, gains: GainBounds, sigmas: tuple[float, ...]
@@ -131,7 +141,7 @@ def certify(scenario: Scenario | DesignInputs, law: str | AncillaryLaw | None = 
     dist, designs, best, safe, backup, loop, plant_conds = _solve(read, region, gains, sigmas)
     tried = tuple(SigmaTrial(sigma=d.sigma, certified=d.certified, score=d.score if math.isfinite(d.score) else None,
                              failed=tuple(c.condition for c in d.failures)) for d in designs)
-    assumptions = ASSUMPTIONS + (_dynamic_assumptions(dist) if inputs.dynamic else ())
+    assumptions = assumptions_of(inputs.dynamic, dist)
     handed = handed_sigma(tiers_of(best, safe, backup, plant_conds), best.sigma)
     return Certificate(inputs=inputs.with_sigma(handed), region=region, gains=gains, disturbance=dist, design=best,
                        tried=tried, sigma_source=source, elapsed_s=round(time.perf_counter() - t0, 3),

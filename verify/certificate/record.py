@@ -39,20 +39,25 @@ if TYPE_CHECKING:  # loaded only when a dynamic scenario or the paper's route is
     from verify.lemma1.route import PaperRoute
     from verify.vehicle.bound import LoopBound
 
-__all__ = ["CertificateRecord", "THEOREM", "ASSUMPTIONS", "PREMISES"]
+__all__ = ["CertificateRecord", "THEOREM", "ASSUMPTIONS", "EXACT_SENSING", "PREMISES"]
 
 THEOREM = ("sampled-data tube under the nominal reset: one-period box tube (verify.theorem.sampled), per-arc margins "
            "of the replayed candidate (verify.theorem.sampled.horizon_margins), exact arc acceptance with the "
            "terminal condition (tubekit.loop.plan_check), the certified station-keeping backup (verify.backup); "
            "tiers safe and tracking (verify.theorem.tiers)")
 
-#: Outside the model: what no certificate about eq. (11) can check.
+#: Outside the model, whatever the plant.
+EXACT_SENSING = ("Sensing is exact: obstacle centres and radii, the state and the target trajectory are known without "
+                 "noise.")
+
+#: Outside the model on the kinematic plant: what no certificate about eq. (11) can check. A dynamic plant's
+#: certificate states its own (``verify.certificate.certify.assumptions_of``): it does not assume eq. (11).
 ASSUMPTIONS = (
     "The plant is the kinematic model eq. (11) with omega = current + sway term; the error dynamics are the sympy "
     "derivation of tubekit.model.derivation (not the printed eqs. 15-18). A real vehicle's dynamics are not covered.",
     "The simulator integrates eq. (11) with RK4 at a fixed step; the certificate bounds the exact solution, not "
     "the integration error (below 1e-9 m at the default 5 ms step).",
-    "Sensing is exact: obstacle centres and radii, the state and the target trajectory are known without noise.",
+    EXACT_SENSING,
 )
 
 #: Premises of the theorem that depend on the run, checked in every run (tubekit.loop.promises).

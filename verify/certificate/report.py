@@ -1,4 +1,6 @@
-"""The certificate as text (``tubekit certify`` prints it)."""
+"""The certificate as text: :func:`summary_text` (``tubekit certify``, at most about 25 lines: the verdict, each
+failed condition with the field that would make it hold, the tube, the backup, the design key) and
+:func:`certificate_text` (``tubekit certify -v``: every number, condition, premise and assumption)."""
 
 from __future__ import annotations
 
@@ -7,9 +9,14 @@ from typing import Any
 
 from tubekit.design_inputs import THEOREM_VERSION
 
+from verify.certificate.knobs import Knob, knobs_for
 from verify.certificate.record import CertificateRecord
 
-__all__ = ["certificate_text", "tiers_line", "compare", "tried_lines"]
+__all__ = ["certificate_text", "summary_text", "verdict_line", "tiers_line", "compare", "tried_lines", "knob_text",
+           "FAILURE_LINES"]
+
+#: Failed conditions listed one per line in :func:`summary_text`; the others are named on one more line.
+FAILURE_LINES = 12
 
 
 def _f(x: Any, d: int = 4) -> str:
@@ -104,12 +111,23 @@ def _tier_lines(cert: CertificateRecord) -> list[str]:
     return out
 
 
-def certificate_text(cert: CertificateRecord) -> str:
-    """Human-readable certificate: verdict, region, disturbance, tube, conditions, premises, assumptions."""
+def verdict_line(cert: CertificateRecord) -> str:
+    """The first line of either text: scenario, law, verdict and the tiers (:func:`tiers_line`)."""
     n_fail = len(cert.failures)
     status = "CERTIFIED" if cert.certified else f"NOT CERTIFIED ({n_fail} failed condition{'s' * (n_fail != 1)})"
+    return f"tubekit certificate: scenario '{cert.scenario_name}', law '{cert.law}': {status} -- {tiers_line(cert)}"
+
+
+def knob_text(knobs: tuple[Knob, ...]) -> str:
+    """`` — set limits.u_max >= 0.503 m/s or |trajectory.rate| <= 0.0933 rad/s`` ('' without a knob): each knob
+    alone makes the condition hold."""
+    return " — set " + " or ".join(k.clause() for k in knobs) if knobs else ""
+
+
+def certificate_text(cert: CertificateRecord) -> str:
+    """Human-readable certificate: verdict, region, disturbance, tube, conditions, premises, assumptions."""
     dist = cert.disturbance
-    lines = [f"tubekit certificate: scenario '{cert.scenario_name}', law '{cert.law}': {status} -- {tiers_line(cert)}",
+    lines = [verdict_line(cert),
              "Theorem: the sampled-data loop as it runs (nominal reset every period, kappa held at the ancillary "
              "rate, plans accepted by the exact arc check and the terminal condition, the previous plan replayed "
              "otherwise, the certified backup law once the replay is exhausted).",
@@ -124,7 +142,8 @@ def certificate_text(cert: CertificateRecord) -> str:
     for c in cert.conditions:
         tag = {True: "ok  ", False: "FAIL", None: "n/a "}[c.ok]
         lines.append(f"  [{tag}] {c.condition}: {c.inequality}: {compare(c.lhs, c.rhs)}"
-                     + (f"  ({c.detail})" if c.detail and c.ok is not True else ""))
+                     + (f"  ({c.detail})" if c.detail and c.ok is not True else "")
+                     + knob_text(knobs_for(cert, c)))
     lines.append("Premises (checked in every run; a premise failure is reported as such, never as a broken promise):")
     lines.extend(f"  - {p}" for p in cert.premises)
     lines.append("Assumptions (outside the model):")
@@ -133,4 +152,70 @@ def certificate_text(cert: CertificateRecord) -> str:
         lines.extend(cert.paper_route.summary_lines())
     lines.append(f"Design key: {cert.design_key} (theorem {THEOREM_VERSION})")
     lines.append(f"Elapsed: {cert.elapsed_s:.2f} s")
+    return "\n".join(lines)
+
+
+def _failure_lines(cert: CertificateRecord) -> list[str]:
+    """Each condition that does not hold, one line with its numbers and its knob, those with a knob first (at most
+    :data:`FAILURE_LINES`, the rest named on one more line)."""
+    open_ = [c for c in cert.conditions if c.ok is not True]
+    knobs = {c.condition: knobs_for(cert, c) for c in open_}
+    open_.sort(key=lambda c: not knobs[c.condition])  # stable: the ones with a knob first, each group in order
+    if not open_:
+        return [f"Every condition holds ({len(cert.conditions)}; each with its numbers: tubekit certify -v)."]
+    out = [f"Failed conditions ({len(open_)}; the field that makes each hold, where one field decides it):"]
+    for c in open_[:FAILURE_LINES]:
+        numbers = compare(c.lhs, c.rhs) if c.ok is False else "not evaluated"
+        out.append(f"  {c.condition}: {c.inequality}: {numbers}{knob_text(knobs[c.condition])}")
+    rest = open_[FAILURE_LINES:]
+    if rest:
+        out.append(f"  ... and {len(rest)} more: " + ", ".join(c.condition for c in rest))
+    return out
+
+
+def _short_tube_lines(cert: CertificateRecord) -> list[str]:
+    """σ and the tube of the chosen design in one line; the safe-only design in one more when there is one."""
+    d, tried = cert.design, ", ".join(f"{_f(x.sigma)}{'*' if x.certified else ''}" for x in cert.tried)
+    head = f"sigma = {_f(d.sigma)} 1/s (tried {tried}; * = certified); "
+    t = d.tube
+    if not t.certified:
+        out = [head + f"one-period tube: none ({t.reason})"]
+    else:
+        last = f", position margin {_f(d.margins.position[-1], 3)} m on the last arc" if d.margins is not None else ""
+        out = [head + f"one-period tube |rho| <= {_vec(t.rho)} (e_d m, e_z m, e_o){last}"]
+    if cert.safe_design is not None:
+        sd = cert.safe_design
+        out.append(f"Safe tier's design: sigma = 0, position tube {_f(sd.tube.p_xy)} m per period, position margin "
+                   f"{_f(sd.margins.position[-1], 3) if sd.margins is not None else 'n/a'} m on the last arc")
+    return out
+
+
+def _short_backup_lines(cert: CertificateRecord) -> list[str]:
+    """The backup (its verdict, safe set and hand-over) and, on the dynamic plant, the velocity loop: a line each."""
+    out: list[str] = []
+    b = cert.backup
+    if b is not None:
+        s = b.safe_set
+        out.append(f"{b.summary_lines()[0]}; safe radius {s.radius:.3f} m, depth band ±{s.depth:.3f} m, hand-over "
+                   f"within {_f(b.handover[0])} m ({_f(b.handover[1])} m in depth)")
+    loop = getattr(cert, "velocity_loop", None)
+    if loop is not None:
+        e = loop.error
+        out.append(f"velocity loop (derived bound): {'certified' if loop.certified else 'NOT certified'}; "
+                   f"loop error E = ({_f(e[0])} m/s, {_f(e[1])} m/s, {_f(e[2])} rad/s)")
+    return out
+
+
+def summary_text(cert: CertificateRecord) -> str:
+    """The short certificate (``tubekit certify``): at most about 25 lines — the verdict with the tiers, each failed
+    condition with both numbers and the field and value that would make it hold (:mod:`verify.certificate.knobs`),
+    the disturbance, σ and the tube, the backup, the design key. :func:`certificate_text` is the full one."""
+    dist = cert.disturbance
+    lines = [verdict_line(cert)] + _failure_lines(cert)
+    lines.append(f"Disturbance: ||omega_xy|| <= {_f(dist.omega_xy)} m/s, |omega_z| <= {_f(dist.omega_z)} m/s "
+                 f"(sway gamma_bar = {_f(dist.gamma)} m/s)")
+    lines += _short_tube_lines(cert) + _short_backup_lines(cert)
+    lines.append(f"Design key: {cert.design_key} (theorem {THEOREM_VERSION})")
+    lines.append("Full text (every number, condition, premise and assumption): tubekit certify -v, "
+                 "Certificate.summary(verbose=True)")
     return "\n".join(lines)

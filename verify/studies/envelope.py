@@ -21,7 +21,9 @@ current amplitude plus constant current plus the sway the model produces over V)
   so omega_bar_xy <= min(u_max - s, r_max epsilon).
 
 The ratio certified / necessary per speed (1 = the certificate loses nothing to
-physics) and its min and median summarise the conservatism. The plot is drawn by
+physics) and its min and median summarise the conservatism. The scenario's own point
+(its target speed and its omega_bar_xy) is certified as it is, at the envelope's epsilon,
+and its verdict kept beside the frontiers (``own_*`` fields). The plot is drawn by
 the application layer (:func:`tubekit.app.plots.plot_envelope`).
 """
 
@@ -86,6 +88,15 @@ class EnvelopeResult:
         u_max, w_max, r_max.
     bisection_steps : int
         Steps per speed (the work unit).
+    own_speed, own_omega : float
+        The scenario's own horizontal target speed and omega_bar_xy (m/s; NaN: not recorded); its
+        horizontal current is ``own_omega - gamma`` (:attr:`own_current`).
+    own_epsilon : float
+        The scenario's own epsilon (m); its verdict below is at ``epsilon`` (the same unless ``eps`` was given).
+    own_certified, own_safe : bool or None
+        The scenario's verdict at ``epsilon``: both tiers, the safe tier (None: not recorded).
+    own_failure : str
+        Its first failed condition ("" when certified).
     """
 
     scenario_name: str
@@ -103,6 +114,27 @@ class EnvelopeResult:
     amplitude_z: float = 0.0
     limits: tuple[float, float, float] = (0.4, 0.3, 0.5)
     bisection_steps: int = 14
+    own_speed: float = math.nan
+    own_omega: float = math.nan
+    own_epsilon: float = math.nan
+    own_certified: bool | None = None
+    own_safe: bool | None = None
+    own_failure: str = ""
+
+    @property
+    def own_current(self) -> float:
+        """The scenario's horizontal current bound (m/s): own omega_bar_xy minus the sway gamma_bar."""
+        return self.own_omega - self.gamma
+
+    def own_verdict(self) -> str:
+        """The scenario's verdict in words: ``certified``, ``not certified (<first failure>; safe tier certified)``
+        (the safe tier named when it holds) or ``not recorded``."""
+        if self.own_certified is None:
+            return "not recorded"
+        if self.own_certified:
+            return "certified"
+        safe = "; safe tier certified" if self.own_safe else ""
+        return f"not certified ({self.own_failure or 'no failure named'}{safe})"
 
     @property
     def ratio(self) -> np.ndarray:
@@ -151,6 +183,9 @@ class EnvelopeResult:
             "ratio_median": self.ratio_median, "first_failure": list(self.first_failure),
             "sigma_at_edge": self.sigma_at_edge,
             "bisection_steps": self.bisection_steps, "problems": self.check(),
+            "scenario_point": {"speed": self.own_speed, "omega_bar_xy": self.own_omega, "current": self.own_current,
+                               "epsilon": self.own_epsilon, "certified": self.own_certified, "safe": self.own_safe,
+                               "first_failure": self.own_failure},
         })
 
     def summary(self) -> str:
@@ -174,6 +209,9 @@ class EnvelopeResult:
         lines.append("  ratio certified / necessary: " + ("none (no speed is feasible)" if rmin is None else
                                                           f"min {rmin:.4f}, median {rmed:.4f}"))
         lines.append(f"  bisection: {self.bisection_steps} steps per speed on the amplitude (bracket in the JSON)")
+        if self.own_certified is not None:
+            lines.append(f"  your scenario: target {self.own_speed:.4g} m/s, current {self.own_current:.4g} m/s "
+                         f"(omega_bar_xy {self.own_omega:.4g}) at epsilon {self.epsilon:g} m: {self.own_verdict()}")
         problems = self.check()
         if problems:
             lines.append("  SANITY PROBLEMS: " + "; ".join(problems))
@@ -239,6 +277,16 @@ def _default_speeds(scenario: Scenario, quick: bool) -> np.ndarray:
     own = scenario.trajectory.horizontal_speed_bound()
     grid = np.linspace(0.0, u_max, n + 1)[:-1]
     return np.unique(np.round(np.append(grid, [own] if own < u_max else []), 12))
+
+
+def _own_point(scenario: Scenario, law: str, eps: float) -> dict:
+    """The scenario's own speed (m/s), omega_bar_xy (m/s) and epsilon (m), and its verdict at ``eps``
+    (the ``own_*`` fields of :class:`EnvelopeResult`)."""
+    cert = certify(scenario.with_changes(epsilon=eps), law)
+    return {"own_speed": float(scenario.trajectory.horizontal_speed_bound()),
+            "own_omega": float(disturbance_bounds(scenario).omega_xy), "own_epsilon": float(scenario.epsilon),
+            "own_certified": bool(cert.certified), "own_safe": bool(cert.tiers.safe),
+            "own_failure": cert.failures[0].condition if cert.failures else ""}
 
 
 def _frontier_at(scenario: Scenario, law: str, speed: float, eps: float, top: float,
@@ -307,4 +355,4 @@ def envelope(scenario: Scenario, law: str | None = None, *, eps: float | None = 
         certified_amplitude=lo_arr, refuted_amplitude=np.asarray(hi, dtype=float),
         necessary_omega=np.asarray(need, dtype=float), first_failure=fails, gamma=dist.gamma,
         sigma_at_edge=np.asarray(sigmas, dtype=float), current_offset=offset, amplitude_z=scenario.disturbance.amplitude[2],
-        limits=tuple(lim.vector), bisection_steps=steps)
+        limits=tuple(lim.vector), bisection_steps=steps, **_own_point(scenario, law, eps))

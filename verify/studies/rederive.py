@@ -135,8 +135,8 @@ def _verdicts(raw: dict, cert: CertificateRecord, design: Design, derived: tuple
               led: Ledger) -> None:
     """Each condition's verdict (``derived``: every derived condition, the tiers'), the failure list, the
     certified flag, the premises and assumptions."""
-    from verify.certificate.certify import _dynamic_assumptions
-    from verify.certificate.record import ASSUMPTIONS, PREMISES
+    from verify.certificate.certify import assumptions_of
+    from verify.certificate.record import PREMISES
     stored = {c.condition: c for c in cert.conditions}
     for c in derived:
         s = stored.get(c.condition)
@@ -162,8 +162,7 @@ def _verdicts(raw: dict, cert: CertificateRecord, design: Design, derived: tuple
     led.check("certified", not claimed or (everything and cert.certified), raw.get("certified"),
               everything, "not stronger than the derived conditions (both tiers)")
     dist = cert.disturbance
-    assumptions = ASSUMPTIONS + (_dynamic_assumptions(dist) if scenario.plant.dynamic else ())
-    led.equal("assumptions", list(cert.assumptions), list(assumptions))
+    led.equal("assumptions", list(cert.assumptions), list(assumptions_of(scenario.plant.dynamic, dist)))
     led.equal("premises", list(cert.premises), list(PREMISES))
     trial = next((t for t in cert.tried if t.sigma == cert.design.sigma), None)
     led.check("sigma.tried", trial is not None and (not trial.certified or design.certified),

@@ -2,11 +2,18 @@
 
 from __future__ import annotations
 
+import dataclasses
+import math
+
 import numpy as np
 import pytest
 
-from tubekit import paper_scenario
+import verify
+from tubekit import load_scenario, paper_scenario
 from tubekit.loop.candidate import candidate_plan, pursuit_input
+from tubekit.fhocp.registry import make_solver
+from tubekit.loop.pipeline import certified_run
+from tubekit.model.errors import error_coordinates
 
 SC = paper_scenario()
 V = SC.limits.vector
@@ -40,3 +47,41 @@ def test_pursuit_turns_onto_the_line_of_sight_and_closes_in(state, want):
         assert u > 0 and abs(r) < 1e-9 and w < 0
     else:
         assert u == 0.0 and abs(r) == pytest.approx(V[2])
+
+
+
+def _spinning_in(periods: range):
+    """A solver factory: the scenario's FHOCP, except that in ``periods`` its plan yaws at the full rate the way
+    the heading error already leans, for the whole horizon (a plan the exact check rejects for |e_o|)."""
+    def factory(scenario, tightening):
+        solver = make_solver(scenario, tightening)
+
+        class Spinning:
+            def solve(self, t, state, obstacles, v_last=None):
+                result = solver.solve(t, state, obstacles, v_last=v_last)
+                k = int(round(t / scenario.controller.dt))
+                if k not in periods:
+                    return result
+                lean = error_coordinates(state[None, :], np.asarray(scenario.trajectory.position(t))[None, :])[0, 2]
+                inputs = np.array(result.inputs, dtype=float)
+                inputs[:, 2] = math.copysign(float(tightening.v_max[2]), lean)
+                return dataclasses.replace(result, inputs=inputs)
+        return Spinning()
+    return factory
+
+
+def test_a_rejected_plan_is_replaced_by_the_candidate_and_tracking_is_kept(pc_cert):
+    """Issue 31: on the certified ``paper_currents``, the solver's plans of periods 30-33 are rejected by the exact
+    check; the shifted candidate passes it in their place, so the backup never runs, no plan is replayed and
+    both tiers' promises are kept. Without the candidate the same rejections are replayed."""
+    sc = load_scenario(verify.SCENARIOS_DIR / "paper_currents.toml").with_changes(duration=5.0)
+    forced = range(30, 34)
+    done = certified_run(sc, pc_cert.tightening, solver_factory=_spinning_in(forced))
+    run = done.run
+    assert run.rejected[list(forced)].all() and not run.rejected[:30].any()
+    assert run.candidate[list(forced)].all() and (run.plan_age[list(forced)] == 0).all()
+    assert not run.backup_active.any() and not run.recovery.any()
+    assert done.broken == () and done.metrics["outcome"] == {"safe": "certified, kept", "tracking": "certified, kept"}
+    off = sc.with_changes(**{"controller.candidate": False})
+    replayed = certified_run(off, pc_cert.tightening, solver_factory=_spinning_in(forced)).run
+    assert not replayed.candidate.any() and replayed.plan_age[33] == 4

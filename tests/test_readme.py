@@ -105,3 +105,14 @@ def test_every_relative_link_and_figure_exists():
     assert targets
     missing = [t for t in targets if not (ROOT / t).exists()]
     assert not missing, missing
+
+
+def test_every_test_the_docs_cite_exists():
+    """A test named in the README or ``docs/`` (``tests/test_x.py`` or ``tests/test_x.py::test_y``) exists."""
+    missing = []
+    for path in [ROOT / "README.md", *sorted((ROOT / "docs").glob("*.md"))]:
+        for file, name in re.findall(r"(tests/test_\w+\.py)(?:::(\w+))?", path.read_text(encoding="utf-8")):
+            target = ROOT / file
+            if not target.is_file() or (name and f"def {name}(" not in target.read_text(encoding="utf-8")):
+                missing.append(f"{path.name}: {file}{'::' + name if name else ''}")
+    assert not missing, missing

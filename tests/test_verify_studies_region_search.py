@@ -15,12 +15,22 @@ PAPER_CURRENTS = str(verify.SCENARIOS_DIR / "paper_currents.toml")
 
 
 def test_paper_scenario_reports_what_it_tried():
-    res = search_region(paper_scenario(), e_o_max=(0.3, 0.6), e_d_max=(1.5, 3.0))
-    assert len(res.tried) == 4 and res.best is None
+    """Section VI with u_max and epsilon raised past keep_up's and yaw_budget's needs: the search runs its grid."""
+    sc = paper_scenario().with_changes(epsilon=0.5, **{"limits.u_max": 0.6})
+    res = search_region(sc, e_o_max=(0.3, 0.6), e_d_max=(1.5, 3.0))
+    assert len(res.tried) == 4 and res.best is None and res.blocked_by == ()
     assert all(not t.certified and t.first_failure for t in res.tried)
     text = res.summary()
     assert "none certifies" in text and "tried 4" in text
     assert res.to_dict()["any_certified"] is False
+
+
+def test_a_failure_no_region_can_remove_is_said_at_once():
+    """Issue 32: the paper's target (0.377 m/s) and current outrun u_max = 0.4 in every region: nothing searched."""
+    res = search_region(paper_scenario())
+    assert res.tried == () and res.best is None
+    assert any(b.startswith("keep_up[u]: limits.u_max = 0.4 < ") for b in res.blocked_by)
+    assert "no region can help" in res.summary() and res.to_dict()["blocked_by"] == list(res.blocked_by)
 
 
 def test_best_is_widest_certified():
@@ -49,4 +59,4 @@ def test_cli_search_region_exit_codes(capsys):
     assert main(["certify", PAPER_CURRENTS, "--search-region"]) == 0
     assert "best: e_o_max = 0.9" in capsys.readouterr().out
     assert main(["certify", "--search-region"]) == 3
-    assert "none certifies" in capsys.readouterr().out
+    assert "no region can help" in capsys.readouterr().out

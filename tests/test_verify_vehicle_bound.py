@@ -168,3 +168,17 @@ def test_bad_inputs_are_refused_naming_the_field(change, field):
 def test_a_vehicle_that_is_not_one_is_refused():
     with pytest.raises(ConfigError, match="params"):
         velocity_loop_bound({"m": 1.0}, **PAPER)
+
+
+def test_a_diverging_fixed_point_is_one_root_cause_and_no_astronomical_number():
+    """Issue 32: over the published spread the small-gain fixed point diverges; the certificate used to print
+    loop_saturation[X] = 1.5e+267 from the last assumed bounds. Now the fixed point names why and how fast it grew,
+    and the conditions that need its E say they were not evaluated because of it."""
+    bound = velocity_loop_bound(BLUEROV2_HEAVY, **PAPER)
+    by_name = {c.condition: c for c in bound.conditions}
+    fixed = by_name["loop_fixed_point"]
+    assert fixed.ok is False and "diverged" in fixed.detail and "first round multiplied the bounds by" in fixed.detail
+    for name in ("loop_saturation[X]", "loop_saturation[Z]", "loop_saturation[N]", "loop_sway"):
+        assert by_name[name].ok is False and "root cause: loop_fixed_point" in by_name[name].detail
+    numbers = [x for c in bound.conditions for x in (c.lhs, c.rhs) if x is not None]
+    assert all(not math.isfinite(x) or abs(x) < 1e6 for x in numbers)

@@ -166,6 +166,8 @@ def _failure_lines(cert: CertificateRecord) -> list[str]:
     out = [f"Failed conditions ({len(open_)}; the field that makes each hold, where one field decides it):"]
     for c in open_[:FAILURE_LINES]:
         numbers = compare(c.lhs, c.rhs) if c.ok is False else "not evaluated"
+        if c.lhs is None and c.detail:  # no number to compare: say why (a root cause, or what it waits for)
+            numbers = c.detail
         out.append(f"  {c.condition}: {c.inequality}: {numbers}{knob_text(knobs[c.condition])}")
     rest = open_[FAILURE_LINES:]
     if rest:

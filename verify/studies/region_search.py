@@ -3,7 +3,9 @@
 :func:`search_region` certifies the scenario with ``region.e_o_max`` and ``region.e_d_max``
 replaced by every point of a fixed grid (default e_o_max in 0.3 .. 0.9, e_d_max in
 1.5 .. 6 m; points with e_d_max <= epsilon are skipped and reported as such) and keeps
-every verdict with its first failed condition. The best certified point is the one
+every verdict with its first failed condition; when the scenario's own certificate fails a condition no
+region can remove (:func:`region_independent_failures`) it says so at once and searches nothing. The best
+certified point is the one
 with the largest e_o_max, then the largest e_d_max (the widest region that certifies).
 The grid is fixed, so the search is deterministic and its cost is a number of
 certificates, never seconds.
@@ -23,7 +25,12 @@ from tubekit.scenario import Scenario
 
 from verify.certificate.certify import certify, resolve_law
 
-__all__ = ["RegionTrial", "RegionSearchResult", "search_region", "E_O_MAX_GRID", "E_D_MAX_GRID"]
+__all__ = ["RegionTrial", "RegionSearchResult", "search_region", "region_independent_failures", "E_O_MAX_GRID",
+           "E_D_MAX_GRID"]
+
+#: Necessary conditions whose need (rhs) no region changes, by the command limit that must meet it: they read
+#: V-bar <= V, so V below the need fails them for every region.
+_NEED_OF_LIMIT = {"keep_up[u]": "u_max", "keep_up[w]": "w_max", "yaw_budget": "r_max"}
 
 #: Default grid of region.e_o_max (dimensionless, |e_o| = |sin(psi - theta)|).
 E_O_MAX_GRID: tuple[float, ...] = (0.3, 0.4, 0.5, 0.6, 0.7, 0.8, 0.9)
@@ -53,6 +60,7 @@ class RegionSearchResult:
     law: str
     epsilon: float
     tried: tuple[RegionTrial, ...]
+    blocked_by: tuple[str, ...] = ()
 
     @property
     def certified(self) -> list[RegionTrial]:
@@ -70,13 +78,17 @@ class RegionSearchResult:
         return to_jsonable({"scenario": self.scenario_name, "law": self.law, "epsilon": self.epsilon,
                             "any_certified": best is not None, "best": None if best is None else best.to_dict(),
                             "certified": [t.to_dict() for t in self.certified],
-                            "tried": [t.to_dict() for t in self.tried]})
+                            "tried": [t.to_dict() for t in self.tried], "blocked_by": list(self.blocked_by)})
 
     def summary(self) -> str:
         """A table of verdicts (e_o_max rows, e_d_max columns) with the first failures, then the best point."""
+        head = (f"tubekit certify --search-region: scenario '{self.scenario_name}', law '{self.law}', "
+                f"epsilon = {self.epsilon:g} m")
+        if self.blocked_by:
+            return "\n".join([head, "  no region can help, nothing searched (none certifies):",
+                              *(f"    {b}" for b in self.blocked_by)])
         eds = sorted({t.e_d_max for t in self.tried})
-        lines = [f"tubekit certify --search-region: scenario '{self.scenario_name}', law '{self.law}', "
-                 f"epsilon = {self.epsilon:g} m",
+        lines = [head,
                  "  e_o_max \\ e_d_max [m] | " + " | ".join(f"{e:>14g}" for e in eds)]
         for eo in sorted({t.e_o_max for t in self.tried}):
             row = {t.e_d_max: t for t in self.tried if t.e_o_max == eo}
@@ -103,6 +115,27 @@ def _grid(field: str, values, upper: float | None) -> tuple[float, ...]:
     return tuple(np.unique(grid))
 
 
+def region_independent_failures(scenario: Scenario, law: str) -> tuple[str, ...]:
+    """The failures of ``scenario``'s own certificate that no region can remove, one line each (empty: searching
+    may help).
+
+    ``keep_up[u]``, ``keep_up[w]`` and ``yaw_budget`` compare V-bar = V - kappa-bar <= V with a need (target speed +
+    omega-bar, omega-bar_xy / epsilon) that the region does not enter; where the command limit V itself is below
+    the need, every region fails the condition.
+    """
+    cert = certify(scenario, law)
+    out = []
+    for c in cert.failures:
+        limit = _NEED_OF_LIMIT.get(c.condition)
+        if limit is None or c.rhs is None:
+            continue
+        value = float(getattr(scenario.limits, limit))
+        if value < float(c.rhs):
+            out.append(f"{c.condition}: limits.{limit} = {value:g} < {float(c.rhs):.6g} needed "
+                       f"({c.inequality.split('>=', 1)[-1].split(' (')[0].strip()}), whatever the region")
+    return tuple(out)
+
+
 def search_region(scenario: Scenario, law: str | None = None, *, e_o_max=E_O_MAX_GRID,
                   e_d_max=E_D_MAX_GRID) -> RegionSearchResult:
     """Certify ``scenario`` on every (e_o_max, e_d_max) of the grid (module doc).
@@ -127,6 +160,10 @@ def search_region(scenario: Scenario, law: str | None = None, *, e_o_max=E_O_MAX
     law = resolve_law(scenario.controller.law if law is None else law)
     eo_grid = _grid("e_o_max", e_o_max, 1.0)
     ed_grid = _grid("e_d_max", e_d_max, None)
+    blocked = region_independent_failures(scenario, law)
+    if blocked:
+        return RegionSearchResult(scenario_name=scenario.name, law=law, epsilon=scenario.epsilon, tried=(),
+                                  blocked_by=blocked)
     tried = []
     for eo in eo_grid:
         for ed in ed_grid:

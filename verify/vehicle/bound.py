@@ -301,23 +301,44 @@ def velocity_loop_bound(params: VehicleParams, *, v_max: Sequence[float], tick: 
     authority = actuator_authority(params, v)
     base = computed_bounds(loop, jt, jp)
     assumed = [[x * (1 + LOOP_INFLATION) + 1e-12 for x in row] for row in base]
-    found, k, computed, inputs = False, 0, base, None
+    found, k, computed, inputs, growth = False, 0, base, None, None
+    stop = f"no closing after {max_iterations} rounds"
     while loop.stable and k < max_iterations and not found:
         k += 1
         inputs = input_bounds(loop, [r[0] for r in assumed], [r[2] for r in assumed], [r[3] for r in assumed])
         computed = computed_bounds(loop, jt, jp, inputs)
         found = all(computed[c][o] < assumed[c][o] for c in range(3) for o in range(4))
+        if growth is None:
+            growth = [[computed[c][o] / assumed[c][o] for o in range(4)] for c in range(3)]
         if not found:
             grown = [[x * (1 + LOOP_INFLATION) for x in row] for row in computed]
             if not all(math.isfinite(x) for row in grown for x in row):
+                stop = f"the bounds overflow after {k} rounds"
                 break
             assumed = [[max(a, g) for a, g in zip(ra, rg)] for ra, rg in zip(assumed, grown)]
     return _result(loop, params, (v, h, d, jt, jp), assumed, computed, inputs, authority, (k, max_iterations),
-                   found, rho)
+                   found, rho, _why_open(found, stop, growth))
 
 
-def _saturation(loop: _Loop, params: VehicleParams, v: Sequence[float], assumed: list) -> list[Condition]:
-    """``loop_saturation[X|Z|N]``: sup|n̂_c| + m̂_c Â_c < the smallest limit over |u| <= V_u + E_u and Θ."""
+#: What the fixed point bounds, per channel, in the order of :func:`computed_bounds`' rows.
+_QUANTITIES = ("sup|e|", "sup|a|", "sup|z|", "sup|ydot|")
+
+
+def _why_open(found: bool, stop: str, growth: list | None) -> str:
+    """The root cause of a fixed point that did not close (empty when it closed), in words an owner can act on."""
+    if found or growth is None:
+        return ""
+    c, o = max(((c, o) for c in range(3) for o in range(4)), key=lambda co: growth[co[0]][co[1]])
+    return (f"diverged ({stop}); the first round multiplied the bounds by up to {growth[c][o]:.3g} "
+            f"({_QUANTITIES[o]} of channel {_CHANNELS[c]}): the small-gain loop's gain is not below 1 here, the "
+            "coefficient mismatch entering it as an input that grows with E (docs/plant.md, section 4); a narrower "
+            "coefficient box, a smaller V or smaller command jumps (a gentler backup, a lower plan rate) lower it")
+
+
+def _saturation(loop: _Loop, params: VehicleParams, v: Sequence[float], assumed: list,
+                closed: bool = True) -> list[Condition]:
+    """``loop_saturation[X|Z|N]``: sup|n̂_c| + m̂_c Â_c < the smallest limit over |u| <= V_u + E_u and Θ; not
+    evaluated (no number) when the fixed point did not ``closed`` (its assumed bounds mean nothing then)."""
     box, sway = loop.box([r[0] for r in assumed])
     a_assumed = [r[1] for r in assumed]
     finite_box = all(math.isfinite(x) for x in (*box, sway, *a_assumed))
@@ -330,13 +351,17 @@ def _saturation(loop: _Loop, params: VehicleParams, v: Sequence[float], assumed:
                if floor[c] > 0 else
                f"{_ACTUATOR[ch]} is 0 at u = 0, inside the velocity box |u| <= {u_bar:.4g} m/s: a fin's lift grows "
                "with u², so this vehicle cannot produce it at rest")
+        peak = peaks[c]
+        if not closed and floor[c] > 0:
+            peak, why = None, "not evaluated: the loop bound did not close (root cause: loop_fixed_point)"
         conds.append(Condition(f"loop_saturation[{ch}]", f"sup|tau_cmd_{ch}| < smallest {ch} limit over the box",
-                               peaks[c], floor[c], bool(peaks[c] < floor[c]), why))
+                               peak, floor[c], bool(peak is not None and peak < floor[c]), why))
     return conds
 
 
 def _result(loop: _Loop, params: VehicleParams, given: tuple, assumed: list, computed: list, inputs: Inputs | None,
-            authority: tuple, iterations: tuple[int, int], found: bool, rho: tuple | None) -> LoopBound:
+            authority: tuple, iterations: tuple[int, int], found: bool, rho: tuple | None,
+            why_open: str = "") -> LoopBound:
     """The :class:`LoopBound` with every condition of the theorem (bounds +inf when not certified)."""
     v, h, d, jt, jp = given
     error = tuple(r[0] for r in computed) if found else (math.inf,) * 3
@@ -346,11 +371,15 @@ def _result(loop: _Loop, params: VehicleParams, given: tuple, assumed: list, com
                        s.rho, 1.0, s.stable, f"K = {s.terms} ticks summed term by term, A_d = exp(A h) in Arb, "
                        f"lambda_{ax} = {lam:.4g} 1/s") for ax, s, lam in zip(_CHANNELS, loop.sums, loop.slope)]
     ratio = max(computed[c][o] / assumed[c][o] for c in range(3) for o in range(4)) if loop.stable else None
+    if ratio is not None and not math.isfinite(ratio):
+        ratio = None
     conds.append(Condition("loop_fixed_point", "max computed/assumed of (sup|e|, sup|a|, sup|z|, sup|ydot|) < 1 "
-                           "(first exit)", ratio, 1.0, found, f"{iterations[0]} iterations (at most {iterations[1]})"))
-    conds += _saturation(loop, params, v, assumed)
+                           "(first exit)", ratio, 1.0, found, f"{iterations[0]} iterations (at most {iterations[1]})"
+                           + (f"; {why_open}" if why_open else "")))
+    conds += _saturation(loop, params, v, assumed, closed=found or not loop.stable)
     conds.append(Condition("loop_sway", "gamma_bar finite (sway damped over the box)", gamma, None,
-                           math.isfinite(gamma), "hull_sway_bound over |u| <= V_u + E_u, |r| <= V_r + E_r and Θ"))
+                           math.isfinite(gamma), "hull_sway_bound over |u| <= V_u + E_u, |r| <= V_r + E_r and Θ"
+                           if found else "not evaluated: no loop bound E (root cause: loop_fixed_point)"))
     if rho is not None:
         conds += rate_authority_conditions(authority, rho)
     failed = [c.condition for c in conds if c.ok is not True]

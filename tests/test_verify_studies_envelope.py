@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -13,6 +14,8 @@ from tubekit.app.plots import plot_envelope
 from tubekit.exceptions import ConfigError
 from tubekit.scenario import load_scenario
 from verify.studies.envelope import EnvelopeResult, necessary_omega, scenario_at
+
+ROOT = Path(__file__).resolve().parent.parent
 
 PAPER_CURRENTS = verify.SCENARIOS_DIR / "paper_currents.toml"
 
@@ -127,6 +130,8 @@ def test_paper_scenario_speed_is_physically_out_of_reach():
     (dict(speeds=[0.5]), "speeds"),
     (dict(speeds=["fast"]), "speeds"),
     (dict(speeds=[]), "speeds"),
+    (dict(speeds=[0.1], steps=0), "steps"),
+    (dict(speeds=[0.1], steps=2.5), "steps"),
 ])
 def test_bad_inputs(scenario, kwargs, field):
     with pytest.raises(ConfigError, match=field):
@@ -136,3 +141,18 @@ def test_bad_inputs(scenario, kwargs, field):
 def test_bad_law():
     with pytest.raises(ConfigError, match="law"):
         verify.envelope(verify.certifiable_scenario(), "pid")
+
+
+@pytest.mark.slow
+def test_a_dynamic_scenario_has_an_envelope_of_dynamic_certificates():
+    """Issue 32: ``tubekit envelope`` on the BlueROV2 Heavy (examples/bluerov2_slow.toml) at its own speed: every
+    point a dynamic certificate; its omega_bar_xy holds the hull's sway and the loop error on top of the current."""
+    sc = load_scenario(ROOT / "examples" / "bluerov2_slow.toml")
+    env = verify.envelope(sc, speeds=[0.079], steps=2)
+    assert env.dynamic and env.to_dict()["dynamic"] is True and env.check() == []
+    lo, hi = env.certified_amplitude[0], env.refuted_amplitude[0]
+    assert 0.0 < lo < hi <= env.necessary_omega[0]                 # a current certifies, a larger one does not
+    assert env.gamma > 0.05                                         # the hull sway alone is several cm/s
+    assert env.certified_omega[0] >= lo + env.gamma - 1e-12         # the non-current part only grows with the current
+    assert env.own_certified is True and env.own_current == pytest.approx(0.04, abs=1e-9)
+    assert "hull sway + loop error" in env.summary()

@@ -109,8 +109,11 @@ def open_client(workers: int, scheduler: str | None) -> Iterator[Any]:
 
     method = "forkserver" if start_fork_server(None) else dask.config.get("distributed.worker.multiprocessing-method")
     with dask.config.set({"distributed.worker.multiprocessing-method": method}):
-        with children_ignore_interrupts():  # Ctrl-C: the client stops the workers, no worker traceback
+        # Ctrl-C: the client stops the workers, no worker traceback. The workers' logs are silenced below
+        # CRITICAL: on a loaded machine a worker's heartbeat can still fail against the closing scheduler and
+        # distributed logs that at ERROR with a traceback; a run's own failure reaches the client as its error.
+        with children_ignore_interrupts():
             cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, host="127.0.0.1",
-                                   scheduler_port=0, dashboard_address="127.0.0.1:0", silence_logs=logging.ERROR)
+                                   scheduler_port=0, dashboard_address="127.0.0.1:0", silence_logs=logging.CRITICAL)
         with cluster, Client(cluster) as client:
             yield client

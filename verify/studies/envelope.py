@@ -20,6 +20,14 @@ current amplitude plus constant current plus the sway the model produces over V)
   and holding e_o at e_d = epsilon needs the bearing rate omega_bar_xy / epsilon <= r_max,
   so omega_bar_xy <= min(u_max - s, r_max epsilon).
 
+On the dynamic plant (``[plant] kind = "dynamic"``) each point is a dynamic certificate: omega_bar_xy is the
+certificate's own (current + the hull's sway + the velocity loop's error, derived from the vehicle; the part
+that is not current grows with the current, through the backup's command and E), ``gamma`` is that part at
+zero current, and the certified frontier is the certificate's omega_bar_xy at the certified amplitude. The
+bisection assumes the verdict monotone in the amplitude; on the dynamic plant the backup's design search is
+not proved monotone, so there each point is a certificate of its own and the edge between them a bracket of
+two verdicts, not a proof that every amplitude below certifies.
+
 The ratio certified / necessary per speed (1 = the certificate loses nothing to
 physics) and its min and median summarise the conservatism. The scenario's own point
 (its target speed and its omega_bar_xy) is certified as it is, at the envelope's epsilon,
@@ -34,6 +42,7 @@ import math
 from dataclasses import dataclass, field
 
 import numpy as np
+from flint import arb
 
 from tubekit.exceptions import ConfigError
 from tubekit.jsonable import to_jsonable
@@ -42,6 +51,7 @@ from tubekit.model.trajectory import Circle, Line, Trajectory
 from tubekit.validation import finite, positive
 
 from verify.certificate.certify import certify, resolve_law
+from verify.kernel.intervals import upper
 from verify.theorem.design import disturbance_bounds
 
 __all__ = ["EnvelopeResult", "envelope", "necessary_omega", "scenario_at", "REFERENCE_POINTS",
@@ -81,7 +91,10 @@ class EnvelopeResult:
     sigma_at_edge : array (k,)
         sigma (1/s) of the certified design at the certified amplitude (NaN: none certifies).
     gamma, current_offset : float
-        gamma_bar (sway) and ||c_xy|| (constant current), both in omega_bar_xy (m/s).
+        gamma_bar (sway; on the dynamic plant: hull sway + loop error at zero current) and ||c_xy|| (constant
+        current), both in omega_bar_xy (m/s).
+    dynamic : bool
+        The scenario's plant is the dynamic one (module doc).
     amplitude_z : float
         The vertical current amplitude kept for every point (m/s).
     limits : (3,)
@@ -89,8 +102,9 @@ class EnvelopeResult:
     bisection_steps : int
         Steps per speed (the work unit).
     own_speed, own_omega : float
-        The scenario's own horizontal target speed and omega_bar_xy (m/s; NaN: not recorded); its
-        horizontal current is ``own_omega - gamma`` (:attr:`own_current`).
+        The scenario's own horizontal target speed and omega_bar_xy (m/s; NaN: not recorded).
+    own_current_xy : float
+        Its horizontal current bound (m/s: amplitude and constant current; :attr:`own_current`).
     own_epsilon : float
         The scenario's own epsilon (m); its verdict below is at ``epsilon`` (the same unless ``eps`` was given).
     own_certified, own_safe : bool or None
@@ -120,11 +134,14 @@ class EnvelopeResult:
     own_certified: bool | None = None
     own_safe: bool | None = None
     own_failure: str = ""
+    dynamic: bool = False
+    own_current_xy: float = math.nan
 
     @property
     def own_current(self) -> float:
-        """The scenario's horizontal current bound (m/s): own omega_bar_xy minus the sway gamma_bar."""
-        return self.own_omega - self.gamma
+        """The scenario's horizontal current bound (m/s): as recorded (``own_current_xy``), else own omega_bar_xy
+        minus the sway gamma_bar."""
+        return self.own_current_xy if math.isfinite(self.own_current_xy) else self.own_omega - self.gamma
 
     def own_verdict(self) -> str:
         """The scenario's verdict in words: ``certified``, ``not certified (<first failure>; safe tier certified)``
@@ -175,7 +192,10 @@ class EnvelopeResult:
         """Strict-JSON-ready dict (NaN as None)."""
         return to_jsonable({
             "scenario": self.scenario_name, "law": self.law, "epsilon": self.epsilon,
-            "omega_bar_xy": "current amplitude a + ||c_xy|| + gamma_bar (sway: gain u_max r_max + amplitude)",
+            "omega_bar_xy": ("the dynamic certificate's: current + hull sway + velocity-loop error (gamma: the part "
+                             "that is not current, at zero current)" if self.dynamic else
+                             "current amplitude a + ||c_xy|| + gamma_bar (sway: gain u_max r_max + amplitude)"),
+            "dynamic": self.dynamic,
             "gamma": self.gamma, "current_offset": self.current_offset, "amplitude_z": self.amplitude_z,
             "limits": list(self.limits), "speeds": self.speeds, "certified_omega": self.certified_omega,
             "certified_amplitude": self.certified_amplitude, "refuted_amplitude": self.refuted_amplitude,
@@ -195,7 +215,9 @@ class EnvelopeResult:
 
         lines = [f"tubekit envelope: scenario '{self.scenario_name}', law '{self.law}', epsilon = {self.epsilon:g} m",
                  f"  omega_bar_xy = horizontal current amplitude + {self.current_offset:.4g} (constant) + "
-                 f"gamma_bar {self.gamma:.4g} (sway); vertical amplitude kept at {self.amplitude_z:.4g} m/s",
+                 + (f"hull sway + loop error (derived per certificate; {self.gamma:.4g} at zero current)"
+                    if self.dynamic else f"gamma_bar {self.gamma:.4g} (sway)")
+                 + f"; vertical amplitude kept at {self.amplitude_z:.4g} m/s",
                  f"  necessary: omega_bar_xy <= min(u_max - speed, r_max epsilon) = min({self.limits[0]:g} - speed, "
                  f"{self.limits[2] * self.epsilon:.4g})",
                  "  speed [m/s] | certified omega_bar_xy [m/s] | necessary [m/s] | ratio | sigma [1/s] | first failure above",
@@ -252,9 +274,6 @@ def _check_inputs(scenario: Scenario, eps: float | None, speeds) -> tuple[float,
     """Validated epsilon (m) and speed grid (m/s); the default grid spans (0, u_max) plus the scenario's speed."""
     if not isinstance(scenario, Scenario):
         raise ConfigError("scenario", "a tubekit.scenario.Scenario", type(scenario).__name__)
-    if scenario.plant.dynamic:
-        raise ConfigError("plant.kind", "\"kinematic\" (the envelope sweeps the kinematic theorem; a dynamic "
-                          "scenario's bounds come from its vehicle: use tubekit certify)", scenario.plant.kind)
     eps = scenario.epsilon if eps is None else positive("eps", eps)
     if eps >= scenario.region.e_d_max:
         raise ConfigError("eps", f"a number < region.e_d_max = {scenario.region.e_d_max}", eps)
@@ -279,44 +298,59 @@ def _default_speeds(scenario: Scenario, quick: bool) -> np.ndarray:
     return np.unique(np.round(np.append(grid, [own] if own < u_max else []), 12))
 
 
+def _current_xy(scenario: Scenario) -> float:
+    """The horizontal current bound max(a_x, a_y) + ||c_xy|| (m/s), rounded outward: the part of omega_bar_xy
+    that is water current on either plant (:func:`verify.theorem.design.disturbance_bounds`)."""
+    a, c = scenario.disturbance.amplitude, scenario.disturbance.constant
+    return upper(arb(max(a[0], a[1])) + (arb(c[0]) ** 2 + arb(c[1]) ** 2).sqrt())
+
+
 def _own_point(scenario: Scenario, law: str, eps: float) -> dict:
     """The scenario's own speed (m/s), omega_bar_xy (m/s) and epsilon (m), and its verdict at ``eps``
     (the ``own_*`` fields of :class:`EnvelopeResult`)."""
     cert = certify(scenario.with_changes(epsilon=eps), law)
+    if scenario.plant.dynamic:
+        omega, current = cert.disturbance.omega_xy, _current_xy(scenario)
+    else:
+        kinematic = disturbance_bounds(scenario)
+        omega, current = kinematic.omega_xy, kinematic.omega_xy - kinematic.gamma
     return {"own_speed": float(scenario.trajectory.horizontal_speed_bound()),
-            "own_omega": float(disturbance_bounds(scenario).omega_xy), "own_epsilon": float(scenario.epsilon),
+            "own_omega": float(omega), "own_current_xy": float(current),
+            "own_epsilon": float(scenario.epsilon),
             "own_certified": bool(cert.certified), "own_safe": bool(cert.tiers.safe),
             "own_failure": cert.failures[0].condition if cert.failures else ""}
 
 
 def _frontier_at(scenario: Scenario, law: str, speed: float, eps: float, top: float,
-                 steps: int) -> tuple[float, float, str, float]:
+                 steps: int) -> tuple[float, float, str, float, float]:
     """Bisection on the amplitude in [0, top] (m/s): certified a (NaN: none), refuted a (NaN: top certifies),
-    the first failure at the refuted a, and the sigma (1/s) of the certified design at the certified a."""
-    def verdict(a: float) -> tuple[bool, str, float]:
+    the first failure at the refuted a, the sigma (1/s) of the certified design and its certificate's omega_bar_xy
+    (m/s) at the certified a (NaN: none)."""
+    def verdict(a: float) -> tuple[bool, str, float, float]:
         cert = certify(scenario_at(scenario, speed=speed, amplitude_xy=a, epsilon=eps), law)
-        return cert.certified, (cert.failures[0].condition if cert.failures else ""), cert.design.sigma
+        return (cert.certified, (cert.failures[0].condition if cert.failures else ""), cert.design.sigma,
+                float(cert.disturbance.omega_xy))
 
-    ok, fail, sigma = verdict(0.0)
+    ok, fail, sigma, omega = verdict(0.0)
     if not ok:
-        return math.nan, 0.0, fail, math.nan
+        return math.nan, 0.0, fail, math.nan, math.nan
     top = max(top, 0.0)
-    ok_top, fail_top, sigma_top = verdict(top)
+    ok_top, fail_top, sigma_top, omega_top = verdict(top)
     if ok_top or top == 0.0:
-        return top, math.nan, "", sigma_top if ok_top else sigma
+        return (top, math.nan, "", *((sigma_top, omega_top) if ok_top else (sigma, omega)))
     lo, hi, fail = 0.0, top, fail_top
     for _ in range(steps):
         mid = 0.5 * (lo + hi)
-        ok, why, sig = verdict(mid)
+        ok, why, sig, om = verdict(mid)
         if ok:
-            lo, sigma = mid, sig
+            lo, sigma, omega = mid, sig, om
         else:
             hi, fail = mid, why
-    return lo, hi, fail, sigma
+    return lo, hi, fail, sigma, omega
 
 
 def envelope(scenario: Scenario, law: str | None = None, *, eps: float | None = None, speeds=None,
-             quick: bool = False) -> EnvelopeResult:
+             quick: bool = False, steps: int | None = None) -> EnvelopeResult:
     """Certified and physical-necessity frontiers of ``scenario`` at one epsilon (module doc).
 
     Parameters
@@ -331,6 +365,8 @@ def envelope(scenario: Scenario, law: str | None = None, *, eps: float | None = 
         Horizontal target speeds in [0, u_max) (m/s); default an even grid plus the scenario's speed.
     quick : bool
         Fewer speeds (5 + the scenario's) and bisection steps (9 instead of 14).
+    steps : int, optional
+        Bisection steps per speed, in place of the ``quick`` choice (>= 1).
 
     Returns
     -------
@@ -339,20 +375,32 @@ def envelope(scenario: Scenario, law: str | None = None, *, eps: float | None = 
     eps, grid = _check_inputs(scenario, eps, speeds)
     law = resolve_law(scenario.controller.law if law is None else law)
     grid = grid if grid.size else _default_speeds(scenario, quick)
-    steps = BISECTION_STEPS[bool(quick)]
-    lim = scenario.limits
-    dist = disturbance_bounds(scenario_at(scenario, speed=float(grid[0]), amplitude_xy=0.0, epsilon=eps))
-    offset = max(dist.omega_xy - dist.gamma, 0.0)  # ||c_xy|| rounded outward, as the certificate sees it
+    if steps is None:
+        steps = BISECTION_STEPS[bool(quick)]
+    elif isinstance(steps, bool) or not isinstance(steps, int) or steps < 1:
+        raise ConfigError("steps", "an integer >= 1", steps)
+    lim, dynamic = scenario.limits, scenario.plant.dynamic
+    first = scenario_at(scenario, speed=float(grid[0]), amplitude_xy=0.0, epsilon=eps)
+    if dynamic:  # gamma: the part of the dynamic certificate's omega_bar_xy that is not current, at zero current
+        offset = _current_xy(first)
+        omega0 = float(certify(first, law).disturbance.omega_xy)
+        gamma = max(omega0 - offset, 0.0) if math.isfinite(omega0) else math.nan
+    else:
+        dist = disturbance_bounds(first)
+        offset = max(dist.omega_xy - dist.gamma, 0.0)  # ||c_xy|| rounded outward, as the certificate sees it
+        gamma = dist.gamma
     rows = []
     for s in grid:
         need = necessary_omega(float(s), eps, lim.u_max, lim.r_max)
-        rows.append((need, *_frontier_at(scenario, law, float(s), eps, need - dist.gamma - offset, steps)))
-    need, lo, hi, fails, sigmas = (list(x) for x in zip(*rows))
+        top = need - offset - (0.0 if dynamic else gamma)  # dynamic: the non-current part may grow with a
+        rows.append((need, *_frontier_at(scenario, law, float(s), eps, top, steps)))
+    need, lo, hi, fails, sigmas, omegas = (list(x) for x in zip(*rows))
     lo_arr = np.asarray(lo, dtype=float)
+    certified = np.asarray(omegas, dtype=float) if dynamic else lo_arr + offset + gamma
     return EnvelopeResult(
         scenario_name=scenario.name, law=law, epsilon=eps, speeds=grid,
-        certified_omega=np.where(np.isfinite(lo_arr), lo_arr + offset + dist.gamma, np.nan),
+        certified_omega=np.where(np.isfinite(lo_arr), certified, np.nan),
         certified_amplitude=lo_arr, refuted_amplitude=np.asarray(hi, dtype=float),
-        necessary_omega=np.asarray(need, dtype=float), first_failure=fails, gamma=dist.gamma,
+        necessary_omega=np.asarray(need, dtype=float), first_failure=fails, gamma=gamma,
         sigma_at_edge=np.asarray(sigmas, dtype=float), current_offset=offset, amplitude_z=scenario.disturbance.amplitude[2],
-        limits=tuple(lim.vector), bisection_steps=steps, **_own_point(scenario, law, eps))
+        limits=tuple(lim.vector), bisection_steps=steps, dynamic=dynamic, **_own_point(scenario, law, eps))

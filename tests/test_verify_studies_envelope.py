@@ -156,3 +156,12 @@ def test_a_dynamic_scenario_has_an_envelope_of_dynamic_certificates():
     assert env.certified_omega[0] >= lo + env.gamma - 1e-12         # the non-current part only grows with the current
     assert env.own_certified is True and env.own_current == pytest.approx(0.04, abs=1e-9)
     assert "hull sway + loop error" in env.summary()
+
+
+def test_progress_is_reported_once_per_speed_and_changes_nothing(scenario):
+    """``on_speed(done, total)`` after each speed; the result is the one without it."""
+    seen = []
+    with_progress = verify.envelope(scenario, speeds=[0.05, 0.1], steps=2, on_speed=lambda d, t: seen.append((d, t)))
+    plain = verify.envelope(scenario, speeds=[0.05, 0.1], steps=2)
+    assert seen == [(1, 2), (2, 2)]
+    assert with_progress.to_dict() == plain.to_dict()

@@ -8,7 +8,9 @@ from __future__ import annotations
 
 import argparse
 import logging
+import sys
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from tubekit.checks import check_log_size, check_run_inputs, require_one_period, unit_hints
 from tubekit.exceptions import ConfigError
@@ -16,6 +18,9 @@ from tubekit.scenario import Scenario, load_scenario, paper_scenario
 from tubekit.validation import bounded_int, duration_seconds, gain, positive
 from tubekit.app.exit_codes import EXIT_NOT_CERTIFIED, EXIT_OK
 from tubekit.app.output import check_figure_target, check_file_target, emit_json, write_json_creating_dirs
+
+if TYPE_CHECKING:  # the progress bar's type only; tqdm is imported where a command runs
+    from tqdm import tqdm
 
 LOGGER = logging.getLogger(__name__)
 
@@ -164,6 +169,12 @@ def configure_envelope(parser: argparse.ArgumentParser) -> None:
                         help="epsilon = min e_d in m for both frontiers (default: the scenario's)")
 
 
+def _advance(bar: tqdm, done: int, total: int) -> None:
+    """Move the envelope's progress bar to ``done`` of ``total`` speeds."""
+    bar.total = total
+    bar.update(done - bar.n)
+
+
 def run_envelope(args: argparse.Namespace) -> int:
     """Certified and physical-necessity frontiers at one epsilon; print the table and the ratio; JSON, plot."""
     from verify import envelope
@@ -178,7 +189,12 @@ def run_envelope(args: argparse.Namespace) -> int:
     eps = None if args.eps is None else positive("--eps", args.eps)
     if eps is not None and eps >= scenario.region.e_d_max:
         raise ConfigError("--eps", f"a number < region.e_d_max = {scenario.region.e_d_max:g} m", args.eps)
-    result = envelope(scenario, law, eps=eps, quick=args.quick)
+    from tqdm.auto import tqdm
+
+    # each speed is a bisection of certificates (minutes on a dynamic plant): a bar on a terminal only
+    with tqdm(desc="envelope", unit="speed", leave=False, disable=not sys.stderr.isatty()) as bar:
+        result = envelope(scenario, law, eps=eps, quick=args.quick, on_speed=lambda done, total: _advance(
+            bar, done, total))
     if args.json != "-":
         print(result.summary())
     if args.json is not None:

@@ -40,6 +40,7 @@ from __future__ import annotations
 import dataclasses
 import math
 from dataclasses import dataclass, field
+from typing import Callable
 
 import numpy as np
 from flint import arb
@@ -350,7 +351,8 @@ def _frontier_at(scenario: Scenario, law: str, speed: float, eps: float, top: fl
 
 
 def envelope(scenario: Scenario, law: str | None = None, *, eps: float | None = None, speeds=None,
-             quick: bool = False, steps: int | None = None) -> EnvelopeResult:
+             quick: bool = False, steps: int | None = None,
+             on_speed: Callable[[int, int], None] | None = None) -> EnvelopeResult:
     """Certified and physical-necessity frontiers of ``scenario`` at one epsilon (module doc).
 
     Parameters
@@ -367,6 +369,8 @@ def envelope(scenario: Scenario, law: str | None = None, *, eps: float | None = 
         Fewer speeds (5 + the scenario's) and bisection steps (9 instead of 14).
     steps : int, optional
         Bisection steps per speed, in place of the ``quick`` choice (>= 1).
+    on_speed : callable, optional
+        ``on_speed(done, total)`` after each speed's frontier (a progress report; the result does not depend on it).
 
     Returns
     -------
@@ -394,6 +398,8 @@ def envelope(scenario: Scenario, law: str | None = None, *, eps: float | None = 
         need = necessary_omega(float(s), eps, lim.u_max, lim.r_max)
         top = need - offset - (0.0 if dynamic else gamma)  # dynamic: the non-current part may grow with a
         rows.append((need, *_frontier_at(scenario, law, float(s), eps, top, steps)))
+        if on_speed is not None:
+            on_speed(len(rows), len(grid))
     need, lo, hi, fails, sigmas, omegas = (list(x) for x in zip(*rows))
     lo_arr = np.asarray(lo, dtype=float)
     certified = np.asarray(omegas, dtype=float) if dynamic else lo_arr + offset + gamma

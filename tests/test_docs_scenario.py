@@ -40,8 +40,9 @@ ACCEPTED: dict[str, set[str]] = {
     "disturbance.sway": _names(SwayModel),
     "controller": _names(ControllerSettings),
     "region": _names(RegionSettings),
-    # the table [plant]: overrides are written as the table [plant.vehicle], so the key is `vehicle`
-    "plant": _names(PlantSettings) - {"overrides"},
+    # the table [plant]: overrides are written as the table [plant.vehicle], so the key is `vehicle`; the loader
+    # also reads `vehicle_file` (a file holding that table)
+    "plant": _names(PlantSettings) - {"overrides"} | {"vehicle_file"},
     "plant.vehicle": _names(VehicleParams) | {"name"},
 }
 

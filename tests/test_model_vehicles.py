@@ -2,12 +2,14 @@
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import pytest
 
 from tubekit import paper_scenario
 from tubekit.exceptions import ConfigError
 from tubekit.scenario import load_scenario, scenario_from_dict
-from tubekit.model.vehicles import REMUS100, VEHICLES, PlantSettings, VehicleParams, vehicle_params
+from tubekit.model.vehicles import CUSTOM, REMUS100, VEHICLES, PlantSettings, VehicleParams, vehicle_params
 
 
 def test_the_module_re_exports_the_shipped_sets():
@@ -93,3 +95,54 @@ def test_simulate_exits_2_naming_the_vehicle_field(tmp_path, capsys):
         load_scenario(path)
     assert main(["simulate", str(path), "--out", str(tmp_path / "out")]) == 2
     assert "plant.vehicle.m" in capsys.readouterr().err
+
+
+# ---- your own vehicle: a complete table, or a vehicle file ---------------------------------------------------------
+
+EXAMPLES = Path(__file__).resolve().parent.parent / "examples"
+
+
+def _toml_value(value) -> str:
+    if isinstance(value, str):
+        return f'"{value}"'
+    if isinstance(value, (list, tuple)):
+        return "[" + ", ".join(repr(float(x)) for x in value) + "]"
+    return repr(float(value))
+
+
+def _with_vehicle_file(tmp_path: Path, vehicle: dict) -> Path:
+    """examples/bluerov2_slow.toml with its [plant.vehicle] table replaced by ``vehicle_file = "myrov.toml"``."""
+    (tmp_path / "myrov.toml").write_text("".join(f"{k} = {_toml_value(v)}\n" for k, v in vehicle.items()))
+    head, rest = (EXAMPLES / "bluerov2_slow.toml").read_text().split("[plant.vehicle]", 1)
+    tail = rest[rest.index("\n["):] if "\n[" in rest else ""     # the tables after it, if any
+    path = tmp_path / "scenario.toml"
+    path.write_text(head.replace('kind = "dynamic"\n', 'kind = "dynamic"\nvehicle_file = "myrov.toml"\n') + tail)
+    return path
+
+
+def test_a_vehicle_file_with_every_parameter_is_the_vehicle(tmp_path):
+    """Issue 32: a vehicle of your own, every parameter in a file beside the scenario (no shipped set): the same
+    coefficient box as the shipped scenario's inline table, and it survives the scenario's round trip."""
+    shipped = load_scenario(EXAMPLES / "bluerov2_slow.toml")
+    sc = load_scenario(_with_vehicle_file(tmp_path, shipped.plant.params.to_dict()))
+    assert sc.plant.vehicle == CUSTOM and sc.plant.params == shipped.plant.params
+    assert scenario_from_dict(sc.to_dict()).plant == sc.plant
+
+
+def test_a_vehicle_file_may_start_from_a_shipped_set(tmp_path):
+    file = tmp_path / "v.toml"
+    file.write_text('name = "bluerov2_heavy"\nX_uu = [-150.0, -30.0]\n')
+    plant = PlantSettings.from_dict({"kind": "dynamic", "vehicle_file": str(file)})
+    assert plant.vehicle == "bluerov2_heavy" and plant.params.X_uu == (-150.0, -30.0)
+
+
+@pytest.mark.parametrize("plant, field", [
+    ({"vehicle_file": "/nonexistent/myrov.toml"}, "plant.vehicle_file"),
+    ({"vehicle_file": 3}, "plant.vehicle_file"),
+    ({"vehicle_file": "x.toml", "vehicle": "remus100"}, "plant.vehicle_file"),
+    ({"vehicle": {"name": "custom", "m": 11.5}}, r"plant\.vehicle\.I_zz: expected every parameter of a 'custom'"),
+    ({"vehicle": "myrov"}, r"plant\.vehicle: expected one of \['bluerov2_heavy', 'remus100'\] or 'custom'"),
+])
+def test_your_own_vehicle_errors_name_the_field(plant, field):
+    with pytest.raises(ConfigError, match=field):
+        PlantSettings.from_dict({"kind": "dynamic", **plant})

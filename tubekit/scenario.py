@@ -15,7 +15,6 @@ re-exported here; :class:`Scenario` composes them.
 
 from __future__ import annotations
 
-import tomllib
 from contextlib import contextmanager
 from dataclasses import asdict, dataclass, field, replace
 from pathlib import Path
@@ -29,7 +28,7 @@ from tubekit.model.trajectory import Circle, Trajectory, trajectory_from_dict
 from tubekit.model.vehicles import PlantSettings
 from tubekit.settings import (HEADINGS, HEMISPHERE_SIGN, LAW_NAMES, ControllerSettings, Disturbance, FhocpMode,
                               Heading, Obstacle, RegionSettings, TerminalMode)
-from tubekit.validation import as_vector, period_count, positive, replace_fields, text
+from tubekit.validation import as_vector, period_count, positive, read_toml, replace_fields, text
 
 __all__ = [
     "Obstacle",
@@ -287,21 +286,11 @@ def scenario_from_dict(d: dict) -> Scenario:
     return replace(base, **kw)
 
 
-def read_toml(path: str | Path, field: str) -> dict:
-    """The table of a TOML file; every failure is a :class:`ConfigError` naming ``field`` (e.g. ``CONFIG``)."""
-    p = Path(path)
-    if not p.is_file():
-        raise ConfigError(field, "a path to an existing TOML file", str(p))
-    try:
-        return tomllib.loads(p.read_text(encoding="utf-8"))
-    except tomllib.TOMLDecodeError as exc:
-        raise ConfigError(field, "valid TOML", str(p), str(exc)) from None
-    except UnicodeDecodeError:
-        raise ConfigError(field, "a UTF-8 text (TOML) file", str(p), "It is binary or not UTF-8.") from None
-    except OSError as exc:
-        raise ConfigError(field, "a readable file", str(p), exc.strerror or str(exc)) from None
-
-
 def load_scenario(path: str | Path) -> Scenario:
-    """Load a scenario from a TOML file (see :func:`scenario_from_dict`)."""
-    return scenario_from_dict(read_toml(path, "CONFIG"))
+    """Load a scenario from a TOML file (see :func:`scenario_from_dict`); a relative ``[plant] vehicle_file`` is
+    read from the scenario file's folder."""
+    d = read_toml(path, "CONFIG")
+    plant = d.get("plant")
+    if isinstance(plant, dict) and isinstance(plant.get("vehicle_file"), str):
+        d = {**d, "plant": {**plant, "vehicle_file": str(Path(path).parent / plant["vehicle_file"])}}
+    return scenario_from_dict(d)

@@ -10,7 +10,9 @@ from __future__ import annotations
 
 import enum
 import math
+import tomllib
 from dataclasses import fields, is_dataclass, replace
+from pathlib import Path
 from typing import Any, Mapping, TypeVar
 
 import numpy as np
@@ -20,7 +22,7 @@ from tubekit.exceptions import ConfigError, ShapeError
 __all__ = ["as_vector", "is_number", "bounded_int", "positive", "nonnegative", "finite", "interval", "positive_triple",
            "nonnegative_triple", "StrChoice", "choice", "duration_seconds", "replace_fields", "text", "period_count",
            "ticks_per_period", "speed_bound", "MAX_PERIODS", "MAX_TICKS_PER_PERIOD", "MAX_SPEED",
-           "gain", "MAX_GAIN"]
+           "gain", "MAX_GAIN", "read_toml"]
 
 _E = TypeVar("_E", bound="StrChoice")
 
@@ -241,3 +243,18 @@ def replace_fields(obj: Any, changes: Mapping[str, Any], prefix: str = "") -> An
                               f"{type(inner).__name__})", next(iter(sub)))
         whole[head] = replace_fields(inner, sub, f"{prefix}{head}.")
     return replace(obj, **whole)
+
+
+def read_toml(path: str | Path, field: str) -> dict:
+    """The table of a TOML file; every failure is a :class:`ConfigError` naming ``field`` (e.g. ``CONFIG``)."""
+    p = Path(path)
+    if not p.is_file():
+        raise ConfigError(field, "a path to an existing TOML file", str(p))
+    try:
+        return tomllib.loads(p.read_text(encoding="utf-8"))
+    except tomllib.TOMLDecodeError as exc:
+        raise ConfigError(field, "valid TOML", str(p), str(exc)) from None
+    except UnicodeDecodeError:
+        raise ConfigError(field, "a UTF-8 text (TOML) file", str(p), "It is binary or not UTF-8.") from None
+    except OSError as exc:
+        raise ConfigError(field, "a readable file", str(p), exc.strerror or str(exc)) from None

@@ -11,24 +11,40 @@ with ``[plant.truth]``: the coefficients of the plant as simulated, a point of t
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, fields
+from pathlib import Path
 from typing import Any, Mapping
 
 from tubekit.exceptions import ConfigError
 from tubekit.model.vehicle_params import ACTUATIONS, VehicleParams
 from tubekit.model.vehicle_sets import BLUEROV2_HEAVY, REMUS100, VEHICLES
+from tubekit.validation import read_toml
 
-__all__ = ["VehicleParams", "VEHICLES", "PlantSettings", "PLANT_KINDS", "vehicle_params", "REMUS100",
-           "BLUEROV2_HEAVY", "ACTUATIONS"]
+__all__ = ["VehicleParams", "VEHICLES", "PlantSettings", "PLANT_KINDS", "vehicle_params", "read_vehicle_file",
+           "CUSTOM", "REMUS100", "BLUEROV2_HEAVY", "ACTUATIONS"]
 
 PLANT_KINDS = ("kinematic", "dynamic")
 
 
+#: The name of a vehicle given whole (every parameter in ``[plant.vehicle]`` or a vehicle file, no shipped set).
+CUSTOM = "custom"
+
+
 def vehicle_params(name: str, overrides: Mapping[str, Any] | None = None) -> VehicleParams:
-    """The shipped set ``name`` with ``overrides`` applied (ConfigError naming ``plant.vehicle...``)."""
+    """The shipped set ``name`` with ``overrides`` applied, or with ``name = "custom"`` (:data:`CUSTOM`) the vehicle
+    ``overrides`` gives whole: every parameter, none taken from a shipped set (ConfigError naming
+    ``plant.vehicle...``)."""
+    overrides = overrides or {}
+    if name == CUSTOM:
+        missing = [f.name for f in fields(VehicleParams) if f.name not in overrides]
+        if missing:
+            raise ConfigError(f"plant.vehicle.{missing[0]}", f"every parameter of a {CUSTOM!r} vehicle (no shipped "
+                              f"set to take it from; {len(missing)} missing: {', '.join(missing[:6])}"
+                              f"{', ...' if len(missing) > 6 else ''})", "missing")
+        return VehicleParams().with_overrides(overrides)
     if name not in VEHICLES:
-        raise ConfigError("plant.vehicle", f"one of {sorted(VEHICLES)}", name)
-    return VEHICLES[name].with_overrides(overrides or {})
+        raise ConfigError("plant.vehicle", f"one of {sorted(VEHICLES)} or {CUSTOM!r} with every parameter", name)
+    return VEHICLES[name].with_overrides(overrides)
 
 
 @dataclass(frozen=True)
@@ -96,10 +112,16 @@ class PlantSettings:
         if "tracking_bound" in d:
             raise ConfigError("plant.tracking_bound", "absent: the velocity loop's error bound is derived from the "
                               "vehicle by the certificate (verify.vehicle.bound), never assumed", d["tracking_bound"])
-        unknown = set(d) - {"kind", "vehicle", "truth"}
+        unknown = set(d) - {"kind", "vehicle", "vehicle_file", "truth"}
         if unknown:
-            raise ConfigError(f"plant.{sorted(unknown)[0]}", "one of the keys ['kind', 'truth', 'vehicle']",
-                              sorted(unknown)[0])
+            raise ConfigError(f"plant.{sorted(unknown)[0]}", "one of the keys ['kind', 'truth', 'vehicle', "
+                              "'vehicle_file']", sorted(unknown)[0])
+        if "vehicle_file" in d:
+            if "vehicle" in d:
+                raise ConfigError("plant.vehicle_file", "absent when [plant] vehicle is given (one vehicle)",
+                                  d["vehicle_file"])
+            d = {**{k: v for k, v in d.items() if k != "vehicle_file"},
+                 "vehicle": read_vehicle_file(d["vehicle_file"])}
         kw: dict[str, Any] = {k: d[k] for k in ("kind",) if k in d}
         if "truth" in d:
             if not isinstance(d["truth"], dict):
@@ -116,6 +138,21 @@ class PlantSettings:
             raise ConfigError("plant.vehicle", "a vehicle name or a table of parameters", veh)
         return cls(**kw)
 
+
+
+def read_vehicle_file(path: Any) -> dict[str, Any]:
+    """The ``[plant.vehicle]`` table a vehicle file holds (``[plant] vehicle_file``): a TOML file of parameters,
+    with ``name`` a shipped set to start from, or without it (or ``name = "custom"``) every parameter.
+
+    Raises
+    ------
+    ConfigError
+        ``plant.vehicle_file``: not a path, missing, or not valid TOML.
+    """
+    if not isinstance(path, (str, Path)) or not str(path):
+        raise ConfigError("plant.vehicle_file", "the path of a TOML file of vehicle parameters", path)
+    table = read_toml(path, "plant.vehicle_file")
+    return {"name": CUSTOM, **table}
 
 
 def _pairs(field: str, value: Any) -> dict[str, Any]:

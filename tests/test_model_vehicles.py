@@ -142,6 +142,7 @@ def test_a_vehicle_file_may_start_from_a_shipped_set(tmp_path):
     ({"vehicle_file": "x.toml", "vehicle": "remus100"}, "plant.vehicle_file"),
     ({"vehicle": {"name": "custom", "m": 11.5}}, r"plant\.vehicle\.I_zz: expected every parameter of a 'custom'"),
     ({"vehicle": "myrov"}, r"plant\.vehicle: expected one of \['bluerov2_heavy', 'remus100'\] or 'custom'"),
+    ({"vehicle": {"name": "custom", "mass": 11.5}}, r"plant\.vehicle\.mass: expected one of the keys"),
 ])
 def test_your_own_vehicle_errors_name_the_field(plant, field):
     with pytest.raises(ConfigError, match=field):

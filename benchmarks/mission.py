@@ -29,7 +29,7 @@ from pathlib import Path
 
 import verify
 from tubekit import paper_scenario, simulate
-from tubekit.loop.pipeline import certified_run
+from tubekit.loop.pipeline import CertifiedRun, certified_run
 from tubekit.model.trajectory import Line
 from tubekit.scenario import Obstacle, Scenario, load_scenario
 
@@ -56,6 +56,11 @@ def scenarios() -> dict[str, Scenario]:
             "paper_currents_steady": steady, "transit": transit()}
 
 
+def recovery_seconds(done: CertifiedRun) -> float:
+    """Seconds (rounded to 1 ms) a recovery plan was followed in the run (tracking not in force)."""
+    return round(float(done.run.recovery[:-1].sum()) * float(done.run.t[1] - done.run.t[0]), 3)
+
+
 def measure(name: str, scenario: Scenario, duration: float, mode: str = "realtime") -> dict:
     """The certificate's tiers and, for the tube run with and without the candidate and the baseline, the figures
     (``mode``: the FHOCP's ``controller.fhocp_mode``, not a certificate input)."""
@@ -69,8 +74,7 @@ def measure(name: str, scenario: Scenario, duration: float, mode: str = "realtim
         sc = scenario.with_changes(**{"controller.candidate": candidate, "controller.recovery": recovery})
         done = certified_run(sc, tight, progress=False)
         m = done.metrics
-        recovering = float(done.run.recovery[:-1].sum()) * float(done.run.t[1] - done.run.t[0])
-        out[label] = {"backup_s": m["backup_s"], "recovery_s": round(recovering, 3),
+        out[label] = {"backup_s": m["backup_s"], "recovery_s": recovery_seconds(done),
                       "candidate_periods": int(done.run.candidate.sum()),
                       "tracking_rmse": m["tracking_rmse"],
                       "rmse_ratio": m["tracking_rmse"] / out["baseline_rmse"] if out["baseline_rmse"] else math.nan,
@@ -95,9 +99,9 @@ def spread(name: str, scenario: Scenario, duration: float, starts: int, offset: 
         cert = verify.certify(sc)
         base = simulate(sc, None, progress=False).metrics["tracking_rmse"]
         done = certified_run(sc, cert.best_effort_tightening(), progress=False)
-        m, dt = done.metrics, float(done.run.t[1] - done.run.t[0])
+        m = done.metrics
         runs.append({"tiers": cert.tiers.to_dict(), "backup_s": m["backup_s"],
-                     "recovery_s": round(float(done.run.recovery[:-1].sum()) * dt, 3),
+                     "recovery_s": recovery_seconds(done),
                      "rmse_ratio": m["tracking_rmse"] / base, "encirclements": m.get("encirclements"),
                      "broken": list(done.broken)})
 

@@ -34,6 +34,8 @@ from verify.theorem.design import choose_design
 from verify.theorem.design import disturbance_bounds, evaluate_design
 from verify.theorem.gains import gain_bounds
 
+from .json_edits import with_value as _with, without as _without
+
 PAPER_CURRENTS = verify.SCENARIOS_DIR / "paper_currents.toml"
 CERTIFIABLE = verify.SCENARIOS_DIR / "certifiable.toml"
 
@@ -401,22 +403,6 @@ def test_typed_views(pc_cert, paper_cert):
     assert d["theorem_version"] == d["inputs"]["theorem_version"] == THEOREM_VERSION
 
 
-def _without(d: dict, *path: str) -> dict:
-    out = json.loads(json.dumps(d))
-    node = out
-    for k in path[:-1]:
-        node = node[k]
-    del node[path[-1]]
-    return out
-
-
-def _with(d: dict, value, *path: str) -> dict:
-    out = json.loads(json.dumps(d))
-    node = out
-    for k in path[:-1]:
-        node = node[k]
-    node[path[-1]] = value
-    return out
 
 
 FROM_DICT_ERRORS = [

@@ -25,6 +25,8 @@ from verify import SCENARIOS_DIR
 from verify.lemma1 import ROUTE_BUDGET, PaperRoute, paper_route
 from verify.kernel.region import Region
 
+from .json_edits import with_value as _with, without as _without
+
 CURRENTS = load_scenario(SCENARIOS_DIR / "paper_currents.toml")
 SCENARIOS = {"paper_currents": CURRENTS, "paper": paper_scenario(),
              "certifiable": load_scenario(SCENARIOS_DIR / "certifiable.toml")}
@@ -111,22 +113,6 @@ def test_round_trip_through_json(law):
     assert "elapsed_s" not in json.dumps(d)  # no wall time: the JSON is the same under load
 
 
-def _without(d: dict, *path: str) -> dict:
-    d = json.loads(json.dumps(d))
-    node = d
-    for key in path[:-1]:
-        node = node[key]
-    del node[path[-1]]
-    return d
-
-
-def _with(d: dict, value, *path: str) -> dict:
-    d = json.loads(json.dumps(d))
-    node = d
-    for key in path[:-1]:
-        node = node[key]
-    node[path[-1]] = value
-    return d
 
 
 @pytest.mark.parametrize("edit, match", [

@@ -251,12 +251,17 @@ class VehicleParams:
         return x, _abs_floor(self.interval("Z_uuds")) * q, _abs_floor(self.interval("N_uudr")) * q
 
     # ---- copies and output -------------------------------------------------------------------
-    def with_overrides(self, overrides: Mapping[str, Any]) -> VehicleParams:
-        """A copy with ``overrides`` (keys = field names; numbers, [lo, hi] or the actuation) applied and validated."""
-        known = {f.name for f in fields(self)}
+    @classmethod
+    def check_keys(cls, overrides: Mapping[str, Any]) -> None:
+        """ConfigError naming ``plant.vehicle.<key>`` for the first key of ``overrides`` that is no parameter."""
+        known = {f.name for f in fields(cls)}
         for key in overrides:
             if key not in known:
                 raise ConfigError(f"plant.vehicle.{key}", f"one of the keys {sorted(known)}", key)
+
+    def with_overrides(self, overrides: Mapping[str, Any]) -> VehicleParams:
+        """A copy with ``overrides`` (keys = field names; numbers, [lo, hi] or the actuation) applied and validated."""
+        self.check_keys(overrides)
         return replace(self, **dict(overrides))
 
     def to_dict(self) -> dict[str, Any]:

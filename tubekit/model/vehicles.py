@@ -36,11 +36,8 @@ def vehicle_params(name: str, overrides: Mapping[str, Any] | None = None) -> Veh
     ``plant.vehicle...``)."""
     overrides = overrides or {}
     if name == CUSTOM:
-        known = [f.name for f in fields(VehicleParams)]
-        for key in overrides:  # a misspelt key first: it is also why its intended key is missing
-            if key not in known:
-                raise ConfigError(f"plant.vehicle.{key}", f"one of the keys {sorted(known)}", key)
-        missing = [k for k in known if k not in overrides]
+        VehicleParams.check_keys(overrides)  # a misspelt key first: it is also why its intended key is missing
+        missing = [f.name for f in fields(VehicleParams) if f.name not in overrides]
         if missing:
             raise ConfigError(f"plant.vehicle.{missing[0]}", f"every parameter of a {CUSTOM!r} vehicle (no shipped "
                               f"set to take it from; {len(missing)} missing: {', '.join(missing[:6])}"

@@ -51,6 +51,7 @@ from tubekit.scenario import Scenario
 from tubekit.model.trajectory import Circle, Line, Trajectory
 from tubekit.validation import finite, positive
 
+from verify.certificate.artefact import Certificate
 from verify.certificate.certify import certify, resolve_law
 from verify.kernel.intervals import upper
 from verify.theorem.design import disturbance_bounds
@@ -323,12 +324,13 @@ def _own_point(scenario: Scenario, law: str, eps: float) -> dict:
 
 
 def _frontier_at(scenario: Scenario, law: str, speed: float, eps: float, top: float,
-                 steps: int) -> tuple[float, float, str, float, float]:
+                 steps: int, zero: Certificate | None = None) -> tuple[float, float, str, float, float]:
     """Bisection on the amplitude in [0, top] (m/s): certified a (NaN: none), refuted a (NaN: top certifies),
     the first failure at the refuted a, the sigma (1/s) of the certified design and its certificate's omega_bar_xy
-    (m/s) at the certified a (NaN: none)."""
+    (m/s) at the certified a (NaN: none). ``zero``: the certificate at a = 0, when the caller has it already."""
     def verdict(a: float) -> tuple[bool, str, float, float]:
-        cert = certify(scenario_at(scenario, speed=speed, amplitude_xy=a, epsilon=eps), law)
+        cert = zero if a == 0.0 and zero is not None else certify(
+            scenario_at(scenario, speed=speed, amplitude_xy=a, epsilon=eps), law)
         return (cert.certified, (cert.failures[0].condition if cert.failures else ""), cert.design.sigma,
                 float(cert.disturbance.omega_xy))
 
@@ -387,17 +389,19 @@ def envelope(scenario: Scenario, law: str | None = None, *, eps: float | None = 
     first = scenario_at(scenario, speed=float(grid[0]), amplitude_xy=0.0, epsilon=eps)
     if dynamic:  # gamma: the part of the dynamic certificate's omega_bar_xy that is not current, at zero current
         offset = _current_xy(first)
-        omega0 = float(certify(first, law).disturbance.omega_xy)
+        zero = certify(first, law)  # also the first speed's verdict at a = 0 (not certified twice)
+        omega0 = float(zero.disturbance.omega_xy)
         gamma = max(omega0 - offset, 0.0) if math.isfinite(omega0) else math.nan
     else:
-        dist = disturbance_bounds(first)
+        dist, zero = disturbance_bounds(first), None
         offset = max(dist.omega_xy - dist.gamma, 0.0)  # ||c_xy|| rounded outward, as the certificate sees it
         gamma = dist.gamma
     rows = []
     for s in grid:
         need = necessary_omega(float(s), eps, lim.u_max, lim.r_max)
         top = need - offset - (0.0 if dynamic else gamma)  # dynamic: the non-current part may grow with a
-        rows.append((need, *_frontier_at(scenario, law, float(s), eps, top, steps)))
+        rows.append((need, *_frontier_at(scenario, law, float(s), eps, top, steps,
+                                         zero if s == grid[0] else None)))
         if on_speed is not None:
             on_speed(len(rows), len(grid))
     need, lo, hi, fails, sigmas, omegas = (list(x) for x in zip(*rows))

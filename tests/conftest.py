@@ -49,7 +49,10 @@ def paper_cert():
 
 @pytest.fixture(scope="session")
 def stationary():
-    """verify.certifiable_scenario() with a stationary target (trajectory rate 0)."""
+    """verify.certifiable_scenario() with a stationary target (trajectory rate 0) and obstacles at (+-3, 0, 0) r 0.4
+    (the promises' tests place the vehicle against them)."""
     import verify
+    from tubekit.scenario import Obstacle
     sc = verify.certifiable_scenario()
-    return sc.with_changes(trajectory=replace(sc.trajectory, rate=0.0))
+    return sc.with_changes(trajectory=replace(sc.trajectory, rate=0.0),
+                           obstacles=(Obstacle((3.0, 0.0, 0.0), 0.4), Obstacle((-3.0, 0.0, 0.0), 0.4)))

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+import re
 
 import numpy as np
 import pytest
@@ -32,24 +33,17 @@ def test_one_row_has_every_figure_for_the_three_ways():
         assert r["backup_s"] >= 0 and math.isfinite(r["rmse_ratio"]) and r["broken"] == []
 
 
-@pytest.mark.slow
-def test_counterexample_the_transit_certifies_tracking_yet_the_vehicle_is_pinned_behind_the_rock():
-    """Counterexample (issue 31, open): the transit certifies both tiers, yet the real-time FHOCP pins the vehicle
-    behind the first rock. Its heading must stay within e_o_max = 0.5 rad of the line of sight and it has no sway,
-    so once the rock's terminal footprint lies between vehicle and target, forward motion leads into the footprint
-    and reverse motion away from the target; the cross current holds it there. Plans are rejected from t = 37.6 s, the backup takes over, tracking is
-    reported not in force (``recursive_feasibility``), and safety is kept. When the tracking tier becomes a
-    theorem (or is refused for this path by name) this test must change."""
-    sc = MISSION.transit().with_changes(duration=42.0)
-    cert = verify.certify(sc)
-    assert cert.tiers.safe and cert.tiers.tracking
-    done = certified_run(sc, cert.tightening, progress=False)
-    run = done.run
-    rock = np.asarray(sc.obstacles[0].center[:2])
-    assert run.rejected.any() and run.backup_active.any()
-    assert run.states[-1, 0] < rock[0] - 1.0 < run.desired[-1, 0] - 2.0      # stuck behind it; the target went on
-    assert done.metrics["outcome"]["safe"] == "certified, kept"
-    assert done.metrics["outcome"]["tracking"].startswith("certified, not in force")
+def test_the_transit_past_two_rocks_is_refused_the_tracking_tier_by_name():
+    """Issue 31 (was a counterexample: the transit certified both tiers, yet the real-time FHOCP pinned the vehicle
+    behind the first rock for 62 s). The tracking theorem asks the candidate's footprint — X_f about the target
+    plus the backup's safe set — to clear every obstacle along the target's path; the rocks lie 0.9 m off the line,
+    so the certificate refuses the tracking tier by name and number and gives the safe tier alone."""
+    cert = verify.certify(MISSION.transit())
+    assert cert.tiers.safe and not cert.tiers.tracking
+    failed = {c.condition: c for c in cert.failures}
+    assert {"path_clearance[0]", "path_clearance[1]"} <= set(failed)
+    assert all(n.startswith(("path_", "initial_terminal")) for n in failed)
+    assert re.search(r"has 0\.9\d* m", failed["path_clearance[0]"].detail) and failed["path_clearance[0]"].lhs < 0
 
 
 def test_the_spread_certifies_each_start_and_summarises_min_median_max():

@@ -106,8 +106,8 @@ def test_the_dict_round_trip_is_exact_and_another_theorem_version_is_refused():
     d = DesignInputs.of(SC, "paper", 6.25, region_override={"e_o": (-0.5, 0.5)})
     back = DesignInputs.from_dict(json.loads(json.dumps(d.to_dict())))
     assert back == d and back.key() == d.key()
-    old = dict(d.to_dict(), theorem_version="sampled-data-tube+backup+velocity-loop/5")
-    with pytest.raises(ConfigError, match=r"design\.theorem_version: expected sampled-data-tube.*/6"):
+    old = dict(d.to_dict(), theorem_version="sampled-data-tube+backup+velocity-loop/6")
+    with pytest.raises(ConfigError, match=r"design\.theorem_version: expected sampled-data-tube.*terminal/7"):
         DesignInputs.from_dict(old)
 
 

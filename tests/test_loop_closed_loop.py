@@ -516,7 +516,7 @@ def test_no_tolerance_outside_the_proof_a_plan_above_v_bar_never_clips(paper_cur
     res = run_closed_loop(sc, tight, solver_factory=_Tampered(_above_v_bar), progress=False)
     assert not np.any(res.saturated[:-1])
     assert np.max(np.abs(res.inputs[:-1, 0])) <= float(tight.v_max[0])
-    assert not np.all(res.replaced[:-1])            # the projected plans are accepted
+    assert np.all(res.plan_age == 0) and not np.any(res.backup_active)   # a plan accepted at every period
 
 
 def test_a_rejected_plan_is_replaced_by_the_shifted_candidate_and_tracking_is_kept(paper_currents):

@@ -381,3 +381,44 @@ def test_each_tier_says_what_happened_on_the_run(promises, tiers, want):
     """Issue 31, item 3: a certified tier is reported with its outcome (kept, BROKEN, not in force), never alone."""
     from tubekit.loop.promises import tier_outcomes
     assert tier_outcomes(promises, tiers) == want
+
+
+_LAW = dict(d_lo=0.6, d_hi=2.5, d_star=1.5, alpha_max=0.2, z_max=0.8, gain_d=0.5, gain_z=0.3, turn=0.5)
+
+
+def test_with_the_tracking_theorem_a_plan_at_every_period_is_a_promise_of_tracking(stationary):
+    """With the terminal law (and the candidate on), recursive feasibility is proved: ``plan_available`` replaces
+    the premise, tracking rests on the disturbance bound alone, and a clean run keeps it."""
+    from tubekit.model.terminal_law import TerminalLaw
+    run = _run(stationary, tightening=_tight(terminal_law=TerminalLaw(**_LAW)))
+    p = _promise(run, "plan_available")
+    assert p.ok and p.tier == "tracking" and p.depends_on == ("disturbance",) and p.given
+    assert "recursive_feasibility" not in {q.name for q in check_promises(run)}
+    assert _promise(run, "tube").depends_on == ("disturbance",)
+
+
+@pytest.mark.parametrize("lapse", ["replay", "backup"])
+def test_a_lapse_of_plans_under_the_tracking_theorem_is_a_broken_promise(stationary, lapse):
+    """A replayed plan or a backup tick under a certified tracking tier with its terminal law: broken (exit 4), not
+    a failed premise."""
+    from tubekit.model.terminal_law import TerminalLaw
+    run = _run(stationary, tightening=_tight(terminal_law=TerminalLaw(**_LAW)))
+    if lapse == "replay":
+        age = run.plan_age.copy()
+        age[1] = 1
+        run = replace(run, plan_age=age)
+    else:
+        active = run.backup_active.copy()
+        active[2:4] = True
+        run = replace(run, backup_active=active)
+    p = _promise(run, "plan_available")
+    assert not p.ok and p.observed >= 1
+    assert "plan_available" in broken_promises(check_promises(run))
+
+
+def test_without_the_candidate_plans_stay_a_premise(stationary):
+    from tubekit.model.terminal_law import TerminalLaw
+    sc = stationary.with_changes(**{"controller.candidate": False})
+    run = _run(stationary, scenario=sc, tightening=_tight(terminal_law=TerminalLaw(**_LAW)))
+    assert "plan_available" not in {q.name for q in check_promises(run)}
+    assert _promise(run, "recursive_feasibility").tier == "premise"

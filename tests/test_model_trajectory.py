@@ -100,3 +100,23 @@ def test_line_takes_its_documented_velocity_key():
 def test_repr_holds_plain_floats(traj):
     """Issue 24 item 9: no ``np.float64(...)`` in a trajectory's repr."""
     assert "np." not in repr(traj) and "float64" not in repr(traj)
+
+
+@pytest.mark.parametrize("make", [
+    lambda: Circle(radius=3.0, rate=0.2),
+    lambda: Helix(radius=2.0, rate=-0.3, climb=0.05),
+    lambda: Line(start=(0.0, 0.0, 0.0), direction_velocity=(0.2, 0.1, -0.05)),
+    lambda: Waypoints(points=((0.0, 0.0, 0.0), (4.0, 0.0, 1.0), (4.0, 3.0, 1.0)), speed=0.3),
+])
+def test_the_acceleration_bound_holds_on_second_differences(make):
+    """Property: |p_d(t+h) − 2 p_d(t) + p_d(t−h)| / h² (the acceleration, to O(h²)) stays below the bound, and
+    for the circle and the line the bound is attained (it is the exact sup, not a loose one)."""
+    tr = make()
+    a_xy, a_z = tr.acceleration_bound()
+    t = np.linspace(0.05, 60.0, 6001)
+    h = 1e-3
+    acc = (tr.position(t + h) - 2 * tr.position(t) + tr.position(t - h)) / h ** 2
+    assert np.max(np.hypot(acc[:, 0], acc[:, 1])) <= a_xy * (1 + 1e-4) + 1e-9
+    assert np.max(np.abs(acc[:, 2])) <= a_z * (1 + 1e-4) + 1e-9
+    if isinstance(tr, (Circle, Line)):
+        assert np.max(np.hypot(acc[:, 0], acc[:, 1])) == pytest.approx(a_xy, rel=1e-4, abs=1e-9)

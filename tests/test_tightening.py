@@ -50,7 +50,7 @@ def test_certified_tightening_is_the_pontryagin_difference():
     from dataclasses import replace
     free = load_scenario(verify.SCENARIOS_DIR / "paper_currents.toml")
     assert np.array_equal(verify.certify(free).tightening.v_max, free.limits.vector)  # sigma = 0: no kappa
-    sc = free.with_changes(controller=replace(free.controller, sigma=3.125))
+    sc = load_scenario(verify.SCENARIOS_DIR / "certifiable.toml")    # sigma = 100 declared, both tiers
     cert = verify.certify(sc)
     t = cert.tightening
     assert t.certified and t.horizon_arcs == sc.controller.horizon_steps

@@ -335,15 +335,17 @@ def _variant(kind: str):
                                obstacles=tuple(Obstacle(tuple(a + b for a, b in zip(o.center, centre)), o.radius)
                                                for o in sc.obstacles),
                                initial_state=(-0.8 + centre[0], 3.0 + centre[1], 0.2 + centre[2], 0.0))
-    if kind == "radius 4.5":  # same target speed 0.19 m/s on a larger circle
+    if kind == "radius 4.5":  # same target speed 0.19 m/s on a larger circle, the obstacles 2.3 m outside it
         return sc.with_changes(trajectory=dc_replace(tr, radius=4.5, rate=tr.rate * 3.0 / 4.5),
+                               obstacles=(Obstacle((6.8, 0.0, 0.0), 0.4), Obstacle((-6.8, 0.0, 0.0), 0.4)),
                                initial_state=(-0.8, 4.5, 0.2, 0.0))
-    if kind == "obstacles":
-        return sc.with_changes(obstacles=(Obstacle((0.0, -3.0, 0.0), 0.5), Obstacle((2.1, 2.1, 0.0), 0.3)))
+    if kind == "obstacles":  # other sizes and places, each off the path by more than path_clearance needs
+        return sc.with_changes(obstacles=(Obstacle((0.0, -5.4, 0.0), 0.5), Obstacle((4.0, 4.0, 0.0), 0.3)))
     if kind == "period 6 s":
         return sc.with_changes(disturbance=dc_replace(dist, period=6.0))
-    if kind == "speed 0.25 m/s":  # stretch goal
-        return sc.with_changes(trajectory=dc_replace(tr, rate=0.25 / 3.0))
+    if kind == "speed 0.25 m/s":  # stretch goal: the line of sight turns faster, the terminal set lies farther out
+        return sc.with_changes(trajectory=dc_replace(tr, rate=0.25 / 3.0), initial_state=(-0.95, 3.0, 0.2, 0.0),
+                               obstacles=(Obstacle((6.0, 0.0, 0.0), 0.4), Obstacle((-6.0, 0.0, 0.0), 0.4)))
     if kind == "epsilon 0.3":  # stretch goal
         return sc.with_changes(epsilon=0.3)
     raise ValueError(kind)

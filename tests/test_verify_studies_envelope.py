@@ -13,7 +13,7 @@ import verify
 from tubekit.app.plots import plot_envelope
 from tubekit.exceptions import ConfigError
 from tubekit.scenario import load_scenario
-from verify.studies.envelope import EnvelopeResult, necessary_omega, scenario_at
+from verify.studies.envelope import EnvelopeResult, frontier_verdict, necessary_omega, scenario_at
 
 ROOT = Path(__file__).resolve().parent.parent
 
@@ -57,8 +57,10 @@ def test_bisection_brackets_certify(env, scenario):
     lo, hi = env.certified_amplitude[i], env.refuted_amplitude[i]
     assert math.isfinite(lo) and math.isfinite(hi) and lo < hi
     assert (hi - lo) / hi < 0.01
-    assert verify.certify(scenario_at(scenario, speed=0.3, amplitude_xy=lo, epsilon=0.5), "corrected").certified
-    assert not verify.certify(scenario_at(scenario, speed=0.3, amplitude_xy=hi, epsilon=0.5), "corrected").certified
+    assert frontier_verdict(verify.certify(scenario_at(scenario, speed=0.3, amplitude_xy=lo, epsilon=0.5),
+                                           "corrected"))[0]
+    assert not frontier_verdict(verify.certify(scenario_at(scenario, speed=0.3, amplitude_xy=hi, epsilon=0.5),
+                                               "corrected"))[0]
 
 
 def test_plot_summary_json(env, tmp_path):

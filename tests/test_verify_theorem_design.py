@@ -133,7 +133,7 @@ def test_state_condition_numbers(design, pc):
     reach = 0.8 * math.hypot(design.v_bar[0], design.v_bar[1]) + m.position[-1] + 0.2
     assert sens.lhs == pytest.approx(reach, rel=1e-12) and sens.rhs == 1.5
     ob = _cond(design, "obstacles[0,1]")
-    assert ob.lhs == pytest.approx(6.0) and ob.rhs == pytest.approx(2 * (0.2 + m.position[-1]) + 0.8)
+    assert ob.lhs == pytest.approx(10.6) and ob.rhs == pytest.approx(2 * (0.2 + m.position[-1]) + 0.8)
 
 
 @pytest.mark.parametrize("state, why", [

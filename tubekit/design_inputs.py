@@ -44,15 +44,18 @@ from tubekit.model.kinematics import SwayModel
 from tubekit.scenario import ControllerSettings, Disturbance, Scenario, scenario_from_dict
 from tubekit.tiers import Tiers
 
-__all__ = ["DesignInputs", "THEOREM_VERSION", "RATE_TOLERANCE", "DYNAMIC_SIGMA_SOURCE", "handed_sigma",
+__all__ = ["DesignInputs", "THEOREM_VERSION", "RATE_TOLERANCE", "ARC_SAMPLES", "DYNAMIC_SIGMA_SOURCE", "handed_sigma",
            "canonical"]
 
 #: Version of the theorem a certificate states; a certificate of another version is not this design (6: the start
 #: is part of the design; a plan is used with exactly N rows, projected onto V̄ and checked against V̄ exactly).
-THEOREM_VERSION = "sampled-data-tube+backup+velocity-loop/6"
+THEOREM_VERSION = "sampled-data-tube+backup+velocity-loop+terminal/7"
 #: Absolute tolerance (m/s, rad/s) of the plan check's rate rows (round-off only). The proof carries it: the
 #: dynamic plant's velocity loop is bounded for command jumps of J + RATE_TOLERANCE (``verify.vehicle.compose``).
 RATE_TOLERANCE = 1e-9
+#: Points per arc at which a plan is checked (plus the arc's end, ``tubekit.loop.plan_check``); the theorem's
+#: terminal ingredients pad each constraint by rate · (δ / ARC_SAMPLES) / 2 as the check does.
+ARC_SAMPLES = 10
 #: Why σ = 0 on the dynamic plant.
 DYNAMIC_SIGMA_SOURCE = "dynamic plant: sigma = 0 (kappa = 0, so the velocity loop sees only bounded command jumps)"
 #: Controller settings the theorem reads; the others are the FHOCP's own.

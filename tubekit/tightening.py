@@ -31,6 +31,7 @@ import numpy as np
 from tubekit.design_inputs import DesignInputs
 from tubekit.exceptions import ConfigError
 from tubekit.model.backup import BackupPlan
+from tubekit.model.terminal_law import TerminalLaw
 from tubekit.scenario import Scenario
 from tubekit.tiers import Tiers
 
@@ -134,6 +135,10 @@ class Tightening:
         Dynamic plant: the certificate's derived bound on the velocity loop's error
         |u_b − u|, |w_b − w|, |r_b − r| (m/s, m/s, rad/s), checked in every run (promise
         ``velocity_loop``); None otherwise.
+    terminal_law : TerminalLaw or None
+        The tracking theorem's terminal set and law (``docs/verify.md``, step 17): every accepted plan ends in
+        its set X_f, and the candidate is completed by its law, so a plan is always available. Given only with
+        the tracking tier; None otherwise (then ``recursive_feasibility`` stays a premise of tracking).
     """
 
     v_max: np.ndarray
@@ -152,8 +157,12 @@ class Tightening:
     backup: BackupPlan | None = None
     tiers: Tiers = field(default_factory=Tiers)
     velocity_loop: tuple[float, float, float] | None = None
+    terminal_law: TerminalLaw | None = None
 
     def __post_init__(self) -> None:
+        if self.terminal_law is not None and not isinstance(self.terminal_law, TerminalLaw):
+            raise ConfigError("tightening.terminal_law", "a tubekit.model.terminal_law.TerminalLaw or None",
+                              type(self.terminal_law).__name__)
         if not isinstance(self.tiers, Tiers):
             raise ConfigError("tightening.tiers", "a tubekit.Tiers", type(self.tiers).__name__)
         if self.design is not None and not isinstance(self.design, DesignInputs):
@@ -185,6 +194,12 @@ class Tightening:
     def rho_tilde(self) -> float:
         """Euclidean norm of the per-axis tube ``tube`` (plots); 0 without a tube."""
         return float(np.linalg.norm(np.asarray(self.tube, dtype=float)))
+
+    @property
+    def plan_always_available(self) -> bool:
+        """True when recursive feasibility is a theorem here: the tracking tier with its terminal law (every run
+        then follows a plan at every period; a lapse is a broken promise, not a failed premise)."""
+        return self.tiers.tracking and self.terminal_law is not None and self.horizon_arcs > 0
 
     @property
     def terminal_backup(self) -> BackupPlan | None:

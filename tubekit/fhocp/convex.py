@@ -215,9 +215,10 @@ class ConvexSubproblem:
         """|e_o| <= e_o_max, |e_z| <= e_z_max with the z walls, the nearer x/y walls, slacks >= 0."""
         nlp, N = self.nlp, self.nlp.n
         eo, z, sig_box = v["e_o"], v["z"], slack["box"]
+        cap = nlp.node_bounds()["e_o"]
         cons = [
-            eo <= nlp.e_o_max + slack["e_o"],
-            -eo <= nlp.e_o_max + slack["e_o"],
+            eo <= cap + slack["e_o"],
+            -eo <= cap + slack["e_o"],
             # |e_z| <= e_z_max and the z walls share a row: z <= min(zd + e_z_max, hi_z - c), etc.
             z - sig_box <= par("zhi", N),
             z + sig_box >= par("zlo", N),
@@ -395,10 +396,11 @@ class ConvexSubproblem:
         st[0] = ex / ed
         st[1] = ey / ed
         npd = st[0] * r1[:, 0] + st[1] * r1[:, 1]
-        st[2] = nlp.e_d_min + npd
-        st[3] = nlp.e_d_max + npd
-        st[4] = r1[:, 2] - nlp.e_z_max
-        st[5] = r1[:, 2] + nlp.e_z_max
+        nb = nlp.node_bounds()
+        st[2] = nb["e_d_lo"] + npd
+        st[3] = nb["e_d_hi"] + npd
+        st[4] = r1[:, 2] - nb["e_z"]
+        st[5] = r1[:, 2] + nb["e_z"]
         if nlp.workspace is not None:
             lo = nlp.workspace[0] + nlp.clearance - o
             hi = nlp.workspace[1] - nlp.clearance - o

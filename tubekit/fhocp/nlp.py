@@ -300,6 +300,9 @@ class FhocpNlp:
         ``Tightening.terminal_rest``; a ramped backup blends from the last command instead).
     rate_penalty : float
         lambda (s, >= 0) of the rate penalty.
+    tracking_terminal : (d_lo, d_hi, e_o_f, z_f) or None
+        The tracking theorem's terminal set X_f at the last node (m, m, -, m): d_lo <= e_d <= d_hi,
+        |e_o| <= e_o_f, |e_z| <= z_f (``Tightening.terminal_law``; :meth:`node_bounds`).
     """
 
     dt: float
@@ -322,6 +325,7 @@ class FhocpNlp:
     rate_jump: np.ndarray | None = None
     terminal_rest: bool = False
     rate_penalty: float = 0.0
+    tracking_terminal: tuple[float, float, float, float] | None = None
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "dt", positive("dt", self.dt))
@@ -384,7 +388,20 @@ class FhocpNlp:
                    penalty=penalty,
                    terminal_penalty=penalty / 20.0 if terminal_penalty is None else terminal_penalty,
                    backup_terminal=backup, rate_jump=None if jump is None else jump * (1.0 - RATE_MARGIN),
-                   terminal_rest=jump is not None and tightening.terminal_rest, rate_penalty=rate_penalty)
+                   terminal_rest=jump is not None and tightening.terminal_rest, rate_penalty=rate_penalty,
+                   tracking_terminal=_tracking_terminal(tightening))
+
+    def node_bounds(self) -> dict[str, np.ndarray]:
+        """Per-node bounds (N,) ``e_d_lo``, ``e_d_hi``, ``e_z``, ``e_o``: the tightened sets, the last node
+        narrowed to the tracking theorem's X_f when there is one."""
+        n = self.horizon_steps
+        out = {k: np.full(n, float(v)) for k, v in (("e_d_lo", self.e_d_min), ("e_d_hi", self.e_d_max),
+                                                     ("e_z", self.e_z_max), ("e_o", self.e_o_max))}
+        if self.tracking_terminal is not None:
+            d_lo, d_hi, e_o, z_f = self.tracking_terminal
+            out["e_d_lo"][-1], out["e_d_hi"][-1] = max(out["e_d_lo"][-1], d_lo), min(out["e_d_hi"][-1], d_hi)
+            out["e_o"][-1], out["e_z"][-1] = min(out["e_o"][-1], e_o), min(out["e_z"][-1], z_f)
+        return out
 
     @property
     def n(self) -> int:
@@ -469,3 +486,11 @@ class FhocpNlp:
         per_step = {"e_d_min": viol[0], "obstacle": viol[1], "e_o": viol[2], "box": viol[3]}
         return NlpEvaluation(cost=cost, merit=merit, violations=violations, per_step=per_step,
                              max_violation=mv)
+
+
+def _tracking_terminal(tightening: Tightening) -> tuple[float, float, float, float] | None:
+    """(d_lo, d_hi, sin α_f, z_f) of the tightening's terminal law when it proves tracking, else None."""
+    law = tightening.terminal_law if tightening.plan_always_available else None
+    if law is None:
+        return None
+    return (law.d_lo, law.d_hi, math.sin(law.alpha_max), law.z_max)

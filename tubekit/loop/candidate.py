@@ -10,11 +10,13 @@ Why the shifted part passes. A plan accepted at t_k satisfies every constraint o
 margin M_{j+1} (``verify.theorem.sampled.horizon_margins``). At t_{k+1} the measured state lies within
 the one-period tube of the plan's first node, and the same inputs from there deviate from the old arcs
 by at most M_{j+1} − M_j (the start offset plus the heading offset times the distance run), so the
-shifted arc j meets its constraint with the margin M_j the check asks for. What the theorem does not
-give yet is the completion: the terminal input below is a pursuit of the target, clipped to V̄ and to
+shifted arc j meets its constraint with the margin M_j the check asks for. The completion: with the tracking
+tier, the certified terminal law (:class:`tubekit.model.terminal_law.TerminalLaw`), under which
+``verify.theorem.terminal`` proves that the candidate passes the check (a plan is always available, also at
+t = 0, where the candidate is the law's own N rows); otherwise a pursuit of the target, clipped to V̄ and to
 the rate rows, and the check decides (no tolerance is added: a candidate that fails is not used).
 
-:func:`candidate_plan` builds it; :func:`pursuit_input` is the completion law.
+:func:`candidate_plan` builds it; :func:`completion_row` is the completion (:func:`pursuit_input` without a law).
 """
 
 from __future__ import annotations
@@ -24,9 +26,10 @@ import math
 import numpy as np
 
 from tubekit.loop.plan_check import plan_arcs
+from tubekit.model.terminal_law import TerminalLaw
 from tubekit.scenario import Scenario
 
-__all__ = ["candidate_plan", "pursuit_input", "PURSUIT_GAIN"]
+__all__ = ["candidate_plan", "completion_row", "pursuit_input", "PURSUIT_GAIN"]
 
 #: Gain (1/s) of the completion law on the distance and depth errors (a period's worth of correction at δ = 0.1 s
 #: over about four periods).
@@ -53,23 +56,42 @@ def pursuit_input(scenario: Scenario, state: np.ndarray, t: float, v_max: np.nda
     return np.clip(np.array([u, w, r]), -np.asarray(v_max, dtype=float), np.asarray(v_max, dtype=float))
 
 
-def candidate_plan(scenario: Scenario, plan: np.ndarray, age: int, x0: np.ndarray, t0: float, v_max: np.ndarray,
-                   jump: np.ndarray | None, e_d_goal: float) -> np.ndarray | None:
+def completion_row(scenario: Scenario, law: TerminalLaw | None, end: np.ndarray, t: float, v_max: np.ndarray,
+                   e_d_goal: float) -> np.ndarray:
+    """One completion row from the nominal ``end`` (4,) at ``t`` (s): the certified terminal ``law`` when given
+    (inside V̄ by the theorem; the clip to ``v_max`` only absorbs round-off), else :func:`pursuit_input`."""
+    if law is None:
+        return pursuit_input(scenario, end, t, v_max, e_d_goal)
+    p = np.asarray(scenario.trajectory.position(t), dtype=float).reshape(3)
+    v = np.asarray(scenario.trajectory.velocity(t), dtype=float).reshape(3)
+    bound = np.asarray(v_max, dtype=float)
+    return np.clip(law.command(end, p, v, scenario.controller.dt), -bound, bound)
+
+
+def candidate_plan(scenario: Scenario, plan: np.ndarray | None, age: int, x0: np.ndarray, t0: float,
+                   v_max: np.ndarray, jump: np.ndarray | None, e_d_goal: float,
+                   law: TerminalLaw | None = None) -> np.ndarray | None:
     """The candidate at ``t0`` (s) from the measured ``x0`` (4,): rows ``age + 1 ..`` of the last accepted
-    ``plan`` (N, 3), ``age`` periods old, completed with :func:`pursuit_input` (each completion row within
-    ``jump`` (3,) of the row before it, when the plans are rate-limited). None when nothing of the plan is left
-    to shift (the candidate would be the completion alone)."""
-    plan = np.asarray(plan, dtype=float)
-    n = len(plan)
-    kept = plan[age + 1:]
-    if len(kept) == 0:
-        return None
-    rows = [row for row in kept]
+    ``plan`` (N, 3), ``age`` periods old, completed row by row (:func:`completion_row`; each completion row
+    within ``jump`` (3,) of the row before it, when the plans are rate-limited). With the certified terminal
+    ``law`` and no plan (``plan`` None, e.g. at t = 0), the candidate is the law's own N rows; without a law,
+    None when nothing of the plan is left to shift."""
+    n = scenario.controller.horizon_steps
+    if plan is None:
+        if law is None:
+            return None
+        rows: list[np.ndarray] = []
+    else:
+        plan = np.asarray(plan, dtype=float)
+        n = len(plan)
+        rows = [row for row in plan[age + 1:]]
+        if not rows and law is None:
+            return None
     dt = scenario.controller.dt
-    for _ in range(n - len(kept)):
-        end = plan_arcs(x0, np.asarray(rows), dt, 1)[-1, -1]
-        v = pursuit_input(scenario, end, t0 + dt * len(rows), v_max, e_d_goal)
-        if jump is not None:
+    for _ in range(n - len(rows)):
+        end = plan_arcs(x0, np.asarray(rows), dt, 1)[-1, -1] if rows else np.asarray(x0, dtype=float)
+        v = completion_row(scenario, law, end, t0 + dt * len(rows), v_max, e_d_goal)
+        if jump is not None and rows:
             v = np.clip(v, rows[-1] - jump, rows[-1] + jump)
         rows.append(v)
     return np.asarray(rows, dtype=float)

@@ -213,12 +213,15 @@ class _ClosedLoop:
         """v̂ of the shifted candidate (:mod:`tubekit.loop.candidate`) when it passes the exact check (with
         ``recovery``: its safe part) — it is then the accepted plan — else None. Only where plans are checked."""
         memory, tight = self.memory, self.tightening
-        if not self.scenario.controller.candidate or tight.horizon_arcs == 0 or memory.plan is None \
-                or memory.exhausted:
+        law = tight.terminal_law if tight.tiers.tracking else None
+        if not self.scenario.controller.candidate or tight.horizon_arcs == 0:
+            return None
+        previous = None if memory.plan is None or memory.exhausted else memory.plan
+        if previous is None and law is None:
             return None
         goal = tight.e_d_min + CANDIDATE_GOAL * (tight.e_d_max - tight.e_d_min)
-        plan = candidate_plan(self.scenario, memory.plan, memory.age, xk, tk, self.v_bar,
-                              self.scenario.limits.jump(self.scenario.controller.dt), goal)
+        plan = candidate_plan(self.scenario, previous, memory.age, xk, tk, self.v_bar,
+                              self.scenario.limits.jump(self.scenario.controller.dt), goal, law=law)
         if plan is None:
             return None
         check = check_plan(self.scenario, tight, tk, xk, plan, known, self.sign, v_last=self.v_last)

@@ -17,6 +17,8 @@ follows), that
   |e_o| <= e_o_max - M_o[j], and the heading stays in the certified hemisphere;
 * the vehicle ball inflated by M_pos[j] is clear of every known obstacle and
   inside the workspace;
+* with the tracking theorem's terminal law (``tightening.terminal_law``), the plan's nominal end lies in its
+  terminal set X_f ("terminal set: ...", :meth:`tubekit.model.terminal_law.TerminalLaw.slacks`);
 * when the tightening has a certified backup (``tightening.terminal_backup``), the plan's nominal end position
   meets the terminal condition (:func:`tubekit.loop.terminal.terminal_condition`: the backup's
   safe set there, inflated by the vehicle ball, is clear of every known obstacle, inside the
@@ -40,7 +42,7 @@ from typing import Sequence
 
 import numpy as np
 
-from tubekit.design_inputs import RATE_TOLERANCE
+from tubekit.design_inputs import ARC_SAMPLES, RATE_TOLERANCE
 from tubekit.model.errors import error_coordinates, heading_cosine
 from tubekit.model.kinematics import sinc, unicycle_step
 from tubekit.plant.kinematic import nominal_arc
@@ -52,7 +54,7 @@ __all__ = ["PlanCheck", "check_plan", "check_rates", "rate_slacks", "plan_arcs",
            "RATE_TOLERANCE"]
 
 #: Points per arc of the check (plus the arc's end).
-SAMPLES_PER_ARC = 10
+SAMPLES_PER_ARC = ARC_SAMPLES
 
 
 @dataclass(frozen=True)
@@ -207,6 +209,9 @@ def check_plan(scenario: Scenario, tight: Tightening, t0: float, x0: np.ndarray,
     safety.update(_position_slacks(scenario, arcs[..., :3], m[:, 3:4] + pad[3], obstacles))
     safe_name, safe_worst = _worst(safety)
     slacks = _error_slacks(tight, e, cos_rel, m, pad, sign) if tracking_checked(tight) else {}
+    if tight.terminal_law is not None and tracking_checked(tight):
+        end_target = np.asarray(scenario.trajectory.position(t0 + dt * n), dtype=float).reshape(3)
+        slacks.update({k: np.array([v]) for k, v in tight.terminal_law.slacks(arcs[-1, -1], end_target).items()})
     worst_name, worst = _worst(slacks)
     if safe_worst < worst or math.isnan(safe_worst):
         worst_name, worst = safe_name, safe_worst

@@ -22,7 +22,9 @@ Each :class:`Promise` compares an observed figure with the certificate's bound:
     (:func:`current_bound` of the certified design's current). Either over every evaluation the
     plant's integrator made (between ticks included) and at the logged ticks;
   - ``recursive_feasibility``: a plan accepted at t = 0, and the replayed candidate never older than
-    N - 1 periods;
+    N - 1 periods. With the tracking theorem (``Tightening.plan_always_available``, the candidate on) it is
+    no premise: ``plan_available`` (tracking tier) promises a plan accepted at every period (no replay,
+    recovery plan or backup), and a lapse is a broken promise (exit 4);
   - ``plant_in_box`` (dynamic plant only; absent on the kinematic plant, which has no coefficients):
     every coefficient of the vehicle as simulated (``scenario.plant.truth_params``) lies in the
     coefficient box the certificate covers (the vehicle of the tightening's design; the run's own
@@ -58,7 +60,7 @@ from tubekit.tiers import Tiers
 from tubekit.tightening import Tightening
 
 __all__ = ["Promise", "check_promises", "RunLog", "PREMISES", "TIER_OF", "premises_of", "tier_outcomes",
-           "broken_promises", "current_bound"]
+           "broken_promises", "current_bound", "proves_plans"]
 
 #: Promises that are premises of the theorem: a run breaking one claims nothing of the tiers resting on it
 #: (``plant_in_box`` is measured on the dynamic plant only).
@@ -67,7 +69,8 @@ PREMISES: tuple[str, ...] = ("disturbance", "recursive_feasibility", "plant_in_b
 #: The tier of every promise ("premise" for the premises).
 TIER_OF: dict[str, str] = {"clearance": "safe", "workspace": "safe", "inputs": "safe", "sway": "safe",
                            "velocity_loop": "safe", "tube": "tracking", "region": "tracking",
-                           "epsilon": "tracking", "disturbance": "premise", "recursive_feasibility": "premise",
+                           "epsilon": "tracking", "plan_available": "tracking", "disturbance": "premise",
+                           "recursive_feasibility": "premise",
                            "plant_in_box": "premise"}
 
 
@@ -311,7 +314,32 @@ def _velocity_loop(run: RunLog) -> list[Promise]:
                      f"derived bound {np.round(bound, 6).tolist()} (observed = largest ratio)")]
 
 
+def proves_plans(tightening: Tightening, scenario: Scenario) -> bool:
+    """True when a plan at every period is a promise of the tracking tier, not a premise: the tightening carries
+    the tracking theorem's terminal law (:attr:`Tightening.plan_always_available`) and the loop tries the
+    candidate it completes (``controller.candidate``)."""
+    return tightening.plan_always_available and bool(scenario.controller.candidate)
+
+
+def _plans(run: RunLog) -> Promise:
+    """``plan_available`` (tracking tier, with the tracking theorem): a plan accepted at every period, never a
+    replay, a recovery plan or the backup."""
+    age = np.asarray(run.plan_age, dtype=int)
+    replays = int(np.sum(age > 0))
+    flags = getattr(run, "recovery", None)
+    backup_ticks = int(np.sum(np.asarray(run.backup_active, dtype=bool)[:-1]))
+    recovery_ticks = int(np.sum(flags[:-1])) if flags is not None else 0
+    first_ok = len(age) > 0 and age[0] == 0
+    observed = float(replays + (backup_ticks > 0) + (recovery_ticks > 0) + (not first_ok))
+    return Promise("plan_available", observed, 0.0, observed == 0.0,
+                   f"tracking theorem (terminal law): periods without an accepted plan {replays}; backup ticks "
+                   f"{backup_ticks}; recovery ticks {recovery_ticks}; rejected solver plans "
+                   f"{int(np.sum(run.rejected))} (each replaced by the candidate); accepted at t = 0: {first_ok}")
+
+
 def _feasibility(run: RunLog) -> Promise:
+    if proves_plans(run.tightening, run.scenario):
+        return _plans(run)
     n = run.tightening.horizon_arcs
     age = np.asarray(run.plan_age, dtype=int)
     first_ok = len(age) > 0 and age[0] == 0 and not bool(run.replaced[0])
@@ -333,7 +361,7 @@ def premises_of(tier: str, tightening: Tightening, *, dynamic: bool = False) -> 
     derived from the vehicle (γ̄, E, hence ω̄) holds for the coefficients of its box only."""
     if tier == "premise":
         return ()
-    if tier == "safe" and tightening.backup is not None:
+    if (tier == "safe" and tightening.backup is not None) or (tier == "tracking" and tightening.plan_always_available):
         base: tuple[str, ...] = ("disturbance",)
     else:
         base = ("disturbance", "recursive_feasibility")

@@ -7,6 +7,7 @@ max|zdot_d|] plus ``horizontal_speed_bound()`` used by the verifier.
 
 from __future__ import annotations
 
+import math
 from abc import ABC, abstractmethod
 from dataclasses import dataclass, field, fields
 
@@ -39,6 +40,10 @@ class Trajectory(ABC):
     def horizontal_speed_bound(self) -> float:
         """Bound on sqrt(xdot_d^2 + ydot_d^2) (m/s)."""
         return float(np.hypot(*self.velocity_bound()[:2]))
+
+    def acceleration_bound(self) -> tuple[float, float]:
+        """(horizontal, vertical) bounds on ‖p̈_d,xy‖ and |z̈_d| (m/s²); (inf, inf) when not known."""
+        return (math.inf, math.inf)
 
     @abstractmethod
     def to_dict(self) -> dict:
@@ -91,6 +96,9 @@ class Circle(Trajectory):
 
     def horizontal_speed_bound(self):
         return abs(self.radius * self.rate)
+
+    def acceleration_bound(self):
+        return (abs(self.radius) * self.rate * self.rate, 0.0)
 
     def to_dict(self):
         return {"kind": "circle", "radius": self.radius, "rate": self.rate,
@@ -164,6 +172,9 @@ class Line(Trajectory):
     def horizontal_speed_bound(self):
         return float(np.hypot(*self.direction_velocity[:2]))
 
+    def acceleration_bound(self):
+        return (0.0, 0.0)
+
     def to_dict(self):
         return {"kind": "line", "start": list(self.start), "velocity": list(self.direction_velocity)}
 
@@ -230,6 +241,14 @@ class Waypoints(Trajectory):
         d = np.diff(pts, axis=0)
         unit = d / np.linalg.norm(d, axis=1, keepdims=True)
         return float(np.max(np.hypot(unit[:, 0], unit[:, 1])) * self.speed)
+
+    def acceleration_bound(self):
+        # p̈_d = (b − a) s''(τ) / T² on a segment of duration T, and max |s''| = 10 / √3 for the quintic
+        # s = 10τ³ − 15τ⁴ + 6τ⁵ (at τ = (3 − √3) / 6); outside the segments p_d is at rest.
+        pts, dur, _ = self._segments()
+        d = np.diff(pts, axis=0)
+        peak = 10.0 / math.sqrt(3.0) / dur ** 2
+        return (float(np.max(np.hypot(d[:, 0], d[:, 1]) * peak)), float(np.max(np.abs(d[:, 2]) * peak)))
 
     def to_dict(self):
         return {"kind": "waypoints", "points": [list(p) for p in self.points], "speed": self.speed}

@@ -19,6 +19,10 @@ promised, not checked at acceptance; they keep plans off ε), ``obstacle_margin`
 position margin plus its inter-node allowance; ``certified`` = True, ``tiers`` = ``{"safe": True,
 "tracking": False}``.
 
+With the tracking tier, the tightening carries the terminal set and law of the tracking theorem
+(``terminal_law``, :func:`verify.theorem.terminal.design_terminal`): plans must end in its set, the candidate
+is completed by its law.
+
 Every tightening carries its ``tiers`` (:class:`tubekit.tiers.Tiers`) and the backup (:class:`tubekit.model.backup.BackupPlan`: the
 law, its safe set, the hand-over it was proved for) when the certificate has one — also a best-effort
 one (then the backup is not certified either, ``tiers`` says so). ``certified`` is True when the
@@ -135,5 +139,6 @@ def tightening_of(cert: CertificateRecord, min_input_fraction: float = 0.5) -> T
     rates = np.asarray(d.rates, dtype=float)
     nodes = _node_bounds(cert, np.where(np.isfinite(margins), margins, 0.0) if margins.size else margins, rates)
     tube = np.asarray(d.tube.rho, dtype=float) if d.tube.certified else np.zeros(3)
+    terminal = cert.design.terminal if cert.tiers.tracking else None
     return Tightening(v_max=_input_limits(cert, min_input_fraction), sigma=cert.inputs.sigma, margins=margins,
-                      rates=rates, tube=tube, **_common(cert), **nodes)
+                      rates=rates, tube=tube, terminal_law=terminal, **_common(cert), **nodes)

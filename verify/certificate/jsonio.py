@@ -21,6 +21,7 @@ from typing import TYPE_CHECKING, Any, TypeVar
 from tubekit.design_inputs import THEOREM_VERSION, DesignInputs
 from tubekit.exceptions import ConfigError
 from tubekit.jsonable import to_jsonable
+from tubekit.model.terminal_law import TerminalLaw
 
 from verify.backup import BackupCertificate
 from verify.theorem.tiers import SAFE_PREFIX
@@ -67,7 +68,8 @@ def certificate_to_dict(cert: CertificateRecord) -> dict:
         "problem": d.problem.to_dict(), "tube": tube,
         "margins": None if d.margins is None else d.margins.to_dict(), "v_bar": cert.v_bar,
         "kappa_bar": cert.kappa_bar, "e_bar": None if e_bar is None else e_bar.to_dict(),
-        "arc_rates": list(d.rates), "conditions": [c.to_dict() for c in cert.conditions],
+        "arc_rates": list(d.rates), "terminal": None if d.terminal is None else d.terminal.to_dict(),
+        "conditions": [c.to_dict() for c in cert.conditions],
         "failures": [{k: v for k, v in c.to_dict().items() if k != "ok"} for c in cert.failures],
         "not_evaluated": list(cert.not_evaluated), "assumptions": list(cert.assumptions),
         "premises": list(cert.premises), "inputs": cert.inputs.to_dict(), "design_key": cert.design_key,
@@ -148,7 +150,14 @@ def _design(d: dict, sigma: SigmaChoice) -> Design:
                   margins=None if margins is None else HorizonMargins.from_dict(block(d, "margins", "certificate")),
                   v_bar=None if v_bar is None else numbers(d, "v_bar", "certificate", 3, none=None),
                   conditions=_design_conditions(d), score=-math.inf if score is None else score,
-                  rates=numbers(d, "arc_rates", "certificate", 4))
+                  rates=numbers(d, "arc_rates", "certificate", 4), terminal=_terminal(d))
+
+
+def _terminal(d: dict) -> TerminalLaw | None:
+    """The tracking theorem's terminal set and law (``terminal``; None: not certified)."""
+    if item(d, "terminal", "certificate") is None:
+        return None
+    return TerminalLaw.from_dict(d["terminal"], "certificate.terminal")
 
 
 def _route(d: dict) -> PaperRoute | None:

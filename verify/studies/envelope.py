@@ -28,6 +28,11 @@ bisection assumes the verdict monotone in the amplitude; on the dynamic plant th
 not proved monotone, so there each point is a certificate of its own and the edge between them a bracket of
 two verdicts, not a proof that every amplitude below certifies.
 
+A point *certifies* when the safe tier and every condition of the tracking tier hold, except the tracking
+theorem's conditions on the geometry of one mission — the start (``initial_terminal``), the obstacles along
+the path (``path_*``) and the plans' rate limit (``terminal_rate``), :data:`GEOMETRY_CONDITIONS` — which a
+speed and a current do not decide (:func:`frontier_verdict`).
+
 The ratio certified / necessary per speed (1 = the certificate loses nothing to
 physics) and its min and median summarise the conservatism. The scenario's own point
 (its target speed and its omega_bar_xy) is certified as it is, at the envelope's epsilon,
@@ -56,7 +61,7 @@ from verify.certificate.certify import certify, resolve_law
 from verify.kernel.intervals import upper
 from verify.theorem.design import disturbance_bounds
 
-__all__ = ["EnvelopeResult", "envelope", "necessary_omega", "scenario_at", "REFERENCE_POINTS",
+__all__ = ["EnvelopeResult", "envelope", "necessary_omega", "scenario_at", "frontier_verdict", "GEOMETRY_CONDITIONS", "REFERENCE_POINTS",
            "BISECTION_STEPS"]
 
 #: Bisection steps on the current amplitude (full, quick): the bracket is top / 2**steps wide.
@@ -110,7 +115,8 @@ class EnvelopeResult:
     own_epsilon : float
         The scenario's own epsilon (m); its verdict below is at ``epsilon`` (the same unless ``eps`` was given).
     own_certified, own_safe : bool or None
-        The scenario's verdict at ``epsilon``: both tiers, the safe tier (None: not recorded).
+        The scenario's verdict at ``epsilon``: the envelope's (:func:`frontier_verdict`), the safe tier (None: not
+        recorded).
     own_failure : str
         Its first failed condition ("" when certified).
     """
@@ -307,6 +313,17 @@ def _current_xy(scenario: Scenario) -> float:
     return upper(arb(max(a[0], a[1])) + (arb(c[0]) ** 2 + arb(c[1]) ** 2).sqrt())
 
 
+#: The tracking theorem's conditions on one mission's geometry (prefixes), left out of an envelope's verdict.
+GEOMETRY_CONDITIONS = ("initial_terminal", "path_", "terminal_rate")
+
+
+def frontier_verdict(cert: Certificate) -> tuple[bool, str]:
+    """(certifies, first failed condition or "") of a point (module doc)."""
+    failed = [c.condition for tier in ("safe", "tracking") for c in cert.tier_conditions[tier]
+              if c.ok is not True and not c.condition.startswith(GEOMETRY_CONDITIONS)]
+    return (not failed, failed[0] if failed else "")
+
+
 def _own_point(scenario: Scenario, law: str, eps: float) -> dict:
     """The scenario's own speed (m/s), omega_bar_xy (m/s) and epsilon (m), and its verdict at ``eps``
     (the ``own_*`` fields of :class:`EnvelopeResult`)."""
@@ -319,8 +336,8 @@ def _own_point(scenario: Scenario, law: str, eps: float) -> dict:
     return {"own_speed": float(scenario.trajectory.horizontal_speed_bound()),
             "own_omega": float(omega), "own_current_xy": float(current),
             "own_epsilon": float(scenario.epsilon),
-            "own_certified": bool(cert.certified), "own_safe": bool(cert.tiers.safe),
-            "own_failure": cert.failures[0].condition if cert.failures else ""}
+            "own_certified": frontier_verdict(cert)[0], "own_safe": bool(cert.tiers.safe),
+            "own_failure": frontier_verdict(cert)[1]}
 
 
 def _frontier_at(scenario: Scenario, law: str, speed: float, eps: float, top: float,
@@ -331,8 +348,7 @@ def _frontier_at(scenario: Scenario, law: str, speed: float, eps: float, top: fl
     def verdict(a: float) -> tuple[bool, str, float, float]:
         cert = zero if a == 0.0 and zero is not None else certify(
             scenario_at(scenario, speed=speed, amplitude_xy=a, epsilon=eps), law)
-        return (cert.certified, (cert.failures[0].condition if cert.failures else ""), cert.design.sigma,
-                float(cert.disturbance.omega_xy))
+        return (*frontier_verdict(cert), cert.design.sigma, float(cert.disturbance.omega_xy))
 
     ok, fail, sigma, omega = verdict(0.0)
     if not ok:

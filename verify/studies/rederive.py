@@ -258,6 +258,7 @@ def rederive(raw: dict, cert: CertificateRecord, led: Ledger, gain_boxes: int) -
         disturbance_bounds(scenario), ())
     design = tracking_design(scenario, region, cert.gains, sigma, dist)
     tiers = derive_tiers(cert, scenario, region, dist, design)
+    design = tiers.design or design
     safe, backup = tiers.safe, tiers.backup
     _key(raw, cert, led, handed_sigma(tiers_of(design, safe, backup, plant), sigma))
     _inputs(raw, cert, scenario, region, dist, led)
@@ -265,6 +266,8 @@ def rederive(raw: dict, cert: CertificateRecord, led: Ledger, gain_boxes: int) -
     _problem(cert, tube_problem(scenario, region, cert.gains, sigma, dist), led)
     _tube(raw, cert, design, led)
     _e_bar(raw, region, design, led)
+    led.equal("terminal", None if cert.design.terminal is None else cert.design.terminal.to_dict(),
+              None if design.terminal is None else design.terminal.to_dict())
     check_tiers(raw, cert, design, tiers, led, plant)
     derived = tier_conditions(design, safe, backup, plant)
     backup_part = derived["tracking"][len(design.conditions):]

@@ -27,6 +27,7 @@ from verify.certificate.record import CertificateRecord
 from verify.kernel.region import Region
 from verify.studies.ledger import Ledger
 from verify.theorem.design import Condition, Design, DisturbanceBounds
+from verify.theorem.terminal import with_terminal
 from verify.theorem.tiers import backup_of, recertify_backup, safe_only_design, tiers_of
 
 __all__ = ["DerivedTiers", "derive_tiers", "check_tiers"]
@@ -39,21 +40,38 @@ class DerivedTiers:
     safe: Design | None
     backup: BackupCertificate | None
     fresh: BackupCertificate | None = None
+    design: Design | None = None
+
+
+def _with_terminal(cert: CertificateRecord, scenario: Scenario, region: Region, dist: DisturbanceBounds,
+                   design: Design) -> Design:
+    """The tracking design with its terminal ingredients re-derived (:func:`verify.theorem.terminal.with_terminal`)
+    against the backup for its margins: designed afresh on the kinematic plant (as ``certify`` does), the stored
+    law re-certified on the dynamic one (whose design needs the velocity loop's fit)."""
+    if not design.certified:
+        return design
+    if scenario.plant.dynamic and cert.backup is not None:
+        bk = recertify_backup(scenario, cert.backup.law, cert.backup.safe_set, dist, design.margins)
+    else:
+        bk = backup_of(scenario, dist, design.margins)
+    return with_terminal(scenario, design, region, bk.safe_set if bk.certified else None)
 
 
 def derive_tiers(cert: CertificateRecord, scenario: Scenario, region: Region, dist: DisturbanceBounds,
                  design: Design) -> DerivedTiers:
-    """The safe-only design (None when tracking certifies) and the stored backup re-certified (module doc)."""
+    """The tracking design with its terminal ingredients, the safe-only design (None when tracking certifies)
+    and the stored backup re-certified (module doc)."""
+    design = _with_terminal(cert, scenario, region, dist, design)
     safe = None if design.certified else safe_only_design(scenario, region, cert.gains, dist)
     if cert.backup is None:
-        return DerivedTiers(safe, None)
+        return DerivedTiers(safe, None, design=design)
     try:
         proof_for(cert.backup.law)
     except ConfigError as exc:
         raise ConfigError("certificate.backup.law.kind", exc.expected, exc.received) from None
     margins = (safe if safe is not None else design).margins
     bk = recertify_backup(scenario, cert.backup.law, cert.backup.safe_set, dist, margins)
-    return DerivedTiers(safe, bk, None if bk.certified else backup_of(scenario, dist, margins))
+    return DerivedTiers(safe, bk, None if bk.certified else backup_of(scenario, dist, margins), design=design)
 
 
 def _backup(raw: dict, cert: CertificateRecord, derived: DerivedTiers, led: Ledger) -> None:

@@ -27,6 +27,7 @@ from flint import arb
 
 from tubekit.model.errors import error_coordinates, heading_cosine
 from tubekit.scenario import Scenario
+from tubekit.model.terminal_law import TerminalLaw
 from tubekit.model.vehicles import VehicleParams
 
 from verify.theorem.gains import GainBounds
@@ -188,6 +189,7 @@ class Design:
     conditions: tuple[Condition, ...]
     score: float
     rates: tuple[float, float, float, float] = field(default=(0.0, 0.0, 0.0, 0.0))
+    terminal: TerminalLaw | None = None
 
     @property
     def certified(self) -> bool:

@@ -35,6 +35,7 @@ from verify.theorem.gains import GainBounds
 from verify.kernel.intervals import lower, upper
 from verify.kernel.region import Region
 from verify.theorem.sampled import HorizonMargins, PeriodTube, _asin_ratio, horizon_margins
+from verify.theorem.terminal import with_terminal
 from verify.theorem.workspace import initial_workspace, target_in_workspace
 
 __all__ = ["SAFE_CONDITIONS", "SAFE_PREFIX", "is_safe_condition", "tracking_design", "position_tube",
@@ -152,12 +153,27 @@ def solve_tiers(scenario: Scenario, region: Region, gains: GainBounds, sigmas: t
                 dist: DisturbanceBounds, fits: Fits | None = None,
                 ) -> tuple[tuple[Design, ...], Design, Design | None, BackupCertificate]:
     """(designs, best, safe, backup) at ``dist``: the tracking design per σ (1/s) of ``sigmas``, the chosen one
-    (:func:`verify.theorem.design.choose_design`), the safe-only design when it does not certify, and the backup
-    (:func:`backup_of`, ``fits`` passed on)."""
+    (:func:`verify.theorem.design.choose_design`; when it certifies, with the terminal ingredients of
+    :func:`verify.theorem.terminal.with_terminal` proved against the backup designed for its margins), the
+    safe-only design when it does not certify, and the backup (:func:`backup_of`, ``fits`` passed on)."""
     designs = tuple(tracking_design(scenario, region, gains, s, dist) for s in sigmas)
     best = choose_design(list(designs))
-    safe = None if best.certified else safe_only_design(scenario, region, gains, dist)
-    return designs, best, safe, backup_of(scenario, dist, (safe or best).margins, fits)
+    if best.certified:
+        ranked = sorted((d for d in designs if d.certified), key=lambda d: (d.score, d.sigma), reverse=True)
+        completed = {}
+        for d in ranked:  # the first certified σ, by choose_design's order, whose terminal ingredients hold
+            backup = backup_of(scenario, dist, d.margins, fits)
+            completed[id(d)] = with_terminal(scenario, d, region, backup.safe_set if backup.certified else None)
+            if completed[id(d)].certified:
+                best = completed[id(d)]
+                break
+        else:
+            best = completed[id(best)]
+        designs = tuple(completed.get(id(d), d) for d in designs)
+        if best.certified:
+            return designs, best, None, backup
+    safe = safe_only_design(scenario, region, gains, dist)
+    return designs, best, safe, backup_of(scenario, dist, safe.margins, fits)
 
 
 def recertify_backup(scenario: Scenario, law: BackupLaw, safe: SafeSet, dist: DisturbanceBounds,

@@ -1,0 +1,71 @@
+"""tubekit.model.terminal_law: the terminal set X_f and the terminal law, evaluated (the proof is verify's)."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from tubekit.exceptions import ConfigError
+from tubekit.model.kinematics import unicycle_step
+from tubekit.model.terminal_law import TerminalLaw, line_of_sight
+
+GOOD = dict(d_lo=0.6, d_hi=0.9, d_star=0.75, alpha_max=0.06, z_max=0.8, gain_d=1.5, gain_z=0.3, turn=0.6)
+
+
+@pytest.mark.parametrize("change, match", [
+    ({"d_star": 1.0}, "terminal.d_star"),
+    ({"d_lo": 0.0}, "terminal.d_lo"),
+    ({"alpha_max": 1.6}, "terminal.alpha_max"),
+    ({"turn": 0.0}, "terminal.turn"),
+    ({"turn": 1.5}, "terminal.turn"),
+    ({"gain_d": -1.0}, "terminal.gain_d"),
+    ({"z_max": float("nan")}, "terminal.z_max"),
+])
+def test_a_bad_set_is_refused_naming_the_field(change, match):
+    with pytest.raises(ConfigError, match=match):
+        TerminalLaw(**{**GOOD, **change})
+
+
+def test_the_dict_round_trip_is_exact_and_a_missing_key_is_named():
+    law = TerminalLaw(**GOOD)
+    assert TerminalLaw.from_dict(law.to_dict()) == law
+    with pytest.raises(ConfigError, match="certificate.terminal"):
+        TerminalLaw.from_dict({k: v for k, v in GOOD.items() if k != "turn"}, "certificate.terminal")
+
+
+def test_line_of_sight_by_hand():
+    # vehicle at the origin heading +y, target 1 m along +x and 0.5 m above: alpha = pi/2 (target to starboard)
+    d, alpha, e_z = line_of_sight(np.array([0.0, 0.0, 0.0, math.pi / 2]), np.array([1.0, 0.0, 0.5]))
+    assert d == pytest.approx(1.0) and alpha == pytest.approx(math.pi / 2) and e_z == pytest.approx(-0.5)
+
+
+def test_the_slacks_name_each_face():
+    law = TerminalLaw(**GOOD)
+    s = law.slacks(np.array([-0.7, 0.0, 0.1, 0.0]), np.array([0.0, 0.0, 0.0]))
+    assert s["terminal set: d >= d_lo"] == pytest.approx(0.1) and s["terminal set: d <= d_hi"] == pytest.approx(0.2)
+    assert s["terminal set: |alpha|"] == pytest.approx(0.06) and s["terminal set: |e_z|"] == pytest.approx(0.7)
+    assert law.contains(np.array([-0.7, 0.0, 0.1, 0.0]), np.zeros(3))
+    assert not law.contains(np.array([-0.7, 0.0, 0.1, 0.1]), np.zeros(3))
+
+
+@settings(max_examples=60, deadline=None)
+@given(d=st.floats(0.5, 2.0), alpha=st.floats(-0.3, 0.3), speed=st.floats(-0.2, 0.2), e_z=st.floats(-0.5, 0.5))
+def test_the_arc_closes_the_radial_gap_by_lambda_delta(d, alpha, speed, e_z):
+    """Property: against a target moving at constant velocity along the line of sight, one held row of the law
+    moves the vehicle on the exact unicycle arc so that d' − d* = (1 − λδ)(d − d*) and e_z' = (1 − λ_z δ) e_z,
+    and the heading turns by −g α (the design relation the proof uses; here with no lateral target motion)."""
+    law = TerminalLaw(**{**GOOD, "d_lo": 0.4, "d_hi": 2.2, "d_star": 1.0})
+    dt = 0.1
+    x = np.array([-d, 0.0, e_z, alpha])            # target at the origin: line of sight along +x
+    v_target = np.array([speed, 0.0, 0.0])
+    row = law.command(x, np.zeros(3), v_target, dt)
+    end = unicycle_step(x, row, dt)
+    target_end = v_target * dt
+    q = target_end[:2] - end[:2]
+    assert q[0] == pytest.approx((1 - law.gain_d * dt) * (d - 1.0) + 1.0, abs=1e-12)
+    assert end[2] - target_end[2] == pytest.approx((1 - law.gain_z * dt) * e_z, abs=1e-12)
+    assert end[3] == pytest.approx(alpha * (1 - law.turn), abs=1e-12)

@@ -1,0 +1,35 @@
+"""verify.theorem.initial_plan: the terminal law's own plan from the start, checked once at certify time."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import verify
+from tubekit import load_scenario
+from tubekit.loop.plan_check import check_plan
+from verify.theorem.initial_plan import initial_plan_condition, law_plan
+
+PC = load_scenario(verify.SCENARIOS_DIR / "paper_currents.toml")
+
+
+def test_the_plan_is_the_loops_candidate_at_t0_and_passes_the_loops_check(pc_cert):
+    """The certify-time evaluation agrees with the loop: the same rows (``candidate_plan`` with no plan) pass the
+    loop's own exact check (``tubekit.loop.plan_check``, independent code) when ``initial_terminal`` holds."""
+    from tubekit.loop.candidate import candidate_plan
+    tight = pc_cert.tightening
+    rows, arcs, _ = law_plan(PC, pc_cert.design.terminal, np.asarray(pc_cert.design.v_bar))
+    x0 = np.asarray(PC.initial_state, float)
+    loop_rows = candidate_plan(PC, None, 0, x0, 0.0, tight.v_max, None, 1.0, law=tight.terminal_law)
+    np.testing.assert_allclose(loop_rows, rows, rtol=0, atol=1e-12)
+    cond = initial_plan_condition(PC, pc_cert.design, pc_cert.region, pc_cert.design.terminal,
+                                  pc_cert.backup.safe_set)
+    check = check_plan(PC, tight, 0.0, x0, loop_rows, PC.obstacles, -1)
+    assert cond.ok and check.ok and cond.lhs == pytest.approx(check.slack, abs=1e-9)
+
+
+def test_a_start_pointing_away_is_refused_naming_the_tightest_row(pc_cert):
+    sc = PC.with_changes(initial_state=(-0.8, 3.0, 0.2, 2.0))
+    cond = initial_plan_condition(sc, pc_cert.design, pc_cert.region, pc_cert.design.terminal,
+                                  pc_cert.backup.safe_set)
+    assert not cond.ok and cond.lhs < 0 and "tightest:" in cond.detail

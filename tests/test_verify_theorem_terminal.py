@@ -1,0 +1,96 @@
+"""verify.theorem.terminal: the tracking theorem's terminal set and law, and what it refuses by name."""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+import verify
+from tubekit import load_scenario
+from tubekit.model.kinematics import unicycle_step
+from tubekit.model.terminal_law import line_of_sight
+from tubekit.scenario import Obstacle
+from verify.theorem.terminal import TERMINAL_PREFIXES, law_conditions, terminal_bounds
+
+PC = load_scenario(verify.SCENARIOS_DIR / "paper_currents.toml")
+
+
+def test_paper_currents_gets_a_terminal_law_and_every_condition_holds(pc_cert):
+    law = pc_cert.design.terminal
+    assert pc_cert.tiers.tracking and law is not None
+    mine = [c for c in pc_cert.design.conditions if c.condition.startswith(TERMINAL_PREFIXES)]
+    names = {c.condition for c in mine}
+    assert {"terminal_inputs[u]", "terminal_invariant[d_lo]", "terminal_invariant[alpha]", "terminal_in_region[e_o]",
+            "terminal_sensing", "path_clearance[0]", "path_clearance[1]", "initial_terminal"} <= names
+    assert all(c.ok for c in mine)
+    assert pc_cert.region.e_d[0] < law.d_lo < law.d_star < law.d_hi < pc_cert.region.e_d[1]
+    assert pc_cert.tightening.terminal_law == law and pc_cert.tightening.plan_always_available
+
+
+def test_the_papers_obstacles_on_the_circle_refuse_tracking_by_name():
+    """The paper puts its obstacles on the target's circle: the candidate's footprint cannot pass them."""
+    sc = PC.with_changes(obstacles=(Obstacle((3.0, 0.0, 0.0), 0.4), Obstacle((-3.0, 0.0, 0.0), 0.4)))
+    cert = verify.certify(sc)
+    assert cert.tiers.safe and not cert.tiers.tracking and cert.design.terminal is None
+    failed = {c.condition: c for c in cert.failures}
+    assert set(failed) == {"path_clearance[0]", "path_clearance[1]"}
+    assert failed["path_clearance[0]"].detail.split("has ")[1].startswith("0")        # the path meets the centre
+    assert cert.tightening.terminal_law is None and not cert.tightening.plan_always_available
+
+
+@pytest.mark.parametrize("change, name", [
+    ({"limits.rate": (0.1, 0.1, 0.2)}, "terminal_rate"),
+    ({"region.heading": "both"}, "terminal_heading"),
+])
+def test_designs_outside_the_theorem_are_named(change, name):
+    cert = verify.certify(PC.with_changes(**change))
+    assert not cert.tiers.tracking and name in [c.condition for c in cert.failures]
+
+
+def test_a_law_without_radial_gain_is_not_invariant(pc_cert):
+    """λ = 0: the completion never closes the radial gap, so the deviation pushes d out of [d_lo, d_hi]."""
+    b = terminal_bounds(PC, pc_cert.design, pc_cert.region)
+    lazy = dataclasses.replace(pc_cert.design.terminal, gain_d=0.0)
+    failed = {c.condition for c in law_conditions(b, lazy) if not c.ok}
+    assert {"terminal_invariant[d_lo]", "terminal_invariant[d_hi]"} <= failed
+
+
+def test_a_start_the_law_cannot_bring_to_the_set_refuses_tracking():
+    """2.5 m behind the target (inside R): the law's 8 rows cannot close 1.6 m to X_f (d_hi ≈ 0.86 m) in 0.8 s."""
+    cert = verify.certify(PC.with_changes(initial_state=(-2.5, 3.0, 0.2, 0.0)))
+    assert not cert.tiers.tracking and [c.condition for c in cert.failures] == ["initial_terminal"]
+    assert "d <= d_hi" in cert.failures[0].detail
+
+
+def _circle_target(t: float) -> tuple[np.ndarray, np.ndarray]:
+    tr = PC.trajectory
+    return np.asarray(tr.position(t), float).reshape(3), np.asarray(tr.velocity(t), float).reshape(3)
+
+
+@settings(max_examples=80, deadline=None, derandomize=True)
+@given(t=st.floats(0.0, 100.0), u=st.floats(0.0, 1.0), a=st.floats(-1.0, 1.0), z=st.floats(-1.0, 1.0),
+       bearing=st.floats(-math.pi, math.pi), dx=st.floats(-1.0, 1.0), dy=st.floats(-1.0, 1.0), dpsi=st.floats(-1, 1))
+def test_one_completion_from_the_deviated_set_lands_in_the_set(pc_cert, t, u, a, z, bearing, dx, dy, dpsi):
+    """Property (step 17, invariance): from any state of X_f moved by the replay's deviation (D_xy, D_ψ, D_z), one
+    row of the certified law held over δ along the exact arc stays in V̄ and ends in X_f, against the scenario's
+    own target (a circle at 0.19 m/s). Independent of the proof: a float simulation of the arc."""
+    law, design = pc_cert.design.terminal, pc_cert.design
+    b = terminal_bounds(PC, design, pc_cert.region)
+    dt = PC.controller.dt
+    p, v = _circle_target(t)
+    d = law.d_lo + u * (law.d_hi - law.d_lo)
+    where = p[:2] + d * np.array([math.cos(bearing), math.sin(bearing)])   # the vehicle at distance d
+    los = math.atan2(p[1] - where[1], p[0] - where[0])
+    x = np.array([where[0], where[1], p[2] + z * law.z_max, los + a * law.alpha_max])
+    shift = np.array([dx, dy]) / max(1.0, math.hypot(dx, dy)) * b.dev_xy
+    x = x + np.array([shift[0], shift[1], math.copysign(b.dev_z, z), dpsi * b.dev_psi])
+    row = law.command(x, p, v, dt)
+    assert np.all(np.abs(row) <= np.asarray(design.v_bar) + 1e-12)
+    end = unicycle_step(x, row, dt)
+    p_end, _ = _circle_target(t + dt)
+    assert law.contains(end, p_end), (line_of_sight(end, p_end), law)

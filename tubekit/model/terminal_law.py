@@ -1,0 +1,108 @@
+"""The terminal tracking law and its terminal set: what completes the shifted candidate at its end.
+
+Tube MPC keeps a plan available by the *candidate* (Chisci et al. 2001): the previous plan shifted by one
+period and completed at its end by a terminal law that keeps the error in a terminal set. Here the terminal
+set is, with d the horizontal distance to the target, α = ψ − λ_los the heading's angle to the line of
+sight λ_los = atan2(y_d − y, x_d − x) (α = 0: pointing at the target; e_o = −sin α) and e_z = z − z_d,
+
+    X_f = {d_lo <= d <= d_hi, |α| <= α_f, |e_z| <= z_f},
+
+and the law, held over one period δ (a plan's row) from the state at time t, is
+
+* r = −g α / δ (turn the fraction g of the way onto the line of sight);
+* u = (V_r + λ (d − d*)) / (S(g α / 2) cos(α (1 − g / 2))), V_r = ṗ_d(t) · (p_d − p) / d the target's
+  speed away from the vehicle along the line of sight, S(x) = sin x / x: the exact unicycle arc then closes
+  the radial gap by the fraction λ δ of d − d* (the target's own curvature aside);
+* w = ż_d(t) − λ_z e_z.
+
+``verify.theorem.terminal`` proves, for the target's path and the certified disturbance, that the law from
+any state within the replay's deviation of X_f stays in V̄ and in R (with the last arc's margins), lands in
+X_f again one period later, and that its arc and the backup's footprint at its end stay clear of every
+obstacle: the candidate always passes the exact check, so a plan is always available (``docs/verify.md``,
+step 17). This module only evaluates the law and the set.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import asdict, dataclass, fields
+
+import numpy as np
+
+from tubekit.exceptions import ConfigError
+from tubekit.model.kinematics import sinc
+from tubekit.validation import finite, positive
+
+__all__ = ["TerminalLaw", "line_of_sight"]
+
+
+def line_of_sight(state: np.ndarray, p_d: np.ndarray) -> tuple[float, float, float]:
+    """(d (m), α (rad), e_z (m)) of the nominal ``state`` [x, y, z, ψ] against the target position ``p_d`` (3,)."""
+    dx, dy = float(p_d[0] - state[0]), float(p_d[1] - state[1])
+    los = math.atan2(dy, dx)
+    alpha = math.atan2(math.sin(state[3] - los), math.cos(state[3] - los))
+    return math.hypot(dx, dy), alpha, float(state[2] - p_d[2])
+
+
+@dataclass(frozen=True)
+class TerminalLaw:
+    """The certified terminal set X_f and law (module doc); lengths in m, angles in rad, gains in 1/s."""
+
+    d_lo: float
+    d_hi: float
+    d_star: float
+    alpha_max: float
+    z_max: float
+    gain_d: float
+    gain_z: float
+    turn: float
+
+    def __post_init__(self) -> None:
+        for f in fields(self):
+            finite(f"terminal.{f.name}", getattr(self, f.name))
+        positive("terminal.d_lo", self.d_lo)
+        if not self.d_lo <= self.d_star <= self.d_hi:
+            raise ConfigError("terminal.d_star", f"within [d_lo, d_hi] = [{self.d_lo}, {self.d_hi}] m", self.d_star)
+        if not 0.0 < self.alpha_max < math.pi / 2:
+            raise ConfigError("terminal.alpha_max", "in (0, pi/2) rad", self.alpha_max)
+        positive("terminal.z_max", self.z_max)
+        if not 0.0 < self.turn <= 1.0:
+            raise ConfigError("terminal.turn", "in (0, 1]", self.turn)
+        for name in ("gain_d", "gain_z"):
+            if getattr(self, name) < 0.0:
+                raise ConfigError(f"terminal.{name}", ">= 0 (1/s)", getattr(self, name))
+
+    def slacks(self, state: np.ndarray, p_d: np.ndarray) -> dict[str, float]:
+        """Slack (>= 0: inside) of each face of X_f at ``state`` (4,) against ``p_d`` (3,)."""
+        d, alpha, e_z = line_of_sight(np.asarray(state, dtype=float), np.asarray(p_d, dtype=float))
+        return {"terminal set: d >= d_lo": d - self.d_lo, "terminal set: d <= d_hi": self.d_hi - d,
+                "terminal set: |alpha|": self.alpha_max - abs(alpha), "terminal set: |e_z|": self.z_max - abs(e_z)}
+
+    def contains(self, state: np.ndarray, p_d: np.ndarray) -> bool:
+        """True when ``state`` lies in X_f."""
+        return min(self.slacks(state, p_d).values()) >= 0.0
+
+    def command(self, state: np.ndarray, p_d: np.ndarray, pd_dot: np.ndarray, dt: float) -> np.ndarray:
+        """The law's row v = [u, w, r] (m/s, m/s, rad/s) at the nominal ``state`` (4,), the target's position
+        ``p_d`` (3,) and velocity ``pd_dot`` (3,) at the row's start, held over ``dt`` (s)."""
+        x = np.asarray(state, dtype=float)
+        p = np.asarray(p_d, dtype=float)
+        v = np.asarray(pd_dot, dtype=float)
+        d, alpha, e_z = line_of_sight(x, p)
+        radial = (v[0] * (p[0] - x[0]) + v[1] * (p[1] - x[1])) / d if d > 0.0 else 0.0
+        g = self.turn
+        u = (radial + self.gain_d * (d - self.d_star)) / (float(sinc(0.5 * g * alpha)) * math.cos(alpha * (1 - g / 2)))
+        return np.array([u, v[2] - self.gain_z * e_z, -g * alpha / dt])
+
+    def to_dict(self) -> dict[str, float]:
+        """The eight numbers by name."""
+        return {k: float(v) for k, v in asdict(self).items()}
+
+    @classmethod
+    def from_dict(cls, d: object, where: str = "terminal") -> "TerminalLaw":
+        """Inverse of :meth:`to_dict`; a missing or extra key is a ConfigError naming ``where``."""
+        names = [f.name for f in fields(cls)]
+        if not isinstance(d, dict) or set(d) != set(names):
+            raise ConfigError(where, f"an object with exactly the keys {names}",
+                              sorted(d) if isinstance(d, dict) else type(d).__name__)
+        return cls(**{k: float(d[k]) for k in names})

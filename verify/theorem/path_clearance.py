@@ -1,0 +1,126 @@
+"""The obstacle and workspace part of the tracking theorem: a condition on the target's path.
+
+A completion arc of the candidate (``verify.theorem.terminal``) keeps the vehicle within ``reach`` (m)
+horizontally and ``rise`` (m) vertically of the target p_d(t), and ends, in X_f, within d_hi and z_f of it. So
+
+* its vehicle ball (r̄ + M_pos,N−1 + the check's pad) misses obstacle o when the cylinder of radius
+  ``reach`` and half-height ``rise`` about p_d(t) lies farther than r_o + r̄ + M_pos,N−1 + pad from o's centre;
+* the backup's footprint (R_f, H_f) about the completion's end (the terminal condition, step 11 (a)) misses o
+  when the cylinder (R_f + d_hi, H_f + z_f) about p_d(t) lies farther than r_o from o's centre.
+
+:func:`path_clearance` checks both for every t ∈ [0, T_end] on a dense sample of :data:`PATH_SAMPLES` points:
+each distance is 1-Lipschitz in p_d, so between samples it changes by at most v̄ h / 2 (v̄ the target's speed
+bound, h the spacing), which is subtracted (with a relative 1e-9 for the float evaluation). Its lhs is the
+smallest clearance (m) left beyond what is needed; ``detail`` gives the time and the path's distance from
+the obstacle's centre. :func:`path_workspace` does the same for the workspace walls.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from tubekit.scenario import Scenario
+
+from verify.theorem.design import Condition
+
+__all__ = ["PathFootprint", "PathSamples", "path_samples", "path_clearance", "path_workspace", "horizon_end",
+           "PATH_SAMPLES"]
+
+#: Sample count of the target's path over [0, T_end].
+PATH_SAMPLES = 20001
+
+
+@dataclass(frozen=True)
+class PathFootprint:
+    """What must clear the obstacles about the target (m): the completion arc's cylinder (``reach``, ``rise``)
+    carrying a ball of ``ball``, and the backup footprint's cylinder (``outer``, ``outer_height``) about it."""
+
+    reach: float
+    rise: float
+    ball: float
+    outer: float
+    outer_height: float
+
+
+@dataclass(frozen=True)
+class PathSamples:
+    """The target's path over [0, t_end] (s): ``times`` (n,), ``positions`` (n, 3) (m) and the Lipschitz
+    ``allowance`` v̄ h / 2 (m) between samples; built once (:func:`path_samples`) for every set tried."""
+
+    times: np.ndarray
+    positions: np.ndarray
+    allowance: float
+
+
+def path_samples(scenario: Scenario, t_end: float) -> PathSamples:
+    """:data:`PATH_SAMPLES` samples of the target's path over [0, ``t_end``] (s)."""
+    t = np.linspace(0.0, t_end, PATH_SAMPLES)
+    p = np.asarray(scenario.trajectory.position(t), dtype=float)
+    speed = float(np.linalg.norm(np.asarray(scenario.trajectory.velocity_bound(), dtype=float)))
+    return PathSamples(t, p, speed * (t_end / (PATH_SAMPLES - 1)) / 2.0)
+
+
+def _samples(scenario: Scenario, path: PathSamples | float) -> tuple[np.ndarray, np.ndarray, float]:
+    """(times, positions, allowance) of ``path`` (samples, or the end time t_end (s) to sample up to)."""
+    if not isinstance(path, PathSamples):
+        path = path_samples(scenario, float(path))
+    return path.times, path.positions, path.allowance
+
+
+def _cylinder_distance(centre: np.ndarray, p: np.ndarray, radius: float, half: float) -> np.ndarray:
+    """Signed distance (m) from ``centre`` (3,) to the cylinders (``radius``, ``half``) about each row of ``p``
+    (n, 3): the distance when outside, minus the depth of penetration (the nearer face) when inside; 1-Lipschitz
+    in each row of ``p``."""
+    h = np.hypot(p[:, 0] - centre[0], p[:, 1] - centre[1]) - radius
+    v = np.abs(p[:, 2] - centre[2]) - half
+    outside = np.hypot(np.maximum(0.0, h), np.maximum(0.0, v))
+    return np.where((h <= 0.0) & (v <= 0.0), np.maximum(h, v), outside)
+
+
+def path_clearance(scenario: Scenario, foot: PathFootprint, t_end: PathSamples | float) -> tuple[Condition, ...]:
+    """``path_clearance[i]`` for each obstacle (module doc); ``t_end``: the end time (s) or its samples."""
+    t, p, allowance = _samples(scenario, t_end)
+    out = []
+    for i, o in enumerate(scenario.obstacles):
+        c = np.asarray(o.center, dtype=float)
+        arc = _cylinder_distance(c, p, foot.reach, foot.rise) - (o.radius + foot.ball)
+        end = _cylinder_distance(c, p, foot.outer, foot.outer_height) - o.radius
+        both = np.minimum(arc, end)
+        k = int(np.argmin(both))
+        slack = float(both[k]) - allowance - 1e-9 * (1.0 + abs(float(both[k])))
+        part = "the completion arc's ball" if arc[k] <= end[k] else "the backup's footprint at the completion's end"
+        has = float(np.hypot(p[k, 0] - c[0], p[k, 1] - c[1]))
+        need = (foot.reach + o.radius + foot.ball) if arc[k] <= end[k] else (foot.outer + o.radius)
+        out.append(Condition(
+            f"path_clearance[{i}]", "smallest clearance of the candidate's completion from the obstacle over the "
+            "target's path, minus the Lipschitz allowance, > 0", slack, 0.0, slack > 0.0,
+            f"needs {need:.3g} m, has {has:.3g} m at t = {t[k]:.1f} s (the target's horizontal distance from "
+            f"the obstacle's centre; binding: {part}; X_f reaches {foot.reach:.3g} m, footprint "
+            f"{foot.outer:.3g} m)"))
+    return tuple(out)
+
+
+def path_workspace(scenario: Scenario, foot: PathFootprint, t_end: PathSamples | float) -> tuple[Condition, ...]:
+    """``path_workspace``: both cylinders about p_d(t) inside the workspace box for t ∈ [0, t_end] (module doc);
+    empty without a workspace."""
+    if scenario.workspace is None:
+        return ()
+    t, p, allowance = _samples(scenario, t_end)
+    lo, hi = (np.asarray(b, dtype=float) for b in scenario.workspace)
+    horizontal = max(foot.reach + foot.ball, foot.outer)
+    vertical = max(foot.rise + foot.ball, foot.outer_height)
+    pad = np.array([horizontal, horizontal, vertical])
+    room = np.minimum(p - pad - lo, hi - p - pad).min(axis=1)
+    k = int(np.argmin(room))
+    slack = float(room[k]) - allowance - 1e-9 * (1.0 + abs(float(room[k])))
+    return (Condition("path_workspace", "smallest distance of the candidate's completion (and the backup's "
+                      "footprint at its end) from the workspace walls over the target's path > 0", slack, 0.0,
+                      slack > 0.0, f"tightest at t = {t[k]:.1f} s"),)
+
+
+def horizon_end(scenario: Scenario) -> float:
+    """T_end = duration + N δ (s): the last time a candidate's completion reaches."""
+    ctrl = scenario.controller
+    return float(scenario.duration) + ctrl.horizon_steps * ctrl.dt

@@ -1,0 +1,326 @@
+"""The tracking theorem's terminal ingredients: a terminal set and law under which the candidate always exists.
+
+Recursive feasibility is proved here, at certify time, instead of checked in the run (``docs/verify.md``,
+step 17). A plan accepted at t_k ends in the terminal set X_f of :class:`tubekit.model.terminal_law.TerminalLaw`
+(the exact check asks it, :mod:`tubekit.loop.plan_check`). At t_{k+1} the candidate is that plan shifted by one
+period, replayed from the measured state, and completed by one row of the terminal law. Step 8 gives the
+shifted rows their margins; what is left is the completion, from a state within the replay's deviation
+(D_xy = p_xy + ū ψ (N − 1) δ, D_z = p_z, D_ψ = ψ of the one-period tube) of X_f. With A_xy, A_z the target's
+acceleration bounds, P, W its speed bounds, ū̄, w̄̄, r̄̄ = V̄, and the completion held over δ along the exact
+unicycle arc (``tubekit.model.terminal_law`` for the law), in the line-of-sight frame of the completion's start:
+
+* q'_x = d − λδ (d − d*) + ρ_x and |q'_y| <= Y = δP / cos β + tan β λδ Δ + A_xy δ² / 2 (Cauchy–Schwarz on the
+  target's velocity), β = A_0 (1 − g / 2), A_0 = α_f + D_ψ + asin(D_xy / d_lo), Δ = the largest |d − d*|;
+* so d' >= x_min = (d_lo − D_xy)(1 − λδ) + λδ d* − A_xy δ² / 2 >= d_lo (``terminal_invariant[d_lo]``),
+  d' <= hypot(x_max, Y) <= d_hi (``terminal_invariant[d_hi]``), and the new angle to the line of sight
+  |α'| <= (1 − g) A_0 + atan(Y / x_min) <= α_f (``terminal_invariant[alpha]``);
+* e_z' = (1 − λ_z δ) e_z − ρ_z: (1 − λ_z δ)(z_f + D_z) + A_z δ² / 2 <= z_f (``terminal_invariant[e_z]``);
+* the row is in V̄: (P + λΔ) / (S(g A_0 / 2) cos β) <= ū̄, W + λ_z (z_f + D_z) <= w̄̄, g A_0 / δ <= r̄̄
+  (``terminal_inputs[u|w|r]``);
+* along the arc (a Lipschitz function between two ends in an interval leaves it by at most rate · δ / 2):
+  d ∈ [d_lo − D_xy − Lδ/2, d_hi + D_xy + Lδ/2], L = ū̄ + P; |α| <= A_0 + asin(Lδ / (d_lo − D_xy)) and
+  |e_z| <= z_f + D_z + (w̄̄ + W) δ / 2, each inside R shrunk by the last arc's margins and the check's pad
+  (``terminal_in_region[e_d_lo|e_d_hi|e_o|e_z]``), the heading in the `toward` hemisphere;
+* the completion's end within the sensed region: hypot(N δ ū̄ + c, N δ w̄̄ + Z) <= R̄ − r̄ (``terminal_sensing``);
+* the obstacles and the workspace along the target's path (:mod:`verify.theorem.path_clearance`);
+* at t = 0, the law's own plan from the start passes the exact check (``initial_terminal``,
+  :mod:`verify.theorem.initial_plan`): it is the candidate when the solver's plan is rejected.
+
+Plans with a rate limit are not covered (``terminal_rate``: the completion's row would have to be within J of
+the plan's last row, which is not proved). Every inequality is evaluated in Arb and must hold with the slack
+:data:`FLOAT_SLACK`, so that the run's float check of the same set agrees. :func:`design_terminal` searches a
+small grid of sets, largest first, and keeps the first that meets every condition.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from dataclasses import dataclass
+
+from flint import arb
+
+from tubekit.design_inputs import ARC_SAMPLES
+from tubekit.model.backup import SafeSet
+from tubekit.model.terminal_law import TerminalLaw
+from tubekit.scenario import Scenario
+
+from verify.kernel.intervals import lower, upper
+from verify.kernel.region import Region
+from verify.theorem.design import Condition, Design
+from verify.theorem.initial_plan import initial_plan_condition
+from verify.theorem.path_clearance import PathFootprint, horizon_end, path_clearance, path_samples, path_workspace
+
+__all__ = ["TerminalBounds", "terminal_bounds", "law_conditions", "footprint_of", "sensing_condition",
+           "design_terminal", "with_terminal", "FLOAT_SLACK", "TERMINAL_PREFIXES"]
+
+#: Every inequality of the completion holds with this slack (m or rad), so the run's float check agrees.
+FLOAT_SLACK = 1e-9
+#: Name prefixes of the terminal ingredients' conditions (tracking tier).
+TERMINAL_PREFIXES = ("terminal_", "path_", "initial_terminal")
+#: Fractions of the free e_d band X_f's width is tried at, largest first.
+WIDTHS = (1.0, 0.6, 0.35, 0.2, 0.1)
+#: Where X_f's lower end d_lo is tried, as fractions of the free e_d band above its least value (a larger d_lo
+#: lets the line of sight turn slower than r̄̄ allows, at the price of a wider footprint).
+LOWER_ENDS = (0.0, 0.1, 0.2, 0.35, 0.5)
+#: Fractions of the free heading room α_f is tried at, largest first.
+ANGLES = (1.0, 0.6, 0.3)
+
+
+@dataclass(frozen=True)
+class TerminalBounds:
+    """What the completion's proof reads (floats; m, s, rad): V̄, the target's speed and acceleration bounds,
+    the replay's deviation at the shifted end, and R shrunk by the last arc's margins and the check's pad."""
+
+    dt: float
+    steps: int
+    v_bar: tuple[float, float, float]
+    speed_xy: float
+    speed_z: float
+    accel_xy: float
+    accel_z: float
+    dev_xy: float
+    dev_z: float
+    dev_psi: float
+    room_d: tuple[float, float]
+    room_o: float
+    room_z: float
+
+
+def terminal_bounds(scenario: Scenario, design: Design, region: Region) -> TerminalBounds:
+    """The :class:`TerminalBounds` of ``design`` (a design with margins and V̄)."""
+    p, tube, m = design.problem, design.tube, design.margins
+    dt, n = float(scenario.controller.dt), int(scenario.controller.horizon_steps)
+    pad = [upper(arb(0.5) * arb(dt) / ARC_SAMPLES * arb(r)) for r in design.rates]
+    dev_xy = upper(arb(tube.p_xy) + arb(p.u_max) * arb(tube.psi) * arb(dt) * (n - 1))
+    md, mz, mo = m.e_d[-1], m.e_z[-1], m.e_o[-1]
+    ax, az = scenario.trajectory.acceleration_bound()
+    return TerminalBounds(
+        dt=dt, steps=n, v_bar=tuple(float(v) for v in design.v_bar), speed_xy=p.pd_xy, speed_z=p.pd_z,
+        accel_xy=float(ax), accel_z=float(az), dev_xy=dev_xy, dev_z=tube.p_z, dev_psi=tube.psi,
+        room_d=(upper(arb(region.e_d[0]) + arb(md) + arb(pad[0])), lower(arb(region.e_d[1]) - arb(md) - arb(pad[0]))),
+        room_o=lower(arb(min(-region.e_o[0], region.e_o[1])) - arb(mo) - arb(pad[2])),
+        room_z=lower(arb(min(-region.e_z[0], region.e_z[1])) - arb(mz) - arb(pad[1])))
+
+
+def _cond(name: str, text: str, lhs: arb, rhs: arb, detail: str = "") -> Condition:
+    """lhs + FLOAT_SLACK <= rhs, in Arb (lhs's upper end, rhs's lower end reported)."""
+    ok = bool((lhs + arb(FLOAT_SLACK)) <= rhs) and lhs.is_finite() and rhs.is_finite()
+    return Condition(name, text, upper(lhs) if lhs.is_finite() else math.inf,
+                     lower(rhs) if rhs.is_finite() else math.inf, ok, detail)
+
+
+@dataclass(frozen=True)
+class _Arc:
+    """Derived quantities of one completion (Arb)."""
+
+    a0: arb
+    beta: arb
+    spread: arb
+    x_min: arb
+    x_max: arb
+    lateral: arb
+    start_min: arb
+
+
+def _arc(b: TerminalBounds, law: TerminalLaw) -> _Arc | None:
+    """The completion's derived bounds (module doc), None when a premise of the formulas fails."""
+    dt, dxy = arb(b.dt), arb(b.dev_xy)
+    d_lo, d_hi, d_star = arb(law.d_lo), arb(law.d_hi), arb(law.d_star)
+    start_min = d_lo - dxy
+    if not start_min > 0:
+        return None
+    a0 = arb(law.alpha_max) + arb(b.dev_psi) + (dxy / d_lo).asin()
+    beta = a0 * (1 - arb(law.turn) / 2)
+    if not (beta < arb.pi() / 2 and a0 < arb.pi()):
+        return None
+    spread = max(d_hi + dxy - d_star, d_star - d_lo + dxy)
+    lam = arb(law.gain_d) * dt
+    curve = arb(b.accel_xy) * dt * dt / 2
+    lateral = dt * arb(b.speed_xy) / beta.cos() + beta.tan() * lam * spread + curve
+    x_min = start_min * (1 - lam) + lam * d_star - curve
+    x_max = (d_hi + dxy) * (1 - lam) + lam * d_star + curve
+    return _Arc(a0=a0, beta=beta, spread=spread, x_min=x_min, x_max=x_max, lateral=lateral, start_min=start_min)
+
+
+def _input_conditions(b: TerminalBounds, law: TerminalLaw, arc: _Arc) -> list[Condition]:
+    dt, g = arb(b.dt), arb(law.turn)
+    ub, wb, rb = (arb(v) for v in b.v_bar)
+    u_peak = (arb(b.speed_xy) + arb(law.gain_d) * arc.spread) / ((g * arc.a0 / 2).sinc() * arc.beta.cos())
+    w_peak = arb(b.speed_z) + arb(law.gain_z) * (arb(law.z_max) + arb(b.dev_z))
+    return [_cond("terminal_inputs[u]", "(P + lambda Delta) / (S(g A_0/2) cos beta) <= u_bar_bar", u_peak, ub),
+            _cond("terminal_inputs[w]", "W + lambda_z (z_f + D_z) <= w_bar_bar", w_peak, wb),
+            _cond("terminal_inputs[r]", "g A_0 / delta <= r_bar_bar", g * arc.a0 / dt, rb),
+            _cond("terminal_gains", "lambda delta <= 1 and lambda_z delta <= 1 (no overshoot past d*, z_d)",
+                  max(arb(law.gain_d), arb(law.gain_z)) * dt, arb(1))]
+
+
+def _invariance_conditions(b: TerminalBounds, law: TerminalLaw, arc: _Arc) -> list[Condition]:
+    dt, g = arb(b.dt), arb(law.turn)
+    d_hi, alpha_f, z_f = arb(law.d_hi), arb(law.alpha_max), arb(law.z_max)
+    alpha_next = (1 - g) * arc.a0 + (arc.lateral / arc.x_min).atan() if arc.x_min > 0 else arb("inf")
+    lam_z = arb(law.gain_z) * dt
+    z_next = (1 - lam_z) * (z_f + arb(b.dev_z)) + arb(b.accel_z) * dt * dt / 2
+    return [_cond("terminal_invariant[d_lo]", "d_lo <= x_min (the completion ends no nearer than d_lo)",
+                  arb(law.d_lo), arc.x_min),
+            _cond("terminal_invariant[d_hi]", "hypot(x_max, Y) <= d_hi", (arc.x_max ** 2 + arc.lateral ** 2).sqrt(),
+                  d_hi),
+            _cond("terminal_invariant[alpha]", "(1 - g) A_0 + atan(Y / x_min) <= alpha_f", alpha_next, alpha_f),
+            _cond("terminal_invariant[e_z]", "(1 - lambda_z delta)(z_f + D_z) + A_z delta^2 / 2 <= z_f", z_next, z_f)]
+
+
+def _region_conditions(b: TerminalBounds, law: TerminalLaw, arc: _Arc) -> list[Condition]:
+    dt, dxy = arb(b.dt), arb(b.dev_xy)
+    ub, wb = arb(b.v_bar[0]), arb(b.v_bar[1])
+    run = (ub + arb(b.speed_xy)) * dt
+    d_in_lo = arc.start_min - run / 2
+    d_in_hi = arb(law.d_hi) + dxy + run / 2
+    turn = (run / arc.start_min).asin() if run < arc.start_min else arb("inf")
+    alpha_in = arc.a0 + turn
+    e_o_in = alpha_in.sin() if alpha_in < arb.pi() / 2 else arb("inf")
+    z_in = arb(law.z_max) + arb(b.dev_z) + (wb + arb(b.speed_z)) * dt / 2
+    return [_cond("terminal_in_region[e_d_lo]", "epsilon + M_d + pad <= d_lo - D_xy - L delta / 2",
+                  arb(b.room_d[0]), d_in_lo),
+            _cond("terminal_in_region[e_d_hi]", "d_hi + D_xy + L delta / 2 <= e_d_max - M_d - pad", d_in_hi,
+                  arb(b.room_d[1])),
+            _cond("terminal_in_region[e_o]", "sin(A_0 + asin(L delta / (d_lo - D_xy))) <= e_o_max - M_o - pad "
+                  "(heading toward the target)", e_o_in, arb(b.room_o)),
+            _cond("terminal_in_region[e_z]", "z_f + D_z + (w_bar_bar + W) delta / 2 <= e_z_max - M_z - pad", z_in,
+                  arb(b.room_z))]
+
+
+def law_conditions(b: TerminalBounds, law: TerminalLaw) -> tuple[Condition, ...]:
+    """The completion's conditions for ``law`` (module doc): inputs, invariance and the region along the arc."""
+    arc = _arc(b, law)
+    if arc is None:
+        return (Condition("terminal_invariant[geometry]", "D_xy < d_lo and beta < pi/2", None, None, False,
+                          f"the replay's deviation {b.dev_xy:.4g} m or the heading room does not fit this set"),)
+    return tuple(_input_conditions(b, law, arc) + _invariance_conditions(b, law, arc) + _region_conditions(b, law, arc))
+
+
+def footprint_of(scenario: Scenario, design: Design, b: TerminalBounds, law: TerminalLaw,
+                 safe: SafeSet) -> PathFootprint:
+    """The cylinders about the target a completion of ``law`` occupies (:class:`PathFootprint`)."""
+    dt = arb(b.dt)
+    reach = arb(law.d_hi) + arb(b.dev_xy) + (arb(b.v_bar[0]) + arb(b.speed_xy)) * dt / 2
+    rise = arb(law.z_max) + arb(b.dev_z) + (arb(b.v_bar[1]) + arb(b.speed_z)) * dt / 2
+    pad = arb(0.5) * dt / ARC_SAMPLES * arb(design.rates[3])
+    rv = arb(scenario.vehicle_radius)
+    return PathFootprint(reach=upper(reach), rise=upper(rise),
+                         ball=upper(rv + arb(design.margins.position[-1]) + pad),
+                         outer=upper(arb(safe.radius) + rv + arb(law.d_hi)),
+                         outer_height=upper(arb(safe.depth) + rv + arb(law.z_max)))
+
+
+def sensing_condition(scenario: Scenario, b: TerminalBounds, safe: SafeSet) -> Condition:
+    """``terminal_sensing``: the completion's end, N arcs from the measured start, keeps the safe set in the
+    sensed region: hypot(N δ ū̄ + c, N δ w̄̄ + Z) <= R̄ − r̄ (step 11 (c) for every candidate)."""
+    run = arb(b.steps) * arb(b.dt)
+    spread = ((run * arb(b.v_bar[0]) + arb(safe.radius)) ** 2 + (run * arb(b.v_bar[1]) + arb(safe.depth)) ** 2).sqrt()
+    return _cond("terminal_sensing", "hypot(N delta u_bar_bar + c, N delta w_bar_bar + Z) <= sensing_range - r_bar",
+                 spread, arb(scenario.sensing_range) - arb(scenario.vehicle_radius))
+
+
+def _sets(b: TerminalBounds) -> list[TerminalLaw]:
+    """The grid of terminal sets and their gains, largest first (module doc)."""
+    dt, (ub, wb, rb) = b.dt, b.v_bar
+    half_run = (ub + b.speed_xy) * dt / 2
+    lo_min = b.room_d[0] + b.dev_xy + half_run + 1e-6
+    hi_max = b.room_d[1] - b.dev_xy - half_run - 1e-6
+    z_f = b.room_z - b.dev_z - (wb + b.speed_z) * dt / 2 - 1e-6
+    if hi_max <= lo_min or z_f <= 0.0 or lo_min <= b.dev_xy:
+        return []
+    out = []
+    for width in WIDTHS:
+        for d_lo in (lo_min + f * (hi_max - lo_min) for f in LOWER_ENDS):
+            d_hi = d_lo + width * (hi_max - d_lo)
+            seen = b.dev_psi + math.asin(min(1.0, b.dev_xy / d_lo))
+            turn = math.asin(min(1.0, 2 * half_run / (d_lo - b.dev_xy)))
+            room = math.asin(min(b.room_o, 0.999)) - seen - turn if b.room_o > 0 else -1.0
+            for frac in ANGLES:
+                alpha_f = min(frac * room, 1.2)
+                if alpha_f <= 0.0:
+                    continue
+                a0 = alpha_f + seen
+                g = min(1.0, rb * dt / a0 * (1 - 1e-6))
+                beta = a0 * (1 - g / 2)
+                spread = (d_hi - d_lo) / 2 + b.dev_xy
+                lam = max(0.0, min(1.0 / dt, (ub * math.sin(g * a0 / 2) / (g * a0 / 2) * math.cos(beta) - b.speed_xy)
+                                   / spread) * (1 - 1e-6))
+                lam_z = max(0.0, min(1.0 / dt, (wb - b.speed_z) / (z_f + b.dev_z)) * (1 - 1e-6))
+                out.append(TerminalLaw(d_lo=d_lo, d_hi=d_hi, d_star=(d_lo + d_hi) / 2, alpha_max=alpha_f, z_max=z_f,
+                                       gain_d=lam, gain_z=lam_z, turn=g))
+    return out
+
+
+def _no_set(b: TerminalBounds) -> Condition:
+    return Condition("terminal_in_region[room]", "R shrunk by the last arc's margins, the replay's deviation and "
+                     "half an arc leaves room for a terminal set", None, None, False,
+                     f"e_d room [{b.room_d[0]:.4g}, {b.room_d[1]:.4g}] m, |e_o| room {b.room_o:.4g}, "
+                     f"|e_z| room {b.room_z:.4g} m, deviation {b.dev_xy:.4g} m")
+
+
+def _not_covered(scenario: Scenario, region: Region) -> tuple[Condition, ...]:
+    """The designs the theorem does not cover yet, named (whatever the backup): rate-limited plans, a region
+    whose heading is not ``toward``."""
+    if scenario.limits.rate is not None:
+        return (Condition("terminal_rate", "plans without a rate limit (the completion's row is not proved "
+                          "within J of the plan's last)", None, None, False,
+                          "the tracking theorem covers plans without limits.rate"),)
+    if region.heading != "toward":
+        return (Condition("terminal_heading", "region.heading = toward (the terminal law points at the "
+                          "target)", None, None, False, f"heading {region.heading!r}"),)
+    return ()
+
+
+def design_terminal(scenario: Scenario, design: Design, region: Region, safe: SafeSet
+                    ) -> tuple[TerminalLaw | None, tuple[Condition, ...]]:
+    """(law, conditions): the first set of the grid meeting every condition (module doc), else None and the
+    conditions of the set most favourable to the path (the invariant one with the smallest reach, or the first
+    tried)."""
+    refused = _not_covered(scenario, region)
+    if refused:
+        return None, refused
+    b = terminal_bounds(scenario, design, region)
+    sensing = sensing_condition(scenario, b, safe)
+    path = path_samples(scenario, horizon_end(scenario))
+
+    def geometry(law: TerminalLaw) -> tuple[Condition, ...]:
+        foot = footprint_of(scenario, design, b, law, safe)
+        return path_clearance(scenario, foot, path) + path_workspace(scenario, foot, path)
+
+    first: tuple[Condition, ...] | None = None
+    narrowest: tuple[float, TerminalLaw, tuple[Condition, ...]] | None = None
+    for law in _sets(b):
+        own = law_conditions(b, law)
+        first = first or own
+        if not all(c.ok for c in own):
+            continue
+        conds = own + (sensing, initial_plan_condition(scenario, design, region, law, safe))
+        if all(c.ok for c in conds):  # the path is sampled only for sets that pass everything else
+            conds = conds + geometry(law)
+            if all(c.ok for c in conds):
+                return law, conds
+        if narrowest is None or law.d_hi < narrowest[0]:
+            narrowest = (law.d_hi, law, conds)
+    if narrowest is not None:
+        _, law, conds = narrowest
+        return None, conds if any(c.condition.startswith("path_") for c in conds) else conds + geometry(law)
+    return None, (first or (_no_set(b),)) + (sensing,)
+
+
+def with_terminal(scenario: Scenario, design: Design, region: Region, safe: SafeSet | None) -> Design:
+    """``design`` with the terminal ingredients' conditions appended and its ``terminal`` law set when they all
+    hold; unchanged when it has no finite margins or V̄ (nothing to complete)."""
+    m = design.margins
+    if m is None or design.v_bar is None or not all(math.isfinite(x) for x in m.position + m.e_d + m.e_z + m.e_o):
+        return design
+    refused = _not_covered(scenario, region)
+    if refused:
+        return dataclasses.replace(design, conditions=design.conditions + refused)
+    if safe is None:
+        return dataclasses.replace(design, conditions=design.conditions + (
+            Condition("terminal_backup", "a backup safe set for the terminal condition", None, None, False,
+                      "no backup"),))
+    law, conds = design_terminal(scenario, design, region, safe)
+    return dataclasses.replace(design, conditions=design.conditions + conds, terminal=law)

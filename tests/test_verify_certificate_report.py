@@ -155,3 +155,18 @@ def test_tried_lines_give_every_design_s_failures(paper_cert):
     assert lines[0] == f"Designs tried ({len(paper_cert.tried)}):" and len(lines) == 1 + len(paper_cert.tried)
     for trial, line in zip(paper_cert.tried, lines[1:]):
         assert all(name in line for name in trial.failed) and f"{len(trial.failed)} failed" in line
+
+
+def test_a_path_clearance_failure_says_where_when_and_how_much():
+    """The tracking theorem's refusal on a path too close to an obstacle prints the distance needed, the distance
+    the path has and the time, on the failure's line (the summary ``tubekit certify`` prints)."""
+    import re
+
+    import verify
+    from tubekit.scenario import Obstacle
+    sc = load_scenario(verify.SCENARIOS_DIR / "paper_currents.toml").with_changes(
+        obstacles=(Obstacle((3.0, 0.0, 0.0), 0.4), Obstacle((-5.3, 0.0, 0.0), 0.4)))
+    text = certify(sc).summary()
+    line = next(x for x in text.splitlines() if x.strip().startswith("path_clearance[0]:"))
+    assert re.search(r"needs \d\.\d+ m, has 0(\.\d+)? m at t = 25\.0 s", line), line
+    assert "tracking: not certified (path_clearance[0])" in text.splitlines()[0]

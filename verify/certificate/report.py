@@ -168,6 +168,8 @@ def _failure_lines(cert: CertificateRecord) -> list[str]:
         numbers = compare(c.lhs, c.rhs) if c.ok is False else "not evaluated"
         if c.lhs is None and c.detail:  # no number to compare: say why (a root cause, or what it waits for)
             numbers = c.detail
+        elif c.condition.startswith(("path_", "initial_terminal")) and c.detail:  # where, when and how much
+            numbers = f"{numbers} ({c.detail})"
         out.append(f"  {c.condition}: {c.inequality}: {numbers}{knob_text(knobs[c.condition])}")
     rest = open_[FAILURE_LINES:]
     if rest:

@@ -363,6 +363,7 @@ class FhocpNlp:
         if self.rate_penalty < 0 or not math.isfinite(self.rate_penalty):
             raise ConfigError("rate_penalty", "a finite number >= 0", self.rate_penalty)
         object.__setattr__(self, "_rate_w", self.rate_penalty * self.r)
+        object.__setattr__(self, "_nodes", self._node_bounds())
 
     @classmethod
     def from_scenario(cls, scenario: Scenario, tightening: Tightening, *, terminal: TerminalMode | str = "soft",
@@ -393,7 +394,10 @@ class FhocpNlp:
 
     def node_bounds(self) -> dict[str, np.ndarray]:
         """Per-node bounds (N,) ``e_d_lo``, ``e_d_hi``, ``e_z``, ``e_o``: the tightened sets, the last node
-        narrowed to the tracking theorem's X_f when there is one."""
+        narrowed to the tracking theorem's X_f when there is one (built once: the solver's step reads them)."""
+        return self._nodes
+
+    def _node_bounds(self) -> dict[str, np.ndarray]:
         n = self.horizon_steps
         out = {k: np.full(n, float(v)) for k, v in (("e_d_lo", self.e_d_min), ("e_d_hi", self.e_d_max),
                                                      ("e_z", self.e_z_max), ("e_o", self.e_o_max))}

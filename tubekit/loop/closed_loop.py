@@ -213,7 +213,7 @@ class _ClosedLoop:
         """v̂ of the shifted candidate (:mod:`tubekit.loop.candidate`) when it passes the exact check (with
         ``recovery``: its safe part) — it is then the accepted plan — else None. Only where plans are checked."""
         memory, tight = self.memory, self.tightening
-        law = tight.terminal_law if tight.tiers.tracking else None
+        law = tight.terminal_law if tight.plan_always_available else None
         if not self.scenario.controller.candidate or tight.horizon_arcs == 0:
             return None
         previous = None if memory.plan is None or memory.exhausted else memory.plan

@@ -328,6 +328,7 @@ def _own_point(scenario: Scenario, law: str, eps: float) -> dict:
     """The scenario's own speed (m/s), omega_bar_xy (m/s) and epsilon (m), and its verdict at ``eps``
     (the ``own_*`` fields of :class:`EnvelopeResult`)."""
     cert = certify(scenario.with_changes(epsilon=eps), law)
+    certifies, failure = frontier_verdict(cert)
     if scenario.plant.dynamic:
         omega, current = cert.disturbance.omega_xy, _current_xy(scenario)
     else:
@@ -336,8 +337,7 @@ def _own_point(scenario: Scenario, law: str, eps: float) -> dict:
     return {"own_speed": float(scenario.trajectory.horizontal_speed_bound()),
             "own_omega": float(omega), "own_current_xy": float(current),
             "own_epsilon": float(scenario.epsilon),
-            "own_certified": frontier_verdict(cert)[0], "own_safe": bool(cert.tiers.safe),
-            "own_failure": frontier_verdict(cert)[1]}
+            "own_certified": certifies, "own_safe": bool(cert.tiers.safe), "own_failure": failure}
 
 
 def _frontier_at(scenario: Scenario, law: str, speed: float, eps: float, top: float,

@@ -5,8 +5,9 @@ Usage::
     python benchmarks/mission.py [--duration S] [--json FILE] [--only NAME ...] [--fhocp-mode realtime|converged]
                                  [--spread K]
 
-For each scenario (the paper's Section VI, ``verify/scenarios/paper_currents.toml`` and its variants with a
-faster current (period 3 s) and a steady one, the two-rock transit of issue 31) the certificate is computed
+For each scenario (the paper's Section VI; each shipped scenario certified on both tiers —
+``verify/scenarios/paper_currents.toml``, ``verify/scenarios/certifiable.toml``, ``examples/paper_law.toml`` — with its
+variants with a faster current (period 3 s) and a steady one; the two-rock transit) the certificate is computed
 (:func:`verify.certify`), then the tube run is simulated under the scenario's own current three ways: as shipped
 (the shifted candidate, :mod:`tubekit.loop.candidate`, and recovery plans, ``Tightening.recovers``), without
 recovery plans (``controller.recovery = false``) and with neither (``controller.candidate = false`` too: the
@@ -46,14 +47,25 @@ def transit() -> Scenario:
         **{"disturbance.amplitude": (0.0, 0.0, 0.0), "disturbance.constant": (0.0, 0.12, 0.0)})
 
 
+def variants(name: str, scenario: Scenario) -> dict[str, Scenario]:
+    """``scenario`` as shipped, with a faster current (period 3 s) and with a steady one (the amplitude held)."""
+    steady = scenario.with_changes(**{"disturbance.amplitude": (0.0, 0.0, 0.0),
+                                      "disturbance.constant": tuple(scenario.disturbance.amplitude)})
+    return {name: scenario, f"{name}_fast": scenario.with_changes(**{"disturbance.period": 3.0}),
+            f"{name}_steady": steady}
+
+
 def scenarios() -> dict[str, Scenario]:
-    """The scenarios of the module doc, by name."""
-    pc = load_scenario(verify.SCENARIOS_DIR / "paper_currents.toml")
-    steady = pc.with_changes(**{"disturbance.amplitude": (0.0, 0.0, 0.0),
-                                "disturbance.constant": tuple(pc.disturbance.amplitude)})
-    return {"section_vi": paper_scenario(), "paper_currents": pc,
-            "paper_currents_fast": pc.with_changes(**{"disturbance.period": 3.0}),
-            "paper_currents_steady": steady, "transit": transit()}
+    """The scenarios of the module doc, by name: Section VI, every shipped scenario certified on both tiers with its
+    variants (:func:`variants`), the transit."""
+    shipped = {"paper_currents": verify.SCENARIOS_DIR / "paper_currents.toml",
+               "certifiable": verify.SCENARIOS_DIR / "certifiable.toml",
+               "paper_law": ROOT / "examples" / "paper_law.toml"}
+    out: dict[str, Scenario] = {"section_vi": paper_scenario()}
+    for name, path in shipped.items():
+        out.update(variants(name, load_scenario(path)))
+    out["transit"] = transit()
+    return out
 
 
 def recovery_seconds(done: CertifiedRun) -> float:

@@ -18,10 +18,20 @@ MISSION = load_script("benchmarks/mission.py", "mission_benchmark")
 
 def test_the_scenarios_are_the_issues_and_the_transit_is_as_described():
     names = set(MISSION.scenarios())
-    assert names == {"section_vi", "paper_currents", "paper_currents_fast", "paper_currents_steady", "transit"}
+    shipped = {f"{n}{v}" for n in ("paper_currents", "certifiable", "paper_law") for v in ("", "_fast", "_steady")}
+    assert names == {"section_vi", "transit"} | shipped
     transit = MISSION.transit()
     assert transit.disturbance.constant == (0.0, 0.12, 0.0) and transit.epsilon == 0.5
     assert [o.center[1] for o in transit.obstacles] == [0.9, -0.9]          # 0.9 m off the path, either side
+
+
+def test_the_variants_hold_the_amplitude_steady_and_speed_the_current_up():
+    base = MISSION.scenarios()["paper_law"]
+    out = MISSION.variants("x", base)
+    assert set(out) == {"x", "x_fast", "x_steady"} and out["x"] is base
+    assert out["x_fast"].disturbance.period == 3.0 and out["x_fast"].disturbance.amplitude == base.disturbance.amplitude
+    assert out["x_steady"].disturbance.amplitude == (0.0, 0.0, 0.0)
+    assert out["x_steady"].disturbance.constant == base.disturbance.amplitude
 
 
 def test_one_row_has_every_figure_for_the_three_ways():

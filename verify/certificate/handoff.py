@@ -116,8 +116,8 @@ def _safe_only_nodes(cert: CertificateRecord) -> dict[str, float]:
     """The FHOCP's e-node bounds of a safe-only tightening: R's, except e_d_min (m, m, m, -).
 
     The safe tier promises nothing about e, and plan acceptance does not check it, so R is not shrunk by the
-    margins of a tracking design that did not certify: those margins only narrowed the plans (a heading room of
-    0.19 of R's 0.5 pinned the transit behind its first rock for 112 of 150 s; ``benchmarks/mission.py``). The
+    margins of a tracking design that did not certify: those margins only narrowed the plans (|e_o| <= 0.19 instead of
+    R's 0.5 pinned the transit behind its first rock for 112 of 150 s; ``benchmarks/mission.py``). The
     lower end keeps the tracking design's best-effort margin (clamped to keep a quarter of R), so plans stay off
     the ε the user declared: without it the paper's run came within 0.09 m of the target, ε = 0.1 m.
     """

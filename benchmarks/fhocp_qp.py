@@ -23,7 +23,6 @@ import argparse
 import json
 import sys
 import time
-from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -33,32 +32,14 @@ __all__ = ["record_problems", "compare", "main"]
 
 
 def record_problems(duration: float) -> tuple[list[tuple], object]:
-    """The tube run's subproblems as (P, q, A, b) with the compiled program they came from."""
-    import verify
+    """The tube run's subproblems as (P, q, A, b) with the compiled program they came from
+    (:func:`clarabel_settings.record` on the paper scenario)."""
+    sys.path.insert(0, str(Path(__file__).resolve().parent))
+    import clarabel_settings  # noqa: E402 - the sibling benchmark's recorder
     from tubekit import paper_scenario
-    from tubekit.fhocp.registry import make_solver
-    from tubekit.loop.closed_loop import run_closed_loop
 
-    sc = replace(paper_scenario(), duration=float(duration))
-    tg = verify.certify(sc, law=sc.controller.law).best_effort_tightening()
-    solvers: list = []
-
-    def factory(scenario, tightening):
-        solvers.append(make_solver(scenario, tightening))
-        compiled = solvers[-1].subproblem.compiled
-        original = compiled.solve
-
-        def recording_solve():
-            P, q, A, b, _d = compiled.data()
-            problems.append((P.copy(), q.copy(), A.copy(), b.copy()))
-            return original()
-
-        compiled.solve = recording_solve
-        return solvers[-1]
-
-    problems: list[tuple] = []
-    run_closed_loop(sc, tg, tube=True, progress=False, solver_factory=factory)
-    return problems, solvers[0].subproblem.compiled
+    problems, compiled, _ = clarabel_settings.record(paper_scenario(), duration)
+    return problems, compiled
 
 
 def _cone_dims(compiled) -> tuple[int, int, list[int]]:

@@ -2,7 +2,7 @@
 
 Usage::
 
-    python benchmarks/clarabel_settings.py [--duration S] [--only NAME ...] [--json FILE]
+    python benchmarks/clarabel_settings.py [--duration S] [--only NAME ...] [--json FILE] [--closed-loop]
 
 Every shipped scenario (Section VI, ``paper_currents``, ``certifiable``, ``examples/paper_law.toml`` with their
 faster and steady currents, the transit, the examples ``circle``, ``helix``, ``line``, ``waypoints``) is certified
@@ -20,6 +20,11 @@ Per setting: the problems not ``Solved`` (``AlmostSolved`` counted apart: the co
 inaccurate), the largest difference of the solution from the shipped setting's (all of x, slacks included, and the
 plan's inputs u, w, r), the median and p99 of the bare solve time (ms; reported, never a verdict). Nothing here
 changes the controller: it measures what a change would do.
+
+``--closed-loop`` instead runs each scenario's certified tube loop once per setting (the controller's
+:data:`tubekit.fhocp.convex.DEFAULT_CLARABEL_SETTINGS` overridden for the run, restored after) and prints, per
+setting, the tracking RMSE, the seconds the backup ran, the periods the candidate replaced a plan, the smallest
+clearance and the promises broken: what the change does to the loop rather than to one subproblem.
 """
 
 from __future__ import annotations
@@ -32,7 +37,7 @@ from pathlib import Path
 
 import numpy as np
 
-__all__ = ["SETTINGS", "record", "compare", "main"]
+__all__ = ["SETTINGS", "record", "compare", "closed_loop", "main"]
 
 #: The settings compared (overrides of tubekit.fhocp.qp.clarabel.clarabel_settings), the shipped one first.
 SETTINGS: dict[str, dict] = {
@@ -126,12 +131,44 @@ def compare(problems: list[tuple], compiled, inputs: np.ndarray) -> dict:
                 "p99_ms": float(np.percentile(s["times"], 99) * 1e3)} for n, s in stats.items()}
 
 
+def closed_loop(scenario, duration: float) -> dict:
+    """Per setting: the certified tube run's figures (module doc) with the controller's Clarabel settings
+    overridden for the run."""
+    import verify
+    import tubekit.fhocp.convex as convex
+    from tubekit.loop.pipeline import certified_run
+
+    sc = scenario.with_changes(duration=float(duration))
+    tight = verify.certify(sc).best_effort_tightening()
+    shipped = dict(convex.DEFAULT_CLARABEL_SETTINGS)
+    out = {}
+    try:
+        for name, over in SETTINGS.items():
+            convex.DEFAULT_CLARABEL_SETTINGS.clear()
+            convex.DEFAULT_CLARABEL_SETTINGS.update({**shipped, **over})
+            done = certified_run(sc, tight, progress=False)
+            m = done.metrics
+            out[name] = {"tracking_rmse": m["tracking_rmse"], "backup_s": m["backup_s"],
+                         "candidate_periods": int(done.run.candidate.sum()), "min_clearance": m["min_clearance"],
+                         "broken": list(done.broken)}
+    finally:
+        convex.DEFAULT_CLARABEL_SETTINGS.clear()
+        convex.DEFAULT_CLARABEL_SETTINGS.update(shipped)
+    return out
+
+
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--duration", type=float, default=100.0, help="simulated seconds of each recorded run")
     ap.add_argument("--only", nargs="*", help="scenario names (default all)")
     ap.add_argument("--json", type=Path, help="write the rows to this JSON file")
+    ap.add_argument("--closed-loop", action="store_true", help="compare whole tube runs instead (module doc)")
     args = ap.parse_args(argv)
+    if args.closed_loop:
+        for name, sc in _scenarios().items():
+            if not args.only or name in args.only:
+                print(json.dumps({"scenario": name, "settings": closed_loop(sc, args.duration)}), flush=True)
+        return 0
     rows, total = [], 0
     for name, sc in _scenarios().items():
         if args.only and name not in args.only:

@@ -43,3 +43,14 @@ def test_the_scenarios_are_the_shipped_ones_and_the_examples():
     names = set(STUDY._scenarios())
     assert {"section_vi", "paper_currents", "transit", "circle", "helix", "line", "waypoints"} <= names
     assert all(np.isfinite(s.duration) for s in STUDY._scenarios().values())
+
+
+def test_the_closed_loop_comparison_restores_the_shipped_settings():
+    import tubekit.fhocp.convex as convex
+
+    shipped = dict(convex.DEFAULT_CLARABEL_SETTINGS)
+    sc = load_scenario(verify.SCENARIOS_DIR / "paper_currents.toml")
+    out = STUDY.closed_loop(sc, 1.0)
+    assert set(out) == set(STUDY.SETTINGS) and convex.DEFAULT_CLARABEL_SETTINGS == shipped
+    for row in out.values():
+        assert row["broken"] == [] and row["min_clearance"] > 0 and row["backup_s"] == 0.0

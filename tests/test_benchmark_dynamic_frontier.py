@@ -18,3 +18,26 @@ def test_the_shipped_point_certifies_and_the_paper_current_does_not():
     lines = mod.table([0.3], [0.1])
     assert lines[0].startswith("| u_max") and len(lines) == 3
     assert lines[2].startswith("| 0.3 | keep_up[u], ")
+
+
+def test_the_spread_option_widens_von_benzons_values_or_takes_the_published_box():
+    mod = _module()
+    assert mod.plant_overrides(None) is None and mod.plant_overrides("published") == ()
+    box = dict(mod.plant_overrides("0.1"))
+    assert box["X_uu"] == (-141.0 * 1.1, -141.0 * 0.9) and box["Y_v"] == 0.0      # zero coefficients stay points
+    assert set(box) == set(mod.VON_BENZON)
+
+
+def test_over_the_published_box_the_shipped_point_does_not_certify():
+    """The published spread (von Benzon ↔ Einarsson): the velocity loop's small-gain fixed point diverges, so the
+    shipped point certifies neither tier there (docs/plant.md section 4)."""
+    import dataclasses
+
+    import verify
+    from tubekit.scenario import load_scenario
+
+    mod = _module()
+    sc = load_scenario(mod.SCENARIO)
+    cert = verify.certify(sc.with_changes(plant=dataclasses.replace(sc.plant, overrides=mod.plant_overrides("published"))))
+    names = [c.condition for c in cert.failures]
+    assert not cert.tiers.safe and "loop_fixed_point" in names

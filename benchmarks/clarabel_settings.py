@@ -21,8 +21,8 @@ inaccurate), the largest difference of the solution from the shipped setting's (
 plan's inputs u, w, r), the median and p99 of the bare solve time (ms; reported, never a verdict). Nothing here
 changes the controller: it measures what a change would do.
 
-``--closed-loop`` instead runs each scenario's certified tube loop once per setting (the controller's
-:data:`tubekit.fhocp.convex.DEFAULT_CLARABEL_SETTINGS` overridden for the run, restored after) and prints, per
+``--closed-loop`` instead runs each scenario's certified tube loop once per setting (the FHOCP built with the
+setting as ``ScpOptions(clarabel_settings=...)``, on top of the shipped defaults) and prints, per
 setting, the tracking RMSE, the seconds the backup ran, the periods the candidate replaced a plan, the smallest
 clearance and the promises broken: what the change does to the loop rather than to one subproblem.
 """
@@ -132,28 +132,24 @@ def compare(problems: list[tuple], compiled, inputs: np.ndarray) -> dict:
 
 
 def closed_loop(scenario, duration: float) -> dict:
-    """Per setting: the certified tube run's figures (module doc) with the controller's Clarabel settings
-    overridden for the run."""
+    """Per setting: the certified tube run's figures (module doc), its FHOCP built with the setting's Clarabel
+    overrides (``ScpOptions.clarabel_settings``)."""
     import verify
-    import tubekit.fhocp.convex as convex
+    from tubekit.fhocp.options import ScpOptions
+    from tubekit.fhocp.scp import FHOCP
     from tubekit.loop.pipeline import certified_run
 
     sc = scenario.with_changes(duration=float(duration))
     tight = verify.certify(sc).best_effort_tightening()
-    shipped = dict(convex.DEFAULT_CLARABEL_SETTINGS)
     out = {}
-    try:
-        for name, over in SETTINGS.items():
-            convex.DEFAULT_CLARABEL_SETTINGS.clear()
-            convex.DEFAULT_CLARABEL_SETTINGS.update({**shipped, **over})
-            done = certified_run(sc, tight, progress=False)
-            m = done.metrics
-            out[name] = {"tracking_rmse": m["tracking_rmse"], "backup_s": m["backup_s"],
-                         "candidate_periods": int(done.run.candidate.sum()), "min_clearance": m["min_clearance"],
-                         "broken": list(done.broken)}
-    finally:
-        convex.DEFAULT_CLARABEL_SETTINGS.clear()
-        convex.DEFAULT_CLARABEL_SETTINGS.update(shipped)
+    for name, over in SETTINGS.items():
+        options = ScpOptions(clarabel_settings=over or None)
+        done = certified_run(sc, tight, progress=False,
+                             solver_factory=lambda scen, tightening, o=options: FHOCP(scen, tightening, options=o))
+        m = done.metrics
+        out[name] = {"tracking_rmse": m["tracking_rmse"], "backup_s": m["backup_s"],
+                     "candidate_periods": int(done.run.candidate.sum()), "min_clearance": m["min_clearance"],
+                     "broken": list(done.broken)}
     return out
 
 

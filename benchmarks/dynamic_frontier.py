@@ -25,9 +25,8 @@ U_MAX = (0.2, 0.25, 0.3, 0.35, 0.4)
 CURRENT = (0.02, 0.03, 0.04, 0.05, 0.06, 0.08, 0.1)
 
 
-#: von Benzon et al. (2022): the BlueROV2 Heavy's coefficients the shipped scenario's box is centred on.
-VON_BENZON = {"X_udot": -6.36, "Y_vdot": -7.12, "Z_wdot": -18.69, "N_rdot": -0.2215, "X_u": -13.7, "Y_v": 0.0,
-              "Z_w": -33.0, "N_r": 0.0, "X_uu": -141.0, "Y_vv": -217.0, "Z_ww": -190.0, "N_rr": -1.5}
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from dynamic_gap import VON_BENZON  # noqa: E402 - the coefficients the shipped scenario's box is centred on
 
 
 def plant_overrides(spread: str | None) -> tuple | None:

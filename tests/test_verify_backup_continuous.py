@@ -156,3 +156,18 @@ def test_the_sampled_rate_is_the_formula_for_every_shape(level, omega, yaw_err):
         want.append(rate.max())
     got = continuous_rate_sampled_shapes(law, level, shapes, omega, yaw_err=yaw_err)
     np.testing.assert_allclose(got, want, rtol=0, atol=1e-5)
+
+
+@settings(max_examples=25, deadline=None, derandomize=True)
+@given(level=st.floats(1.0, 12.0), omega=st.floats(0.0, 0.15), yaw_err=st.floats(0.0, 0.1),
+       step=st.sampled_from([0.05, 0.1, 0.35]))
+def test_the_pruned_best_shape_is_the_argmin_of_every_shape(level, omega, yaw_err, step):
+    """Property: continuous_best_shape returns the first index of the smallest value of
+    continuous_rate_sampled_shapes and that value, bit for bit (the pruning only skips shapes that cannot attain
+    it)."""
+    from verify.backup.continuous import continuous_best_shape, continuous_rate_sampled_shapes
+    law = StationKeeping(0.2, 0.2, 0.3, 0.15, 0.1, 2.0, 2.0, 5.0, "continuous", 0.6)
+    shapes = np.round(np.arange(0.05, level - 0.1, step), 6)
+    every = continuous_rate_sampled_shapes(law, level, shapes, omega, yaw_err=yaw_err)
+    i, value = continuous_best_shape(law, level, shapes, omega, yaw_err=yaw_err)
+    assert i == int(np.argmin(every)) and value == float(every.min())

@@ -6,7 +6,10 @@ import dataclasses
 import functools
 import math
 
+import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from tubekit.exceptions import ConfigError
 from tubekit.model.backup import SafeSet
@@ -111,3 +114,25 @@ def test_fits_is_not_asked_without_the_smooth_design():
 def test_bad_arguments_are_refused(kwargs, match):
     with pytest.raises(ConfigError, match=match):
         design_backup(**{**PAPER, **kwargs})
+
+
+@settings(max_examples=60, deadline=None, derandomize=True)
+@given(n=st.integers(1, 60), first=st.integers(0, 60))
+def test_the_first_fitting_level_is_found_by_bisection(n, first):
+    """Property: when the ratio falls below 1 at level index ``first`` and stays there (the hopeless levels a
+    prefix), ``first_fitting`` returns that index (None when every level is hopeless), asking ``fits`` at most
+    ceil(log2 n) + 1 times instead of once per level."""
+    from verify.backup.search import _Search
+    levels = np.round(np.arange(1, n + 1) * GENTLE_LEVEL_STEP, 6)
+    asked: list[float] = []
+
+    def fits(law, safe: SafeSet) -> float:
+        asked.append(safe.level)
+        return 0.5 if safe.level >= levels[min(first, n - 1)] and first < n else 2.0
+
+    search = _Search(0.12, 0.1, LIMITS, TICK, HAND, 1024, 0.0, True, 0.2, fits)
+    law = search._law(0.3, 0.5, 0.5)
+    got = search.first_fitting(law, levels)
+    assert got == (first if first < n else None)
+    assert len(asked) <= math.ceil(math.log2(n)) + 1
+    assert set(asked) <= set(float(x) for x in levels)  # levels of the grid only

@@ -227,3 +227,25 @@ def test_the_last_round_compares_e_with_the_assumption_it_was_derived_with(monke
     consistent = next(c for c in cert.plant_conditions if c.condition == "loop_consistent")
     assert consistent.ok is False and consistent.lhs >= 1.0
     assert not cert.certified and not cert.tiers.safe
+
+
+def test_the_loop_ratio_does_not_rise_with_the_level_on_the_slow_scenario(slow_solution):
+    """What the gentle search's bisection rests on, measured on the shipped dynamic scenario: at the gentlest shape,
+    the loop error ratio E / E_a of every law of the grid (widest yaw band) never rises as the safe set's level
+    grows, over the whole level grid (``verify.backup.search``, module doc)."""
+    from verify.backup.search import MIN_SHAPE, _candidates, _Search
+    from verify.vehicle.compose import _fits
+    sc, sol = slow_solution
+    fits = _fits(sc, sol.dist, sol.assumed)
+    limits = tuple(float(x) for x in sc.limits.vector)
+    search = _Search(sol.dist.omega_xy, sol.dist.omega_z, limits, 1.0 / sc.controller.ancillary_rate_hz,
+                     (0.13, 0.046), 1024, sol.dist.yaw_rate_error, True, 0.2, fits)
+    series = 0
+    for surge, yaw in _candidates(limits, sol.dist.omega_xy):
+        law = search._law(surge, yaw, 0.5)
+        ratios = [float(fits(*search._candidate(law, float(level), MIN_SHAPE))) for level in search._levels()]
+        finite = [r for r in ratios if math.isfinite(r)]
+        assert len(finite) > 10
+        assert all(b <= a for a, b in zip(ratios, ratios[1:]) if math.isfinite(a)), (surge, ratios)
+        series += 1
+    assert series >= 3

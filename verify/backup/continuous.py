@@ -34,7 +34,8 @@ from tubekit.model.backup import SafeSet, StationKeeping
 from verify.theorem.design import Condition
 from verify.kernel.intervals import bisect_sup, enclose, lower, upper
 
-__all__ = ["continuous_rate_bound", "continuous_rate_sampled", "continuous_rate_sampled_shapes", "unstable_condition", "cone_angle",
+__all__ = ["continuous_rate_bound", "continuous_rate_sampled", "continuous_rate_sampled_shapes", "continuous_best_shape",
+           "COARSE_STRIDE", "unstable_condition", "cone_angle",
            "shape_enclosure", "yaw_shape_enclosure"]
 
 _PI_UP = math.nextafter(math.pi, math.inf)
@@ -159,16 +160,18 @@ def _profiles(law: StationKeeping, x: np.ndarray) -> tuple[np.ndarray, np.ndarra
     return 0.5 * (1.0 - np.cos(arg)), slope, rho
 
 
-def continuous_rate_sampled_shapes(law: StationKeeping, level: float, shapes: np.ndarray, omega_xy: float,
-                                   n: int = 1441, yaw_err: float = 0.0) -> np.ndarray:
-    """The largest V̇ (m/s) at sampled x ∈ [0, π] with the input of the same instant (no hold) and the worst ω, for
-    every shape β of ``shapes`` at the level ``level`` (m), at once (the design's filter):
-    −u_b cos²x + ω̄_xy √(1 + (g/d)²) + g (−k ρ + u_b cos x sin x / d) + |g| E_r, d = c − β a, g = β a'."""
+def _sampled_terms(law: StationKeeping, n: int) -> tuple[np.ndarray, ...]:
+    """(a, a', −u_b cos²x, −k ρ, u_b cos x sin x) at the n sampled x ∈ [0, π] (the design's filter)."""
     x = np.linspace(0.0, math.pi, n)
     a, slope, rho = _profiles(law, x)
     cos = np.cos(x)
-    radial = -law.surge * cos ** 2
-    turn, along = -law.yaw_rate * rho, law.surge * cos * np.sin(x)
+    return a, slope, -law.surge * cos ** 2, -law.yaw_rate * rho, law.surge * cos * np.sin(x)
+
+
+def _rates_at(terms: tuple[np.ndarray, ...], level: float, shapes: np.ndarray, omega_xy: float,
+              yaw_err: float) -> np.ndarray:
+    """V̇ (m/s) of :func:`continuous_rate_sampled_shapes` for every shape (rows) and sample of ``terms`` (columns)."""
+    a, slope, radial, turn, along = terms
     beta = np.asarray(shapes, dtype=float)[:, None]
     d = level - beta * a                       # (shapes, n)
     g = beta * slope
@@ -185,7 +188,40 @@ def continuous_rate_sampled_shapes(law: StationKeeping, level: float, shapes: np
     ratio *= omega_xy
     rate += ratio
     rate += radial
-    return rate.max(axis=1)
+    return rate
+
+
+def continuous_rate_sampled_shapes(law: StationKeeping, level: float, shapes: np.ndarray, omega_xy: float,
+                                   n: int = 1441, yaw_err: float = 0.0) -> np.ndarray:
+    """The largest V̇ (m/s) at sampled x ∈ [0, π] with the input of the same instant (no hold) and the worst ω, for
+    every shape β of ``shapes`` at the level ``level`` (m), at once (the design's filter):
+    −u_b cos²x + ω̄_xy √(1 + (g/d)²) + g (−k ρ + u_b cos x sin x / d) + |g| E_r, d = c − β a, g = β a'."""
+    return _rates_at(_sampled_terms(law, n), level, shapes, omega_xy, yaw_err).max(axis=1)
+
+
+#: Every COARSE_STRIDE-th sample is evaluated for every shape first (:func:`continuous_best_shape`).
+COARSE_STRIDE = 16
+
+
+def continuous_best_shape(law: StationKeeping, level: float, shapes: np.ndarray, omega_xy: float,
+                          n: int = 1441, yaw_err: float = 0.0) -> tuple[int, float]:
+    """(i, m): the first index of the smallest value m of :func:`continuous_rate_sampled_shapes`, the same
+    numbers, with the full grid evaluated only for the shapes that can attain it.
+
+    The maximum over every :data:`COARSE_STRIDE`-th sample is a lower bound of the maximum over all of them
+    (the same floats: the terms are computed once and indexed). The shape with the smallest coarse value gives
+    an attained maximum M; a shape whose coarse value exceeds M cannot attain the minimum, so only the shapes
+    with coarse value <= M are evaluated on every sample.
+    """
+    terms = _sampled_terms(law, n)
+    shapes = np.asarray(shapes, dtype=float)
+    coarse = _rates_at(tuple(t[::COARSE_STRIDE] for t in terms), level, shapes, omega_xy, yaw_err).max(axis=1)
+    first = int(np.argmin(coarse))
+    bound = float(_rates_at(terms, level, shapes[first:first + 1], omega_xy, yaw_err).max())
+    keep = np.flatnonzero(coarse <= bound)
+    full = _rates_at(terms, level, shapes[keep], omega_xy, yaw_err).max(axis=1)
+    j = int(np.argmin(full))
+    return int(keep[j]), float(full[j])
 
 
 def continuous_rate_sampled(law: StationKeeping, safe: SafeSet, omega_xy: float, n: int = 1441,

@@ -12,8 +12,14 @@ the loop error that the candidate's command rate causes to the error the disturb
 ``fits < 1``, scanning the levels on the coarser :data:`GENTLE_LEVEL_STEP` grid up to
 :data:`GENTLE_MAX_LEVEL`; ``fits`` is evaluated before the (costly) proof, so only a design that fits is proved.
 Every smoothing length (fades, ramp, heave band) shrinks as β grows, so the command is gentlest at the smallest
-β of the grid: a level where even that does not fit is skipped before its shape is searched. When none fits it
-returns the candidate with the smallest ratio, proved (certified or not), so the caller can say by how much.
+β of the grid: a level where even that does not fit is *hopeless* and skipped before its shape is searched. The
+levels grow gentler as they grow (longer fades and ramp), so the hopeless levels of a law are taken to be a
+prefix of the grid and the first level that is not is found by bisection (:meth:`_Search.first_fitting`: about
+six evaluations of ``fits`` per law instead of one per level). That is a property of the search, not of the
+proof: measured on the shipped dynamic scenario that reaches the search (70 series of levels, not one ratio rising
+with the level; ``tests/test_verify_vehicle_compose.py``), and where it failed the search would only return a larger safe set, proved like
+any other. When none fits it returns the candidate with the smallest ratio, proved (certified or not), so the
+caller can say by how much.
 
 The smooth designs' yaw bands are :data:`SMOOTH_BAND_FRACTIONS` of the unstable angle χ_u (the widest band
 χ_u/2 is the gentlest yaw command: the command's rate grows like k (k + E_r)/χ_0), then :data:`NARROW_YAW_BAND`.
@@ -29,7 +35,7 @@ from flint import arb
 
 from tubekit.model.backup import SafeSet, StationKeeping
 from tubekit.validation import nonnegative, positive
-from verify.backup.continuous import cone_angle, continuous_rate_sampled_shapes
+from verify.backup.continuous import cone_angle, continuous_best_shape
 from verify.backup.proof import BACKUP_MAX_BOXES, certify_backup, ramp_window, rate_sampled, tick_distance
 from verify.backup.protocol import BackupCertificate, Fits
 from verify.kernel.intervals import lower, upper
@@ -104,6 +110,7 @@ class _Search:
     last: BackupCertificate | None = None
     closest: tuple[float, StationKeeping, SafeSet] | None = None
     hopeless: list[tuple[float, StationKeeping, float]] = dataclasses.field(default_factory=list)
+    ratios: dict[tuple[StationKeeping, float], float] = dataclasses.field(default_factory=dict)
 
     def _levels(self) -> np.ndarray:
         if self.fits is not None:
@@ -142,11 +149,29 @@ class _Search:
         does not fit at ``level``; then no β does, and the level is only remembered for :meth:`fallback`."""
         if self.fits is None:
             return False
-        trial, safe = self._candidate(law, level, MIN_SHAPE)
-        ratio = float(self.fits(trial, safe))
-        if ratio >= 1.0:
-            self.hopeless.append((ratio, law, level))
-        return ratio >= 1.0
+        if (law, level) not in self.ratios:
+            trial, safe = self._candidate(law, level, MIN_SHAPE)
+            ratio = float(self.fits(trial, safe))
+            self.ratios[(law, level)] = ratio
+            if ratio >= 1.0:
+                self.hopeless.append((ratio, law, level))
+        return self.ratios[(law, level)] >= 1.0
+
+    def first_fitting(self, law: StationKeeping, levels: np.ndarray) -> int | None:
+        """Index of the first of ``levels`` (ascending, m) that is not hopeless for ``law``, by bisection on the
+        hopeless prefix (module doc); None when the last level is hopeless too (then no level fits)."""
+        if self.fits is None:
+            return 0 if len(levels) else None
+        if len(levels) == 0 or self._hopeless(law, float(levels[-1])):
+            return None
+        lo, hi = 0, len(levels) - 1  # levels[hi] is not hopeless
+        while lo < hi:
+            mid = (lo + hi) // 2
+            if self._hopeless(law, float(levels[mid])):
+                lo = mid + 1
+            else:
+                hi = mid
+        return lo
 
     def _candidate(self, law: StationKeeping, level: float, shape: float) -> tuple[StationKeeping, SafeSet]:
         safe = SafeSet(level=float(level), shape=shape, depth=self._depth()[1])
@@ -157,11 +182,14 @@ class _Search:
     def run(self, band: float | None) -> BackupCertificate | None:
         """The smallest certified (and fitting) design with yaw band ``band`` (a fraction of χ_u; None: narrow)."""
         best: BackupCertificate | None = None
+        grid = self._levels()
         for surge, yaw in _candidates(self.limits, self.wxy):
             law = self._law(surge, yaw, band)
-            for level in self._levels():
-                if best is not None and level >= best.safe_set.level:
-                    break
+            levels = grid if best is None else grid[grid < best.safe_set.level]
+            start = self.first_fitting(law, levels)
+            if start is None:
+                continue
+            for level in levels[start:]:
                 if self._hopeless(law, float(level)):
                     continue
                 shape = _best_shape(law, float(level), self.wxy, self.handover[0], self.e_r)
@@ -227,14 +255,13 @@ def _smoothed(law: StationKeeping, safe: SafeSet, wxy: float, wz: float, h: floa
 def _best_shape(law: StationKeeping, level: float, omega_xy: float, handover: float,
                 yaw_err: float = 0.0) -> float | None:
     """The shape β on a grid with the most negative sampled level-set rate at ``level``, or None (the continuous
-    law's shapes evaluated at once, :func:`verify.backup.continuous.continuous_rate_sampled_shapes`)."""
+    law's shapes evaluated at once and pruned, :func:`verify.backup.continuous.continuous_best_shape`)."""
     shapes = np.round(np.arange(MIN_SHAPE, level - handover, MIN_SHAPE), 6)
     if law.yaw_law == "continuous":
         if shapes.size == 0:
             return None
-        rates = continuous_rate_sampled_shapes(law, level, shapes, omega_xy, yaw_err=yaw_err)
-        i = int(np.argmin(rates))
-        return float(shapes[i]) if rates[i] < 0.0 else None
+        i, rate = continuous_best_shape(law, level, shapes, omega_xy, yaw_err=yaw_err)
+        return float(shapes[i]) if rate < 0.0 else None
     best, value = None, 0.0
     for shape in shapes:
         rate = rate_sampled(law, SafeSet(level=level, shape=float(shape), depth=1.0), omega_xy, yaw_err=yaw_err)

@@ -12,7 +12,8 @@ Modules, from the contract outwards:
 * :mod:`~tubekit.fhocp.options` — :class:`ScpOptions`, the SCP solver's validated options;
 * :mod:`~tubekit.fhocp.scp` — :class:`FHOCP`: SCP loop, trust region, fallback;
 * :mod:`~tubekit.fhocp.ipopt` — :class:`IpoptFHOCP`, the CasADi + IPOPT peer (optional);
-* :mod:`~tubekit.fhocp.registry` — the FHOCP backends by name (``"scp"``, ``"ipopt"``, ``"scp-piqp"``):
+* :mod:`~tubekit.fhocp.registry` — the FHOCP backends by name (``"scp"``, ``"ipopt"``, ``"scp-piqp"``,
+  ``"scp-qoco"``):
   :func:`make_solver`.
 """
 

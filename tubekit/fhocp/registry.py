@@ -7,7 +7,9 @@ Built in:
 * ``"ipopt"`` — :class:`tubekit.fhocp.ipopt.IpoptFHOCP`, the CasADi + IPOPT peer (optional:
   without CasADi, :class:`~tubekit.exceptions.NotAvailableError` with the install hint);
 * ``"scp-piqp"`` — the SCP solver with ``ScpOptions(qp_solver="piqp")``: PIQP on the QP relaxation,
-  checked against the cones, else Clarabel (:mod:`tubekit.fhocp.qp.relaxed`; opt-in, needs PIQP).
+  checked against the cones, else Clarabel (:mod:`tubekit.fhocp.qp.relaxed`; opt-in, needs PIQP);
+* ``"scp-qoco"`` — the SCP solver with ``ScpOptions(qp_solver="qoco")``: QOCO on the whole cone program
+  (:mod:`tubekit.fhocp.qp.qoco`; opt-in, needs QOCO).
 
 The closed loop builds its solver with :func:`make_solver` from
 ``scenario.controller.fhocp_backend``; :func:`register_backend` adds a backend.
@@ -52,7 +54,13 @@ def _scp_piqp(scenario: Scenario, tightening: Tightening) -> FhocpSolver:
     return FHOCP(scenario, tightening, options=ScpOptions(qp_solver="piqp"))
 
 
-_BACKENDS: dict[str, SolverFactory] = {"scp": _scp, "ipopt": _ipopt, "scp-piqp": _scp_piqp}
+def _scp_qoco(scenario: Scenario, tightening: Tightening) -> FhocpSolver:
+    """The SCP solver whose subproblems QOCO solves (cones taken natively)."""
+    get_qp_backend("qoco", "backend")  # NotAvailableError with the install hint before anything is built
+    return FHOCP(scenario, tightening, options=ScpOptions(qp_solver="qoco"))
+
+
+_BACKENDS: dict[str, SolverFactory] = {"scp": _scp, "ipopt": _ipopt, "scp-piqp": _scp_piqp, "scp-qoco": _scp_qoco}
 
 
 def backends() -> tuple[str, ...]:

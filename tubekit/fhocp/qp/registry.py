@@ -1,4 +1,5 @@
-"""The QP backends by name, registered by try-import: ``"clarabel"`` (default, cones) and ``"piqp"`` (no cones).
+"""The QP backends by name, registered by try-import: ``"clarabel"`` (default, cones), ``"piqp"`` (no cones) and
+``"qoco"`` (cones).
 
 Every built-in backend is registered when this module is imported, whether its package is installed
 or not: a backend imports its package only in :meth:`QpBackend.load` (a try-import), so a missing
@@ -17,6 +18,7 @@ from tubekit.exceptions import ConfigError
 from tubekit.fhocp.qp.base import QpBackend
 from tubekit.fhocp.qp.clarabel import ClarabelBackend
 from tubekit.fhocp.qp.piqp import PiqpBackend
+from tubekit.fhocp.qp.qoco import QocoBackend
 from tubekit.fhocp.qp.relaxed import RelaxedQpBackend
 
 __all__ = ["DEFAULT_QP_BACKEND", "register_qp_backend", "qp_backends", "qp_backend_names", "get_qp_backend",
@@ -106,5 +108,5 @@ def make_qp_backend(backend: str | QpBackend = DEFAULT_QP_BACKEND,
     return RelaxedQpBackend(backend, get_qp_backend(DEFAULT_QP_BACKEND, field)(per.get(DEFAULT_QP_BACKEND)))
 
 
-for _builtin in (ClarabelBackend, PiqpBackend):
+for _builtin in (ClarabelBackend, PiqpBackend, QocoBackend):
     register_qp_backend(_builtin)

@@ -68,7 +68,7 @@ def test_the_transits_safe_tier_goes_past_the_first_rock_instead_of_holding_behi
     """Was a counterexample: the safe-only tightening shrank R's heading room by the margins of the tracking design
     that did not certify (|e_o| <= 0.19 of R's 0.5), so from t ≈ 30 s every plan could only move into the first
     rock's terminal footprint or away from the target, and the backup held the vehicle behind the rock (30 s of
-    the first 60). With R's bounds at the FHOCP's nodes the plans go round the rock. Measured: 3.4 s of backup in
+    the first 60). With R's bounds at the FHOCP's nodes the plans go round the rock. Measured: 3.5 s of backup in
     150 s (``benchmarks/mission.py --only transit``); asserted here on the first 60 s, with room."""
     sc = MISSION.transit().with_changes(duration=60.0)
     cert = verify.certify(sc)

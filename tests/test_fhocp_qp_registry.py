@@ -117,8 +117,9 @@ def test_a_registered_backend_is_selected_by_name(private_registry):
     assert type(mine.subproblem.compiled.backend) is Delegate
     for t, s in STATES[:3]:
         a, b = ref.solve(t, np.array(s), SC.obstacles), mine.solve(t, np.array(s), SC.obstacles)
-        # Clarabel under another name (without the SCP's Clarabel settings, which go to "clarabel" only)
-        np.testing.assert_allclose(b.inputs, a.inputs, atol=1e-5)
+        # Clarabel under another name (without the SCP's Clarabel settings, which go to "clarabel" only: the
+        # real-time mode's 1e-6 against Clarabel's own 1e-8)
+        np.testing.assert_allclose(b.inputs, a.inputs, atol=1e-4)
     register_qp_backend(_named("mine"), replace=True)
     assert get_qp_backend("mine").__name__ == "Named"
 

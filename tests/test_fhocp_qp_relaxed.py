@@ -123,10 +123,12 @@ def test_the_piqp_path_returns_clarabels_plans_on_the_run_states():
             alt._plan_t, alt._plan_inputs = ref._plan_t, ref._plan_inputs
             a = ref.solve(t + dt, np.asarray(s), SC.obstacles)
             b = alt.solve(t + dt, np.asarray(s), SC.obstacles)
-            np.testing.assert_allclose(b.inputs, a.inputs, atol=1e-5)
+            # PIQP at 1e-9 against the real-time mode's Clarabel at 1e-6 (REALTIME_CLARABEL_SETTINGS)
+            np.testing.assert_allclose(b.inputs, a.inputs, atol=1e-4)
             # cold starts run the converged loop: the tolerance 1e-5 on its stopping test, with exact
-            # penalties of weight 1e3, leaves the merit equal to ~1e-4 between two solvers
-            assert b.merit == pytest.approx(a.merit, rel=1e-4)
+            # penalties of weight 1e3, leaves the merit equal to ~1e-4 between two solvers; the real-time
+            # Clarabel at 1e-6 adds up to ~2e-4 (measured 2.1e-4 on these states)
+            assert b.merit == pytest.approx(a.merit, rel=1e-3)
             assert not b.fallback
     backend = alt.subproblem.compiled.backend
     assert backend.relaxed_solves > 0 and backend.cone_solves > 0

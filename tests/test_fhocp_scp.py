@@ -324,7 +324,8 @@ def rated():
 @settings(max_examples=20)
 def test_every_plan_meets_the_rate_rows_from_any_last_command(rated, v_last, case, mode):
     """Property: from any v_last inside V, the plan meets (a) steps, (b) the first node and (c) the terminal
-    rest against J, within the solver's tolerance (Clarabel's 1e-7) below the imposed J (1 - RATE_MARGIN)."""
+    rest against J, within 1e-7 of the imposed J (1 - RATE_MARGIN) (Clarabel's tolerance is 1e-7 in the converged
+    mode and 1e-6 in the real-time one; the rows' own scale keeps both within 1e-7 here)."""
     solver = rated[mode]
     solver.reset()
     t, s = STATES[case]

@@ -19,7 +19,7 @@ Modules, from the contract outwards:
 
 from __future__ import annotations
 
-from tubekit.fhocp.convex import DEFAULT_CLARABEL_SETTINGS, ConvexSubproblem
+from tubekit.fhocp.convex import DEFAULT_CLARABEL_SETTINGS, REALTIME_CLARABEL_SETTINGS, ConvexSubproblem
 from tubekit.fhocp.fastpath import CompiledConeProgram
 from tubekit.fhocp.ipopt import IpoptFHOCP
 from tubekit.fhocp.nlp import FhocpNlp, NlpEvaluation
@@ -29,6 +29,6 @@ from tubekit.fhocp.registry import backends, get_backend, make_solver, register_
 from tubekit.fhocp.scp import FHOCP, MODES, obstacle_slots
 
 __all__ = ["FHOCP", "ScpOptions", "FhocpResult", "FallbackWarning", "MODES", "obstacle_slots",
-           "DEFAULT_CLARABEL_SETTINGS", "Status", "RESULT_STATUSES", "shifted_plan", "IpoptFHOCP", "FhocpNlp",
+           "DEFAULT_CLARABEL_SETTINGS", "REALTIME_CLARABEL_SETTINGS", "Status", "RESULT_STATUSES", "shifted_plan", "IpoptFHOCP", "FhocpNlp",
            "NlpEvaluation", "ConvexSubproblem", "CompiledConeProgram", "backends", "get_backend", "make_solver",
            "register_backend"]

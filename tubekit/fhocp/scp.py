@@ -41,7 +41,7 @@ from tubekit.exceptions import ConfigError
 from tubekit.scenario import FhocpMode, Obstacle, Scenario
 from tubekit.tightening import Tightening
 from tubekit.validation import as_vector, choice, finite
-from tubekit.fhocp.convex import ConvexSubproblem
+from tubekit.fhocp.convex import REALTIME_CLARABEL_SETTINGS, ConvexSubproblem
 from tubekit.fhocp.fastpath import CompiledConeProgram
 from tubekit.fhocp.nlp import FhocpNlp, NlpEvaluation, rollout, select_obstacles
 from tubekit.fhocp.options import ScpOptions
@@ -192,9 +192,16 @@ class FHOCP:
         s0 = np.asarray(scenario.initial_state, dtype=float)
         self.subproblem = ConvexSubproblem(self.nlp, self.max_obstacles, s0,
                                            self.nlp.reference(scenario.trajectory, 0.0), self.trust_radius,
-                                           fast_path=self.fast_path, clarabel_settings=opts.clarabel_overrides(),
+                                           fast_path=self.fast_path, clarabel_settings=self._clarabel_settings(opts),
                                            qp_backend=opts.qp_solver)
         self.build_time_s = time.perf_counter() - t0
+
+    def _clarabel_settings(self, opts: ScpOptions) -> dict | None:
+        """Clarabel's overrides: :data:`~tubekit.fhocp.convex.REALTIME_CLARABEL_SETTINGS` in the real-time mode,
+        then the user's (``opts.clarabel_settings``)."""
+        if self.mode is not FhocpMode.REALTIME:
+            return opts.clarabel_overrides()
+        return {**REALTIME_CLARABEL_SETTINGS, **(opts.clarabel_overrides() or {})}
 
     def _check_workspace(self) -> None:
         """The subproblem keeps one wall row per axis: the workspace must be wide enough for that."""

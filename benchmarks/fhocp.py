@@ -22,8 +22,9 @@ Usage::
    calls, or the CasADi ``nlpsol`` call).
 
 Methods: ``scp_realtime`` (ours, one convex solve), ``scp_converged`` (ours, SCP
-to convergence), opt-in beside them ``scp_realtime_piqp`` (``--piqp``), ``scp_realtime_qoco`` (``--qoco``: the
-QOCO backend) and ``scp_realtime_tuned`` (``--clarabel-tuned``: Clarabel at 1e-6 without refinement), ``ipopt`` (CasADi + IPOPT, tuned: tol 1e-8, adaptive mu,
+to convergence), opt-in beside them ``scp_realtime_piqp`` (``--piqp``), ``scp_realtime_qoco``
+(``--qoco``: the QOCO backend) and ``scp_realtime_tuned`` (``--clarabel-tuned``: Clarabel at 1e-6
+without refinement), ``ipopt`` (CasADi + IPOPT, tuned: tol 1e-8, adaptive mu,
 warm start with multipliers), ``sqpmethod_qrqp`` (CasADi ``sqpmethod``, exact
 Hessian with eigenvalue clipping, ``qrqp``).
 

@@ -10,7 +10,8 @@ the free e_d band, narrower widths; everything else as shipped). For every set w
 (inputs, invariance, region: ``law_conditions``), two lower bounds of how far one period's replay deviation alone
 (D_xy, D_ψ of the certified one-period tube) moves the law's row, at a state of X_f with d = d_lo:
 
-* yaw: r = −g α / δ, and the deviation turns α by D_ψ + atan(D_xy / d_lo): |Δr| >= g (D_ψ + atan(D_xy / d_lo)) / δ;
+* yaw: r = −g α / δ, and the deviation turns α by D_ψ + atan(D_xy / d_lo):
+  |Δr| >= g (D_ψ + atan(D_xy / d_lo)) / δ;
 * surge: u = (V_r + λ (d − d*)) / (S cos) with S cos <= 1, and the deviation moves d by D_xy: |Δu| >= λ D_xy.
 
 Where both exceed J for every invariant set, no plan check can make the memoryless law's completion meet the rate

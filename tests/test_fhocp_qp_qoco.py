@@ -79,4 +79,4 @@ def test_the_iteration_cap_is_a_user_limit_without_a_solution():
 def test_unknown_settings_are_named():
     assert QocoBackend({"abstol": 1e-6}).solve(_qp([3.0, 1.0])).status is Status.OPTIMAL
     with pytest.raises(ConfigError, match=r"^qoco settings: expected names of QOCO settings"):
-        QocoBackend({"tolerance": 1e-6}).solve(_qp([3.0, 1.0]))
+        QocoBackend({"tolerance": 1e-6})  # refused when built, before any solve

@@ -29,6 +29,6 @@ from tubekit.fhocp.registry import backends, get_backend, make_solver, register_
 from tubekit.fhocp.scp import FHOCP, MODES, obstacle_slots
 
 __all__ = ["FHOCP", "ScpOptions", "FhocpResult", "FallbackWarning", "MODES", "obstacle_slots",
-           "DEFAULT_CLARABEL_SETTINGS", "REALTIME_CLARABEL_SETTINGS", "Status", "RESULT_STATUSES", "shifted_plan", "IpoptFHOCP", "FhocpNlp",
-           "NlpEvaluation", "ConvexSubproblem", "CompiledConeProgram", "backends", "get_backend", "make_solver",
-           "register_backend"]
+           "DEFAULT_CLARABEL_SETTINGS", "REALTIME_CLARABEL_SETTINGS", "Status", "RESULT_STATUSES", "shifted_plan",
+           "IpoptFHOCP", "FhocpNlp", "NlpEvaluation", "ConvexSubproblem", "CompiledConeProgram", "backends",
+           "get_backend", "make_solver", "register_backend"]

@@ -34,9 +34,9 @@ from tubekit.model.backup import SafeSet, StationKeeping
 from verify.theorem.design import Condition
 from verify.kernel.intervals import bisect_sup, enclose, lower, upper
 
-__all__ = ["continuous_rate_bound", "continuous_rate_sampled", "continuous_rate_sampled_shapes", "continuous_best_shape",
-           "COARSE_STRIDE", "unstable_condition", "cone_angle",
-           "shape_enclosure", "yaw_shape_enclosure"]
+__all__ = ["continuous_rate_bound", "continuous_rate_sampled", "continuous_rate_sampled_shapes",
+           "continuous_best_shape", "COARSE_STRIDE", "unstable_condition", "cone_angle", "shape_enclosure",
+           "yaw_shape_enclosure"]
 
 _PI_UP = math.nextafter(math.pi, math.inf)
 

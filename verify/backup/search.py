@@ -16,10 +16,10 @@ Every smoothing length (fades, ramp, heave band) shrinks as β grows, so the com
 levels grow gentler as they grow (longer fades and ramp), so the hopeless levels of a law are taken to be a
 prefix of the grid and the first level that is not is found by bisection (:meth:`_Search.first_fitting`: about
 six evaluations of ``fits`` per law instead of one per level). That is a property of the search, not of the
-proof: measured on the shipped dynamic scenario that reaches the search (70 series of levels, not one ratio rising
-with the level; ``tests/test_verify_vehicle_compose.py``), and where it failed the search would only return a larger safe set, proved like
-any other. When none fits it returns the candidate with the smallest ratio, proved (certified or not), so the
-caller can say by how much.
+proof: measured on the shipped dynamic scenario that reaches the search (70 series of levels, not one ratio
+rising with the level; ``tests/test_verify_vehicle_compose.py``), and where it failed the search would only
+return a larger safe set, proved like any other. When none fits it returns the candidate with the smallest
+ratio, proved (certified or not), so the caller can say by how much.
 
 The smooth designs' yaw bands are :data:`SMOOTH_BAND_FRACTIONS` of the unstable angle χ_u (the widest band
 χ_u/2 is the gentlest yaw command: the command's rate grows like k (k + E_r)/χ_0), then :data:`NARROW_YAW_BAND`.

@@ -51,6 +51,10 @@ class QocoBackend(QpBackend):
     def __init__(self, settings: Mapping[str, Any] | None = None) -> None:
         super().__init__(settings)
         self._qoco = self.load()
+        known = {k for k in dir(self._qoco.QOCO().ext.QOCOSettings()) if not k.startswith("_")}
+        for key in self.settings:
+            if key not in known:
+                raise ConfigError("qoco settings", "names of QOCO settings", key)
         self._solver: Any = None
         self._key: Any = None
         self._blocks: tuple | None = None
@@ -86,14 +90,10 @@ class QocoBackend(QpBackend):
                                 int(result.iters), data.n)
 
     def _setup(self, data: ConeProgramData, a_vals: np.ndarray, g_vals: np.ndarray) -> None:
-        """A new ``qoco.QOCO`` on ``data`` with :attr:`settings` (an unknown setting is a ConfigError)."""
+        """A new ``qoco.QOCO`` on ``data`` with :attr:`settings` (their names checked when the backend was built)."""
         (_, ie, qe), (_, ig, qg) = self._blocks
         zero, dims = data.dims.zero, data.dims
         solver = self._qoco.QOCO()
-        known = {k for k in dir(solver.ext.QOCOSettings()) if not k.startswith("_")}
-        for key in self.settings:
-            if key not in known:
-                raise ConfigError("qoco settings", "names of QOCO settings", key)
         a = sp.csc_matrix((a_vals, ie, qe), shape=(zero, data.n)) if zero else None
         g = sp.csc_matrix((g_vals, ig, qg), shape=(data.m - zero, data.n))
         solver.setup(data.n, data.m - zero, zero, data.P(), np.asarray(data.q, dtype=float), a,

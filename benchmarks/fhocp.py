@@ -22,9 +22,9 @@ Usage::
    calls, or the CasADi ``nlpsol`` call).
 
 Methods: ``scp_realtime`` (ours, one convex solve), ``scp_converged`` (ours, SCP
-to convergence), opt-in beside them ``scp_realtime_piqp`` (``--piqp``), ``scp_realtime_qoco``
-(``--qoco``: the QOCO backend) and ``scp_realtime_tuned`` (``--clarabel-tuned``: Clarabel at 1e-6
-without refinement), ``ipopt`` (CasADi + IPOPT, tuned: tol 1e-8, adaptive mu,
+to convergence), opt-in beside them (:data:`OPT_IN`) ``scp_realtime_piqp`` (``--piqp``),
+``scp_realtime_qoco`` (``--qoco``: the QOCO backend) and ``scp_realtime_1e7`` (``--clarabel-1e7``:
+Clarabel at 1e-7 with refinement, the real-time setting before ``REALTIME_CLARABEL_SETTINGS``), ``ipopt`` (CasADi + IPOPT, tuned: tol 1e-8, adaptive mu,
 warm start with multipliers), ``sqpmethod_qrqp`` (CasADi ``sqpmethod``, exact
 Hessian with eigenvalue clipping, ``qrqp``).
 
@@ -71,8 +71,15 @@ PEER_KEYS = ("median_ms", "p90_ms", "p99_ms", "failures", "cost_gap_max", "conve
 #: IPOPT's tuning (beside warm_start_duals=True): adaptive mu was the fastest of monotone / adaptive /
 #: tol 1e-6 on 300 states (3.5 ms against 5.0 and 4.1 ms median), at the same optimum.
 IPOPT_TUNING = {"mu_strategy": "adaptive"}
-#: Clarabel at 1e-6 without iterative refinement: the candidate setting of ``benchmarks/clarabel_settings.py``.
-TUNED_CLARABEL = {"tol_gap_abs": 1e-6, "tol_gap_rel": 1e-6, "tol_feas": 1e-6, "iterative_refinement_enable": False}
+#: Clarabel at 1e-7 with iterative refinement: the real-time mode's setting before
+#: :data:`tubekit.fhocp.convex.REALTIME_CLARABEL_SETTINGS` (``benchmarks/clarabel_settings.py`` chose that one).
+CLARABEL_1E7 = {"tol_gap_abs": 1e-7, "tol_gap_rel": 1e-7, "tol_feas": 1e-7, "iterative_refinement_enable": True}
+#: The opt-in methods beside ours: flag -> (method name, ScpOptions changes, table label); each the real-time SCP.
+OPT_IN: dict[str, tuple[str, dict, str]] = {
+    "piqp": ("scp_realtime_piqp", {"qp_solver": "piqp"}, "real-time SCP, PIQP path"),
+    "qoco": ("scp_realtime_qoco", {"qp_solver": "qoco"}, "real-time SCP, QOCO backend"),
+    "clarabel_1e7": ("scp_realtime_1e7", {"clarabel_settings": CLARABEL_1E7}, "real-time SCP, Clarabel 1e-7"),
+}
 
 
 def benchmark_tightening(scenario: Scenario) -> Tightening:
@@ -138,8 +145,7 @@ def _versions() -> dict:
 
 def make_methods(scenario: Scenario, tightening: Tightening, slots: int | None = None,
                  with_casadi: bool = True, rate_penalty: float = DEFAULT_RATE_PENALTY,
-                 with_piqp: bool = False, with_qoco: bool = False,
-                 with_tuned: bool = False) -> dict[str, tuple[object, bool]]:
+                 opt_in: tuple[str, ...] = ()) -> dict[str, tuple[object, bool]]:
     """{name: (solver, converged?)}: ours and the CasADi peers, all on one problem: the same obstacle slots
     and the same rate penalty lambda (s). ``sqpmethod`` joins only at ``rate_penalty == 0``: its QP solver
     (qrqp, eigen-clip) fails on the rate penalty's node-to-node coupling, so it cannot solve the same problem."""
@@ -150,15 +156,10 @@ def make_methods(scenario: Scenario, tightening: Tightening, slots: int | None =
     methods: dict[str, tuple[object, bool]] = {
         "scp_realtime": (rt, False),
         "scp_converged": (FHOCP(scenario, tightening, mode="converged", options=opts), True)}
-    if with_piqp:  # the opt-in QP path (tubekit.fhocp.qp.relaxed), real-time mode
-        methods["scp_realtime_piqp"] = (FHOCP(scenario, tightening, mode="realtime", options=dataclasses.replace(
-            opts, qp_solver="piqp")), False)
-    if with_qoco:  # the opt-in cone backend (tubekit.fhocp.qp.qoco), real-time mode
-        methods["scp_realtime_qoco"] = (FHOCP(scenario, tightening, mode="realtime", options=dataclasses.replace(
-            opts, qp_solver="qoco")), False)
-    if with_tuned:  # Clarabel at 1e-6 without iterative refinement (benchmarks/clarabel_settings.py), not the default
-        methods["scp_realtime_tuned"] = (FHOCP(scenario, tightening, mode="realtime", options=dataclasses.replace(
-            opts, clarabel_settings=TUNED_CLARABEL)), False)
+    for flag in opt_in:  # the opt-in methods (OPT_IN), real-time mode
+        name, changes, _ = OPT_IN[flag]
+        methods[name] = (FHOCP(scenario, tightening, mode="realtime", options=dataclasses.replace(opts, **changes)),
+                         False)
     if with_casadi:
         methods["ipopt"] = (IpoptFHOCP(scenario, tightening, max_obstacles=slots, warm_start_duals=True,
                                        ipopt_options=IPOPT_TUNING, rate_penalty=rate_penalty), True)
@@ -232,16 +233,14 @@ def summarize(rec: dict, methods: dict) -> dict[str, dict]:
 
 
 def run(duration: float, with_ipopt: bool = True, profile: bool = False, tolerance: float | None = None,
-        rate_penalty: float = DEFAULT_RATE_PENALTY, with_piqp: bool = False, with_qoco: bool = False,
-        with_tuned: bool = False) -> dict:
+        rate_penalty: float = DEFAULT_RATE_PENALTY, opt_in: tuple[str, ...] = ()) -> dict:
     """Run the benchmark (every method on the problem with rate penalty ``rate_penalty``, s); a JSON-ready dict."""
     sc = paper_scenario()
     tg = benchmark_tightening(sc)
     t0 = time.perf_counter()
     run_states = closed_loop(sc, tg, duration, rate_penalty)
     sim_s = time.perf_counter() - t0
-    methods = make_methods(sc, tg, with_casadi=with_ipopt, rate_penalty=rate_penalty, with_piqp=with_piqp,
-                           with_qoco=with_qoco, with_tuned=with_tuned)
+    methods = make_methods(sc, tg, with_casadi=with_ipopt, rate_penalty=rate_penalty, opt_in=opt_in)
     if tolerance is not None:
         slots = methods["scp_realtime"][0].max_obstacles
         methods["scp_converged"] = (FHOCP(sc, tg, mode="converged", options=ScpOptions(
@@ -293,9 +292,8 @@ def table(res: dict) -> str:
     lines = ["| method | step median ms | p90 | p99 | solver-only median ms | failures | max cost gap |",
              "|---|---|---|---|---|---|---|"]
     label = {"scp_realtime": "real-time SCP step", "scp_converged": "converged SCP", "ipopt": "IPOPT (tuned)",
-             "sqpmethod_qrqp": "CasADi sqpmethod + qrqp", "scp_realtime_piqp": "real-time SCP, PIQP path",
-             "scp_realtime_qoco": "real-time SCP, QOCO backend",
-             "scp_realtime_tuned": "real-time SCP, Clarabel 1e-6 no refinement"}
+             "sqpmethod_qrqp": "CasADi sqpmethod + qrqp",
+             **{name: text for name, _, text in OPT_IN.values()}}
     for n, p in res["peers"].items():
         lines.append(f"| {label.get(n, n)} | {p['median_ms']:.3f} | {p['p90_ms']:.3f} | {p['p99_ms']:.3f} | "
                      f"{p['solver_median_ms']:.3f} | {p['failures']} | {p['cost_gap_max']:.2e} |")
@@ -422,10 +420,8 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--rate-penalty", type=float, default=DEFAULT_RATE_PENALTY,
                     help="the rate penalty lambda (s) of every method's problem (default: the controller's; "
                          "CasADi sqpmethod joins only at 0)")
-    ap.add_argument("--piqp", action="store_true", help="add the real-time SCP with the opt-in PIQP path")
-    ap.add_argument("--qoco", action="store_true", help="add the real-time SCP with the opt-in QOCO backend")
-    ap.add_argument("--clarabel-tuned", action="store_true",
-                    help="add the real-time SCP with Clarabel at 1e-6 without iterative refinement")
+    for flag, (_, _, text) in OPT_IN.items():
+        ap.add_argument(f"--{flag.replace('_', '-')}", dest=flag, action="store_true", help=f"add the {text}")
     ap.add_argument("--no-casadi", action="store_true", help="leave the CasADi peers out")
     ap.add_argument("--per-cell", type=int, default=4, help="warm steps per scaling cell (default 4)")
     args = ap.parse_args(argv)
@@ -438,8 +434,7 @@ def main(argv: list[str] | None = None) -> int:
         print(scaling_table(res))
     else:
         res = run(duration, with_ipopt=with_casadi, profile=args.profile, tolerance=args.tolerance,
-                  rate_penalty=args.rate_penalty, with_piqp=args.piqp, with_qoco=args.qoco,
-                  with_tuned=args.clarabel_tuned)
+                  rate_penalty=args.rate_penalty, opt_in=tuple(f for f in OPT_IN if getattr(args, f)))
         print(table(res))
         if args.profile:
             print(res["details"]["rt_profile"])

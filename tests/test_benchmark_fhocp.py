@@ -59,21 +59,22 @@ def test_every_method_solves_one_problem(lam, with_sqp):
 
 
 def test_the_opt_in_methods_solve_the_same_problem_with_their_own_backend_or_setting():
-    """``--qoco`` adds the real-time SCP on the QOCO backend, ``--clarabel-tuned`` the one with Clarabel at 1e-6
-    without refinement: same rate penalty and slots as ours, and the first state's plans agree to 1e-4."""
+    """``--qoco`` adds the real-time SCP on the QOCO backend, ``--clarabel-1e7`` the one with Clarabel at 1e-7 with
+    refinement (the real-time setting before): same rate penalty and slots as ours, and the first state's plans
+    agree to 1e-4."""
     pytest.importorskip("casadi")
     pytest.importorskip("qoco")
     import numpy as np
     bench = _bench_module()
     from tubekit import paper_scenario
     sc = paper_scenario()
-    methods = bench.make_methods(sc, bench.benchmark_tightening(sc), with_casadi=False, with_qoco=True,
-                                 with_tuned=True)
-    assert set(methods) == {"scp_realtime", "scp_converged", "scp_realtime_qoco", "scp_realtime_tuned"}
+    methods = bench.make_methods(sc, bench.benchmark_tightening(sc), with_casadi=False,
+                                 opt_in=("qoco", "clarabel_1e7"))
+    assert set(methods) == {"scp_realtime", "scp_converged", "scp_realtime_qoco", "scp_realtime_1e7"}
     assert methods["scp_realtime_qoco"][0].options.qp_solver == "qoco"
-    assert dict(methods["scp_realtime_tuned"][0].options.clarabel_settings) == bench.TUNED_CLARABEL
+    assert dict(methods["scp_realtime_1e7"][0].options.clarabel_settings) == bench.CLARABEL_1E7
     x0 = np.asarray(sc.initial_state, dtype=float)
     plans = {n: methods[n][0].solve(0.0, x0.copy(), list(sc.obstacles)).inputs
-             for n in ("scp_realtime", "scp_realtime_qoco", "scp_realtime_tuned")}
-    for name in ("scp_realtime_qoco", "scp_realtime_tuned"):
+             for n in ("scp_realtime", "scp_realtime_qoco", "scp_realtime_1e7")}
+    for name in ("scp_realtime_qoco", "scp_realtime_1e7"):
         assert np.max(np.abs(plans[name] - plans["scp_realtime"])) < 1e-4, name

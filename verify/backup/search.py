@@ -109,7 +109,6 @@ class _Search:
     fits: Fits | None
     last: BackupCertificate | None = None
     closest: tuple[float, StationKeeping, SafeSet] | None = None
-    hopeless: list[tuple[float, StationKeeping, float]] = dataclasses.field(default_factory=list)
     ratios: dict[tuple[StationKeeping, float], float] = dataclasses.field(default_factory=dict)
 
     def _levels(self) -> np.ndarray:
@@ -151,10 +150,7 @@ class _Search:
             return False
         if (law, level) not in self.ratios:
             trial, safe = self._candidate(law, level, MIN_SHAPE)
-            ratio = float(self.fits(trial, safe))
-            self.ratios[(law, level)] = ratio
-            if ratio >= 1.0:
-                self.hopeless.append((ratio, law, level))
+            self.ratios[(law, level)] = float(self.fits(trial, safe))
         return self.ratios[(law, level)] >= 1.0
 
     def first_fitting(self, law: StationKeeping, levels: np.ndarray) -> int | None:
@@ -209,7 +205,9 @@ class _Search:
         ratio at β = :data:`MIN_SHAPE` gets its shape now), else the last refuted one, else the full-speed law at
         level 6 m."""
         family: dict[StationKeeping, tuple[float, float]] = {}
-        for ratio, law, level in self.hopeless:  # each law's gentlest hopeless level
+        for (law, level), ratio in self.ratios.items():  # each law's gentlest hopeless level (in asking order)
+            if ratio < 1.0:
+                continue
             if law not in family or ratio < family[law][0]:
                 family[law] = (ratio, level)
         for law, (ratio, level) in sorted(family.items(), key=lambda t: t[1][0]):

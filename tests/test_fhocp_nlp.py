@@ -139,6 +139,15 @@ def test_the_backup_terminal_rows_come_from_the_tightenings_backup():
     assert bt.safe == pytest.approx((0.8, 0.1)) and bt.sensed_bound == pytest.approx(1.3)
 
 
+def test_the_backup_terminal_rows_give_each_part_the_anchors_reach():
+    """With an anchor that may move 0.25 m from the plan's end, each row is the exact check's part with the anchor
+    moved in its favour: footprint (1.0 - 0.25, 0.3), sphere hypot(0.75, 0.3), the sensed row's radius 0.8 - 0.25."""
+    movable = dataclasses.replace(backup_plan(), anchor_reach=0.25)
+    bt = FhocpNlp.from_scenario(SC, dataclasses.replace(tightening(), backup=movable)).backup_terminal
+    assert bt.footprint == pytest.approx((0.75, 0.3)) and bt.sphere == pytest.approx(math.hypot(0.75, 0.3))
+    assert bt.safe == pytest.approx((0.55, 0.1)) and bt.sensed_bound == pytest.approx(1.3)
+
+
 def test_the_backup_terminal_violation_is_the_worst_row():
     bt = BackupTerminal(sphere=1.0, footprint=(0.9, 0.2), safe=(0.5, 0.1), sensed_bound=2.0)
     p0, pn = np.zeros(3), np.array([1.0, 0.0, 0.0])

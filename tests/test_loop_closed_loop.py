@@ -368,6 +368,29 @@ def test_the_backup_takes_over_when_the_replay_is_exhausted_and_tracking_resumes
     assert metrics["backup_s"] == pytest.approx((25 - (5 + n - 1)) * sc.controller.dt)
 
 
+def test_the_backup_is_anchored_where_the_terminal_condition_placed_it_within_its_reach():
+    """With a backup proved for an anchor up to 0.2 m from the plan's end, the loop anchors it where the accepted
+    plan's terminal condition held: at the plan's depth, within 0.2 m of its end, and not at the end itself (the
+    sensed region's slack grows as the anchor moves back toward the vehicle)."""
+    sc = _scenario(duration=4.0).with_changes(**{"controller.candidate": False})
+    n = sc.controller.horizon_steps
+    movable = dataclasses.replace(BACKUP, anchor_reach=0.2)
+    res = run_closed_loop(sc, tightening=_safe_only(sc, movable), progress=False,
+                          solver_factory=lambda s, t: Pursuit(s, t, nan_at=range(5, 25)))
+    m = res.ticks_per_step
+    state4 = res.states[4 * m]
+    end = state4
+    for v in Pursuit(sc, None).solve(0.4, state4, ()).inputs:
+        end = nominal_arc(end, v, np.array([sc.controller.dt]))[-1]
+    on = res.backup_active[:-1]
+    assert on.sum() == (25 - (5 + n - 1)) * m
+    anchors = np.unique(res.backup_anchor[:-1][on], axis=0)
+    assert anchors.shape == (1, 3)
+    moved = anchors[0] - end[:3]
+    assert moved[2] == 0.0 and 0.1 < math.hypot(moved[0], moved[1]) <= 0.2 * (1 + 1e-12)
+    assert np.dot(moved[:2], state4[:2] - end[:2]) > 0.0                       # toward the vehicle at acceptance
+
+
 def test_the_backup_law_is_the_station_keeping_input_at_every_tick():
     sc = _scenario(duration=2.0).with_changes(**{"controller.candidate": False})
     res = run_closed_loop(sc, tightening=_safe_only(sc), progress=False,

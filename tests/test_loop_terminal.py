@@ -10,11 +10,11 @@ import math
 
 import numpy as np
 import pytest
-from hypothesis import given
+from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from tubekit.exceptions import ConfigError, ShapeError
-from tubekit.loop.terminal import TerminalCheck, cylinder_distance, terminal_condition
+from tubekit.loop.terminal import TerminalCheck, anchor_candidates, cylinder_distance, terminal_condition
 from tubekit.model.backup import BackupPlan, SafeSet, StationKeeping
 from tubekit.scenario import Obstacle
 
@@ -102,3 +102,69 @@ def test_cylinder_distance_is_the_distance_to_its_nearest_point(x, y, z):
     nearest = float(np.min(np.linalg.norm(pts - np.array([x, y, z]), axis=1)))
     d = cylinder_distance(np.array([x, y, z]), np.zeros(3), r, h)
     assert d <= nearest + 1e-12 and nearest - d <= 0.02
+
+
+# ----------------------------------------------------------------------------------- the anchor's reach
+# The same safe set proved for an anchor up to 0.2 m from the plan's end (hand-over 0.35 m = margin 0.15 + 0.2).
+MOVABLE = BackupPlan(BACKUP.law, BACKUP.safe_set, handover=(0.35, 0.1), anchor_reach=0.2)
+
+
+def test_an_obstacle_the_fixed_anchor_touches_is_cleared_by_moving_the_anchor_away():
+    # centre 1.3 m from p*: about p* the footprint (R_f 1.0) leaves 0.3 < 0.4 -> refused; the anchor moved 0.2 m
+    # away leaves 1.5 - 1.0 - 0.4 = 0.1 m (the sensed region, 5 - 0.2 - hypot(0.2 + 0.8, 0.1) = 3.79 m, is slack)
+    obstacle = [Obstacle((1.3, 0.0, 0.0), 0.4)]
+    assert not _check(obstacle).ok
+    res = terminal_condition(P, MOVABLE, 0.2, obstacle, WIDE, P, 5.0)
+    assert res.ok and res.reason == "obstacle 0" and res.slack == pytest.approx(0.1)
+    assert res.anchor == pytest.approx((-0.2, 0.0, 0.0))
+
+
+def test_an_obstacle_beyond_the_reach_is_still_refused():
+    # centre 1.15 m from p*: even 0.2 m away the footprint leaves 1.35 - 1.0 = 0.35 < 0.4
+    res = terminal_condition(P, MOVABLE, 0.2, [Obstacle((1.15, 0.0, 0.0), 0.4)], WIDE, P, 5.0)
+    assert not res.ok and res.slack == pytest.approx(-0.05)
+
+
+def test_two_obstacles_on_either_side_leave_the_anchor_nowhere_to_go():
+    # each alone is cleared by moving away from it; together, moving away from one moves toward the other
+    pair = [Obstacle((1.3, 0.0, 0.0), 0.4), Obstacle((-1.3, 0.0, 0.0), 0.4)]
+    res = terminal_condition(P, MOVABLE, 0.2, pair, WIDE, P, 5.0)
+    assert not res.ok and res.reason.startswith("obstacle")
+
+
+def test_without_reach_the_anchor_is_the_plans_end():
+    res = _check([Obstacle((1.5, 0.0, 0.0), 0.4)], anchor=(1.0, 2.0, 0.5), sensed_at=(1.0, 2.0, 0.5))
+    assert res.anchor == (1.0, 2.0, 0.5)
+    assert anchor_candidates(np.array([1.0, 2.0, 0.5]), 0.0, [], np.zeros(3)).tolist() == [[1.0, 2.0, 0.5]]
+
+
+def test_the_sensed_region_pulls_the_anchor_toward_the_vehicle():
+    # p* 3.5 m ahead of p_k, R_bar 4.4: about p* hypot(3.5 + 0.8, 0.1) = 4.3012 > 4.4 - 0.2 -> refused;
+    # 0.2 m toward p_k, hypot(4.1, 0.1) = 4.1012 <= 4.2
+    assert not terminal_condition((3.5, 0.0, 0.0), BACKUP, 0.2, [], WIDE, P, 4.4).ok
+    res = terminal_condition((3.5, 0.0, 0.0), MOVABLE, 0.2, [], WIDE, P, 4.4)
+    assert res.ok and res.reason == "sensed region" and res.anchor == pytest.approx((3.3, 0.0, 0.0))
+    assert res.slack == pytest.approx(4.2 - math.hypot(4.1, 0.1))
+
+
+@settings(derandomize=True, max_examples=60, deadline=None)
+@given(end=st.tuples(*[st.floats(-3.0, 3.0)] * 2), reach=st.floats(0.0, 0.5),
+       centres=st.lists(st.tuples(st.floats(-4.0, 4.0), st.floats(-4.0, 4.0), st.floats(-1.0, 1.0),
+                                  st.floats(0.1, 0.8)), max_size=4))
+def test_an_accepted_anchor_is_within_reach_and_meets_every_part_about_itself(end, reach, centres):
+    """Property: whatever the obstacles, an ``ok`` check names an anchor at p*'s depth within the reach of p*
+    about which the footprint clears each obstacle, stays in the walls and the safe set is sensed (recomputed
+    here from the cylinder's geometry), and the reported slack is the smallest of those margins."""
+    plan = BackupPlan(BACKUP.law, BACKUP.safe_set, handover=(0.35, 0.1), anchor_reach=reach)
+    end3 = (end[0], end[1], 0.2)
+    obstacles = [Obstacle((x, y, z), r) for x, y, z, r in centres]
+    res = terminal_condition(end3, plan, 0.2, obstacles, WIDE, (0.0, 0.0, 0.0), 6.0)
+    a = np.asarray(res.anchor)
+    assert a[2] == end3[2] and math.hypot(a[0] - end3[0], a[1] - end3[1]) <= reach * (1 + 1e-12) + 1e-12
+    if not res.ok:
+        return
+    parts = [cylinder_distance(np.asarray(o.center), a, 1.0, 0.3) - o.radius for o in obstacles]
+    assert all(p > 0.0 for p in parts)
+    parts += [float(min(np.min(a - (1.0, 1.0, 0.3) - WIDE[0]), np.min(WIDE[1] - a - (1.0, 1.0, 0.3))))]
+    parts += [6.0 - 0.2 - math.hypot(math.hypot(a[0], a[1]) + 0.8, abs(a[2]) + 0.1)]
+    assert min(parts) >= 0.0 and res.slack == pytest.approx(min(parts))

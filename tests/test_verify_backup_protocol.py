@@ -140,10 +140,11 @@ def test_the_theorem_and_the_loop_bound_go_through_the_registry(hover, pc_cert):
     from verify.vehicle.compose import loop_for_law
     sc, dist, margins = pc_cert.inputs.scenario, pc_cert.disturbance, pc_cert.design.margins
     designed = backup_of(sc, dist, margins, kind=Hover.kind)
-    assert hover.calls == ["design"] and type(designed.law) is Hover
+    # designed, then proved again for the anchor's reach (the room the safe set leaves past the margins)
+    assert hover.calls == ["design", "certify"] and type(designed.law) is Hover
     assert designed.safe_set == pc_cert.backup.safe_set and designed.conditions == pc_cert.backup.conditions
-    again = recertify_backup(sc, designed.law, designed.safe_set, dist, margins)
-    assert hover.calls == ["design", "certify"] and again == designed
+    again = recertify_backup(sc, designed.law, designed.safe_set, dist, margins, designed.anchor_reach)
+    assert hover.calls == ["design", "certify", "certify"] and again == designed
     slow = load_scenario("examples/bluerov2_slow.toml")
     loop = loop_for_law(slow, Hover(**{f.name: getattr(LAW, f.name) for f in dataclasses.fields(LAW)}), SAFE,
                         (0.05, 0.02, 0.08), 0.0)

@@ -40,7 +40,9 @@ def test_certified_tightening_is_the_certificate(pc_cert):
     assert t.design == c.inputs and t.design.law == "corrected"
     assert t.tiers == Tiers(True, True)
     b = c.backup
-    assert t.backup == BackupPlan(law=b.law, safe_set=b.safe_set, handover=(m.position[-1], m.e_z[-1]))
+    assert b.anchor_reach > 0.0                                               # the anchor may move: the loop reads it
+    assert t.backup == BackupPlan(law=b.law, safe_set=b.safe_set, handover=(m.position[-1] + b.anchor_reach, m.e_z[-1]),
+                                  anchor_reach=b.anchor_reach)
 
 
 @pytest.fixture(scope="module")
@@ -67,7 +69,9 @@ def test_safe_only_tightening(paper_cert):
     target = 3.0 * np.pi / 25  # the paper's target speed (m/s)
     assert t.e_d_min == pytest.approx(0.1 + min(max(dm.e_d) + half * (0.4 + target), 0.75 * (3.0 - 0.1) / 2))
     assert t.obstacle_margin == pytest.approx(m.position[-1] + 0.05 * 0.5)
-    assert t.backup.handover == (m.position[-1], m.e_z[-1]) and t.backup.safe_set == c.backup.safe_set
+    reach = c.backup.anchor_reach
+    assert t.backup.handover == (m.position[-1] + reach, m.e_z[-1]) and t.backup.safe_set == c.backup.safe_set
+    assert t.backup.anchor_reach == reach > 0.0
     best = c.best_effort_tightening()
     assert best.tiers == t.tiers and np.array_equal(best.margins, t.margins) and best.sigma == 0.0
 

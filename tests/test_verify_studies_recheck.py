@@ -154,6 +154,9 @@ TAMPERING = [
     ("pc", lambda d: _set(d, ("backup", "law", "surge"), 0.1), "backup.law", True),
     ("pc", _scale(("backup", "omega_xy"), 0.5), "backup.omega_xy", True),
     ("pc", _scale(("backup", "handover"), 0.5), "backup.handover", True),
+    # the anchor's reach widened: the hand-over it implies (margin + reach) leaves the proved c − β
+    ("pc", _scale(("backup", "anchor_reach"), 2.0), "backup.certified", True),
+    ("paper", _scale(("backup", "anchor_reach"), 1.5), "backup.certified", True),
     ("pc", _scale(("backup", "rate_bound"), 2.0), "backup.rate_bound", True),
     ("pc", lambda d: _set(d, ("backup",), None), "backup", True),
     ("paper", lambda d: _set(d, ("tiers", "tracking"), True), "tiers.tracking", True),

@@ -25,8 +25,10 @@ def test_paper_currents_certifies_both_tiers_with_a_backup(pc_cert):
     assert b.certified and b.omega_xy == c.disturbance.omega_xy and b.omega_z == c.disturbance.omega_z
     assert b.tick == pytest.approx(0.01)                                      # 100 Hz
     m = c.margins
-    assert b.handover == (m.position[-1], m.e_z[-1])                          # the last arc's margins
-    assert b.safe_set.handover_radius >= m.position[-1] and b.safe_set.depth >= m.e_z[-1]
+    room = b.safe_set.level - b.safe_set.shape - m.position[-1]               # c − β − M_pos: where the anchor may go
+    assert 0.0 < b.anchor_reach <= room and b.anchor_reach == pytest.approx(room, rel=1e-6)
+    assert b.handover == (m.position[-1] + b.anchor_reach, m.e_z[-1])         # the last arc's margins + the reach
+    assert b.safe_set.handover_radius >= b.handover[0] and b.safe_set.depth >= m.e_z[-1]
     names = [x.condition for x in b.conditions]
     assert {"backup_level_set", "backup_handover", "backup_initial"} <= set(names)
     assert all(n.startswith("backup") for n in names)
@@ -49,7 +51,10 @@ def test_the_paper_scenario_certifies_the_safe_tier_only(paper_cert):
     step = math.hypot(0.012, 0.01)
     assert s.margins.position == pytest.approx([step * (j + 1) for j in range(8)])
     assert s.v_bar == (0.4, 0.3, 0.5)                                         # no feedback: V_bar = V
-    assert c.backup.certified and c.backup.handover == (s.margins.position[-1], s.margins.e_z[-1])
+    reach = c.backup.anchor_reach                                             # c − β − M_pos, the room left
+    assert reach == pytest.approx(c.backup.safe_set.level - c.backup.safe_set.shape - s.margins.position[-1], rel=1e-6)
+    assert (c.backup.safe_set.level, c.backup.safe_set.shape) == (0.75, 0.4) and reach == pytest.approx(0.35 - 8 * step)
+    assert c.backup.certified and c.backup.handover == (s.margins.position[-1] + reach, s.margins.e_z[-1])
     assert "safe: certified; tracking: not certified (keep_up[u], yaw_budget" in c.summary()
     assert c.inputs.sigma == 0.0
 
@@ -120,6 +125,7 @@ def test_the_backup_is_designed_and_re_proved_through_the_registry(pc_cert):
     from verify.theorem.tiers import backup_of, recertify_backup
     sc, dist, margins = pc_cert.inputs.scenario, pc_cert.disturbance, pc_cert.design.margins
     assert backup_of(sc, dist, margins) == pc_cert.backup
-    assert recertify_backup(sc, pc_cert.backup.law, pc_cert.backup.safe_set, dist, margins) == pc_cert.backup
+    b = pc_cert.backup
+    assert recertify_backup(sc, b.law, b.safe_set, dist, margins, b.anchor_reach) == b
     with pytest.raises(ConfigError, match=r"backup\.kind"):
         backup_of(sc, dist, margins, kind="hover")

@@ -105,14 +105,18 @@ class BackupTerminal:
     Attributes
     ----------
     sphere : float
-        hypot(R_f, H_f) (m): added to each obstacle radius at p_N (no obstacle margin: p_N is the
-        plan's exact nominal end, the point the exact check reads).
+        hypot(R_f − ρ_a, H_f) (m), ρ_a the backup's anchor reach: added to each obstacle radius at p_N (no obstacle
+        margin: p_N is the plan's exact nominal end, the point the exact check reads).
     footprint : (float, float)
-        (R_f, H_f) (m): the workspace box shrunk by it holds p_N.
+        (R_f − ρ_a, H_f) (m): the workspace box shrunk by it holds p_N.
     safe : (float, float)
-        (c, Z) (m): the safe set's radius and depth, for the sensed-region row.
+        (c − ρ_a, Z) (m): the safe set's radius, less the reach, and depth, for the sensed-region row.
     sensed_bound : float
         R_bar - vehicle radius (m).
+
+    Each row is the exact check's part for one obstacle, the walls or the sensed region with the anchor moved
+    by up to ρ_a in that part's favour (:func:`tubekit.loop.terminal.terminal_condition`); one anchor must serve
+    them all, which the exact check decides.
     """
 
     sphere: float
@@ -127,8 +131,9 @@ class BackupTerminal:
         if backup is None:
             return None
         r_f, h_f = backup.footprint(scenario.vehicle_radius)
+        r_f -= backup.anchor_reach
         return cls(sphere=math.hypot(r_f, h_f), footprint=(r_f, h_f),
-                   safe=(backup.safe_set.radius, backup.safe_set.depth),
+                   safe=(backup.safe_set.radius - backup.anchor_reach, backup.safe_set.depth),
                    sensed_bound=scenario.sensing_range - scenario.vehicle_radius)
 
     def violation(self, p0: np.ndarray, pn: np.ndarray, obstacles: np.ndarray,

@@ -201,10 +201,12 @@ class _ClosedLoop:
         return result, plan, self.accept(k, tk, xk, plan, known) if plan is not None else None
 
     def follow(self, k: int, plan: np.ndarray, fallback: bool, check: PlanCheck, tracking: bool) -> np.ndarray:
-        """Accept ``plan`` (N, 3): remember it (its nominal end is the backup's anchor) and return its first input;
-        ``tracking`` False: a recovery plan (followed for safety, tracking not in force)."""
+        """Accept ``plan`` (N, 3): remember it (the anchor its terminal condition was met about, else its nominal
+        end, is the backup's anchor) and return its first input; ``tracking`` False: a recovery plan (followed for
+        safety, tracking not in force)."""
         checked = self.tightening.horizon_arcs > 0
-        self.memory.remember(plan, fallback, accepted=checked, end=check.end, tracking=tracking)
+        end = check.end if check.anchor is None else np.asarray(check.anchor, dtype=float)
+        self.memory.remember(plan, fallback, accepted=checked, end=end, tracking=tracking)
         self.log.plan_age[k] = self.memory.age
         return plan[0].copy()
 

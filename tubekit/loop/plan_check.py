@@ -60,7 +60,8 @@ SAMPLES_PER_ARC = ARC_SAMPLES
 @dataclass(frozen=True)
 class PlanCheck:
     """Outcome of :func:`check_plan`: ``ok``, the smallest slack (error units or m), where it is, and
-    the plan's nominal end state ``end`` (4,) over the certified horizon (None when not rolled out).
+    the plan's nominal end state ``end`` (4,) over the certified horizon (None when not rolled out) and the
+    backup's ``anchor`` (3,) the terminal condition was met about (None without a backup).
 
     ``safe`` says whether every constraint the safe tier rests on holds (V̄, the rate rows, the
     positions, the terminal condition, the sensed region): a plan that is not ``ok`` only because its
@@ -71,6 +72,7 @@ class PlanCheck:
     where: str
     end: np.ndarray | None = None
     safe: bool = False
+    anchor: tuple[float, float, float] | None = None
 
 
 def plan_arcs(x0: np.ndarray, inputs: np.ndarray, dt: float, samples: int) -> np.ndarray:
@@ -173,13 +175,15 @@ def tracking_checked(tight: Tightening) -> bool:
 
 
 def _terminal_slack(scenario: Scenario, tight: Tightening, x0: np.ndarray, end: np.ndarray,
-                    obstacles: Sequence[Obstacle]) -> dict[str, np.ndarray]:
-    """The terminal condition's slack (m) under "terminal: <part>", empty without a backup."""
+                    obstacles: Sequence[Obstacle]) -> tuple[dict[str, np.ndarray], tuple[float, float, float] | None]:
+    """The terminal condition's slack (m) under "terminal: <part>" and the anchor it holds about (empty and None
+    without a backup)."""
     if tight.terminal_backup is None:
-        return {}
+        return {}, None
     check = terminal_condition(end[:3], tight.terminal_backup, scenario.vehicle_radius, obstacles, scenario.workspace,
                                np.asarray(x0, dtype=float)[:3], scenario.sensing_range)
-    return {f"terminal: {check.reason}": np.array([check.slack if check.ok else min(check.slack, -1e-12)])}
+    slack = np.array([check.slack if check.ok else min(check.slack, -1e-12)])
+    return {f"terminal: {check.reason}": slack}, check.anchor
 
 
 def check_plan(scenario: Scenario, tight: Tightening, t0: float, x0: np.ndarray, inputs: np.ndarray,
@@ -205,7 +209,7 @@ def check_plan(scenario: Scenario, tight: Tightening, t0: float, x0: np.ndarray,
     cos_rel = heading_cosine(arcs, desired)
     pad = 0.5 * (dt / samples) * np.asarray(tight.rates, dtype=float)
     m = np.asarray(tight.margins, dtype=float)
-    safety = _terminal_slack(scenario, tight, x0, arcs[-1, -1], obstacles)
+    safety, anchor = _terminal_slack(scenario, tight, x0, arcs[-1, -1], obstacles)
     safety.update(_position_slacks(scenario, arcs[..., :3], m[:, 3:4] + pad[3], obstacles))
     safe_name, safe_worst = _worst(safety)
     slacks = _error_slacks(tight, e, cos_rel, m, pad, sign) if tracking_checked(tight) else {}
@@ -216,7 +220,7 @@ def check_plan(scenario: Scenario, tight: Tightening, t0: float, x0: np.ndarray,
     if safe_worst < worst or math.isnan(safe_worst):
         worst_name, worst = safe_name, safe_worst
     return PlanCheck(ok=worst >= 0.0 and not math.isnan(worst), slack=worst, where=worst_name, end=arcs[-1, -1],
-                     safe=safe_worst >= 0.0 and not math.isnan(safe_worst))
+                     safe=safe_worst >= 0.0 and not math.isnan(safe_worst), anchor=anchor)
 
 
 def _worst(slacks: dict[str, np.ndarray]) -> tuple[str, float]:

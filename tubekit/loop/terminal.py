@@ -13,6 +13,13 @@ ball), the plan meets the terminal condition when
   Z its depth): an obstacle unseen at p_k has its surface farther than the sensing range from p_k, so
   it cannot reach a vehicle ball centred within sensing_range − vehicle_radius of p_k.
 
+The anchor need not be p*: the backup was proved for a hand-over up to ``backup.anchor_reach`` farther
+from its anchor than the last arc's margin (``docs/verify.md`` step 12), so the condition holds when some
+anchor a within that reach of p* (same depth) meets (a)–(c) about a. :func:`terminal_condition` tries p*
+first, then points at the reach away from each known obstacle, toward p_k and on a ring
+(:func:`anchor_candidates`), keeps the one with the largest smallest slack and returns it: the loop
+anchors the backup there.
+
 Then the shifted plan followed by the backup law is always a safe candidate
 (``docs/verify.md``). :func:`terminal_condition` is the one place the condition is computed;
 :func:`tubekit.loop.plan_check.check_plan` applies it to every plan when the tightening has a backup.
@@ -31,16 +38,21 @@ from tubekit.model.backup import BackupPlan
 from tubekit.scenario import Obstacle
 from tubekit.validation import as_vector, nonnegative, positive
 
-__all__ = ["TerminalCheck", "terminal_condition", "cylinder_distance"]
+__all__ = ["TerminalCheck", "terminal_condition", "cylinder_distance", "anchor_candidates", "ANCHOR_RING"]
+
+#: Directions on the ring of anchors tried at the full reach (besides those away from each obstacle and toward p_k).
+ANCHOR_RING = 16
 
 
 @dataclass(frozen=True)
 class TerminalCheck:
-    """Outcome of :func:`terminal_condition`: ``ok``, the smallest slack (m) and which part it is."""
+    """Outcome of :func:`terminal_condition`: ``ok``, the smallest slack (m), which part it is, and the anchor
+    (3,) (m) the slacks are taken about (the backup's anchor when the plan is accepted)."""
 
     ok: bool
     slack: float
     reason: str
+    anchor: tuple[float, float, float] | None = None
 
 
 def cylinder_distance(point: np.ndarray, anchor: np.ndarray, radius: float, half_height: float) -> float:
@@ -50,27 +62,60 @@ def cylinder_distance(point: np.ndarray, anchor: np.ndarray, radius: float, half
     return math.hypot(horizontal, vertical)
 
 
-def _workspace_slack(anchor: np.ndarray, r_f: float, h_f: float,
-                     workspace: tuple[Sequence[float], Sequence[float]]) -> float:
-    """Smallest distance (m) from the cylinder's faces to the workspace walls (>= 0: inside)."""
-    lo = as_vector("workspace[0]", workspace[0], 3)
-    hi = as_vector("workspace[1]", workspace[1], 3)
-    pad = np.array([r_f, r_f, h_f])
-    return float(min(np.min(anchor - pad - lo), np.min(hi - anchor - pad)))
+def anchor_candidates(end: np.ndarray, reach: float, obstacles: Sequence[Obstacle],
+                      sensed_at: np.ndarray) -> np.ndarray:
+    """Anchors (K, 3) (m) tried by :func:`terminal_condition`: p* = ``end`` first, then, at the horizontal
+    distance ``reach`` (m) and at half of it, the points away from each obstacle, toward ``sensed_at`` and on a
+    ring of :data:`ANCHOR_RING` directions; every one at p*'s depth. Only p* when ``reach`` is 0."""
+    p = np.asarray(end, dtype=float)[:3]
+    if reach <= 0.0:
+        return p[None, :].copy()
+    away = [p[:2] - np.asarray(o.center, dtype=float)[:2] for o in obstacles]
+    toward = [np.asarray(sensed_at, dtype=float)[:2] - p[:2]]
+    angles = 2.0 * math.pi * np.arange(ANCHOR_RING) / ANCHOR_RING
+    ring = list(np.stack([np.cos(angles), np.sin(angles)], axis=1))
+    units = [d / n for d in away + toward + ring if (n := float(np.hypot(d[0], d[1]))) > 0.0]
+    steps = np.array([s * u for s in (reach, 0.5 * reach) for u in units]).reshape(-1, 2)
+    out = np.repeat(p[None, :], len(steps) + 1, axis=0)
+    out[1:, :2] += steps
+    return out
+
+
+def _slacks(anchors: np.ndarray, backup: BackupPlan, rv: float, obstacles: Sequence[Obstacle],
+            workspace: tuple[Sequence[float], Sequence[float]] | None, pk: np.ndarray,
+            reach: float) -> dict[str, np.ndarray]:
+    """Each part's slack (m) at every anchor (K, 3): (a) per obstacle, (b) the walls, (c) the sensed region."""
+    r_f, h_f = backup.footprint(rv)
+    out: dict[str, np.ndarray] = {}
+    for i, o in enumerate(obstacles):
+        c = np.asarray(o.center, dtype=float)
+        horizontal = np.maximum(0.0, np.hypot(c[0] - anchors[:, 0], c[1] - anchors[:, 1]) - r_f)
+        vertical = np.maximum(0.0, np.abs(c[2] - anchors[:, 2]) - h_f)
+        out[f"obstacle {i}"] = np.hypot(horizontal, vertical) - o.radius
+    if workspace is not None:
+        lo = as_vector("workspace[0]", workspace[0], 3)
+        hi = as_vector("workspace[1]", workspace[1], 3)
+        pad = np.array([r_f, r_f, h_f])
+        out["workspace"] = np.minimum((anchors - pad - lo).min(axis=1), (hi - anchors - pad).min(axis=1))
+    safe = backup.safe_set
+    horizontal = np.hypot(anchors[:, 0] - pk[0], anchors[:, 1] - pk[1])
+    out["sensed region"] = reach - rv - np.hypot(horizontal + safe.radius, np.abs(anchors[:, 2] - pk[2]) + safe.depth)
+    return out
 
 
 def terminal_condition(anchor: Sequence[float], backup: BackupPlan, vehicle_radius: float,
                        known_obstacles: Sequence[Obstacle],
                        workspace: tuple[Sequence[float], Sequence[float]] | None,
                        sensed_at: Sequence[float], sensing_range: float) -> TerminalCheck:
-    """Check the terminal condition (module doc) of a plan ending at ``anchor`` (m).
+    """Check the terminal condition (module doc) of a plan ending at ``anchor`` (m), the backup's anchor placed
+    within ``backup.anchor_reach`` of it.
 
     Parameters
     ----------
     anchor : (3,)
         p*, the plan's nominal end position (m).
     backup : BackupPlan
-        The certified backup (its safe set and footprint).
+        The certified backup (its safe set, footprint and anchor reach).
     vehicle_radius : float
         Radius of the vehicle ball (m).
     known_obstacles : sequence of Obstacle
@@ -85,8 +130,9 @@ def terminal_condition(anchor: Sequence[float], backup: BackupPlan, vehicle_radi
     Returns
     -------
     TerminalCheck
-        ``ok`` when all three parts hold; ``slack`` the smallest margin (m), ``reason`` its part
-        ("obstacle i", "workspace", "sensed region").
+        ``ok`` when all three parts hold about the chosen anchor (of :func:`anchor_candidates`, the one with the
+        largest smallest slack; p* first among equals); ``slack`` the smallest margin (m) there, ``reason`` its
+        part ("obstacle i", "workspace", "sensed region"), ``anchor`` the chosen anchor.
 
     Raises
     ------
@@ -100,19 +146,19 @@ def terminal_condition(anchor: Sequence[float], backup: BackupPlan, vehicle_radi
         raise ConfigError("tightening.backup", "a tubekit.model.backup.BackupPlan", type(backup).__name__)
     rv = nonnegative("scenario.vehicle_radius", vehicle_radius)
     reach = positive("scenario.sensing_range", sensing_range)
-    r_f, h_f = backup.footprint(rv)
-    slacks: dict[str, float] = {}
     for i, o in enumerate(known_obstacles):
         if not isinstance(o, Obstacle):
             raise ConfigError(f"known_obstacles[{i}]", "a tubekit.Obstacle", type(o).__name__)
-        slacks[f"obstacle {i}"] = cylinder_distance(np.asarray(o.center), p, r_f, h_f) - o.radius
-    if workspace is not None:
-        slacks["workspace"] = _workspace_slack(p, r_f, h_f, workspace)
-    safe = backup.safe_set
-    horizontal = float(np.hypot(p[0] - pk[0], p[1] - pk[1]))
-    spread = math.hypot(horizontal + safe.radius, abs(float(p[2] - pk[2])) + safe.depth)
-    slacks["sensed region"] = reach - rv - spread
-    reason, worst = min(slacks.items(), key=lambda kv: kv[1])
-    obstacles_clear = all(v > 0.0 for k, v in slacks.items() if k.startswith("obstacle"))
+    anchors = anchor_candidates(p, backup.anchor_reach, known_obstacles, pk)
+    slacks = _slacks(anchors, backup, rv, known_obstacles, workspace, pk, reach)
+    names = list(slacks)
+    table = np.stack([slacks[k] for k in names], axis=1)
+    table = np.where(np.isnan(table), -np.inf, table)
+    best = int(np.argmax(table.min(axis=1)))
+    row = table[best]
+    j = int(np.argmin(row))
+    worst = float(row[j])
+    obstacles_clear = all(row[i] > 0.0 for i, k in enumerate(names) if k.startswith("obstacle"))
     ok = obstacles_clear and worst >= 0.0 and math.isfinite(worst)
-    return TerminalCheck(ok=bool(ok), slack=float(worst), reason=reason)
+    chosen = (float(anchors[best, 0]), float(anchors[best, 1]), float(anchors[best, 2]))
+    return TerminalCheck(ok=bool(ok), slack=worst, reason=names[j], anchor=chosen)

@@ -332,12 +332,19 @@ class BackupPlan:
         Its invariant set about the anchor (the end of the last accepted plan).
     handover : (float, float)
         Largest horizontal distance and depth error (m) from the anchor when the backup takes over
-        (the replayed plan's last position and depth margins).
+        (the replayed plan's last position and depth margins, plus ``anchor_reach`` horizontally).
+    anchor_reach : float
+        Largest horizontal distance (m) from the plan's nominal end at which the loop may place the anchor
+        (``docs/verify.md`` step 12): the hand-over was proved for the last arc's margin plus this distance.
     """
 
     law: BackupLaw
     safe_set: SafeSet
     handover: tuple[float, float] = (0.0, 0.0)
+    anchor_reach: float = 0.0
+
+    def __post_init__(self) -> None:
+        nonnegative("backup.anchor_reach", self.anchor_reach)
 
     def footprint(self, vehicle_radius: float) -> tuple[float, float]:
         """(horizontal radius, half height) (m) of the safe set inflated by the vehicle ball."""

@@ -68,9 +68,13 @@ class BackupCertificate:
     conditions : tuple of Condition
         Every inequality of the proof, with both numbers.
     handover : (float, float)
-        Horizontal distance and depth error (m) from the anchor the hand-over was proved for.
+        Horizontal distance and depth error (m) from the anchor the hand-over was proved for (the last arc's
+        margins, plus ``anchor_reach`` horizontally).
     yaw_rate_error : float
         E_r (rad/s) the proof holds against (0 on the kinematic plant).
+    anchor_reach : float
+        Largest horizontal distance (m) from the plan's nominal end at which the loop may place the anchor
+        (``docs/verify.md`` step 12); included in ``handover[0]``.
     """
 
     law: BackupLaw
@@ -84,6 +88,7 @@ class BackupCertificate:
     conditions: tuple[Condition, ...]
     handover: tuple[float, float] = (0.0, 0.0)
     yaw_rate_error: float = 0.0
+    anchor_reach: float = 0.0
 
     @property
     def certified(self) -> bool:
@@ -104,6 +109,8 @@ class BackupCertificate:
             "handover": list(self.handover), "conditions": [c.to_dict() for c in self.conditions]}
         if self.yaw_rate_error:  # issue 22's keys appear only when on: older certificates keep their JSON
             out["yaw_rate_error"] = self.yaw_rate_error
+        if self.anchor_reach:  # written only when the anchor may move: certificates without it keep their JSON
+            out["anchor_reach"] = self.anchor_reach
         return out
 
     @classmethod
@@ -121,11 +128,20 @@ class BackupCertificate:
                    boxes=integer(d, "boxes", where),
                    conditions=tuple(Condition.from_dict(c, f"{where}.conditions[{i}]") for i, c in enumerate(conds)),
                    handover=numbers(d, "handover", where, 2),
-                   yaw_rate_error=number(d, "yaw_rate_error", where) if "yaw_rate_error" in d else 0.0)
+                   yaw_rate_error=number(d, "yaw_rate_error", where) if "yaw_rate_error" in d else 0.0,
+                   anchor_reach=_reach(d, where))
 
     def summary_lines(self) -> list[str]:
         """Human-readable lines for a certificate's text (the law's own lines from its proof)."""
         return proof_for(self.law).summary_lines(self)
+
+
+def _reach(d: dict[str, Any], where: str) -> float:
+    """The stored anchor reach (m; 0 when absent, as certificates before it stored none); ConfigError below 0."""
+    reach = number(d, "anchor_reach", where) if "anchor_reach" in d else 0.0
+    if reach < 0.0:
+        raise ConfigError(f"{where}.anchor_reach", "a distance >= 0 (m)", reach)
+    return reach
 
 
 def _law(raw: dict[str, Any], where: str) -> BackupLaw:

@@ -84,7 +84,8 @@ def _node_bounds(cert: CertificateRecord, margins: np.ndarray, rates: np.ndarray
 
 def _backup_plan(cert: CertificateRecord) -> BackupPlan | None:
     b = cert.backup
-    return None if b is None else BackupPlan(law=b.law, safe_set=b.safe_set, handover=tuple(b.handover))
+    return None if b is None else BackupPlan(law=b.law, safe_set=b.safe_set, handover=tuple(b.handover),
+                                                anchor_reach=b.anchor_reach)
 
 
 def _common(cert: CertificateRecord) -> dict[str, object]:

@@ -43,7 +43,8 @@ __all__ = ["CertificateRecord", "THEOREM", "ASSUMPTIONS", "EXACT_SENSING", "PREM
 
 THEOREM = ("sampled-data tube under the nominal reset: one-period box tube (verify.theorem.sampled), per-arc margins "
            "of the replayed candidate (verify.theorem.sampled.horizon_margins), exact arc acceptance with the "
-           "terminal condition (tubekit.loop.plan_check), the certified station-keeping backup (verify.backup); "
+           "terminal condition about an anchor within the backup's certified reach of the plan's end "
+           "(tubekit.loop.plan_check), the certified station-keeping backup (verify.backup); "
            "tiers safe and tracking (verify.theorem.tiers)")
 
 #: Outside the model, whatever the plant.

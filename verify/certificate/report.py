@@ -106,8 +106,12 @@ def _tier_lines(cert: CertificateRecord) -> list[str]:
                    "(e-coordinate margins not required)")
     if cert.backup is not None:
         out += cert.backup.summary_lines()
-        out.append(f"  hand-over: within {_f(cert.backup.handover[0])} m horizontally, "
-                   f"{_f(cert.backup.handover[1])} m in depth of the anchor (the last arc's margins)")
+        b = cert.backup
+        reach = (f"; the anchor may be placed up to {_f(b.anchor_reach)} m from the plan's end (the rest of "
+                 f"the hand-over distance is the last arc's margin {_f(b.handover[0] - b.anchor_reach)} m)"
+                 if b.anchor_reach else " (the last arc's margins)")
+        out.append(f"  hand-over: within {_f(b.handover[0])} m horizontally, {_f(b.handover[1])} m in depth of the "
+                   f"anchor{reach}")
     return out
 
 
@@ -200,8 +204,9 @@ def _short_backup_lines(cert: CertificateRecord) -> list[str]:
     b = cert.backup
     if b is not None:
         s = b.safe_set
+        reach = f", anchor within {_f(b.anchor_reach)} m of the plan's end" if b.anchor_reach else ""
         out.append(f"{b.summary_lines()[0]}; safe radius {s.radius:.3f} m, depth band ±{s.depth:.3f} m, hand-over "
-                   f"within {_f(b.handover[0])} m ({_f(b.handover[1])} m in depth)")
+                   f"within {_f(b.handover[0])} m ({_f(b.handover[1])} m in depth){reach}")
     loop = getattr(cert, "velocity_loop", None)
     if loop is not None:
         e = loop.error

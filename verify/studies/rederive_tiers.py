@@ -51,7 +51,8 @@ def _with_terminal(cert: CertificateRecord, scenario: Scenario, region: Region, 
     if not design.certified:
         return design
     if scenario.plant.dynamic and cert.backup is not None:
-        bk = recertify_backup(scenario, cert.backup.law, cert.backup.safe_set, dist, design.margins)
+        bk = recertify_backup(scenario, cert.backup.law, cert.backup.safe_set, dist, design.margins,
+                              cert.backup.anchor_reach)
     else:
         bk = backup_of(scenario, dist, design.margins)
     return with_terminal(scenario, design, region, bk.safe_set if bk.certified else None)
@@ -70,7 +71,7 @@ def derive_tiers(cert: CertificateRecord, scenario: Scenario, region: Region, di
     except ConfigError as exc:
         raise ConfigError("certificate.backup.law.kind", exc.expected, exc.received) from None
     margins = (safe if safe is not None else design).margins
-    bk = recertify_backup(scenario, cert.backup.law, cert.backup.safe_set, dist, margins)
+    bk = recertify_backup(scenario, cert.backup.law, cert.backup.safe_set, dist, margins, cert.backup.anchor_reach)
     return DerivedTiers(safe, bk, None if bk.certified else backup_of(scenario, dist, margins), design=design)
 
 

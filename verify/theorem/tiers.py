@@ -20,6 +20,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+from typing import Callable
 
 import numpy as np
 from flint import arb
@@ -39,7 +40,7 @@ from verify.theorem.terminal import with_terminal
 from verify.theorem.workspace import initial_workspace, target_in_workspace
 
 __all__ = ["SAFE_CONDITIONS", "SAFE_PREFIX", "is_safe_condition", "tracking_design", "position_tube",
-           "safe_only_design", "backup_of", "solve_tiers", "recertify_backup", "initial_backup", "tier_conditions",
+           "safe_only_design", "backup_of", "anchor_reach", "solve_tiers", "recertify_backup", "initial_backup", "tier_conditions",
            "tiers_of"]
 
 #: Names (or name prefixes ending in "[") of the tracking design's conditions the safe tier depends on.
@@ -130,11 +131,33 @@ def initial_backup(scenario: Scenario, law: BackupLaw, safe: SafeSet) -> Conditi
                      "the backup anchored at the start is safe: no plan is needed at t = 0")
 
 
+def anchor_reach(safe: SafeSet, margin: float) -> float:
+    """The largest distance (m) the anchor may be moved from the plan's end: a float <= c − β − M_pos,N−1 (Arb,
+    rounded down, less a relative 1e-9), 0 when there is no room (``docs/verify.md`` step 12)."""
+    room = lower(arb(safe.level) - arb(safe.shape) - arb(margin))
+    return max(0.0, room * (1.0 - 1e-9) - 1e-12)
+
+
+def _with_reach(bc: BackupCertificate, certify: Callable[[float], BackupCertificate],
+                margin: float) -> BackupCertificate:
+    """``bc`` proved again with the hand-over at the last arc's margin plus :func:`anchor_reach`, when that
+    certifies (a law that blends keeps the whole window for its ramp: reach 0)."""
+    if not bc.certified or bc.law.blends:
+        return bc
+    reach = anchor_reach(bc.safe_set, margin)
+    if reach <= 0.0:
+        return bc
+    moved = certify(reach)
+    return dataclasses.replace(moved, anchor_reach=reach) if moved.certified else bc
+
+
 def backup_of(scenario: Scenario, dist: DisturbanceBounds, margins: HorizonMargins | None,
               fits: Fits | None = None, kind: str = DEFAULT_BACKUP_KIND) -> BackupCertificate:
     """The backup law of ``kind`` designed by its proof (:meth:`verify.backup.BackupProof.design`, found by
     :func:`verify.backup.proof_for`) for ``scenario`` (ω̄ of ``dist``, V, tick 1/f, hand-over from ``margins``;
-    ``fits``: the dynamic plant's gentle design), with ``backup_initial`` appended to its conditions."""
+    ``fits``: the dynamic plant's gentle design), with ``backup_initial`` appended to its conditions. Where the
+    safe set leaves room beyond the hand-over margin, the law is proved again for an anchor that the loop may move
+    up to :func:`anchor_reach` from the plan's end (``BackupCertificate.anchor_reach``)."""
     proof = proof_for(kind)
     limits = tuple(float(x) for x in scenario.limits.vector)
     tick = 1.0 / float(scenario.controller.ancillary_rate_hz)
@@ -146,6 +169,11 @@ def backup_of(scenario: Scenario, dist: DisturbanceBounds, margins: HorizonMargi
         bc = proof.certify(bc.law, bc.safe_set, omega_xy=dist.omega_xy, omega_z=dist.omega_z, limits=limits,
                            tick=tick, handover=(np.finfo(float).max, np.finfo(float).max),
                            yaw_rate_error=dist.yaw_rate_error)
+    else:
+        law, safe = bc.law, bc.safe_set
+        bc = _with_reach(bc, lambda reach: proof.certify(
+            law, safe, omega_xy=dist.omega_xy, omega_z=dist.omega_z, limits=limits, tick=tick,
+            handover=(hand[0] + reach, hand[1]), yaw_rate_error=dist.yaw_rate_error), hand[0])
     return _with_initial(scenario, bc)
 
 
@@ -177,17 +205,18 @@ def solve_tiers(scenario: Scenario, region: Region, gains: GainBounds, sigmas: t
 
 
 def recertify_backup(scenario: Scenario, law: BackupLaw, safe: SafeSet, dist: DisturbanceBounds,
-                     margins: HorizonMargins | None) -> BackupCertificate:
+                     margins: HorizonMargins | None, anchor_reach: float = 0.0) -> BackupCertificate:
     """A stored law and safe set proved again by the law's proof (:meth:`verify.backup.BackupProof.certify`,
-    :func:`verify.backup.proof_for`) with the derived bounds and margins, ``backup_initial`` appended."""
+    :func:`verify.backup.proof_for`) with the derived bounds and margins, the hand-over moved out by the stored
+    ``anchor_reach`` (m), ``backup_initial`` appended."""
     hand = _handover(margins)
     big = np.finfo(float).max
+    hand = (hand[0] + anchor_reach, hand[1]) if math.isfinite(hand[0]) else (big, big)
     bc = proof_for(law).certify(law, safe, omega_xy=dist.omega_xy, omega_z=dist.omega_z,
                                 limits=tuple(float(x) for x in scenario.limits.vector),
                                 tick=1.0 / float(scenario.controller.ancillary_rate_hz),
-                                handover=hand if math.isfinite(hand[0]) else (big, big),
-                                yaw_rate_error=dist.yaw_rate_error)
-    return _with_initial(scenario, bc)
+                                handover=hand, yaw_rate_error=dist.yaw_rate_error)
+    return _with_initial(scenario, dataclasses.replace(bc, anchor_reach=anchor_reach) if anchor_reach else bc)
 
 
 def _with_initial(scenario: Scenario, bc: BackupCertificate) -> BackupCertificate:

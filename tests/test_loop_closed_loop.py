@@ -370,9 +370,10 @@ def test_the_backup_takes_over_when_the_replay_is_exhausted_and_tracking_resumes
 
 def test_the_backup_is_anchored_where_the_terminal_condition_placed_it_within_its_reach():
     """With a backup proved for an anchor up to 0.2 m from the plan's end, the loop anchors it where the accepted
-    plan's terminal condition held: at the plan's depth, within 0.2 m of its end, and not at the end itself (the
-    sensed region's slack grows as the anchor moves back toward the vehicle)."""
-    sc = _scenario(duration=4.0).with_changes(**{"controller.candidate": False})
+    plan's terminal condition held: at the plan's depth, within 0.2 m of its end, and not at the end itself. The
+    sensing range 1.2 m leaves the safe set about the plan's end (0.24 m ahead: hypot(0.24 + 0.8, ...) > 1.0)
+    outside the sensed region, and moving the anchor back toward the vehicle brings it in."""
+    sc = _scenario(duration=4.0).with_changes(sensing_range=1.2, **{"controller.candidate": False})
     n = sc.controller.horizon_steps
     movable = dataclasses.replace(BACKUP, anchor_reach=0.2)
     res = run_closed_loop(sc, tightening=_safe_only(sc, movable), progress=False,

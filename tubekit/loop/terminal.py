@@ -15,10 +15,10 @@ ball), the plan meets the terminal condition when
 
 The anchor need not be p*: the backup was proved for a hand-over up to ``backup.anchor_reach`` farther
 from its anchor than the last arc's margin (``docs/verify.md`` step 12), so the condition holds when some
-anchor a within that reach of p* (same depth) meets (a)–(c) about a. :func:`terminal_condition` tries p*
-first, then points at the reach away from each known obstacle, toward p_k and on a ring
-(:func:`anchor_candidates`), keeps the one with the largest smallest slack and returns it: the loop
-anchors the backup there.
+anchor a within that reach of p* (same depth) meets (a)–(c) about a. :func:`terminal_condition` keeps p*
+when it passes; otherwise it tries points at the reach and half of it away from each known obstacle, toward
+p_k and on a ring (:func:`anchor_candidates`), keeps the passing one with the largest smallest slack and
+returns it: the loop anchors the backup there.
 
 Then the shifted plan followed by the backup law is always a safe candidate
 (``docs/verify.md``). :func:`terminal_condition` is the one place the condition is computed;
@@ -62,6 +62,10 @@ def cylinder_distance(point: np.ndarray, anchor: np.ndarray, radius: float, half
     return math.hypot(horizontal, vertical)
 
 
+_RING_ANGLES = 2.0 * math.pi * np.arange(ANCHOR_RING) / ANCHOR_RING
+_RING = np.stack([np.cos(_RING_ANGLES), np.sin(_RING_ANGLES)], axis=1)
+
+
 def anchor_candidates(end: np.ndarray, reach: float, obstacles: Sequence[Obstacle],
                       sensed_at: np.ndarray) -> np.ndarray:
     """Anchors (K, 3) (m) tried by :func:`terminal_condition`: p* = ``end`` first, then, at the horizontal
@@ -70,37 +74,50 @@ def anchor_candidates(end: np.ndarray, reach: float, obstacles: Sequence[Obstacl
     p = np.asarray(end, dtype=float)[:3]
     if reach <= 0.0:
         return p[None, :].copy()
-    away = [p[:2] - np.asarray(o.center, dtype=float)[:2] for o in obstacles]
-    toward = [np.asarray(sensed_at, dtype=float)[:2] - p[:2]]
-    angles = 2.0 * math.pi * np.arange(ANCHOR_RING) / ANCHOR_RING
-    ring = list(np.stack([np.cos(angles), np.sin(angles)], axis=1))
-    units = [d / n for d in away + toward + ring if (n := float(np.hypot(d[0], d[1]))) > 0.0]
-    steps = np.array([s * u for s in (reach, 0.5 * reach) for u in units]).reshape(-1, 2)
-    out = np.repeat(p[None, :], len(steps) + 1, axis=0)
-    out[1:, :2] += steps
+    centres = np.array([o.center for o in obstacles], dtype=float).reshape(-1, 3)
+    toward = np.asarray(sensed_at, dtype=float)[None, :2] - p[None, :2]
+    dirs = np.concatenate([p[None, :2] - centres[:, :2], toward, _RING])
+    norms = np.hypot(dirs[:, 0], dirs[:, 1])
+    units = dirs[norms > 0.0] / norms[norms > 0.0, None]
+    out = np.repeat(p[None, :], 2 * len(units) + 1, axis=0)
+    out[1:, :2] += np.concatenate([reach * units, 0.5 * reach * units])
     return out
 
 
 def _slacks(anchors: np.ndarray, backup: BackupPlan, rv: float, obstacles: Sequence[Obstacle],
             workspace: tuple[Sequence[float], Sequence[float]] | None, pk: np.ndarray,
-            reach: float) -> dict[str, np.ndarray]:
-    """Each part's slack (m) at every anchor (K, 3): (a) per obstacle, (b) the walls, (c) the sensed region."""
+            reach: float) -> tuple[list[str], np.ndarray]:
+    """Each part's name and slack (m) at every anchor, (K, parts): (a) per obstacle, (b) the walls, (c) the sensed
+    region."""
     r_f, h_f = backup.footprint(rv)
-    out: dict[str, np.ndarray] = {}
-    for i, o in enumerate(obstacles):
-        c = np.asarray(o.center, dtype=float)
-        horizontal = np.maximum(0.0, np.hypot(c[0] - anchors[:, 0], c[1] - anchors[:, 1]) - r_f)
-        vertical = np.maximum(0.0, np.abs(c[2] - anchors[:, 2]) - h_f)
-        out[f"obstacle {i}"] = np.hypot(horizontal, vertical) - o.radius
+    names = [f"obstacle {i}" for i in range(len(obstacles))]
+    cols = []
+    if obstacles:
+        obs = np.array([(*o.center, o.radius) for o in obstacles], dtype=float)
+        horizontal = np.maximum(0.0, np.hypot(obs[None, :, 0] - anchors[:, None, 0],
+                                              obs[None, :, 1] - anchors[:, None, 1]) - r_f)
+        vertical = np.maximum(0.0, np.abs(obs[None, :, 2] - anchors[:, None, 2]) - h_f)
+        cols.append(np.hypot(horizontal, vertical) - obs[None, :, 3])
     if workspace is not None:
         lo = as_vector("workspace[0]", workspace[0], 3)
         hi = as_vector("workspace[1]", workspace[1], 3)
         pad = np.array([r_f, r_f, h_f])
-        out["workspace"] = np.minimum((anchors - pad - lo).min(axis=1), (hi - anchors - pad).min(axis=1))
+        names.append("workspace")
+        cols.append(np.minimum((anchors - pad - lo).min(axis=1), (hi - anchors - pad).min(axis=1))[:, None])
     safe = backup.safe_set
     horizontal = np.hypot(anchors[:, 0] - pk[0], anchors[:, 1] - pk[1])
-    out["sensed region"] = reach - rv - np.hypot(horizontal + safe.radius, np.abs(anchors[:, 2] - pk[2]) + safe.depth)
-    return out
+    names.append("sensed region")
+    cols.append((reach - rv - np.hypot(horizontal + safe.radius, np.abs(anchors[:, 2] - pk[2]) + safe.depth))[:, None])
+    table = np.concatenate(cols, axis=1)
+    return names, np.where(np.isnan(table), -np.inf, table)
+
+
+def _passing(table: np.ndarray, n_obstacles: int) -> np.ndarray:
+    """Per row (anchor) of ``table`` (its first ``n_obstacles`` columns the obstacles'): every obstacle's slack
+    > 0 and every other part's >= 0 (finite)."""
+    worst = table.min(axis=1)
+    ok = np.isfinite(worst) & (worst >= 0.0)
+    return ok & (table[:, :n_obstacles].min(axis=1) > 0.0) if n_obstacles else ok
 
 
 def terminal_condition(anchor: Sequence[float], backup: BackupPlan, vehicle_radius: float,
@@ -130,9 +147,10 @@ def terminal_condition(anchor: Sequence[float], backup: BackupPlan, vehicle_radi
     Returns
     -------
     TerminalCheck
-        ``ok`` when all three parts hold about the chosen anchor (of :func:`anchor_candidates`, the one with the
-        largest smallest slack; p* first among equals); ``slack`` the smallest margin (m) there, ``reason`` its
-        part ("obstacle i", "workspace", "sensed region"), ``anchor`` the chosen anchor.
+        ``ok`` when all three parts hold about the chosen anchor (p* when it passes, else of
+        :func:`anchor_candidates` the passing one with the largest smallest slack, else the one with the largest
+        smallest slack); ``slack`` the smallest margin (m) there, ``reason`` its part ("obstacle i",
+        "workspace", "sensed region"), ``anchor`` the chosen anchor.
 
     Raises
     ------
@@ -149,16 +167,15 @@ def terminal_condition(anchor: Sequence[float], backup: BackupPlan, vehicle_radi
     for i, o in enumerate(known_obstacles):
         if not isinstance(o, Obstacle):
             raise ConfigError(f"known_obstacles[{i}]", "a tubekit.Obstacle", type(o).__name__)
-    anchors = anchor_candidates(p, backup.anchor_reach, known_obstacles, pk)
-    slacks = _slacks(anchors, backup, rv, known_obstacles, workspace, pk, reach)
-    names = list(slacks)
-    table = np.stack([slacks[k] for k in names], axis=1)
-    table = np.where(np.isnan(table), -np.inf, table)
-    best = int(np.argmax(table.min(axis=1)))
+    names, table = _slacks(p[None, :], backup, rv, known_obstacles, workspace, pk, reach)
+    anchors = p[None, :]
+    if not _passing(table, len(known_obstacles))[0] and backup.anchor_reach > 0.0:
+        anchors = anchor_candidates(p, backup.anchor_reach, known_obstacles, pk)
+        names, table = _slacks(anchors, backup, rv, known_obstacles, workspace, pk, reach)
+    passing = _passing(table, len(known_obstacles))
+    score = np.where(passing, table.min(axis=1), -np.inf) if passing.any() else table.min(axis=1)
+    best = int(np.argmax(score))
     row = table[best]
     j = int(np.argmin(row))
-    worst = float(row[j])
-    obstacles_clear = all(row[i] > 0.0 for i, k in enumerate(names) if k.startswith("obstacle"))
-    ok = obstacles_clear and worst >= 0.0 and math.isfinite(worst)
     chosen = (float(anchors[best, 0]), float(anchors[best, 1]), float(anchors[best, 2]))
-    return TerminalCheck(ok=bool(ok), slack=worst, reason=names[j], anchor=chosen)
+    return TerminalCheck(ok=bool(passing[best]), slack=float(row[j]), reason=names[j], anchor=chosen)

@@ -568,3 +568,22 @@ def test_a_rejected_plan_is_replaced_by_the_shifted_candidate_and_tracking_is_ke
     off = run_closed_loop(sc.with_changes(**{"controller.candidate": False}), tight, solver_factory=OnceThenNothing,
                           progress=False)
     assert np.any(off.backup_active) and not np.any(off.candidate)   # without it: replay, then the backup
+
+
+def test_a_loiter_backup_keeps_its_surge_and_the_vehicle_clear_in_the_loop():
+    """Section VI with the loiter backup (``controller.backup = "loiter"``) and a 6 m sensing range, 30 s: the
+    loop falls back to the loiter, whose surge command is u_l at every tick it runs, never clipped, and every
+    safety promise holds."""
+    import verify
+    from tubekit import simulate
+    from tubekit.loop.promises import check_promises
+    from tubekit.model.loiter import Loiter
+    sc = paper_scenario().with_changes(duration=30.0, sensing_range=6.0, **{"controller.backup": "loiter"})
+    cert = verify.certify(sc)
+    assert cert.tiers.safe and isinstance(cert.backup.law, Loiter)
+    run = simulate(sc, cert, progress=False)
+    on = run.backup_active[:-1]
+    assert on.sum() > 0 and np.all(run.inputs[:-1][on][:, 0] == cert.backup.law.surge)
+    assert run.saturated_ticks == 0 and run.metrics["min_clearance"] > 0.0
+    safety = {p.name: p.ok for p in check_promises(run)}
+    assert safety["clearance"] and safety["inputs"] and safety["workspace"]

@@ -6,7 +6,7 @@ built from a scenario, the ancillary law and σ:
 * ``scenario`` — the scenario reduced to what the theorem reads: the limits (and their rate), the
   trajectory, ε, the region, the obstacles, the vehicle radius, the sensing range, the workspace, the
   duration, **the start** (``initial_state``), the current's amplitude and constant, the sway model's
-  gain, amplitude and bound, the controller's δ, N and ancillary rate, and the plant (every vehicle
+  gain, amplitude and bound, the controller's δ, N, ancillary rate and backup law's kind, and the plant (every vehicle
   parameter on the dynamic plant, intervals included). Every other field — the current's and the
   sway's periods, the FHOCP weights, modes, terminal level and backend, the declared σ and law, the
   plant as simulated (``plant.truth``: any point of the coefficient box is covered) — is reset to its
@@ -60,7 +60,7 @@ ARC_SAMPLES = 10
 #: Why σ = 0 on the dynamic plant.
 DYNAMIC_SIGMA_SOURCE = "dynamic plant: sigma = 0 (kappa = 0, so the velocity loop sees only bounded command jumps)"
 #: Controller settings the theorem reads; the others are the FHOCP's own.
-_READ_CONTROLLER = ("dt", "horizon_steps", "ancillary_rate_hz")
+_READ_CONTROLLER = ("dt", "horizon_steps", "ancillary_rate_hz", "backup")
 
 
 def canonical(value: Any) -> Any:
@@ -216,7 +216,7 @@ class DesignInputs:
         """The flat, canonical dict the key hashes: dotted names, numbers as floats."""
         data = self.scenario.to_dict()
         data.pop("name")
-        data["controller"] = {k: data["controller"][k] for k in _READ_CONTROLLER}
+        data["controller"] = {k: data["controller"][k] for k in _READ_CONTROLLER if k in data["controller"]}
         data["disturbance"].pop("period")
         data["disturbance"]["sway"].pop("period")
         data.setdefault("plant", {"kind": "kinematic"})

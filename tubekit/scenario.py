@@ -174,6 +174,7 @@ class Scenario:
             "controller": {k: (list(v) if isinstance(v, tuple) else str(v) if isinstance(v, str) else v)
                            for k, v in asdict(self.controller).items()
                            if v is not None and not (k == "fhocp_backend" and v == "scp")
+                           and not (k == "backup" and v == "station_keeping")
                            and not (k in ("candidate", "recovery") and v is True)},
             "region": {k: (str(v) if isinstance(v, str) else v) for k, v in asdict(self.region).items()},
         }

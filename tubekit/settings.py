@@ -150,6 +150,11 @@ class ControllerSettings:
         error may leave R: a recovery plan, tracking not in force while it is followed) instead of holding the
         backup; only under a certificate that allows it (``Tightening.recovers``: σ = 0). Not a certificate
         input. Left out of :meth:`Scenario.to_dict` when True.
+    backup : str
+        The backup law's kind (a key of :data:`tubekit.model.backup.BACKUP_LAWS`): ``"station_keeping"`` (hold
+        station, surging ahead or astern; the default) or ``"loiter"`` (circle about the anchor at a constant
+        surge: :mod:`tubekit.model.loiter`). The certificate designs and proves a law of this kind. Left out of
+        :meth:`Scenario.to_dict` when ``"station_keeping"``.
     """
 
     dt: float = 0.1
@@ -166,6 +171,7 @@ class ControllerSettings:
     fhocp_backend: str = "scp"
     candidate: bool = True
     recovery: bool = True
+    backup: str = "station_keeping"
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "dt", positive("controller.dt", self.dt))
@@ -192,6 +198,9 @@ class ControllerSettings:
         object.__setattr__(self, "fhocp_mode", choice("controller.fhocp_mode", FhocpMode, self.fhocp_mode))
         object.__setattr__(self, "terminal_mode", choice("controller.terminal_mode", TerminalMode,
                                                          self.terminal_mode))
+        from tubekit.model.backup import BACKUP_LAWS  # the registry: station keeping, loiter, registered ones
+        if not isinstance(self.backup, str) or self.backup not in BACKUP_LAWS:
+            raise ConfigError("controller.backup", f"one of {tuple(BACKUP_LAWS)}", self.backup)
         if not isinstance(self.fhocp_backend, str) or not self.fhocp_backend:
             raise ConfigError("controller.fhocp_backend", "a backend name (e.g. 'scp' or 'ipopt')",
                               self.fhocp_backend)

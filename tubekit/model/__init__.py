@@ -8,6 +8,7 @@ from __future__ import annotations
 
 from tubekit.model.ancillary import LAWS, AncillaryLaw, get_law, jacobian_at, register_law
 from tubekit.model.errors import bearing, error_coordinates, heading_cosine, numeric
+from tubekit.model.loiter import Loiter  # registers the loiter backup law (kind "loiter")
 from tubekit.model.kinematics import (InputLimits, SwayModel, dsinc, kinematics, nominal_kinematics, sinc,
                                       unicycle_step)
 from tubekit.model.trajectory import Circle, Helix, Line, Trajectory, Waypoints, trajectory_from_dict
@@ -18,5 +19,5 @@ __all__ = [
     "error_coordinates", "bearing", "heading_cosine", "numeric",
     "AncillaryLaw", "LAWS", "get_law", "register_law", "jacobian_at",
     "Trajectory", "Circle", "Helix", "Line", "Waypoints", "trajectory_from_dict",
-    "VehicleParams", "VEHICLES", "PlantSettings", "vehicle_params",
+    "VehicleParams", "VEHICLES", "PlantSettings", "vehicle_params", "Loiter",
 ]

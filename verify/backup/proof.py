@@ -52,6 +52,7 @@ from flint import arb
 
 from tubekit.exceptions import ConfigError
 from tubekit.model.backup import SafeSet, StationKeeping
+from tubekit.model.loiter import Loiter
 from tubekit.validation import nonnegative, positive
 from verify.theorem.design import Condition
 from verify.kernel.intervals import bisect_sup, enclose, lower, upper
@@ -60,6 +61,7 @@ from verify.backup.protocol import BackupCertificate
 from verify.backup.rate import backup_command_rate, backup_tick_change
 
 __all__ = ["BackupCertificate", "planar_rate_bound", "certify_backup", "ramp_window", "tick_distance", "rate_sampled",
+           "ridge_rate", "hold_conditions", "angle_step",
            "backup_command_rate", "backup_tick_change", "BACKUP_MAX_BOXES"]
 
 #: Bisection budget of :func:`planar_rate_bound` (intervals of χ examined): a work unit, not seconds.
@@ -67,12 +69,14 @@ BACKUP_MAX_BOXES = 4096
 _HALF_PI_UP = math.nextafter(math.pi / 2, math.inf)
 
 
-def tick_distance(law: StationKeeping, safe: SafeSet, omega_xy: float, tick: float) -> float:
-    """A float <= c − β − h (u_b + ω̄_xy) (m): the least distance to the anchor during a tick that ends on V = c."""
+def tick_distance(law: StationKeeping | Loiter, safe: SafeSet, omega_xy: float, tick: float) -> float:
+    """A float <= c − β − h (u_b + ω̄_xy) (m): the least distance to the anchor during a tick that ends on V = c
+    (u_b the law's largest surge)."""
     return lower(arb(safe.level) - arb(safe.shape) - arb(tick) * (arb(law.surge) + arb(omega_xy)))
 
 
-def _angle_step(law: StationKeeping, omega_xy: float, tick: float, d_tick: float, yaw_err: float = 0.0) -> float:
+def angle_step(law: StationKeeping | Loiter, omega_xy: float, tick: float, d_tick: float,
+               yaw_err: float = 0.0) -> float:
     """Δ (rad), a float >= h (k + E_r + (u_b + ω̄_xy) / d_tick): how far χ moves within one tick."""
     return upper(arb(tick) * (arb(law.yaw_rate) + arb(yaw_err) + (arb(law.surge) + arb(omega_xy)) / arb(d_tick)))
 
@@ -117,7 +121,7 @@ def planar_rate_bound(law: StationKeeping, safe: SafeSet, omega_xy: float, tick:
     d_tick = tick_distance(law, safe, omega_xy, tick)
     if not d_tick > 0.0:
         return math.inf, 0
-    delta = _angle_step(law, omega_xy, tick, d_tick, yaw_rate_error)
+    delta = angle_step(law, omega_xy, tick, d_tick, yaw_rate_error)
     if law.yaw_law == "continuous":
         return continuous_rate_bound(law, safe, omega_xy, delta, max_boxes, yaw_rate_error)
     return bisect_sup(lambda a, b: _rate_upper(law, safe, omega_xy, delta, a, b, yaw_rate_error),
@@ -168,15 +172,36 @@ def _smooth_conditions(law: StationKeeping, safe: SafeSet, dist: tuple[float, fl
     return tuple(out)
 
 
+def ridge_rate(surge: float, omega_xy: float, delta: float, d_tick: float, yaw_err: float) -> float:
+    """A float >= (u min(1, 2Δ) + ω̄_xy)/d_tick + E_r (rad/s): how fast the line of sight can turn the heading
+    toward the ridge within 2Δ of it (``inf`` when d_tick <= 0); the law must turn faster (``backup_ridge``)."""
+    if not d_tick > 0:
+        return math.inf
+    return upper((arb(surge) * arb(min(1.0, 2 * delta)) + arb(omega_xy)) / arb(d_tick) + arb(yaw_err))
+
+
+def hold_conditions(law: StationKeeping | Loiter, safe: SafeSet, omega_z: float, tick: float,
+                    handover: tuple[float, float]) -> tuple[Condition, ...]:
+    """The depth hold and the hand-over, the same for every law with a saturated heave w = −w_b sat((z − z*)/z_0)
+    and a safe set {d + β a <= c, |z − z*| <= Z}, a <= 1: ``backup_heave``, ``backup_depth_hold``,
+    ``backup_handover`` (d <= c − β: in S whatever the heading), ``backup_handover_depth``."""
+    hold_z = upper(arb(law.heave_band) + arb(tick) * (arb(law.heave) + arb(omega_z)))
+    return (
+        Condition("backup_heave", "ω̄_z < w_b", omega_z, law.heave, omega_z < law.heave),
+        Condition("backup_depth_hold", "z_0 + h (w_b + ω̄_z) <= Z", hold_z, safe.depth, hold_z <= safe.depth),
+        Condition("backup_handover", "hand-over distance <= c − β", handover[0], safe.handover_radius,
+                  handover[0] <= safe.handover_radius),
+        Condition("backup_handover_depth", "hand-over depth error <= Z", handover[1], safe.depth,
+                  handover[1] <= safe.depth))
+
+
 def _conditions(law: StationKeeping, safe: SafeSet, dist: tuple[float, float], limits: tuple[float, float, float],
                 tick: float, handover: tuple[float, float], rate: float, yaw_err: float) -> tuple[Condition, ...]:
     """Every inequality of the theorem, with both numbers."""
     wxy, wz = dist
     d_tick = tick_distance(law, safe, wxy, tick)
-    delta = _angle_step(law, wxy, tick, d_tick, yaw_err) if d_tick > 0 else math.inf
-    ridge = (upper((arb(law.surge) * arb(min(1.0, 2 * delta)) + arb(wxy)) / arb(d_tick) + arb(yaw_err))
-             if d_tick > 0 else math.inf)
-    hold_z = upper(arb(law.heave_band) + arb(tick) * (arb(law.heave) + arb(wz)))
+    delta = angle_step(law, wxy, tick, d_tick, yaw_err) if d_tick > 0 else math.inf
+    ridge = ridge_rate(law.surge, wxy, delta, d_tick, yaw_err)
     ridge_text = "(u_b sin 2Δ + ω̄_xy) / d_tick" + (" + E_r" if yaw_err > 0 else "") + " < k and χ_0 <= π/2 − 2Δ"
     cond = Condition
     return (
@@ -187,13 +212,7 @@ def _conditions(law: StationKeeping, safe: SafeSet, dist: tuple[float, float], l
         cond("backup_ridge", ridge_text, ridge, law.yaw_rate,
              ridge < law.yaw_rate and law.yaw_band <= math.pi / 2 - 2 * delta),
         cond("backup_level_set", "sup V̇ on V = c < 0", rate, 0.0, rate < 0.0),
-        cond("backup_heave", "ω̄_z < w_b", wz, law.heave, wz < law.heave),
-        cond("backup_depth_hold", "z_0 + h (w_b + ω̄_z) <= Z", hold_z, safe.depth, hold_z <= safe.depth),
-        cond("backup_handover", "hand-over distance <= c − β", handover[0], safe.handover_radius,
-             handover[0] <= safe.handover_radius),
-        cond("backup_handover_depth", "hand-over depth error <= Z", handover[1], safe.depth,
-             handover[1] <= safe.depth),
-    ) + _smooth_conditions(law, safe, dist, tick, handover, d_tick, limits)
+    ) + hold_conditions(law, safe, wz, tick, handover) + _smooth_conditions(law, safe, dist, tick, handover, d_tick, limits)
 
 
 def certify_backup(law: StationKeeping, safe: SafeSet, *, omega_xy: float, omega_z: float,

@@ -29,7 +29,7 @@ from tubekit.model.backup import BackupLaw, SafeSet
 from tubekit.scenario import Scenario
 from tubekit.tiers import Tiers
 
-from verify.backup import DEFAULT_BACKUP_KIND, BackupCertificate, Fits, proof_for
+from verify.backup import BackupCertificate, Fits, proof_for
 from verify.theorem.design import Condition, Design, DisturbanceBounds, arc_rates, choose_design, evaluate_design, \
     input_tightening, state_conditions, sway_condition, tube_problem
 from verify.theorem.gains import GainBounds
@@ -152,13 +152,14 @@ def _with_reach(bc: BackupCertificate, certify: Callable[[float], BackupCertific
 
 
 def backup_of(scenario: Scenario, dist: DisturbanceBounds, margins: HorizonMargins | None,
-              fits: Fits | None = None, kind: str = DEFAULT_BACKUP_KIND) -> BackupCertificate:
+              fits: Fits | None = None, kind: str | None = None) -> BackupCertificate:
     """The backup law of ``kind`` designed by its proof (:meth:`verify.backup.BackupProof.design`, found by
     :func:`verify.backup.proof_for`) for ``scenario`` (ω̄ of ``dist``, V, tick 1/f, hand-over from ``margins``;
     ``fits``: the dynamic plant's gentle design), with ``backup_initial`` appended to its conditions. Where the
     safe set leaves room beyond the hand-over margin, the law is proved again for an anchor that the loop may move
-    up to :func:`anchor_reach` from the plan's end (``BackupCertificate.anchor_reach``)."""
-    proof = proof_for(kind)
+    up to :func:`anchor_reach` from the plan's end (``BackupCertificate.anchor_reach``). ``kind`` None: the
+    scenario's ``controller.backup``."""
+    proof = proof_for(scenario.controller.backup if kind is None else kind)
     limits = tuple(float(x) for x in scenario.limits.vector)
     tick = 1.0 / float(scenario.controller.ancillary_rate_hz)
     hand = _handover(margins)

@@ -16,11 +16,11 @@
   (unless the terminal set is "hard");
 * terminal set F = {||e_N||_P <= terminal_level} as a second-order cone,
   "soft" (default, exact penalty), "hard" or "off";
-* with a backup (``nlp.backup_terminal``), its terminal rows at the last node, sharing one
-  exact-penalty slack: each obstacle's half-space at p_N with the radius enlarged by the
-  footprint's sphere (the same normal as the node's obstacle row), the workspace box shrunk
-  by the footprint, and the sensed region as second-order cones (constant data: the frame's
-  origin is the measured position); none of it is built without a backup;
+* with a backup (``nlp.backup_terminal``), its terminal rows at the last node about the anchor
+  p_N + offset (the offset chosen at the linearisation's end, Parameter ``aT``), sharing one
+  exact-penalty slack: each obstacle's half-space with the radius enlarged by the footprint's
+  sphere (the same normal as the node's obstacle row), the workspace box shrunk by the
+  footprint, and the sensed region as second-order cones; none of it is built without a backup;
 * a box trust region on the input step, intersected with the input box;
 * with a rate limit (``nlp.rate_jump``), the rate rows of :mod:`tubekit.fhocp.rows` (hard): the
   node-to-node steps and the terminal rest with constant J, the first node against the Parameter
@@ -48,6 +48,7 @@ from tubekit.fhocp.nlp import FhocpNlp, eo_linearisation, rollout, step_linearis
 from tubekit.fhocp.qp.base import ConeSolution, QpBackend
 from tubekit.fhocp.qp.registry import DEFAULT_QP_BACKEND, make_qp_backend
 from tubekit.fhocp.result import Status, status_from
+from tubekit.fhocp.rows import backup_rows
 
 __all__ = ["ConvexSubproblem", "DEFAULT_CLARABEL_SETTINGS", "REALTIME_CLARABEL_SETTINGS", "CVXPY_STATUS"]
 
@@ -133,6 +134,7 @@ class ConvexSubproblem:
         # weights: dt*Q on samples 0..N-1, P on sample N (left rectangle rule + terminal cost)
         self._weights = np.vstack([np.tile(nlp.dt * nlp.q, (N, 1)), nlp.p])   # (N+1, 3) for k = 0..N
         self._wref = self._weights[1:, (0, 0, 1)].T  # (3, N) weights of x, y, z at k = 1..N
+        self._anchor_offset = np.zeros(3)  # the backup anchor's offset from p_N in this linearisation (m)
         self._build()
         self.clarabel_settings = {**DEFAULT_CLARABEL_SETTINGS, **(clarabel_settings or {})}
         self.compiled: CompiledConeProgram | None = None
@@ -255,24 +257,11 @@ class ConvexSubproblem:
         return [cp.SOC(cp.Constant(nlp.terminal_level), terminal_vec)], None
 
     def _backup_rows(self, par: _Par, v: dict) -> tuple[list, cp.Variable]:
-        """The backup's terminal rows at the last node (module doc) and their shared slack."""
-        nlp, N = self.nlp, self.nlp.n
-        bt = nlp.backup_terminal
-        x, y, z = v["x"][N - 1], v["y"][N - 1], v["z"][N - 1]
-        sig_b = cp.Variable(name="slack_backup")
-        cons = [sig_b >= 0]
-        for j in range(self.max_obstacles):
-            ox, oy, oz = (self._params[f"{a}{j}"][N - 1] for a in ("ox", "oy", "oz"))
-            cons.append(ox * x + oy * y + oz * z + sig_b >= par(f"rt{j}", 1))
-        if nlp.workspace is not None:
-            wt = par("wT", 6)
-            cons += [x + sig_b >= wt[0], y + sig_b >= wt[1], z + sig_b >= wt[2],
-                     x - sig_b <= wt[3], y - sig_b <= wt[4], z - sig_b <= wt[5]]
-        spread = cp.Variable(2, name="backup_spread")
-        cons += [cp.SOC(spread[0] - bt.safe[0], cp.hstack([x, y])),
-                 spread[1] >= z + bt.safe[1], spread[1] >= -z + bt.safe[1],
-                 cp.SOC(bt.sensed_bound + sig_b, spread)]
-        return cons, sig_b
+        """The backup's terminal rows at the last node (module doc, :func:`tubekit.fhocp.rows.backup_rows`)."""
+        N = self.nlp.n
+        normals = [tuple(self._params[f"{a}{j}"][N - 1] for a in ("ox", "oy", "oz")) for j in range(self.max_obstacles)]
+        return backup_rows(self.nlp.backup_terminal, (v["x"][N - 1], v["y"][N - 1], v["z"][N - 1]), normals, par,
+                           self.nlp.workspace is not None)
 
     def _objective(self, par: _Par, v: dict, slack: dict, sig_t: cp.Variable | None) -> cp.Expression:
         """Quadratic tracking cost + input cost + exact penalties.
@@ -326,7 +315,8 @@ class ConvexSubproblem:
                   "c0": ["c0"],
                   "obsT": [f"rt{j}" for j in range(M)] if nlp.backup_terminal is not None else [],
                   "vlast": ["vlast"] if "vlast" in self._cols else [], "jb": ["jb"] if "jb" in self._cols else [],
-                  "wallT": ["wT"] if nlp.backup_terminal is not None and nlp.workspace is not None else []}
+                  "wallT": ["wT"] if nlp.backup_terminal is not None and nlp.workspace is not None else [],
+                  "anchorT": ["aT"] if nlp.backup_terminal is not None else []}
         self._gidx = {g: np.concatenate([self._cols[n] for n in names]) if names else np.zeros(0, dtype=int)
                       for g, names in groups.items()}
 
@@ -358,6 +348,11 @@ class ConvexSubproblem:
         """
         o = s0[:3]
         psi0 = s0[3]
+        bt = self.nlp.backup_terminal
+        self._anchor_offset = (np.zeros(3) if bt is None
+                               else bt.best_offset(o, np.asarray(s[-1, :3], dtype=float), obs, self.nlp.workspace))
+        if bt is not None:
+            self.param_vector[self._gidx["anchorT"]] = self._anchor_offset[:2]
         s = s.copy()
         s[:, :3] -= o
         ref = ref - o
@@ -423,8 +418,9 @@ class ConvexSubproblem:
             if nlp.backup_terminal is not None:
                 r_f, h_f = nlp.backup_terminal.footprint
                 pad = np.array([r_f, r_f, h_f])
-                self.param_vector[self._gidx["wallT"]] = np.concatenate([nlp.workspace[0] + pad - o,
-                                                                         nlp.workspace[1] - pad - o])
+                shift = o + self._anchor_offset  # the rows hold the anchor p_N + offset inside the box
+                self.param_vector[self._gidx["wallT"]] = np.concatenate([nlp.workspace[0] + pad - shift,
+                                                                         nlp.workspace[1] - pad - shift])
         self.param_vector[self._gidx["step"]] = st.ravel()
 
     def _write_obstacles(self, s: np.ndarray, obs: np.ndarray, o: np.ndarray) -> None:
@@ -444,9 +440,10 @@ class ConvexSubproblem:
             ob[:k, :3] = n.transpose(0, 2, 1)
             ob[:k, 3] = obs[:, 3:4] + self.nlp.clearance + np.einsum("jnc,jc->jn", n, c)
         self.param_vector[self._gidx["obs"]] = ob.ravel()
-        if self.nlp.backup_terminal is not None:  # the last node's half-space with the footprint's sphere
+        if self.nlp.backup_terminal is not None:  # the last node's half-space, the footprint's sphere about the anchor
+            shift = ob[:, 0, -1] * self._anchor_offset[0] + ob[:, 1, -1] * self._anchor_offset[1]
             self.param_vector[self._gidx["obsT"]] = ob[:, 3, -1] + np.where(
-                np.arange(self.max_obstacles) < k, self.nlp.backup_terminal.sphere - self.nlp.clearance, 0.0)
+                np.arange(self.max_obstacles) < k, self.nlp.backup_terminal.sphere - self.nlp.clearance - shift, 0.0)
 
     def write_last_command(self, v_last: np.ndarray, first_row: bool) -> None:
         """Write ``vlast`` (the rate rows' and the rate penalty's v_last, (3,)) and the bound ``jb`` of

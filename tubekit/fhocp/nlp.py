@@ -40,14 +40,14 @@ NLP (k = 0..N-1 stages, e_k = error_coordinates(s_k, p_d(t + k dt)))::
 With a certified backup (``tightening.backup``, :class:`BackupTerminal`) the last node also carries
 the backup's terminal condition, softened by one slack sig_B (weight mu) shared by its rows::
 
-         ||p_N - c_j|| >= r_j + hypot(R_f, H_f) - sig_B     (each obstacle j),
-         lo + (R_f, R_f, H_f) - sig_B <= p_N <= hi - (R_f, R_f, H_f) + sig_B,
-         hypot(||p_N,xy - p_0,xy|| + c, |z_N - z_0| + Z) <= R_bar - r_bar + sig_B,
+         ||a - c_j|| >= r_j + hypot(R_f, H_f) - sig_B     (each obstacle j),   a = p_N + offset,
+         lo + (R_f, R_f, H_f) - sig_B <= a <= hi - (R_f, R_f, H_f) + sig_B,
+         hypot(||a_xy - p_0,xy|| + c, |z_N - z_0| + Z) <= R_bar - r_bar + sig_B,
 
-(R_f, H_f) the safe set's footprint and c its radius, each less the backup's anchor reach ρ, Z its depth,
-p_0 the measured position: the sphere of radius hypot(R_f, H_f) contains the footprint's cylinder, so a
-plan meeting one obstacle's row meets :func:`tubekit.loop.terminal.terminal_condition`'s part for it with
-the anchor moved ρ away from it; ``tubekit.loop.plan_check`` then checks one anchor for every part exactly.
+(R_f, H_f) the safe set's footprint, c and Z its radius and depth, p_0 the measured position, the offset one
+of the backup's anchor offsets (``BackupTerminal.best_offset``: 0 without an anchor reach): the sphere of
+radius hypot(R_f, H_f) contains the footprint's cylinder, so a plan meeting these rows meets
+:func:`tubekit.loop.terminal.terminal_condition` about that anchor, which ``tubekit.loop.plan_check`` checks.
 
 With a rate limit the inputs also meet the rate rows of :mod:`tubekit.fhocp.rows` (hard, like the
 input box; family ``rate``); the cost adds the rate penalty lambda sum_c R_c (sum_k (v_k,c -

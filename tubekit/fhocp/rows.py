@@ -18,13 +18,16 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import Callable
 
+import cvxpy as cp
 import numpy as np
 
+from tubekit.model.backup import anchor_offsets
 from tubekit.scenario import Scenario
 from tubekit.tightening import Tightening
 
-__all__ = ["RATE_MARGIN", "rate_violation", "rate_project", "rate_penalty_cost", "BackupTerminal"]
+__all__ = ["RATE_MARGIN", "rate_violation", "rate_project", "rate_penalty_cost", "BackupTerminal", "backup_rows"]
 
 #: The FHOCP imposes J (1 - RATE_MARGIN): room for the solver's tolerance below the J the exact check reads.
 RATE_MARGIN = 1e-4
@@ -105,24 +108,26 @@ class BackupTerminal:
     Attributes
     ----------
     sphere : float
-        hypot(R_f − ρ_a, H_f) (m), ρ_a the backup's anchor reach: added to each obstacle radius at p_N (no obstacle
-        margin: p_N is the plan's exact nominal end, the point the exact check reads).
+        hypot(R_f, H_f) (m): added to each obstacle radius about the anchor a = p_N + offset (no obstacle margin:
+        p_N is the plan's exact nominal end, the point the exact check reads).
     footprint : (float, float)
-        (R_f − ρ_a, H_f) (m): the workspace box shrunk by it holds p_N.
+        (R_f, H_f) (m): the workspace box shrunk by it holds the anchor.
     safe : (float, float)
-        (c − ρ_a, Z) (m): the safe set's radius, less the reach, and depth, for the sensed-region row.
+        (c, Z) (m): the safe set's radius and depth, for the sensed-region row about the anchor.
     sensed_bound : float
         R_bar - vehicle radius (m).
-
-    Each row is the exact check's part for one obstacle, the walls or the sensed region with the anchor moved
-    by up to ρ_a in that part's favour (:func:`tubekit.loop.terminal.terminal_condition`); one anchor must serve
-    them all, which the exact check decides.
+    reach : float
+        ρ_a (m), the backup's anchor reach: each solve places the anchor at one offset of
+        :func:`tubekit.model.backup.anchor_offsets` (:meth:`best_offset` at the linearisation's end), and every
+        row holds about that one anchor, so a plan that meets them meets the exact check
+        (:func:`tubekit.loop.terminal.terminal_condition`, which tries the same offsets).
     """
 
     sphere: float
     footprint: tuple[float, float]
     safe: tuple[float, float]
     sensed_bound: float
+    reach: float = 0.0
 
     @classmethod
     def of(cls, scenario: Scenario, tightening: Tightening) -> "BackupTerminal | None":
@@ -131,20 +136,61 @@ class BackupTerminal:
         if backup is None:
             return None
         r_f, h_f = backup.footprint(scenario.vehicle_radius)
-        r_f -= backup.anchor_reach
         return cls(sphere=math.hypot(r_f, h_f), footprint=(r_f, h_f),
-                   safe=(backup.safe_set.radius - backup.anchor_reach, backup.safe_set.depth),
-                   sensed_bound=scenario.sensing_range - scenario.vehicle_radius)
+                   safe=(backup.safe_set.radius, backup.safe_set.depth),
+                   sensed_bound=scenario.sensing_range - scenario.vehicle_radius, reach=backup.anchor_reach)
+
+    def _violations(self, p0: np.ndarray, anchors: np.ndarray, obstacles: np.ndarray,
+                    workspace: np.ndarray | None) -> np.ndarray:
+        """Largest signed violation (m; < 0: the smallest slack) of the rows about each anchor (K, 3), sensed
+        from ``p0``."""
+        worst = np.full(len(anchors), -np.inf)
+        if len(obstacles):
+            dist = np.linalg.norm(obstacles[None, :, :3] - anchors[:, None, :], axis=2)
+            worst = np.maximum(worst, np.max(obstacles[None, :, 3] + self.sphere - dist, axis=1))
+        if workspace is not None:
+            pad = np.array([self.footprint[0], self.footprint[0], self.footprint[1]])
+            worst = np.maximum(worst, np.max(np.maximum(workspace[0] + pad - anchors, anchors - workspace[1] + pad),
+                                             axis=1))
+        spread = np.hypot(np.hypot(anchors[:, 0] - p0[0], anchors[:, 1] - p0[1]) + self.safe[0],
+                          np.abs(anchors[:, 2] - p0[2]) + self.safe[1])
+        return np.maximum(worst, spread - self.sensed_bound)
+
+    def best_offset(self, p0: np.ndarray, pn: np.ndarray, obstacles: np.ndarray,
+                    workspace: np.ndarray | None) -> np.ndarray:
+        """The offset (3,) (m) of :func:`tubekit.model.backup.anchor_offsets` whose anchor pn + offset leaves the
+        rows the most room (the smallest signed violation; none first among equals)."""
+        offsets = anchor_offsets(self.reach)
+        return offsets[int(np.argmin(self._violations(p0, pn[None, :] + offsets, obstacles, workspace)))]
 
     def violation(self, p0: np.ndarray, pn: np.ndarray, obstacles: np.ndarray,
                   workspace: np.ndarray | None) -> float:
-        """Largest violation (m, >= 0) of the rows at the end position ``pn`` sensed from ``p0``."""
-        worst = 0.0
-        if len(obstacles):
-            dist = np.linalg.norm(obstacles[:, :3] - pn[None, :], axis=1)
-            worst = max(worst, float(np.max(obstacles[:, 3] + self.sphere - dist)))
-        if workspace is not None:
-            pad = np.array([self.footprint[0], self.footprint[0], self.footprint[1]])
-            worst = max(worst, float(np.max(workspace[0] + pad - pn)), float(np.max(pn - workspace[1] + pad)))
-        spread = math.hypot(math.hypot(pn[0] - p0[0], pn[1] - p0[1]) + self.safe[0], abs(pn[2] - p0[2]) + self.safe[1])
-        return max(worst, spread - self.sensed_bound)
+        """Largest violation (m, >= 0) of the rows at the end position ``pn`` sensed from ``p0``, about the best
+        anchor of :meth:`best_offset`."""
+        offsets = anchor_offsets(self.reach)
+        return max(0.0, float(np.min(self._violations(p0, pn[None, :] + offsets, obstacles, workspace))))
+
+
+def backup_rows(bt: BackupTerminal, end: tuple[cp.Expression, cp.Expression, cp.Expression],
+                normals: list[tuple[cp.Expression, cp.Expression, cp.Expression]],
+                par: Callable[[str, int], cp.Parameter], walls: bool) -> tuple[list, cp.Variable]:
+    """The backup's terminal rows at the last node p_N = ``end`` (x, y, z relative to the measured position) and
+    their shared slack sig_B: per obstacle slot j the half-space ``normals[j]`` · p_N + sig_B >= rt_j (rt_j
+    carries the sphere about the anchor, :meth:`ConvexSubproblem._write_obstacles`), the walls' box wT about the
+    anchor (``walls``), and the sensed region hypot(‖p_N,xy + aT‖ + c, |z_N| + Z) <= R_bar − r_bar + sig_B with
+    aT the anchor's offset (:meth:`BackupTerminal.best_offset`). ``par(name, size)`` makes a Parameter."""
+    x, y, z = end
+    sig_b = cp.Variable(name="slack_backup")
+    cons = [sig_b >= 0]
+    for j, (ox, oy, oz) in enumerate(normals):
+        cons.append(ox * x + oy * y + oz * z + sig_b >= par(f"rt{j}", 1))
+    if walls:
+        wt = par("wT", 6)
+        cons += [x + sig_b >= wt[0], y + sig_b >= wt[1], z + sig_b >= wt[2],
+                 x - sig_b <= wt[3], y - sig_b <= wt[4], z - sig_b <= wt[5]]
+    spread = cp.Variable(2, name="backup_spread")
+    at = par("aT", 2)
+    cons += [cp.SOC(spread[0] - bt.safe[0], cp.hstack([x + at[0], y + at[1]])),
+             spread[1] >= z + bt.safe[1], spread[1] >= -z + bt.safe[1],
+             cp.SOC(bt.sensed_bound + sig_b, spread)]
+    return cons, sig_b

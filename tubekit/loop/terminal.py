@@ -34,14 +34,11 @@ from typing import Sequence
 import numpy as np
 
 from tubekit.exceptions import ConfigError
-from tubekit.model.backup import BackupPlan
+from tubekit.model.backup import ANCHOR_DIRECTIONS, BackupPlan
 from tubekit.scenario import Obstacle
 from tubekit.validation import as_vector, nonnegative, positive
 
-__all__ = ["TerminalCheck", "terminal_condition", "cylinder_distance", "anchor_candidates", "ANCHOR_RING"]
-
-#: Directions on the ring of anchors tried at the full reach (besides those away from each obstacle and toward p_k).
-ANCHOR_RING = 16
+__all__ = ["TerminalCheck", "terminal_condition", "cylinder_distance", "anchor_candidates"]
 
 
 @dataclass(frozen=True)
@@ -62,21 +59,18 @@ def cylinder_distance(point: np.ndarray, anchor: np.ndarray, radius: float, half
     return math.hypot(horizontal, vertical)
 
 
-_RING_ANGLES = 2.0 * math.pi * np.arange(ANCHOR_RING) / ANCHOR_RING
-_RING = np.stack([np.cos(_RING_ANGLES), np.sin(_RING_ANGLES)], axis=1)
-
-
 def anchor_candidates(end: np.ndarray, reach: float, obstacles: Sequence[Obstacle],
                       sensed_at: np.ndarray) -> np.ndarray:
     """Anchors (K, 3) (m) tried by :func:`terminal_condition`: p* = ``end`` first, then, at the horizontal
     distance ``reach`` (m) and at half of it, the points away from each obstacle, toward ``sensed_at`` and on a
-    ring of :data:`ANCHOR_RING` directions; every one at p*'s depth. Only p* when ``reach`` is 0."""
+    ring of :data:`tubekit.model.backup.ANCHOR_DIRECTIONS` (the FHOCP's, :class:`tubekit.fhocp.rows.BackupTerminal`);
+    every one at p*'s depth. Only p* when ``reach`` is 0."""
     p = np.asarray(end, dtype=float)[:3]
     if reach <= 0.0:
         return p[None, :].copy()
     centres = np.array([o.center for o in obstacles], dtype=float).reshape(-1, 3)
     toward = np.asarray(sensed_at, dtype=float)[None, :2] - p[None, :2]
-    dirs = np.concatenate([p[None, :2] - centres[:, :2], toward, _RING])
+    dirs = np.concatenate([p[None, :2] - centres[:, :2], toward, ANCHOR_DIRECTIONS])
     norms = np.hypot(dirs[:, 0], dirs[:, 1])
     units = dirs[norms > 0.0] / norms[norms > 0.0, None]
     out = np.repeat(p[None, :], 2 * len(units) + 1, axis=0)

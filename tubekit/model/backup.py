@@ -64,7 +64,7 @@ from tubekit.validation import nonnegative, positive
 
 __all__ = ["BackupLaw", "BACKUP_LAWS", "register_backup_law", "backup_law_from_dict", "StationKeeping", "SafeSet",
            "BackupPlan", "line_of_sight_angle", "axis_angle", "station_keeping_input", "yaw_shape", "axis_shape",
-           "YAW_LAWS", "SHAPE_PLATEAU"]
+           "YAW_LAWS", "SHAPE_PLATEAU", "ANCHOR_RING", "ANCHOR_DIRECTIONS", "anchor_offsets"]
 
 
 @runtime_checkable
@@ -349,6 +349,25 @@ class BackupPlan:
     def footprint(self, vehicle_radius: float) -> tuple[float, float]:
         """(horizontal radius, half height) (m) of the safe set inflated by the vehicle ball."""
         return self.safe_set.radius + vehicle_radius, self.safe_set.depth + vehicle_radius
+
+
+#: Directions (unit vectors in the horizontal plane, (ANCHOR_RING, 2)) in which the loop and the FHOCP may move the
+#: backup's anchor from a plan's end, by ``BackupPlan.anchor_reach`` (``docs/verify.md`` step 11): both read the same
+#: ring, so an anchor the FHOCP plans for is one the exact check tries.
+ANCHOR_RING = 16
+ANCHOR_DIRECTIONS = np.stack([np.cos(2.0 * np.pi * np.arange(ANCHOR_RING) / ANCHOR_RING),
+                              np.sin(2.0 * np.pi * np.arange(ANCHOR_RING) / ANCHOR_RING)], axis=1)
+ANCHOR_DIRECTIONS.setflags(write=False)
+
+
+def anchor_offsets(reach: float) -> np.ndarray:
+    """(ANCHOR_RING + 1, 3) horizontal offsets (m) of the anchor from a plan's end: none first, then ``reach`` along
+    each of :data:`ANCHOR_DIRECTIONS` (only the first when ``reach`` is 0)."""
+    if reach <= 0.0:
+        return np.zeros((1, 3))
+    out = np.zeros((ANCHOR_RING + 1, 3))
+    out[1:, :2] = reach * ANCHOR_DIRECTIONS
+    return out
 
 
 #: Backup laws by ``kind`` (their JSON tag); :func:`register_backup_law` adds one.

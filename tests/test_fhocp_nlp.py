@@ -139,13 +139,23 @@ def test_the_backup_terminal_rows_come_from_the_tightenings_backup():
     assert bt.safe == pytest.approx((0.8, 0.1)) and bt.sensed_bound == pytest.approx(1.3)
 
 
-def test_the_backup_terminal_rows_give_each_part_the_anchors_reach():
-    """With an anchor that may move 0.25 m from the plan's end, each row is the exact check's part with the anchor
-    moved in its favour: footprint (1.0 - 0.25, 0.3), sphere hypot(0.75, 0.3), the sensed row's radius 0.8 - 0.25."""
+def test_the_backup_terminal_rows_hold_about_one_anchor_within_the_reach():
+    """With an anchor that may move 0.25 m from the plan's end, the rows keep the whole footprint (1.0, 0.3) and the
+    safe set (0.8, 0.1) about one anchor p_N + offset, the offset one of the shared ring's (or none): an obstacle
+    1.3 m from p_N (needs 1.0 + 0.4 from the anchor) is cleared by the offset pointing away from it."""
+    from tubekit.model.backup import ANCHOR_DIRECTIONS
     movable = dataclasses.replace(backup_plan(), anchor_reach=0.25)
     bt = FhocpNlp.from_scenario(SC, dataclasses.replace(tightening(), backup=movable)).backup_terminal
-    assert bt.footprint == pytest.approx((0.75, 0.3)) and bt.sphere == pytest.approx(math.hypot(0.75, 0.3))
-    assert bt.safe == pytest.approx((0.55, 0.1)) and bt.sensed_bound == pytest.approx(1.3)
+    assert bt.footprint == pytest.approx((1.0, 0.3)) and bt.sphere == pytest.approx(math.hypot(1.0, 0.3))
+    assert bt.safe == pytest.approx((0.8, 0.1)) and bt.reach == 0.25
+    p0, pn = np.array([0.9, 0.0, 0.0]), np.array([1.0, 0.0, 0.0])   # sensed 0.1 m behind p_N
+    obstacle = np.array([[2.3, 0.0, 0.0, 0.4]])                  # 1.3 m ahead of p_N
+    offset = bt.best_offset(p0, pn, obstacle, None)
+    assert offset == pytest.approx(np.append(-0.25 * ANCHOR_DIRECTIONS[0], 0.0))   # straight away from it
+    # about p_N + offset: 1.55 m from the centre, needs 0.4 + hypot(1.0, 0.3) = 1.444 m; sensed hypot(0.95, 0.1) < 1.3
+    assert bt.violation(p0, pn, obstacle, None) == 0.0
+    fixed = dataclasses.replace(bt, reach=0.0)
+    assert fixed.violation(p0, pn, obstacle, None) == pytest.approx(0.4 + math.hypot(1.0, 0.3) - 1.3)
 
 
 def test_the_backup_terminal_violation_is_the_worst_row():

@@ -293,6 +293,28 @@ def test_the_terminal_rows_keep_the_footprint_off_an_obstacle_ahead(mode):
     assert _end_check(SC, s, with_rows, ob).ok and with_rows.violations["backup_terminal"] <= 1e-9
 
 
+@pytest.mark.parametrize("mode", ["realtime", "converged"])
+def test_an_anchor_that_may_move_lets_the_plan_end_nearer_and_still_meets_the_exact_check(mode):
+    """The same obstacle ahead, the backup proved for an anchor 0.2 m from the plan's end: the rows hold about
+    one anchor of the shared ring, the plan ends nearer the obstacle than with the anchor fixed, and the exact check
+    (which tries the same anchors) accepts it."""
+    t, s = STATES[0]
+    s = np.asarray(s, dtype=float)
+    free = FHOCP(SC, tightening(SC), mode="converged").solve(t, s, ())
+    end = plan_arcs(s, free.inputs, SC.controller.dt, 1)[-1, -1]
+    ahead = (end[:2] - s[:2]) / np.linalg.norm(end[:2] - s[:2])
+    ob = (Obstacle((end[0] + 0.9 * ahead[0], end[1] + 0.9 * ahead[1], end[2]), 0.3),)
+    movable = dataclasses.replace(backup_plan(), anchor_reach=0.2)
+    fixed = FHOCP(SC, dataclasses.replace(tightening(SC), backup=backup_plan()), mode=mode).solve(t, s, ob)
+    moved = FHOCP(SC, dataclasses.replace(tightening(SC), backup=movable), mode=mode).solve(t, s, ob)
+    gap = [float(np.linalg.norm(plan_arcs(s, r.inputs, SC.controller.dt, 1)[-1, -1][:2] - ob[0].center[:2]))
+           for r in (fixed, moved)]
+    assert gap[1] < gap[0] - 0.05 and moved.violations["backup_terminal"] <= 1e-9
+    end = plan_arcs(s, moved.inputs, SC.controller.dt, 1)[-1, -1]
+    check = terminal_condition(end[:3], movable, SC.vehicle_radius, ob, SC.workspace, s[:3], SC.sensing_range)
+    assert check.ok and math.hypot(check.anchor[0] - end[0], check.anchor[1] - end[1]) <= 0.2 + 1e-12
+
+
 def test_without_a_backup_the_problem_is_unchanged():
     solver = FHOCP(SC, tightening(SC))
     names = {v.name() for v in solver.problem.variables()}

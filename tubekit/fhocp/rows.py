@@ -156,17 +156,37 @@ class BackupTerminal:
                           np.abs(anchors[:, 2] - p0[2]) + self.safe[1])
         return np.maximum(worst, spread - self.sensed_bound)
 
+    def _violation_at(self, p0: np.ndarray, anchor: np.ndarray, obstacles: np.ndarray,
+                      workspace: np.ndarray | None) -> float:
+        """:meth:`_violations` of one anchor (3,), on floats (the common path: no offset needed)."""
+        ax, ay, az = float(anchor[0]), float(anchor[1]), float(anchor[2])
+        worst = -math.inf
+        for cx, cy, cz, radius in obstacles.tolist():
+            worst = max(worst, radius + self.sphere - math.sqrt((cx - ax) ** 2 + (cy - ay) ** 2 + (cz - az) ** 2))
+        if workspace is not None:
+            pad = (self.footprint[0], self.footprint[0], self.footprint[1])
+            for a, lo, hi, d in zip((ax, ay, az), workspace[0], workspace[1], pad):
+                worst = max(worst, float(lo) + d - a, a - float(hi) + d)
+        spread = math.hypot(math.hypot(ax - float(p0[0]), ay - float(p0[1])) + self.safe[0],
+                            abs(az - float(p0[2])) + self.safe[1])
+        return max(worst, spread - self.sensed_bound)
+
     def best_offset(self, p0: np.ndarray, pn: np.ndarray, obstacles: np.ndarray,
                     workspace: np.ndarray | None) -> np.ndarray:
         """The offset (3,) (m) of :func:`tubekit.model.backup.anchor_offsets` whose anchor pn + offset leaves the
         rows the most room (the smallest signed violation; none first among equals)."""
         offsets = anchor_offsets(self.reach)
+        if len(offsets) == 1:
+            return offsets[0]
         return offsets[int(np.argmin(self._violations(p0, pn[None, :] + offsets, obstacles, workspace)))]
 
     def violation(self, p0: np.ndarray, pn: np.ndarray, obstacles: np.ndarray,
                   workspace: np.ndarray | None) -> float:
         """Largest violation (m, >= 0) of the rows at the end position ``pn`` sensed from ``p0``, about the best
-        anchor of :meth:`best_offset`."""
+        anchor of :meth:`best_offset` (the end itself first: no offset is tried when it meets the rows)."""
+        at_end = self._violation_at(p0, pn, obstacles, workspace)
+        if at_end <= 0.0 or self.reach <= 0.0:
+            return max(0.0, at_end)
         offsets = anchor_offsets(self.reach)
         return max(0.0, float(np.min(self._violations(p0, pn[None, :] + offsets, obstacles, workspace))))
 

@@ -114,6 +114,29 @@ def _passing(table: np.ndarray, n_obstacles: int) -> np.ndarray:
     return ok & (table[:, :n_obstacles].min(axis=1) > 0.0) if n_obstacles else ok
 
 
+def _end_check(p: np.ndarray, backup: BackupPlan, rv: float, obstacles: Sequence[Obstacle],
+               workspace: tuple[Sequence[float], Sequence[float]] | None, pk: np.ndarray,
+               reach: float) -> TerminalCheck:
+    """The three parts about p* itself, on floats (the common path: a plan whose end needs no other anchor)."""
+    r_f, h_f = backup.footprint(rv)
+    slacks: dict[str, float] = {}
+    for i, o in enumerate(obstacles):
+        slacks[f"obstacle {i}"] = cylinder_distance(np.asarray(o.center), p, r_f, h_f) - o.radius
+    if workspace is not None:
+        pad = (r_f, r_f, h_f)
+        slacks["workspace"] = min(min(float(p[j]) - pad[j] - float(workspace[0][j]),
+                                      float(workspace[1][j]) - float(p[j]) - pad[j]) for j in range(3))
+    safe = backup.safe_set
+    spread = math.hypot(math.hypot(float(p[0] - pk[0]), float(p[1] - pk[1])) + safe.radius,
+                        abs(float(p[2] - pk[2])) + safe.depth)
+    slacks["sensed region"] = reach - rv - spread
+    reason, worst = min(slacks.items(), key=lambda kv: kv[1])
+    ok = (math.isfinite(worst) and worst >= 0.0
+          and all(v > 0.0 for k, v in slacks.items() if k.startswith("obstacle")))
+    return TerminalCheck(ok=bool(ok), slack=float(worst), reason=reason,
+                         anchor=(float(p[0]), float(p[1]), float(p[2])))
+
+
 def terminal_condition(anchor: Sequence[float], backup: BackupPlan, vehicle_radius: float,
                        known_obstacles: Sequence[Obstacle],
                        workspace: tuple[Sequence[float], Sequence[float]] | None,
@@ -161,11 +184,11 @@ def terminal_condition(anchor: Sequence[float], backup: BackupPlan, vehicle_radi
     for i, o in enumerate(known_obstacles):
         if not isinstance(o, Obstacle):
             raise ConfigError(f"known_obstacles[{i}]", "a tubekit.Obstacle", type(o).__name__)
-    names, table = _slacks(p[None, :], backup, rv, known_obstacles, workspace, pk, reach)
-    anchors = p[None, :]
-    if not _passing(table, len(known_obstacles))[0] and backup.anchor_reach > 0.0:
-        anchors = anchor_candidates(p, backup.anchor_reach, known_obstacles, pk)
-        names, table = _slacks(anchors, backup, rv, known_obstacles, workspace, pk, reach)
+    at_end = _end_check(p, backup, rv, known_obstacles, workspace, pk, reach)
+    if at_end.ok or backup.anchor_reach <= 0.0:
+        return at_end
+    anchors = anchor_candidates(p, backup.anchor_reach, known_obstacles, pk)
+    names, table = _slacks(anchors, backup, rv, known_obstacles, workspace, pk, reach)
     passing = _passing(table, len(known_obstacles))
     score = np.where(passing, table.min(axis=1), -np.inf) if passing.any() else table.min(axis=1)
     best = int(np.argmax(score))

@@ -53,6 +53,7 @@ for every current within the certified bound; this module only evaluates the law
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import asdict, dataclass
 from typing import Any, ClassVar, Protocol, runtime_checkable
@@ -360,13 +361,14 @@ ANCHOR_DIRECTIONS = np.stack([np.cos(2.0 * np.pi * np.arange(ANCHOR_RING) / ANCH
 ANCHOR_DIRECTIONS.setflags(write=False)
 
 
+@functools.lru_cache(maxsize=64)
 def anchor_offsets(reach: float) -> np.ndarray:
     """(ANCHOR_RING + 1, 3) horizontal offsets (m) of the anchor from a plan's end: none first, then ``reach`` along
-    each of :data:`ANCHOR_DIRECTIONS` (only the first when ``reach`` is 0)."""
-    if reach <= 0.0:
-        return np.zeros((1, 3))
-    out = np.zeros((ANCHOR_RING + 1, 3))
-    out[1:, :2] = reach * ANCHOR_DIRECTIONS
+    each of :data:`ANCHOR_DIRECTIONS` (only the first when ``reach`` is 0). Read-only (cached per reach)."""
+    out = np.zeros((1 if reach <= 0.0 else ANCHOR_RING + 1, 3))
+    if reach > 0.0:
+        out[1:, :2] = reach * ANCHOR_DIRECTIONS
+    out.setflags(write=False)
     return out
 
 

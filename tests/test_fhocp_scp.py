@@ -278,15 +278,20 @@ def test_the_terminal_rows_keep_the_plan_end_in_the_sensed_region(mode):
     assert bound.violations["backup_terminal"] <= 1e-9 and "backup_terminal" not in free.violations
 
 
-@pytest.mark.parametrize("mode", ["realtime", "converged"])
-def test_the_terminal_rows_keep_the_footprint_off_an_obstacle_ahead(mode):
-    """An obstacle 0.9 m beyond the free plan's end, clear of every node: only the terminal rows see it."""
+def _obstacle_ahead():
+    """(t, state, (obstacle,)): the first case's state and a 0.3 m obstacle 0.9 m beyond the free plan's end."""
     t, s = STATES[0]
     s = np.asarray(s, dtype=float)
     free = FHOCP(SC, tightening(SC), mode="converged").solve(t, s, ())
     end = plan_arcs(s, free.inputs, SC.controller.dt, 1)[-1, -1]
     ahead = (end[:2] - s[:2]) / np.linalg.norm(end[:2] - s[:2])
-    ob = (Obstacle((end[0] + 0.9 * ahead[0], end[1] + 0.9 * ahead[1], end[2]), 0.3),)
+    return t, s, (Obstacle((end[0] + 0.9 * ahead[0], end[1] + 0.9 * ahead[1], end[2]), 0.3),)
+
+
+@pytest.mark.parametrize("mode", ["realtime", "converged"])
+def test_the_terminal_rows_keep_the_footprint_off_an_obstacle_ahead(mode):
+    """An obstacle 0.9 m beyond the free plan's end, clear of every node: only the terminal rows see it."""
+    t, s, ob = _obstacle_ahead()
     without = FHOCP(SC, tightening(SC), mode=mode).solve(t, s, ob)
     with_rows = FHOCP(SC, dataclasses.replace(tightening(SC), backup=backup_plan()), mode=mode).solve(t, s, ob)
     assert without.violations["obstacle"] == 0.0 and not _end_check(SC, s, without, ob).ok
@@ -298,12 +303,7 @@ def test_an_anchor_that_may_move_lets_the_plan_end_nearer_and_still_meets_the_ex
     """The same obstacle ahead, the backup proved for an anchor 0.2 m from the plan's end: the rows hold about
     one anchor of the shared ring, the plan ends nearer the obstacle than with the anchor fixed, and the exact check
     (which tries the same anchors) accepts it."""
-    t, s = STATES[0]
-    s = np.asarray(s, dtype=float)
-    free = FHOCP(SC, tightening(SC), mode="converged").solve(t, s, ())
-    end = plan_arcs(s, free.inputs, SC.controller.dt, 1)[-1, -1]
-    ahead = (end[:2] - s[:2]) / np.linalg.norm(end[:2] - s[:2])
-    ob = (Obstacle((end[0] + 0.9 * ahead[0], end[1] + 0.9 * ahead[1], end[2]), 0.3),)
+    t, s, ob = _obstacle_ahead()
     movable = dataclasses.replace(backup_plan(), anchor_reach=0.2)
     fixed = FHOCP(SC, dataclasses.replace(tightening(SC), backup=backup_plan()), mode=mode).solve(t, s, ob)
     moved = FHOCP(SC, dataclasses.replace(tightening(SC), backup=movable), mode=mode).solve(t, s, ob)

@@ -79,8 +79,8 @@ def anchor_candidates(end: np.ndarray, reach: float, obstacles: Sequence[Obstacl
 
 
 def _slacks(anchors: np.ndarray, backup: BackupPlan, rv: float, obstacles: Sequence[Obstacle],
-            workspace: tuple[Sequence[float], Sequence[float]] | None, pk: np.ndarray,
-            reach: float) -> tuple[list[str], np.ndarray]:
+            walls: tuple[np.ndarray, np.ndarray] | None, pk: np.ndarray,
+            sensing: float) -> tuple[list[str], np.ndarray]:
     """Each part's name and slack (m) at every anchor, (K, parts): (a) per obstacle, (b) the walls, (c) the sensed
     region."""
     r_f, h_f = backup.footprint(rv)
@@ -92,16 +92,16 @@ def _slacks(anchors: np.ndarray, backup: BackupPlan, rv: float, obstacles: Seque
                                               obs[None, :, 1] - anchors[:, None, 1]) - r_f)
         vertical = np.maximum(0.0, np.abs(obs[None, :, 2] - anchors[:, None, 2]) - h_f)
         cols.append(np.hypot(horizontal, vertical) - obs[None, :, 3])
-    if workspace is not None:
-        lo = as_vector("workspace[0]", workspace[0], 3)
-        hi = as_vector("workspace[1]", workspace[1], 3)
+    if walls is not None:
+        lo, hi = walls
         pad = np.array([r_f, r_f, h_f])
         names.append("workspace")
         cols.append(np.minimum((anchors - pad - lo).min(axis=1), (hi - anchors - pad).min(axis=1))[:, None])
     safe = backup.safe_set
     horizontal = np.hypot(anchors[:, 0] - pk[0], anchors[:, 1] - pk[1])
     names.append("sensed region")
-    cols.append((reach - rv - np.hypot(horizontal + safe.radius, np.abs(anchors[:, 2] - pk[2]) + safe.depth))[:, None])
+    spread = np.hypot(horizontal + safe.radius, np.abs(anchors[:, 2] - pk[2]) + safe.depth)
+    cols.append((sensing - rv - spread)[:, None])
     table = np.concatenate(cols, axis=1)
     return names, np.where(np.isnan(table), -np.inf, table)
 
@@ -115,21 +115,21 @@ def _passing(table: np.ndarray, n_obstacles: int) -> np.ndarray:
 
 
 def _end_check(p: np.ndarray, backup: BackupPlan, rv: float, obstacles: Sequence[Obstacle],
-               workspace: tuple[Sequence[float], Sequence[float]] | None, pk: np.ndarray,
-               reach: float) -> TerminalCheck:
+               walls: tuple[np.ndarray, np.ndarray] | None, pk: np.ndarray,
+               sensing: float) -> TerminalCheck:
     """The three parts about p* itself, on floats (the common path: a plan whose end needs no other anchor)."""
     r_f, h_f = backup.footprint(rv)
     slacks: dict[str, float] = {}
     for i, o in enumerate(obstacles):
         slacks[f"obstacle {i}"] = cylinder_distance(np.asarray(o.center), p, r_f, h_f) - o.radius
-    if workspace is not None:
+    if walls is not None:
         pad = (r_f, r_f, h_f)
-        slacks["workspace"] = min(min(float(p[j]) - pad[j] - float(workspace[0][j]),
-                                      float(workspace[1][j]) - float(p[j]) - pad[j]) for j in range(3))
+        slacks["workspace"] = min(min(float(p[j] - walls[0][j]) - pad[j], float(walls[1][j] - p[j]) - pad[j])
+                                  for j in range(3))
     safe = backup.safe_set
     spread = math.hypot(math.hypot(float(p[0] - pk[0]), float(p[1] - pk[1])) + safe.radius,
                         abs(float(p[2] - pk[2])) + safe.depth)
-    slacks["sensed region"] = reach - rv - spread
+    slacks["sensed region"] = sensing - rv - spread
     reason, worst = min(slacks.items(), key=lambda kv: kv[1])
     ok = (math.isfinite(worst) and worst >= 0.0
           and all(v > 0.0 for k, v in slacks.items() if k.startswith("obstacle")))
@@ -180,15 +180,17 @@ def terminal_condition(anchor: Sequence[float], backup: BackupPlan, vehicle_radi
     if not isinstance(backup, BackupPlan):
         raise ConfigError("tightening.backup", "a tubekit.model.backup.BackupPlan", type(backup).__name__)
     rv = nonnegative("scenario.vehicle_radius", vehicle_radius)
-    reach = positive("scenario.sensing_range", sensing_range)
+    sensing = positive("scenario.sensing_range", sensing_range)
+    walls = None if workspace is None else (as_vector("workspace[0]", workspace[0], 3),
+                                            as_vector("workspace[1]", workspace[1], 3))
     for i, o in enumerate(known_obstacles):
         if not isinstance(o, Obstacle):
             raise ConfigError(f"known_obstacles[{i}]", "a tubekit.Obstacle", type(o).__name__)
-    at_end = _end_check(p, backup, rv, known_obstacles, workspace, pk, reach)
+    at_end = _end_check(p, backup, rv, known_obstacles, walls, pk, sensing)
     if at_end.ok or backup.anchor_reach <= 0.0:
         return at_end
     anchors = anchor_candidates(p, backup.anchor_reach, known_obstacles, pk)
-    names, table = _slacks(anchors, backup, rv, known_obstacles, workspace, pk, reach)
+    names, table = _slacks(anchors, backup, rv, known_obstacles, walls, pk, sensing)
     passing = _passing(table, len(known_obstacles))
     score = np.where(passing, table.min(axis=1), -np.inf) if passing.any() else table.min(axis=1)
     best = int(np.argmax(score))

@@ -56,7 +56,7 @@ def test_bad_arguments_are_refused(pc_cert, kwargs, match):
 
 
 #: The FHOCP fails from this time on in the transit (s): the vehicle is then abreast of the first rock (the push run's
-#: smallest clearance was 0.43 m, V / c 0.83 at the time of writing).
+#: smallest clearance was 0.44 m, V / c 0.71 at the time of writing).
 BLIND_FROM = 32.0
 
 

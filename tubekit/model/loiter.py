@@ -117,15 +117,16 @@ def loiter_input(law: Loiter, state: tuple[float, float, float, float],
     return law.surge, -law.heave * _sat((z - anchor[2]) / law.heave_band), -law.yaw_rate * _sat(phi / law.yaw_band)
 
 
-def loiter_shape(bend: float, phi: float) -> float:
-    """a(φ) (dimensionless, in [0, 1]) at the heading angle φ (rad), φ_s = ``bend``:
-    φ²/(2 φ_s L) for |φ| <= φ_s, (|φ| − φ_s/2)/L above, L = π − φ_s/2 (so a(±π) = 1)."""
-    x = min(abs(phi), math.pi)
+def loiter_shape(bend: float, phi: float | np.ndarray) -> float | np.ndarray:
+    """a(φ) (dimensionless, in [0, 1]) at the heading angle(s) φ (rad), φ_s = ``bend``:
+    φ²/(2 φ_s L) for |φ| <= φ_s, (|φ| − φ_s/2)/L above, L = π − φ_s/2 (so a(±π) = 1). A float for a float."""
+    x = np.minimum(np.abs(phi), math.pi)
     length = math.pi - 0.5 * bend
-    return x * x / (2.0 * bend * length) if x <= bend else (x - 0.5 * bend) / length
+    out = np.where(x <= bend, x * x / (2.0 * bend * length), (x - 0.5 * bend) / length)
+    return float(out) if out.ndim == 0 else out
 
 
-def loiter_shape_slope(bend: float, phi: float) -> float:
+def loiter_shape_slope(bend: float, phi: float | np.ndarray) -> float | np.ndarray:
     """a'(φ) for φ in [0, π] (rad⁻¹): φ/(φ_s L) below φ_s, 1/L above (module doc of :func:`loiter_shape`)."""
-    length = math.pi - 0.5 * bend
-    return min(phi, bend) / (bend * length)
+    out = np.minimum(phi, bend) / (bend * (math.pi - 0.5 * bend))
+    return float(out) if np.ndim(out) == 0 else out

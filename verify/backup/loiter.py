@@ -41,10 +41,11 @@ from flint import arb
 
 from tubekit.exceptions import ConfigError
 from tubekit.model.backup import BackupLaw, SafeSet
-from tubekit.model.loiter import Loiter
+from tubekit.model.loiter import Loiter, loiter_shape, loiter_shape_slope
 from tubekit.validation import nonnegative, positive
-from verify.backup.proof import angle_step, hold_conditions, ridge_rate, tick_distance
+from verify.backup.proof import angle_step, checked_bounds, hold_conditions, ridge_rate, tick_distance
 from verify.backup.protocol import BackupCertificate, Fits, register_backup_proof
+from verify.backup.search import depth_band
 from verify.kernel.intervals import bisect_sup, enclose, lower, upper
 from verify.theorem.design import Condition
 
@@ -107,13 +108,6 @@ def loiter_rate_bound(law: Loiter, safe: SafeSet, omega_xy: float, tick: float,
     return max(low, high), n_low + n_high
 
 
-def _shape_arrays(bend: float, phi: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """(a, a') at the angles ``phi`` in [0, π] (rad): :func:`tubekit.model.loiter.loiter_shape` and its slope."""
-    length = math.pi - 0.5 * bend
-    shape = np.where(phi <= bend, phi * phi / (2.0 * bend * length), (phi - 0.5 * bend) / length)
-    return shape, np.minimum(phi, bend) / (bend * length)
-
-
 def loiter_rate_sampled(law: Loiter, safe: SafeSet, omega_xy: float, n: int = 1441, yaw_err: float = 0.0) -> float:
     """The largest V̇ (m/s) at sampled φ ∈ [0, π] with the input of the same instant (no hold) and the worst ω."""
     return float(_sampled_rates(law, safe.level, np.array([safe.shape]), omega_xy, n, yaw_err)[0])
@@ -123,7 +117,7 @@ def _sampled_rates(law: Loiter, level: float, shapes: np.ndarray, omega_xy: floa
                    yaw_err: float) -> np.ndarray:
     """The largest sampled V̇ (m/s) at level c = ``level`` for each shape β of ``shapes`` (no hold, worst ω)."""
     phi = np.linspace(0.0, math.pi, n)[None, :]
-    a, slope = _shape_arrays(law.bend, phi)
+    a, slope = loiter_shape(law.bend, phi), loiter_shape_slope(law.bend, phi)
     g = shapes[:, None] * slope
     d = level - shapes[:, None] * a
     r = -law.yaw_rate * np.clip(phi / law.yaw_band, -1.0, 1.0)
@@ -165,21 +159,12 @@ def certify_loiter(law: BackupLaw, safe: SafeSet, *, omega_xy: float, omega_z: f
     """Prove (or refute, naming each failed inequality) that ``safe`` is invariant under the loiter ``law`` held at
     the tick h (s) against ω̄_xy, ω̄_z (m/s) and E_r (rad/s), from every hand-over within ``handover`` (m, m)."""
     loiter = _law_of(law)
-    wxy, wz = nonnegative("omega_xy", omega_xy), nonnegative("omega_z", omega_z)
-    h, e_r = positive("tick", tick), nonnegative("yaw_rate_error", yaw_rate_error)
-    handover = (nonnegative("handover[0]", handover[0]), nonnegative("handover[1]", handover[1]))
+    wxy, wz, h, e_r, handover = checked_bounds(omega_xy, omega_z, tick, yaw_rate_error, handover)
     rate, boxes = loiter_rate_bound(loiter, safe, wxy, h, max_boxes, e_r)
     conditions = _conditions(loiter, safe, (wxy, wz), tuple(float(x) for x in limits), h, handover, rate, e_r)
     return BackupCertificate(law=loiter, safe_set=safe, omega_xy=wxy, omega_z=wz, tick=h, rate_bound=rate,
                              rate_sampled=loiter_rate_sampled(loiter, safe, wxy, yaw_err=e_r), boxes=boxes,
                              conditions=conditions, handover=handover, yaw_rate_error=e_r)
-
-
-def _depth(handover: tuple[float, float], limits: tuple[float, float, float], omega_z: float,
-           tick: float) -> tuple[float, float]:
-    """(z_0, Z) (m): the heave band and the depth half-height, as the station-keeping search takes them."""
-    band = max(1e-3, 0.5 * handover[1])
-    return band, max(handover[1], band + tick * (limits[1] + omega_z)) * (1 + 1e-9)
 
 
 def _best_shape(law: Loiter, level: float, omega_xy: float, handover: float, yaw_err: float) -> float | None:
@@ -207,7 +192,7 @@ def design_loiter(*, omega_xy: float, omega_z: float, limits: tuple[float, float
     candidate when none certifies."""
     wxy, wz, h = nonnegative("omega_xy", omega_xy), nonnegative("omega_z", omega_z), positive("tick", tick)
     lim = tuple(float(x) for x in limits)
-    z0, depth = _depth(handover, lim, wz, h)
+    z0, depth = depth_band(handover, lim, wz, h)
     best: BackupCertificate | None = None
     last: BackupCertificate | None = None
     levels = np.round(np.arange(LEVEL_STEP, MAX_LEVEL + 1e-9, LEVEL_STEP), 6)

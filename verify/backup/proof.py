@@ -61,7 +61,7 @@ from verify.backup.protocol import BackupCertificate
 from verify.backup.rate import backup_command_rate, backup_tick_change
 
 __all__ = ["BackupCertificate", "planar_rate_bound", "certify_backup", "ramp_window", "tick_distance", "rate_sampled",
-           "ridge_rate", "hold_conditions", "angle_step",
+           "ridge_rate", "hold_conditions", "angle_step", "checked_bounds",
            "backup_command_rate", "backup_tick_change", "BACKUP_MAX_BOXES"]
 
 #: Bisection budget of :func:`planar_rate_bound` (intervals of χ examined): a work unit, not seconds.
@@ -215,6 +215,15 @@ def _conditions(law: StationKeeping, safe: SafeSet, dist: tuple[float, float], l
     ) + hold_conditions(law, safe, wz, tick, handover) + _smooth_conditions(law, safe, dist, tick, handover, d_tick, limits)
 
 
+def checked_bounds(omega_xy: float, omega_z: float, tick: float, yaw_rate_error: float,
+                   handover: tuple[float, float]) -> tuple[float, float, float, float, tuple[float, float]]:
+    """(ω̄_xy, ω̄_z, h, E_r, hand-over) as floats, each checked (ConfigError naming it): the numbers every backup
+    proof holds against."""
+    return (nonnegative("omega_xy", omega_xy), nonnegative("omega_z", omega_z), positive("tick", tick),
+            nonnegative("yaw_rate_error", yaw_rate_error),
+            (nonnegative("handover[0]", handover[0]), nonnegative("handover[1]", handover[1])))
+
+
 def certify_backup(law: StationKeeping, safe: SafeSet, *, omega_xy: float, omega_z: float,
                    limits: tuple[float, float, float], tick: float, handover: tuple[float, float] = (0.0, 0.0),
                    max_boxes: int = BACKUP_MAX_BOXES, yaw_rate_error: float = 0.0) -> BackupCertificate:
@@ -237,9 +246,7 @@ def certify_backup(law: StationKeeping, safe: SafeSet, *, omega_xy: float, omega
     """
     if not isinstance(law, StationKeeping) or not isinstance(safe, SafeSet):
         raise ConfigError("backup", "a StationKeeping law and a SafeSet", (type(law).__name__, type(safe).__name__))
-    wxy, wz, h = nonnegative("omega_xy", omega_xy), nonnegative("omega_z", omega_z), positive("tick", tick)
-    e_r = nonnegative("yaw_rate_error", yaw_rate_error)
-    handover = (nonnegative("handover[0]", handover[0]), nonnegative("handover[1]", handover[1]))
+    wxy, wz, h, e_r, handover = checked_bounds(omega_xy, omega_z, tick, yaw_rate_error, handover)
     rate, boxes = planar_rate_bound(law, safe, wxy, h, max_boxes, e_r)
     conditions = _conditions(law, safe, (wxy, wz), tuple(float(x) for x in limits), h, handover, rate, e_r)
     return BackupCertificate(law=law, safe_set=safe, omega_xy=wxy, omega_z=wz, tick=h, rate_bound=rate,

@@ -59,6 +59,14 @@ GENTLE_MAX_LEVEL = 12.0
 MIN_SHAPE = 0.05
 
 
+def depth_band(handover: tuple[float, float], limits: tuple[float, float, float], omega_z: float,
+               tick: float) -> tuple[float, float]:
+    """(z_0, Z) (m) of a saturated heave w = −w̄ sat((z − z*)/z_0): z_0 half the hand-over's depth error (at least
+    1 mm), Z the larger of that error and z_0 + h (w̄ + ω̄_z) (``backup_depth_hold``), with a relative 1e-9 of room."""
+    band = max(1e-3, 0.5 * handover[1])
+    return band, max(handover[1], band + tick * (limits[1] + omega_z)) * (1 + 1e-9)
+
+
 def _candidates(limits: tuple[float, float, float], omega_xy: float) -> list[tuple[float, float]]:
     """(u_b, k) pairs to try: surge fractions of u_max above ω̄_xy, the full yaw rate."""
     return [(f * limits[0], limits[2]) for f in (0.5, 0.625, 0.75, 0.875, 1.0) if f * limits[0] > omega_xy]
@@ -118,9 +126,8 @@ class _Search:
         return np.round(np.arange(max(0.2, self.min_level), max(6.0, self.min_level) + 1e-4, 0.05), 6)
 
     def _depth(self) -> tuple[float, float]:
-        """(z_0, Z) (m): the heave band and the depth half-height before smoothing."""
-        band = max(1e-3, 0.5 * self.handover[1])
-        return band, max(self.handover[1], band + self.h * (self.limits[1] + self.wz)) * (1 + 1e-9)
+        """(z_0, Z) (m): the heave band and the depth half-height before smoothing (:func:`depth_band`)."""
+        return depth_band(self.handover, self.limits, self.wz, self.h)
 
     def _law(self, surge: float, yaw: float, band: float | None) -> StationKeeping:
         z0, _ = self._depth()

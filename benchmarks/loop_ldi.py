@@ -39,7 +39,7 @@ With q = e^{−λh}, N ticks per period, per-tick jumps J_t and period jumps J_p
 S_0 = ‖x(0)‖_P (the trimmed start x(0) = (d/m̂)(0, 1, 1)), B = max_i ‖b_i‖_P, W = Σ_j Ŷ_j ‖g_j‖_P. Every
 output o = c_oᵀx obeys |o| <= √(c_oᵀP⁻¹c_o) s (Cauchy–Schwarz): e (c = (1/k_p, 0, 0)), a = k_p e + k_i I
 (c = (1, 1, 0), plus sup|d|/m̂), z = (τ − τ_cmd)/m̂ and ẏ (c at the vertices). P is *found* by a
-semidefinite program (cvxpy + Clarabel, :func:`find_lyapunov`); only the Arb check makes it a proof.
+semidefinite program (cvxpy + Clarabel, :class:`LyapunovSearch`); only the Arb check makes it a proof.
 
 The box in which the slopes are taken is the command box V plus an assumed error cap E_cap: the first-exit
 argument of :mod:`verify.vehicle.bound` closes it (:func:`ldi_fixed_point` certifies only when every computed
@@ -63,7 +63,7 @@ from verify.theorem.design import hull_sway_bound
 from verify.vehicle.bound import _loop_of, _rates, velocity_loop_bound
 from verify.vehicle.model import velocity_box
 
-__all__ = ["LdiChannel", "LdiBound", "slope_pairs", "vertex_matrices", "LyapunovSearch", "find_lyapunov", "ChannelData", "ldi_bound", "lyapunov_certified",
+__all__ = ["LdiChannel", "LdiBound", "slope_pairs", "vertex_matrices", "LyapunovSearch", "ChannelData", "ldi_bound", "lyapunov_certified",
            "channel_lyapunov", "ldi_fixed_point", "unit_rate_gain", "study_bound", "main", "SLOPE_PIECES", "DECAY_GRID", "CAP_FRACTIONS"]
 
 #: Pieces the own speed's range is cut into for the slope pairs (more: a tighter hull, more vertices).
@@ -90,7 +90,7 @@ class LdiChannel:
     vertices : int
         Number of vertex matrices A_i checked.
     jump_gain : float
-        B = max ‖b_i‖_P (per unit jump of the command, 1/s... in the channel's units).
+        B = max ‖b_i‖_P, per unit jump of the command (m/s or rad/s).
     start_gain : float
         S_0 = ‖x(0)‖_P for the trimmed start.
     coupling_gain : (4,) floats
@@ -214,12 +214,6 @@ class LyapunovSearch:
             return None
         value = 0.5 * (self.p.value + self.p.value.T)
         return value if np.all(np.isfinite(value)) else None
-
-
-def find_lyapunov(mats: Sequence[np.ndarray], jumps: Sequence[np.ndarray], decay: float,
-                  output: np.ndarray) -> np.ndarray | None:
-    """One solve of :class:`LyapunovSearch` at ``decay``."""
-    return LyapunovSearch(mats, jumps, output).solve(decay)
 
 
 def _positive_definite(m: list[list[arb]]) -> bool:

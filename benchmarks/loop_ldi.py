@@ -8,7 +8,8 @@ Not part of the certificate: it measures whether this bound, beside the small-ga
 :mod:`verify.vehicle.bound`, would extend what certifies (the BlueROV2 over wider coefficient boxes). Printed:
 the per-channel gain from a command rate to the error with the channels decoupled, per coefficient box; then the
 coupled fixed point against the small-gain bound on ``examples/bluerov2_slow.toml``'s command box for three jump
-sizes, and the share of the start transient, the jumps and the coupling in each LDI bound.
+sizes, the small-gain bound with its start over V and with the first command within J of rest (``first_command``,
+what the certificate uses when the backup blends).
 
 **Model** (one channel c, y = u, w or r, as :mod:`verify.vehicle.bound`): m ẏ = τ − n(y, ν_o; θ),
 τ̇ = (τ_cmd − τ)/T_thr, τ_cmd = n̂(y, ν_o) + m̂ (k_p e + k_i I), e = y* − y, İ = e, with ν_o the other body
@@ -64,7 +65,7 @@ from verify.vehicle.bound import _loop_of, _rates, velocity_loop_bound
 from verify.vehicle.model import velocity_box
 
 __all__ = ["LdiChannel", "LdiBound", "slope_pairs", "vertex_matrices", "LyapunovSearch", "ChannelData", "ldi_bound", "lyapunov_certified",
-           "channel_lyapunov", "ldi_fixed_point", "unit_rate_gain", "study_bound", "main", "SLOPE_PIECES", "DECAY_GRID", "CAP_FRACTIONS"]
+           "channel_lyapunov", "ldi_fixed_point", "OBJECTIVES", "unit_rate_gain", "study_bound", "main", "SLOPE_PIECES", "DECAY_GRID", "CAP_FRACTIONS"]
 
 #: Pieces the own speed's range is cut into for the slope pairs (more: a tighter hull, more vertices).
 SLOPE_PIECES = 24
@@ -111,10 +112,12 @@ class LdiChannel:
     mismatch: float
 
     def level(self, jump_tick: float, jump_period: float, tick: float, ticks: int, coupling: float) -> float:
-        """The bound on s = √(xᵀPx) of the module doc for the given jumps and W = ``coupling``."""
+        """The bound on s = √(xᵀPx) of the module doc for the given jumps and W = ``coupling``:
+        max(S_0 + J_p B, s_∞), s_∞ = W/λ + J_t B/(1 − q) + (J_p − J_t) B/(1 − q^N)."""
         q = math.exp(-self.decay * tick)
-        return (self.start_gain + coupling / self.decay + jump_tick * self.jump_gain / (1.0 - q)
-                + (jump_period - jump_tick) * self.jump_gain / (1.0 - q ** ticks)) * (1.0 + 1e-12)
+        steady = (coupling / self.decay + jump_tick * self.jump_gain / (1.0 - q)
+                  + (jump_period - jump_tick) * self.jump_gain / (1.0 - q ** ticks))
+        return max(self.start_gain + jump_period * self.jump_gain, steady) * (1.0 + 1e-12)
 
 
 @dataclass(frozen=True)
@@ -187,17 +190,17 @@ def _floats(m: list[list[arb]]) -> np.ndarray:
 
 class LyapunovSearch:
     """The SDP that proposes P for one vertex set, built once (λ a cvxpy Parameter, DPP) and solved per λ:
-    P ≻ 0 with A_iᵀP + PA_i + 2λP ⪯ 0, ‖b_j‖_P <= 1, minimising cᵀP⁻¹c. Only :func:`lyapunov_certified` decides.
+    P ≻ 0 with A_iᵀP + PA_i + 2λP ⪯ 0, ‖b_j‖_P <= 1, minimising max_c cᵀP⁻¹c over the output rows c. Only :func:`lyapunov_certified` decides.
     """
 
-    def __init__(self, mats: Sequence[np.ndarray], jumps: Sequence[np.ndarray], output: np.ndarray) -> None:
+    def __init__(self, mats: Sequence[np.ndarray], jumps: Sequence[np.ndarray], outputs: Sequence[np.ndarray]) -> None:
         import cvxpy as cp
         self._cp = cp
         self.p, g, self.decay = cp.Variable((3, 3), symmetric=True), cp.Variable(), cp.Parameter(nonneg=True)
         cons = [self.p >> 1e-9 * np.eye(3)]
         cons += [a.T @ self.p + self.p @ a + 2.0 * self.decay * self.p << 0 for a in mats]
         cons += [cp.quad_form(b, self.p) <= 1.0 for b in jumps]
-        cons.append(cp.bmat([[cp.reshape(g, (1, 1), order="C"), output[None, :]], [output[:, None], self.p]]) >> 0)
+        cons += [cp.bmat([[cp.reshape(g, (1, 1), order="C"), c[None, :]], [c[:, None], self.p]]) >> 0 for c in outputs]
         self.problem = cp.Problem(cp.Minimize(g), cons)
 
     def solve(self, decay: float) -> np.ndarray | None:
@@ -267,15 +270,28 @@ class ChannelData:
     coupling: tuple[tuple[arb, arb, arb], ...]
 
 
-def channel_lyapunov(data: ChannelData) -> LdiChannel | None:
-    """The certified P and gains of one channel: the SDP at each λ of :data:`DECAY_GRID`, the best jump gain
-    that the Arb check confirms (None when no λ is confirmed)."""
+#: The outputs a channel's P may be shaped for: the error e (row 0 of the gains) or the acceleration ẏ (row 3).
+OBJECTIVES = {"e": 0, "ydot": 3}
+
+
+def _objective_rows(data: ChannelData, objective: str) -> list[np.ndarray]:
+    """The output rows c the SDP minimises √(cᵀP⁻¹c) over: e's, or ẏ's at every slope corner and 1/m end."""
+    if objective == "e":
+        return [np.array([1.0 / data.k_p, 0.0, 0.0])]
+    m_hat = float(data.m_hat.mid())
+    return [np.array([w * p[1] / data.k_p, 0.0, w * m_hat]) for p in data.pairs for w in data.inv_mass]
+
+
+def channel_lyapunov(data: ChannelData, objective: str = "e") -> LdiChannel | None:
+    """The certified P and gains of one channel, P shaped for ``objective`` (``"e"`` or ``"ydot"``): the SDP at
+    each λ of :data:`DECAY_GRID`, the smallest steady gain of that output per unit jump that the Arb check
+    confirms (None when no λ is confirmed)."""
+    row = OBJECTIVES[objective]
     with ctx.workprec(128):
         mats = vertex_matrices(data.k_p, data.k_i, data.lag, data.m_hat, data.pairs, data.inv_mass)
         jumps = _jump_vectors(data.k_p, data.m_hat, data.pairs)
         f_mats, f_jumps = [_floats(a) for a in mats], [np.array([float(x.mid()) for x in b]) for b in jumps]
-        out_e = np.array([1.0 / data.k_p, 0.0, 0.0])
-        search = LyapunovSearch(f_mats, f_jumps, out_e)
+        search = LyapunovSearch(f_mats, f_jumps, _objective_rows(data, objective))
         best, best_score = None, math.inf
         for decay in DECAY_GRID:
             p = search.solve(decay)
@@ -285,7 +301,7 @@ def channel_lyapunov(data: ChannelData) -> LdiChannel | None:
             if not lyapunov_certified(p, mats, proved):
                 continue
             channel = _gains(data, p, proved, mats, jumps)
-            score = channel.outputs[0] * channel.jump_gain / (1.0 - math.exp(-proved * data.tick))
+            score = channel.outputs[row] * channel.jump_gain / (1.0 - math.exp(-proved * data.tick))
             if score < best_score:
                 best, best_score = channel, score
         return best
@@ -309,30 +325,39 @@ def _gains(data: ChannelData, p: np.ndarray, decay: float, mats: list, jumps: li
                       mismatch=data.mismatch)
 
 
-def ldi_fixed_point(channels: Sequence[LdiChannel | None], cap: Sequence[float], sway_rate, jump_tick: Sequence[float],
-                    jump_period: Sequence[float], tick: float, ticks: int,
+def _channel_bounds(shapes: Sequence[LdiChannel], c: int, rates: Sequence[float], jump_tick: float,
+                    jump_period: float, tick: float, ticks: int) -> tuple[float, float, float, float]:
+    """(e, a, z, ẏ) of channel ``c``: each the smallest over the certified P's ``shapes`` (each P's bound holds)."""
+    rows = []
+    for ch in shapes:
+        coupling = sum(g * r for j, (g, r) in enumerate(zip(ch.coupling_gain, rates)) if j != _OWN[c])
+        s = ch.level(jump_tick, jump_period, tick, ticks, coupling)
+        e, a, z, ydot = (x * s for x in ch.outputs)
+        rows.append((e, a + ch.mismatch, z, ydot))
+    return tuple(min(r[o] for r in rows) for o in range(4))
+
+
+def ldi_fixed_point(channels: Sequence[Sequence[LdiChannel | None]], cap: Sequence[float], sway_rate,
+                    jump_tick: Sequence[float], jump_period: Sequence[float], tick: float, ticks: int,
                     max_iterations: int = 60) -> LdiBound:
     """Bounds (e, a, z, ẏ) per channel over the box with error cap ``cap``, closed by first exit.
 
+    ``channels[c]`` holds the certified P's of channel c (one per objective; None where none was certified).
     ``sway_rate(accel)`` bounds |v̇| given (|u̇|, |ẇ|, |ṙ|) bounds. The coupling of channel c is
     W_c = Σ_j ‖g_j‖_P |ν̇_j| with the other channels' ẏ bounds and |v̇|; the accelerations are iterated from
-    the jump-only bounds (inflated 5 %) until every computed bound is strictly below its assumption and E < cap.
+    0 (then 5 % above the last computed) until every computed bound is strictly below its assumption and E < cap.
     """
     inf4 = (math.inf,) * 4
-    if any(c is None for c in channels):
-        missing = [ax for ax, c in zip("uwr", channels) if c is None]
+    shapes = [tuple(p for p in ps if p is not None) for ps in channels]
+    if not all(shapes):
+        missing = [ax for ax, ps in zip("uwr", shapes) if not ps]
         return LdiBound(False, tuple(cap), (inf4,) * 3, tuple(channels), 0,
                         f"no common Lyapunov function certified for channel(s) {', '.join(missing)}")
     accel = [0.0, 0.0, 0.0]
     bounds = [inf4] * 3
     for k in range(1, max_iterations + 1):
         rates = (accel[0], sway_rate(accel), accel[1], accel[2])
-        bounds = []
-        for c, ch in enumerate(channels):
-            coupling = sum(g * r for j, (g, r) in enumerate(zip(ch.coupling_gain, rates)) if j != _OWN[c])
-            s = ch.level(jump_tick[c], jump_period[c], tick, ticks, coupling)
-            e, a, z, ydot = (x * s for x in ch.outputs)
-            bounds.append((e, a + ch.mismatch, z, ydot))
+        bounds = [_channel_bounds(shapes[c], c, rates, jump_tick[c], jump_period[c], tick, ticks) for c in range(3)]
         if not all(math.isfinite(x) for row in bounds for x in row):
             break
         if all(bounds[c][0] < cap[c] for c in range(3)) and all(bounds[c][3] < accel[c] for c in range(3)):
@@ -361,9 +386,11 @@ def _channel_data(params: VehicleParams, box: Sequence[float], gamma: float, c: 
 
 @functools.lru_cache(maxsize=64)
 def _channels_at(params: VehicleParams, box: tuple[float, float, float], gamma: float, k_p: float, k_i: float,
-                 lag: float, tick: float) -> tuple[LdiChannel | None, ...]:
-    """:func:`channel_lyapunov` of every channel over one box, memoised (the SDPs are the costly part)."""
-    return tuple(channel_lyapunov(_channel_data(params, box, gamma, c, k_p, k_i, lag, tick)) for c in range(3))
+                 lag: float, tick: float) -> tuple[tuple[LdiChannel | None, ...], ...]:
+    """:func:`channel_lyapunov` of every channel over one box, one P per objective, memoised (the SDPs are the
+    costly part)."""
+    data = [_channel_data(params, box, gamma, c, k_p, k_i, lag, tick) for c in range(3)]
+    return tuple(tuple(channel_lyapunov(d, objective) for objective in OBJECTIVES) for d in data)
 
 
 def ldi_bound(params: VehicleParams, *, v_max: Sequence[float], k_p: float, k_i: float, lag: float, tick: float,
@@ -425,8 +452,8 @@ def main() -> int:
     for label, params in _boxes():
         loop = _loop_of(params, (0.4, 0.3, 0.3), 0.01, 10)
         box = (0.44, 0.33, 0.33)
-        chans = _channels_at(params, box, upper(hull_sway_bound(params, box[0], box[2])), loop.k_p, loop.k_i,
-                             loop.lag, 0.01)
+        chans = [ps[0] for ps in _channels_at(params, box, upper(hull_sway_bound(params, box[0], box[2])),
+                                              loop.k_p, loop.k_i, loop.lag, 0.01)]
         print(f"  {label:22s}", " / ".join("none" if c is None else f"{unit_rate_gain(c, 0.01):.3f}" for c in chans),
               "  decay", " / ".join("-" if c is None else f"{c.decay:.3g}" for c in chans))
     print(f"coupled fixed point on V = {slow_v}, plan jumps {plans} per period, h = 0.01 s, delta = 0.1 s")
@@ -434,10 +461,12 @@ def main() -> int:
         for jt in ((0.0, 0.0, 0.0), (0.0003, 0.0003, 0.0006), (0.001, 0.0005, 0.001)):
             jp = tuple(max(a, b) for a, b in zip(jt, plans))
             ldi = study_bound(params, slow_v, jt, jp)
-            sg = velocity_loop_bound(params, v_max=slow_v, tick=0.01, period=0.1, jump_tick=jt, jump_period=jp)
-            sg_e = [round(x, 4) for x in sg.error] if sg.certified else "diverges"
+            sg, near = (velocity_loop_bound(params, v_max=slow_v, tick=0.01, period=0.1, jump_tick=jt, jump_period=jp,
+                                            first_command=first) for first in (None, plans))
+            sg_e, near_e = ([round(x, 4) for x in b.error] if b.certified else "diverges" for b in (sg, near))
             ldi_e = [round(x, 4) for x in ldi.error] if ldi.closed else f"open ({ldi.why})"
-            print(f"  {label:22s} per-tick {jt}: LDI {ldi_e} | small-gain {sg_e}")
+            print(f"  {label:22s} per-tick {jt}: LDI {ldi_e} | small-gain {sg_e} | small-gain, first command "
+                  f"within J of rest {near_e}")
     return 0
 
 

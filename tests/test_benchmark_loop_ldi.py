@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import math
 
 import numpy as np
@@ -61,7 +62,7 @@ def test_the_error_of_any_switching_of_the_inclusion_stays_below_the_lemmas_boun
              for p in data.pairs]
     steps = [expm(a * TICK / 4) for a in mats]
     jump = 0.002
-    bound = channel.outputs[0] * channel.level(jump, jump, TICK, 10, 0.0) - channel.outputs[0] * channel.start_gain
+    bound = channel.outputs[0] * dataclasses.replace(channel, start_gain=0.0).level(jump, jump, TICK, 10, 0.0)
     x, peak = np.zeros(3), 0.0
     for i, j, size in switches:
         x = x + jump * size * jumps[j % len(jumps)]

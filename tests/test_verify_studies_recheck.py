@@ -308,6 +308,7 @@ DYNAMIC_TAMPERING = [
     (lambda d: _set(d, ("velocity_loop", "assumed"), [[0.5 * x for x in row] for row in d["velocity_loop"]["assumed"]]),
      "velocity_loop.assumed"),
     (_scale(("velocity_loop", "w_rate"), 0.5), "velocity_loop.w_rate"),
+    (_scale(("velocity_loop", "first_command"), 0.0), "velocity_loop.first_command"),
     (_scale(("velocity_loop", "authority"), 2.0), "velocity_loop.authority"),
     (_scale(("velocity_loop", "thrust_floor"), 2.0), "velocity_loop.thrust_floor"),
     (lambda d: _set(d, ("velocity_loop", "gains", 2, "tick", "e"),

@@ -192,7 +192,7 @@ _ROWS = ("e", "a", "z", "ydot")
 
 def _loop_fields(stored: LoopBound, derived: LoopBound, led: Ledger) -> None:
     """Every stored ``velocity_loop`` field against the bound derived for the stored law: the inputs (V, h, δ, the
-    slopes λ, the terms summed) equal; the jumps, E, the other bounds, the sway, the fixed point's assumption and
+    slopes λ, the terms summed) equal; the first command's box (None: V), the jumps, E, the other bounds, the sway, the fixed point's assumption and
     the response sums at least derived (a smaller assumption claims the state never reaches it: stronger); the
     authority and the thrust floor at most derived; the loop's conditions listed. ``iterations`` and ``reason``
     are reports (the conditions carry the verdicts)."""
@@ -200,6 +200,8 @@ def _loop_fields(stored: LoopBound, derived: LoopBound, led: Ledger) -> None:
     led.equal("velocity_loop.tick", stored.tick, derived.tick)
     led.equal("velocity_loop.period", stored.period, derived.period)
     led.equal("velocity_loop.slope", list(stored.slope), list(derived.slope))
+    led.each("at_least", "velocity_loop.first_command", list(stored.first_command or stored.v_max),
+             list(derived.first_command or derived.v_max))
     for k in _LOOP_BOUNDS:
         led.each("at_least", f"velocity_loop.{k}", list(getattr(stored, k)), list(getattr(derived, k)))
     for k in _LOOP_GRANTED:

@@ -13,7 +13,11 @@ constant drag slope λ_c, x = (Ĩ, e, z) obeys (:func:`loop_matrix`)
 
 and e = (0, 1, 0) x, z = (0, 0, 1) x, ẏ = (k_i, k_p, 1) x, a = (k_i, k_p, 0) x − W; Ẇ = (μ − 1) ṡ + ḋ/m_c
 with ṡ = −z/T_thr − λ_c ẏ − w_n. A command jump J adds J (0, 1, −k_p) to x (τ is continuous). The
-trimmed start (e = I = z = 0) gives x(0) = (W(0)/k_i, 0, 0), |W(0)| <= sup|d|/m_c.
+trimmed start (e = I = z = 0, τ = n̂(ν(0)), ν(0) = (u_c, 0, w_c, r_c) of the first command) gives
+x(0) = (W(0)/k_i, 0, 0) with W(0) = d(ν(0))/m_c, so |W(0)| <= sup|d|/m_c over the first command's box
+|y_c(0)| <= F_c, v(0) = 0 (``first_command``; where it is not given, F = V). d vanishes at rest, so a loop
+that starts from rest and whose first command moves by at most J (the plans' rate limit) starts with almost no
+transient.
 :func:`verify.vehicle.response.impulse_sums` bounds every output by the sums of its sampled
 response: jumps (J_tick at every tick, J_period − J_tick more at period boundaries, worst phase),
 the inputs Ẇ and w_n (L1), and the free response from x(0) (peak).
@@ -31,6 +35,7 @@ little after t* (the signals are right-continuous, jumps isolated): a contradict
 
 from __future__ import annotations
 
+import dataclasses
 import functools
 import math
 from dataclasses import dataclass
@@ -158,8 +163,9 @@ def _rates(loop: _Loop, nu: Sequence[arb], accel: Sequence[float]) -> tuple[arb,
 
 
 def input_bounds(loop: _Loop, error: Sequence[float], z_bound: Sequence[float],
-                 accel: Sequence[float]) -> Inputs:
-    """The model's input bounds over the box |y_c| <= V_c + E_c, |v| <= γ̄ and Θ, given Ẑ and Ŷ = sup|ẏ|.
+                 accel: Sequence[float], first_command: Sequence[float] | None = None) -> Inputs:
+    """The model's input bounds over the box |y_c| <= V_c + E_c, |v| <= γ̄ and Θ, given Ẑ and Ŷ = sup|ẏ|;
+    sup|W(0)| over the first command's box |y_c| <= F_c, v = 0 (``first_command`` F; None: V + E and γ̄).
 
     ŵ_n = (sup|∂n̂_c/∂y_c − λ_c m̂_c| Ŷ_c + Σ_{j ≠ c} sup|∂n̂_c/∂ν_j| |ν̇_j|)/m̂_c;
     sup|Ẇ| = sup|μ − 1| (Ẑ/T_thr + |λ_c| Ŷ_c + ŵ_n) + Σ_j sup|∂d_c/∂ν_j| |ν̇_j| / m_c.
@@ -172,6 +178,8 @@ def input_bounds(loop: _Loop, error: Sequence[float], z_bound: Sequence[float],
     rates = _rates(loop, nu, accel)
     grads = channel_gradient(loop.nominal, nu)
     d, d_grad = channel_mismatch(loop.nominal, loop.hull, nu), channel_mismatch_gradient(loop.nominal, loop.hull, nu)
+    d_first = d if first_command is None else channel_mismatch(
+        loop.nominal, loop.hull, velocity_box(first_command[0], 0.0, first_command[1], first_command[2]))
     start, rate, drag, mismatch = [], [], [], []
     for c in range(3):
         own, lam, y_dot = _OWN[c], arb(loop.slope[c]), arb(accel[c])
@@ -180,7 +188,7 @@ def input_bounds(loop: _Loop, error: Sequence[float], z_bound: Sequence[float],
         s_dot = arb(z_bound[c]) / arb(loop.lag) + abs(lam) * y_dot + w_n
         mu = loop.m_hat[c] / loop.m_true[c]
         d_dot = sum((abs(g) * x for g, x in zip(d_grad[c], rates)), arb(0)) / loop.m_true[c]
-        start.append(upper(abs(d[c]) / loop.m_true[c]))
+        start.append(upper(abs(d_first[c]) / loop.m_true[c]))
         rate.append(upper(abs(mu - 1) * s_dot + d_dot))
         drag.append(upper(w_n))
         mismatch.append(upper(abs(1 - 1 / mu) * y_dot + abs(d[c]) / loop.m_hat[c]))
@@ -276,7 +284,7 @@ def _validate(params: VehicleParams, v_max: Any, tick: Any, period: Any, jump_ti
 
 def velocity_loop_bound(params: VehicleParams, *, v_max: Sequence[float], tick: float, period: float,
                         jump_tick: Sequence[float], jump_period: Sequence[float],
-                        rate: Sequence[float] | None = None,
+                        rate: Sequence[float] | None = None, first_command: Sequence[float] | None = None,
                         max_iterations: int = LOOP_MAX_ITERATIONS) -> LoopBound:
     """The velocity loop's error bound over the command box ``v_max`` (m/s, m/s, rad/s) and Θ.
 
@@ -292,11 +300,16 @@ def velocity_loop_bound(params: VehicleParams, *, v_max: Sequence[float], tick: 
         Bound on the command's change at every tick, and at a period boundary (total, >= jump_tick).
     rate : (3,) floats, optional
         A plan's rate limit ρ (m/s², m/s², rad/s²): adds ``rate_authority[c]`` (ρ_c <= a_c).
+    first_command : (3,) floats, optional
+        F: a bound on |u_c|, |w_c|, |r_c| of the first command, at which the run starts trimmed (m/s, m/s,
+        rad/s); the start transient W(0) = d(ν(0))/m is bounded over |ν(0)| <= min(F, V), v(0) = 0. Default V.
     max_iterations : int
         Bound on the fixed-point iterations.
     """
     v, h, d, ticks, jt, jp, rho = _validate(params, v_max, tick, period, jump_tick, jump_period, rate,
                                             max_iterations)
+    first = v if first_command is None else tuple(min(f, x) for f, x in zip(_triple("first_command",
+                                                                                      first_command), v))
     loop = _loop_of(params, v, h, ticks)
     authority = actuator_authority(params, v)
     base = computed_bounds(loop, jt, jp)
@@ -305,7 +318,8 @@ def velocity_loop_bound(params: VehicleParams, *, v_max: Sequence[float], tick: 
     stop = f"no closing after {max_iterations} rounds"
     while loop.stable and k < max_iterations and not found:
         k += 1
-        inputs = input_bounds(loop, [r[0] for r in assumed], [r[2] for r in assumed], [r[3] for r in assumed])
+        inputs = input_bounds(loop, [r[0] for r in assumed], [r[2] for r in assumed], [r[3] for r in assumed],
+                              first)
         computed = computed_bounds(loop, jt, jp, inputs)
         found = all(computed[c][o] < assumed[c][o] for c in range(3) for o in range(4))
         if growth is None:
@@ -316,8 +330,9 @@ def velocity_loop_bound(params: VehicleParams, *, v_max: Sequence[float], tick: 
                 stop = f"the bounds overflow after {k} rounds"
                 break
             assumed = [[max(a, g) for a, g in zip(ra, rg)] for ra, rg in zip(assumed, grown)]
-    return _result(loop, params, (v, h, d, jt, jp), assumed, computed, inputs, authority, (k, max_iterations),
-                   found, rho, _why_open(found, stop, growth))
+    out = _result(loop, params, (v, h, d, jt, jp), assumed, computed, inputs, authority, (k, max_iterations),
+                  found, rho, _why_open(found, stop, growth))
+    return dataclasses.replace(out, first_command=first)
 
 
 #: What the fixed point bounds, per channel, in the order of :func:`computed_bounds`' rows.

@@ -13,6 +13,11 @@ jumps; the command jumps
   finite because the law is faded near its anchor, ramped after the hand-over and, with the continuous yaw law,
   free of the ridge's jump).
 
+The run starts trimmed at its first command (``docs/plant.md`` section 2), so the loop's start transient is
+d(ν(0))/m, which vanishes at rest. With a rate limit that command is within J of rest: the plan check compares a
+plan's first node with the last applied command, 0 at t = 0, and a blending backup starts from that command. The
+start is then bounded over |ν(0)| <= J (``first_command`` of the loop bound); for a law that does not blend, over V.
+
 E in turn enters ω̄ (:func:`verify.theorem.design.disturbance_bounds`), the tube, the hand-over margins and the
 backup's proof, which fix the backup's command rate. :func:`solve_dynamic` closes this loop as a checked
 fixed point: it *assumes* a bound E_a, derives everything from it (the backup designed so that its command
@@ -170,7 +175,8 @@ class _LoopInputs:
                                               limits=self.v_max, loop_error=assumed, tick=self.tick)
         per_period = tuple(max(j, t) for j, t in zip(self.plans, per_tick))
         return velocity_loop_bound(self.params, v_max=self.v_max, tick=self.tick, period=self.period,
-                                   jump_tick=per_tick, jump_period=per_period)
+                                   jump_tick=per_tick, jump_period=per_period,
+                                   first_command=self.plans if law.blends else None)
 
 
 def _loop_at(scenario: Scenario, law: BackupLaw, safe: SafeSet, dist: DisturbanceBounds,
@@ -188,11 +194,12 @@ def _consistent(loop: LoopBound, assumed: tuple[float, float, float]) -> Conditi
 
 
 def _plans_only(scenario: Scenario) -> LoopBound:
-    """The loop bound for the plans' jumps alone (no backup): the fixed point's start."""
+    """The loop bound for the plans' jumps alone (no backup), the first command within J of rest: the fixed
+    point's start (a smaller start transient only lowers the bound, so a failure here is a failure with any law)."""
     return velocity_loop_bound(scenario.plant.params, v_max=tuple(float(x) for x in scenario.limits.vector),
                                tick=1.0 / float(scenario.controller.ancillary_rate_hz),
                                period=float(scenario.controller.dt), jump_tick=(0.0, 0.0, 0.0),
-                               jump_period=plan_jumps(scenario))
+                               jump_period=plan_jumps(scenario), first_command=plan_jumps(scenario))
 
 
 def _first_assumption(first: LoopBound) -> tuple[float, float, float] | None:

@@ -78,6 +78,9 @@ class LoopBound:
         ``rate_authority[c]`` when a rate limit was given.
     reason : str
         Empty when certified, else the failed conditions.
+    first_command : (3,) floats or None
+        The box |u_c|, |w_c|, |r_c| <= F of the first command the start transient ``w_start`` is taken over
+        (m/s, m/s, rad/s; V when no smaller box was given; None only in a file that predates it: read as V).
     """
 
     v_max: tuple[float, float, float]
@@ -102,6 +105,7 @@ class LoopBound:
     iterations: int
     conditions: tuple[Condition, ...]
     reason: str = ""
+    first_command: tuple[float, float, float] | None = None
 
     @property
     def certified(self) -> bool:
@@ -121,7 +125,8 @@ class LoopBound:
             "thrust_peak", "thrust_floor")}
         out.update(tick=self.tick, period=self.period, sway=self.sway, iterations=self.iterations,
                    assumed=[list(r) for r in self.assumed], gains=[_sums_to_dict(g) for g in self.gains], slope=list(self.slope), reason=self.reason,
-                   certified=self.certified, conditions=[c.to_dict() for c in self.conditions])
+                   certified=self.certified, conditions=[c.to_dict() for c in self.conditions],
+                   first_command=None if self.first_command is None else list(self.first_command))
         return out
 
     @classmethod
@@ -141,6 +146,7 @@ class LoopBound:
                    gains=_gains_from(item(d, "gains", where), f"{where}.gains"),
                    slope=numbers(d, "slope", where, 3),
                    iterations=integer(d, "iterations", where), reason=text(d, "reason", where),
+                   first_command=None if d.get("first_command") is None else numbers(d, "first_command", where, 3),
                    conditions=tuple(Condition.from_dict(c, f"{where}.conditions[{i}]") for i, c in enumerate(conds)))
 
     def summary_lines(self) -> list[str]:

@@ -192,8 +192,8 @@ _ROWS = ("e", "a", "z", "ydot")
 
 def _loop_fields(stored: LoopBound, derived: LoopBound, led: Ledger) -> None:
     """Every stored ``velocity_loop`` field against the bound derived for the stored law: the inputs (V, h, δ, the
-    slopes λ, the terms summed) equal; the first command's box (None: V), the jumps, E, the other bounds, the sway, the fixed point's assumption and
-    the response sums at least derived (a smaller assumption claims the state never reaches it: stronger); the
+    slopes λ, the terms summed) equal; the first command's box (None: V), the jumps, E, the other bounds, the sway,
+    the fixed point's assumption and the response sums at least derived (a smaller assumption claims the state never reaches it: stronger); the
     authority and the thrust floor at most derived; the loop's conditions listed. ``iterations`` and ``reason``
     are reports (the conditions carry the verdicts)."""
     led.equal("velocity_loop.v_max", list(stored.v_max), list(derived.v_max))

@@ -35,7 +35,6 @@ little after t* (the signals are right-continuous, jumps isolated): a contradict
 
 from __future__ import annotations
 
-import dataclasses
 import functools
 import math
 from dataclasses import dataclass
@@ -330,9 +329,8 @@ def velocity_loop_bound(params: VehicleParams, *, v_max: Sequence[float], tick: 
                 stop = f"the bounds overflow after {k} rounds"
                 break
             assumed = [[max(a, g) for a, g in zip(ra, rg)] for ra, rg in zip(assumed, grown)]
-    out = _result(loop, params, (v, h, d, jt, jp), assumed, computed, inputs, authority, (k, max_iterations),
-                  found, rho, _why_open(found, stop, growth))
-    return dataclasses.replace(out, first_command=first)
+    return _result(loop, params, (v, h, d, jt, jp, first), assumed, computed, inputs, authority,
+                   (k, max_iterations), found, rho, _why_open(found, stop, growth))
 
 
 #: What the fixed point bounds, per channel, in the order of :func:`computed_bounds`' rows.
@@ -378,7 +376,7 @@ def _result(loop: _Loop, params: VehicleParams, given: tuple, assumed: list, com
             authority: tuple, iterations: tuple[int, int], found: bool, rho: tuple | None,
             why_open: str = "") -> LoopBound:
     """The :class:`LoopBound` with every condition of the theorem (bounds +inf when not certified)."""
-    v, h, d, jt, jp = given
+    v, h, d, jt, jp, first = given
     error = tuple(r[0] for r in computed) if found else (math.inf,) * 3
     gamma = upper(hull_sway_bound(params, upper(arb(v[0]) + arb(error[0])), upper(arb(v[2]) + arb(error[2])))) \
         if found else math.inf
@@ -408,5 +406,5 @@ def _result(loop: _Loop, params: VehicleParams, given: tuple, assumed: list, com
                      thrust_peak=tuple(c.lhs if c.lhs is not None else math.inf for c in conds
                                        if c.condition.startswith("loop_saturation")),
                      thrust_floor=tuple(c.rhs for c in conds if c.condition.startswith("loop_saturation")),
-                     iterations=iterations[0], conditions=tuple(conds),
+                     iterations=iterations[0], conditions=tuple(conds), first_command=first,
                      reason="" if not failed else "not certified: " + ", ".join(failed))

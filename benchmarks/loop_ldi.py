@@ -54,15 +54,23 @@ import math
 import sys
 import warnings
 from dataclasses import dataclass
+from pathlib import Path
 from typing import Sequence
 
 import numpy as np
 from flint import arb, arb_mat, ctx
 
+from scipy.spatial import ConvexHull, QhullError
+
+from tubekit.model.vehicles import VEHICLES
 from verify.kernel.intervals import enclose, lower, upper
 from verify.theorem.design import hull_sway_bound
 from verify.vehicle.bound import _loop_of, _rates, velocity_loop_bound
-from verify.vehicle.model import velocity_box
+from verify.vehicle.model import (channel_gradient, channel_masses, channel_mismatch, channel_mismatch_gradient,
+                                  hull_balls, nominal_balls, velocity_box)
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from dynamic_gap import _box  # noqa: E402 - von Benzon's values ± a fraction, as the other loop studies use them
 
 __all__ = ["LdiChannel", "LdiBound", "slope_pairs", "vertex_matrices", "LyapunovSearch", "ChannelData", "ldi_bound", "lyapunov_certified",
            "channel_lyapunov", "ldi_fixed_point", "OBJECTIVES", "unit_rate_gain", "study_bound", "main", "SLOPE_PIECES", "DECAY_GRID", "CAP_FRACTIONS"]
@@ -124,13 +132,14 @@ class LdiChannel:
 class LdiBound:
     """The fixed point of :func:`ldi_fixed_point`: bounds per channel (rows e, a, z, ẏ) and what they rest on.
 
+    ``channels[c]``: channel c's certified P's, one per objective of :data:`OBJECTIVES` (None where none was).
     ``closed`` False: ``bounds`` are +inf and ``why`` says what stood in the way.
     """
 
     closed: bool
     cap: tuple[float, float, float]
     bounds: tuple[tuple[float, float, float, float], ...]
-    channels: tuple[LdiChannel | None, ...]
+    channels: tuple[tuple[LdiChannel | None, ...], ...]
     iterations: int
     why: str = ""
 
@@ -147,8 +156,6 @@ def slope_pairs(nominal: dict, hull: dict, nu: Sequence[arb], channel: int,
     The own speed's range is cut into ``pieces``; on each, both slopes are enclosed in Arb (every other
     velocity over its whole range) and the four corners of the pair box kept (exact floats, rounded outward).
     """
-    from scipy.spatial import ConvexHull, QhullError
-    from verify.vehicle.model import channel_gradient
     own = _OWN[channel]
     lo, hi = lower(nu[own]), upper(nu[own])
     corners = []
@@ -371,8 +378,6 @@ def ldi_fixed_point(channels: Sequence[Sequence[LdiChannel | None]], cap: Sequen
 def _channel_data(params: VehicleParams, box: Sequence[float], gamma: float, c: int, k_p: float, k_i: float,
                   lag: float, tick: float) -> ChannelData:
     """The inputs of :func:`channel_lyapunov` for channel ``c`` over |ν| <= (box_u, γ̄, box_w, box_r) and Θ."""
-    from verify.vehicle.model import (channel_gradient, channel_masses, channel_mismatch,
-                                      channel_mismatch_gradient, hull_balls, nominal_balls, velocity_box)
     nominal, hull = nominal_balls(params), hull_balls(params)
     nu = velocity_box(box[0], gamma, box[1], box[2])
     m_hat, m_true = channel_masses(nominal)[c], channel_masses(hull)[c]
@@ -436,12 +441,7 @@ def study_bound(params: VehicleParams, v_max: Sequence[float], jump_tick: Sequen
 
 def _boxes():
     """(label, vehicle): von Benzon's point, ±5 %, ±10 %, ±20 %, the published box (benchmarks/dynamic_gap.py)."""
-    import importlib.util
-    spec = importlib.util.spec_from_file_location("dynamic_gap", __file__.replace("loop_ldi.py", "dynamic_gap.py"))
-    gap = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(gap)
-    from tubekit.model.vehicles import VEHICLES
-    yield from ((f"von Benzon ±{round(f * 100)} %", gap._box(f)) for f in (0.0, 0.05, 0.1, 0.2))
+    yield from ((f"von Benzon ±{round(f * 100)} %", _box(f)) for f in (0.0, 0.05, 0.1, 0.2))
     yield "published box", VEHICLES["bluerov2_heavy"]
 
 

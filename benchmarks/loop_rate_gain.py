@@ -14,7 +14,6 @@ would be, to compare with the decay-rate bound and the small-gain one. About 10â
 
 from __future__ import annotations
 
-import importlib.util
 import math
 import sys
 import warnings
@@ -22,6 +21,13 @@ from pathlib import Path
 from typing import Sequence
 
 import numpy as np
+
+from verify.kernel.intervals import upper
+from verify.theorem.design import hull_sway_bound
+from verify.vehicle.bound import _loop_of
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+import loop_ldi as study  # noqa: E402 - the LDI study's vertex sets, the same boxes
 
 __all__ = ["ALPHAS", "ellipsoid_gain", "channel_gain", "main"]
 
@@ -70,19 +76,8 @@ def _holds(p: np.ndarray | None, mats: Sequence[np.ndarray], columns: Sequence[n
     return True
 
 
-def _study():
-    spec = importlib.util.spec_from_file_location("loop_ldi", Path(__file__).with_name("loop_ldi.py"))
-    module = importlib.util.module_from_spec(spec)
-    sys.modules["loop_ldi"] = module
-    spec.loader.exec_module(module)
-    return module
-
-
-def channel_gain(study, params, channel: int, box: Sequence[float] = (0.44, 0.33, 0.33), tick: float = 0.01) -> float:
+def channel_gain(params, channel: int, box: Sequence[float] = (0.44, 0.33, 0.33), tick: float = 0.01) -> float:
     """Î³ (s) of ``channel`` over the velocity box ``box`` and the vehicle's coefficient box (the LDI's vertex sets)."""
-    from verify.kernel.intervals import upper
-    from verify.theorem.design import hull_sway_bound
-    from verify.vehicle.bound import _loop_of
     loop = _loop_of(params, (0.4, 0.3, 0.3), tick, 10)
     data = study._channel_data(params, box, upper(hull_sway_bound(params, box[0], box[2])), channel, loop.k_p,
                                loop.k_i, loop.lag, tick)
@@ -94,11 +89,10 @@ def channel_gain(study, params, channel: int, box: Sequence[float] = (0.44, 0.33
 
 
 def main() -> int:
-    study = _study()
     print("sup|e| per unit command rate (s) by an invariant ellipsoid, u / w / r (floats, not proved); "
           "V = (0.4, 0.3, 0.3) + 10 %")
     for label, params in study._boxes():
-        print(f"  {label:22s}", " / ".join(f"{channel_gain(study, params, c):.3f}" for c in range(3)), flush=True)
+        print(f"  {label:22s}", " / ".join(f"{channel_gain(params, c):.3f}" for c in range(3)), flush=True)
     return 0
 
 

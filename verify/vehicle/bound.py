@@ -53,7 +53,7 @@ from verify.vehicle.model import (arb_body_forces, channel_forces, channel_gradi
 from verify.vehicle.response import RESPONSE_PREC, ResponseSums, impulse_sums
 
 __all__ = ["LoopBound", "velocity_loop_bound", "actuator_authority", "loop_matrix", "computed_bounds",
-           "input_bounds", "Inputs", "rate_authority_conditions", "LOOP_MAX_ITERATIONS", "LOOP_INFLATION"]
+           "input_bounds", "start_bounds", "Inputs", "rate_authority_conditions", "LOOP_MAX_ITERATIONS", "LOOP_INFLATION"]
 
 #: Default bound on the fixed-point iterations (a count, not seconds).
 LOOP_MAX_ITERATIONS = 60
@@ -161,10 +161,18 @@ def _rates(loop: _Loop, nu: Sequence[arb], accel: Sequence[float]) -> tuple[arb,
     return arb(accel[0]), arb(upper(sway)), arb(accel[1]), arb(accel[2])
 
 
+def start_bounds(loop: _Loop, first_command: Sequence[float]) -> tuple[float, float, float]:
+    """sup|W(0)| = sup|d_c|/m_c over the first command's box |y_c| <= F_c, v = 0, and Θ (m/s², m/s², rad/s²): the
+    start transient of the trimmed start (module doc); it does not depend on the fixed point's assumption."""
+    d = channel_mismatch(loop.nominal, loop.hull,
+                         velocity_box(first_command[0], 0.0, first_command[1], first_command[2]))
+    return tuple(upper(abs(d[c]) / loop.m_true[c]) for c in range(3))
+
+
 def input_bounds(loop: _Loop, error: Sequence[float], z_bound: Sequence[float],
-                 accel: Sequence[float], first_command: Sequence[float] | None = None) -> Inputs:
+                 accel: Sequence[float], start: Sequence[float] | None = None) -> Inputs:
     """The model's input bounds over the box |y_c| <= V_c + E_c, |v| <= γ̄ and Θ, given Ẑ and Ŷ = sup|ẏ|;
-    sup|W(0)| over the first command's box |y_c| <= F_c, v = 0 (``first_command`` F; None: V + E and γ̄).
+    ``start`` is sup|W(0)| (:func:`start_bounds`; None: sup|d|/m over that same box).
 
     ŵ_n = (sup|∂n̂_c/∂y_c − λ_c m̂_c| Ŷ_c + Σ_{j ≠ c} sup|∂n̂_c/∂ν_j| |ν̇_j|)/m̂_c;
     sup|Ẇ| = sup|μ − 1| (Ẑ/T_thr + |λ_c| Ŷ_c + ŵ_n) + Σ_j sup|∂d_c/∂ν_j| |ν̇_j| / m_c.
@@ -177,9 +185,7 @@ def input_bounds(loop: _Loop, error: Sequence[float], z_bound: Sequence[float],
     rates = _rates(loop, nu, accel)
     grads = channel_gradient(loop.nominal, nu)
     d, d_grad = channel_mismatch(loop.nominal, loop.hull, nu), channel_mismatch_gradient(loop.nominal, loop.hull, nu)
-    d_first = d if first_command is None else channel_mismatch(
-        loop.nominal, loop.hull, velocity_box(first_command[0], 0.0, first_command[1], first_command[2]))
-    start, rate, drag, mismatch = [], [], [], []
+    rate, drag, mismatch = [], [], []
     for c in range(3):
         own, lam, y_dot = _OWN[c], arb(loop.slope[c]), arb(accel[c])
         cross = sum((abs(g) * x for j, (g, x) in enumerate(zip(grads[c], rates)) if j != own), arb(0))
@@ -187,10 +193,11 @@ def input_bounds(loop: _Loop, error: Sequence[float], z_bound: Sequence[float],
         s_dot = arb(z_bound[c]) / arb(loop.lag) + abs(lam) * y_dot + w_n
         mu = loop.m_hat[c] / loop.m_true[c]
         d_dot = sum((abs(g) * x for g, x in zip(d_grad[c], rates)), arb(0)) / loop.m_true[c]
-        start.append(upper(abs(d_first[c]) / loop.m_true[c]))
         rate.append(upper(abs(mu - 1) * s_dot + d_dot))
         drag.append(upper(w_n))
         mismatch.append(upper(abs(1 - 1 / mu) * y_dot + abs(d[c]) / loop.m_hat[c]))
+    if start is None:
+        start = tuple(upper(abs(d[c]) / loop.m_true[c]) for c in range(3))
     return Inputs(start=tuple(start), rate=tuple(rate), drag=tuple(drag), mismatch=tuple(mismatch), sway=gamma)
 
 
@@ -310,6 +317,7 @@ def velocity_loop_bound(params: VehicleParams, *, v_max: Sequence[float], tick: 
     first = v if first_command is None else tuple(min(f, x) for f, x in zip(_triple("first_command",
                                                                                       first_command), v))
     loop = _loop_of(params, v, h, ticks)
+    start = start_bounds(loop, first)
     authority = actuator_authority(params, v)
     base = computed_bounds(loop, jt, jp)
     assumed = [[x * (1 + LOOP_INFLATION) + 1e-12 for x in row] for row in base]
@@ -318,7 +326,7 @@ def velocity_loop_bound(params: VehicleParams, *, v_max: Sequence[float], tick: 
     while loop.stable and k < max_iterations and not found:
         k += 1
         inputs = input_bounds(loop, [r[0] for r in assumed], [r[2] for r in assumed], [r[3] for r in assumed],
-                              first)
+                              start)
         computed = computed_bounds(loop, jt, jp, inputs)
         found = all(computed[c][o] < assumed[c][o] for c in range(3) for o in range(4))
         if growth is None:

@@ -196,10 +196,11 @@ def _consistent(loop: LoopBound, assumed: tuple[float, float, float]) -> Conditi
 def _plans_only(scenario: Scenario) -> LoopBound:
     """The loop bound for the plans' jumps alone (no backup), the first command within J of rest: the fixed
     point's start (a smaller start transient only lowers the bound, so a failure here is a failure with any law)."""
+    plans = plan_jumps(scenario)
     return velocity_loop_bound(scenario.plant.params, v_max=tuple(float(x) for x in scenario.limits.vector),
                                tick=1.0 / float(scenario.controller.ancillary_rate_hz),
                                period=float(scenario.controller.dt), jump_tick=(0.0, 0.0, 0.0),
-                               jump_period=plan_jumps(scenario), first_command=plan_jumps(scenario))
+                               jump_period=plans, first_command=plans)
 
 
 def _first_assumption(first: LoopBound) -> tuple[float, float, float] | None:

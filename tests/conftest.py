@@ -56,3 +56,12 @@ def stationary():
     sc = verify.certifiable_scenario()
     return sc.with_changes(trajectory=replace(sc.trajectory, rate=0.0),
                            obstacles=(Obstacle((3.0, 0.0, 0.0), 0.4), Obstacle((-3.0, 0.0, 0.0), 0.4)))
+
+
+@pytest.fixture(scope="session")
+def keep_moving_cert():
+    """The certificate of examples/keep_moving.toml: a minimum surge with the loiter (safe tier only)."""
+    import verify
+    from pathlib import Path
+    from tubekit import load_scenario
+    return verify.certify(load_scenario(Path(__file__).resolve().parents[1] / "examples" / "keep_moving.toml"))

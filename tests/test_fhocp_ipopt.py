@@ -134,3 +134,27 @@ def test_ipopt_meets_the_rate_rows_and_agrees_with_the_scp():
         steps = np.abs(np.diff(np.vstack([v_last, res.inputs]), axis=0))
         assert np.all(steps <= jump) and np.all(np.abs(res.inputs[-1]) <= jump)
     assert b.status == "optimal" and abs(a.merit - b.merit) <= 1e-2 * abs(b.merit)
+
+
+def test_ipopt_keeps_the_surge_floor_and_the_loiters_terminal_command():
+    """The same lower corner and terminal command as the SCP's: facing away from the target the free plan backs
+    up, the floored one never slows below 0.15 m/s; with the loiter (u_l = 0.25 m/s) the plan ends within J of it."""
+    pytest.importorskip("casadi")
+    from tubekit.fhocp.ipopt import IpoptFHOCP
+    from tubekit.model.loiter import Loiter
+    t, s = CASES[1]
+    away = np.array(s)
+    away[3] += np.pi
+    tight = tightening()
+    floor = np.array([0.15, -tight.v_max[1], -tight.v_max[2]])
+    free = IpoptFHOCP(SC, tight, max_obstacles=1).solve(t, away, SC.obstacles)
+    held = IpoptFHOCP(SC, dataclasses.replace(tight, v_min=floor), max_obstacles=1).solve(t, away, SC.obstacles)
+    assert free.inputs[:, 0].min() < 0.05 and held.status == "optimal"
+    assert np.all(held.inputs[:, 0] >= 0.15 - 1e-7) and held.violations["input"] == 0.0
+    sc = SC.with_changes(**{"limits.rate": [1.0, 1.0, 2.0]})
+    loiter = dataclasses.replace(backup_plan(), law=Loiter(0.25, 0.3, 0.5, 0.05, 0.3))
+    t, s = CASES[2]
+    res = IpoptFHOCP(sc, dataclasses.replace(tightening(sc), backup=loiter), max_obstacles=1).solve(
+        t, np.array(s), sc.obstacles, v_last=np.zeros(3))
+    jump = np.array(sc.limits.rate) * sc.controller.dt
+    assert res.status == "optimal" and np.all(np.abs(res.inputs[-1] - [0.25, 0.0, 0.0]) <= jump)

@@ -12,6 +12,7 @@ from tubekit.model.kinematics import dsinc
 from tubekit.fhocp.nlp import (BackupTerminal, FhocpNlp, discrete_step, eo_linearisation, obstacle_array, rollout,
                                select_obstacles, sinc, step_linearisation)
 from tubekit.model.kinematics import nominal_kinematics
+from tubekit.exceptions import ConfigError
 from tubekit.scenario import Obstacle, paper_scenario
 from tubekit.tightening import Tightening
 
@@ -56,6 +57,30 @@ def test_e_d_and_input_violations():
     assert ev.violations["input"] == pytest.approx(0.2)
     e_d = np.hypot(states[1:, 0], states[1:, 1])
     assert ev.violations["e_d_min"] == pytest.approx(np.max(0.3 - e_d))
+
+
+def test_the_input_box_has_a_lower_corner_from_the_tightening():
+    """v_min defaults to -v_max (the symmetric box) and comes from ``Tightening.v_low``: a surge below the floor is
+    an input violation by the shortfall, a surge backing up to -v_max is none without the floor."""
+    assert np.array_equal(NLP.v_min, -TIGHT.v_max) and np.array_equal(NLP.terminal_command, np.zeros(3))
+    floored = FhocpNlp.from_scenario(SC, dataclasses.replace(TIGHT, v_min=[0.1, -0.2, -0.4]), terminal="off")
+    assert np.array_equal(floored.v_min, [0.1, -0.2, -0.4])
+    s0 = np.array([0.0, 1.0, 0.0, 0.0])
+    v = np.zeros((NLP.n, 3))
+    v[:, 0] = 0.1                                     # on the floor
+    v[2, 0] = 0.04                                    # 0.06 below it
+    v[3, 0] = -0.3                                    # backing up at -V-bar_u: 0.4 below it
+    ref = np.tile([0.0, 4.0, 0.0], (NLP.n + 1, 1))
+    states = rollout(s0, v, NLP.dt)
+    assert floored.evaluate(states, v, ref, np.zeros((0, 4))).violations["input"] == pytest.approx(0.4)
+    assert NLP.evaluate(states, v, ref, np.zeros((0, 4))).violations["input"] == 0.0
+    np.testing.assert_array_equal(floored.clip(v)[:, 0], np.maximum(v[:, 0], 0.1))
+
+
+@pytest.mark.parametrize("v_min", [[0.31, -0.2, -0.4], [-0.31, -0.2, -0.4], [math.nan, -0.2, -0.4]])
+def test_a_lower_corner_outside_the_box_is_refused(v_min):
+    with pytest.raises(ConfigError, match="v_min"):
+        dataclasses.replace(NLP, v_min=np.array(v_min))
 
 
 def test_select_obstacles_by_surface_distance_nearest_first():

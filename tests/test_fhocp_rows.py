@@ -80,3 +80,25 @@ def test_projection_meets_the_rest_where_the_envelopes_touch_up_to_rounding():
     v = rate_project(plan, big_j, VMAX, v_last=np.zeros(3), rest=True)
     assert max(rate_violation(v, big_j, np.zeros(3), rest=True).values()) <= 1e-15
     assert v[-1, 1] <= big_j[1] and np.allclose(v[3:, 1], [0.05, 0.1, 0.15, 0.1, 0.05])
+
+
+FLOOR = np.array([0.1, -0.3, -0.5])          # a surge floor: the box's lower corner
+LOITER = np.array([0.25, 0.0, 0.0])          # the loiter's hand-over command (u_l, 0, 0)
+
+
+def test_the_terminal_row_is_about_the_target_command():
+    plan = np.tile([0.25, 0.0, 0.0], (3, 1))   # ends at u_l: 0.25 from rest
+    assert rate_violation(plan, J, rest=True)["terminal rest"] == pytest.approx(0.25 - 0.03)
+    assert rate_violation(plan, J, rest=True, target=LOITER)["terminal rest"] == 0.0
+    assert rate_violation(plan, J, rest=True, target=[0.3, 0.0, 0.0])["terminal rest"] == pytest.approx(0.05 - 0.03)
+
+
+@given(v_last=st.tuples(*[st.floats(lo, hi) for lo, hi in zip(FLOOR, VMAX)]),
+       plan=st.lists(st.tuples(*[st.floats(-b, b) for b in VMAX]), min_size=8, max_size=8))
+def test_projection_keeps_the_floor_and_meets_the_rest_about_the_target(v_last, plan):
+    """Property: any plan (backing up included) projected from a v_last in the floored box lies in
+    [FLOOR, VMAX] and meets (a)-(c) with the terminal rest about the loiter's command."""
+    big_j = np.array([0.06, 0.05, 0.1])   # (N + 1) J covers V: the command is always reachable
+    v = rate_project(np.array(plan), big_j, VMAX, v_last=np.array(v_last), rest=True, v_min=FLOOR, target=LOITER)
+    assert np.all(v >= FLOOR) and np.all(v <= VMAX)
+    assert max(rate_violation(v, big_j, np.array(v_last), rest=True, target=LOITER).values()) <= 1e-15

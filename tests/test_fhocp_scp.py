@@ -384,3 +384,46 @@ def test_the_rate_penalty_smooths_the_plan_and_zero_restores_the_paper_cost():
     assert a.cost == pytest.approx(by_hand, rel=1e-12)
     with pytest.raises(ConfigError, match="rate_penalty"):
         ScpOptions(rate_penalty=-1.0)
+
+
+# ---- a minimum surge (limits.u_min): the input box's lower corner and the loiter's terminal command ----------
+
+def _facing_away():
+    """(t, state): the second case turned round, the target behind: the free plan backs up at up to -V_bar_u."""
+    t, s = STATES[1]
+    s = np.array(s)
+    s[3] += math.pi
+    return t, s
+
+
+@pytest.mark.parametrize("mode", ["realtime", "converged"])
+def test_a_surge_floor_keeps_every_planned_surge_above_it(mode):
+    t, s = _facing_away()
+    tight = tightening()
+    floor = np.array([0.15, -tight.v_max[1], -tight.v_max[2]])
+    free = FHOCP(SC, tight, mode=mode).solve(t, s, OBSTACLES)
+    assert free.inputs[:, 0].min() < 0.15 - 0.1            # without the floor it slows and backs up
+    solver = FHOCP(SC, dataclasses.replace(tight, v_min=floor), mode=mode)
+    assert np.array_equal(solver.nlp.v_min, floor)
+    res = solver.solve(t, s, OBSTACLES)
+    assert not res.fallback and np.all(res.inputs[:, 0] >= 0.15 - 1e-7) and res.violations["input"] == 0.0
+    assert np.all(res.inputs <= tight.v_max)
+    _, tail, _ = solver.shifted_candidate(t + SC.controller.dt, s, OBSTACLES)   # the fallback's grid search too
+    assert np.all(tail[:, 0] >= 0.15)
+
+
+def test_the_loiters_plans_end_within_j_of_its_surge():
+    """A loiter backup (no ramp, surge u_l = 0.25 m/s): the terminal rest holds about (u_l, 0, 0), so the plan's
+    last row is within J of it, where station keeping's plan ends within J of rest (0.15 m/s apart: never both)."""
+    from tubekit.model.loiter import Loiter
+    loiter = dataclasses.replace(backup_plan(), law=Loiter(0.25, 0.3, 0.5, 0.05, 0.3))
+    jump = np.array(RATED.limits.rate) * RATED.controller.dt
+    t, s = STATES[2]
+    last = {}
+    for name, backup in (("loiter", loiter), ("station", backup_plan())):
+        tight = dataclasses.replace(tightening(RATED), backup=backup)
+        res = FHOCP(RATED, tight, mode="converged").solve(t, np.array(s), OBSTACLES, v_last=np.zeros(3))
+        assert not res.fallback and res.violations["rate"] <= 1e-7
+        last[name] = res.inputs[-1]
+    assert np.all(np.abs(last["loiter"] - [0.25, 0.0, 0.0]) <= jump)
+    assert np.all(np.abs(last["station"]) <= jump)

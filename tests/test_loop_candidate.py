@@ -50,6 +50,19 @@ def test_pursuit_turns_onto_the_line_of_sight_and_closes_in(state, want):
 
 
 
+def test_a_surge_floor_bounds_the_completion_from_below():
+    """With V_bar's lower corner a surge floor (0.15 m/s), the completion that would stop facing away surges at the
+    floor, and every completed row of the candidate keeps it; the other axes keep their symmetric bounds."""
+    floor = np.array([0.15, -V[1], -V[2]])
+    u, _, r = pursuit_input(SC, np.array([0.5, 3.0, 0.0, 0.0]), 0.0, V, 0.1, v_min=floor)   # the target behind
+    assert u == 0.15 and abs(r) == pytest.approx(V[2])
+    plan = np.tile([0.2, 0.0, 0.0], (8, 1))
+    cand = candidate_plan(SC, plan, 2, np.array([0.5, 3.0, 0.0, 0.0]), 0.3, V, None, 0.1, v_min=floor)
+    assert np.all(cand[:, 0] >= 0.15) and np.all(cand <= V)
+    free = candidate_plan(SC, plan, 2, np.array([0.5, 3.0, 0.0, 0.0]), 0.3, V, None, 0.1)
+    assert free[5:, 0].min() < 0.15     # without the floor the completion slows below it
+
+
 def _spinning_in(periods: range):
     """A solver factory: the scenario's FHOCP, except that in ``periods`` its plan yaws at the full rate the way
     the heading error already leans, for the whole horizon (a plan the exact check rejects for |e_o|)."""

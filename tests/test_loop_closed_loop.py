@@ -220,6 +220,20 @@ def test_real_fhocp_with_injected_fallbacks():
     assert np.all(np.isfinite(res.v_hat[12 * m:13 * m]))
 
 
+def test_a_minimum_surge_holds_for_every_plan_and_every_applied_input():
+    """The baseline (nominal MPC, V_bar = V) started facing away from the target: without a floor it backs up;
+    with ``limits.u_min`` = 0.1 m/s every planned and applied surge stays at or above it, none clipped."""
+    pytest.importorskip("tubekit.fhocp")
+    sc = _scenario(duration=1.5)
+    turned = list(sc.initial_state)
+    turned[3] += math.pi
+    sc = sc.with_changes(initial_state=tuple(turned))
+    free = run_closed_loop(sc, tube=False, progress=False)
+    assert np.min(free.inputs[:-1, 0]) < 0.0
+    floored = run_closed_loop(sc.with_changes(**{"limits.u_min": 0.1}), tube=False, progress=False)
+    assert np.min(floored.v_hat[:-1, 0]) >= 0.1 and np.min(floored.inputs[:-1, 0]) >= 0.1
+    assert floored.saturated_ticks == 0 and all(floored.checks.values())
+
 # ---- named steps -----------------------------------------------------------------------
 
 def test_saturate_clips_only_outside_the_box():

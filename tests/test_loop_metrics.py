@@ -131,6 +131,16 @@ def test_compute_metrics_on_handmade_log():
     assert m["law"] == "x"
 
 
+def test_a_surge_below_u_min_is_outside_the_limits():
+    """inputs_within_limits reads V's lower corner: the handmade log's surge 0.2 m/s is inside V, below a floor of
+    0.25 m/s it is not (the ratio to the upper corner, 0.6, does not see it)."""
+    sc = paper_scenario().with_changes(duration=50.0)
+    assert compute_metrics(_handmade_log(), sc)["inputs_within_limits"]
+    m = compute_metrics(_handmade_log(), sc.with_changes(**{"limits.u_min": 0.25}))
+    assert not m["inputs_within_limits"] and m["max_input_ratio"] == pytest.approx(0.6)
+    assert compute_metrics(_handmade_log(), sc.with_changes(**{"limits.u_min": 0.2}))["inputs_within_limits"]
+
+
 def test_encirclements_null_for_non_circular_trajectories():
     sc = paper_scenario().with_changes(trajectory=Line(), obstacles=())
     m = compute_metrics(_handmade_log(), sc)

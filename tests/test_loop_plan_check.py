@@ -245,3 +245,36 @@ def test_a_ramped_backup_blends_so_plans_need_not_end_at_rest(stationary):
     assert _tight(backup=BACKUP).terminal_rest and not _tight(backup=ramped).terminal_rest
     assert check_rates(sc, _tight(backup=BACKUP), ends_moving).where == "rate: terminal rest"
     assert check_rates(sc, _tight(backup=ramped), ends_moving).ok
+
+
+# ---- a minimum surge (limits.u_min): V_bar's lower corner is a surge floor, checked like its upper corner ------
+
+FLOOR = np.array([0.15, -0.3, -0.5])   # v_hat_u >= 0.15 m/s (u_min = 0.1 plus kappa_bar_u = 0.05)
+
+
+def test_a_plan_slowing_below_the_surge_floor_is_rejected_and_at_the_floor_accepted(stationary):
+    keep_moving = stationary.with_changes(**{"limits.u_min": 0.1})
+    floored = _tight(v_min=FLOOR)
+    slow = PLAN.copy()
+    slow[5, 0] = 0.14                                  # 0.01 m/s below the floor in one row
+    res = check_plan(keep_moving, floored, 0.0, X0, slow, [], sign=-1)
+    assert not res.ok and res.where == "input outside V_bar" and res.slack == pytest.approx(0.14 - 0.15, abs=1e-12)
+    assert check_plan(keep_moving, _tight(), 0.0, X0, slow, [], sign=-1).ok   # the symmetric box lets it pass
+    at_floor = PLAN.copy()
+    at_floor[5, 0] = 0.15                              # exactly on the floor: inside V_bar
+    assert check_plan(keep_moving, floored, 0.0, X0, at_floor, [], sign=-1).ok
+
+
+def test_the_terminal_rest_is_about_the_loiters_surge(stationary):
+    """With the loiter (no ramp: it starts at its own surge u_l = 0.25 m/s) a plan ends within J of (u_l, 0, 0)
+    instead of at rest: the ramp down to rest that station keeping needs is refused, one ending at u_l passes."""
+    from tubekit.model.loiter import Loiter
+    loiter = BackupPlan(Loiter(0.25, 0.3, 0.5, 0.05, 0.3), BACKUP.safe_set, handover=BACKUP.handover)
+    sc = _rated(stationary)                         # J = (0.1, 0.1, 0.2)
+    tight = _tight(backup=loiter)
+    assert tight.terminal_rest and np.array_equal(tight.terminal_command, [0.25, 0.0, 0.0])
+    res = check_rates(sc, tight, RAMP)              # ends at 0.05 m/s: 0.2 below u_l, J = 0.1
+    assert not res.ok and res.where == "rate: terminal rest" and res.slack == pytest.approx(0.1 - 0.2, abs=1e-12)
+    cruise = _with_u([0.05, 0.1, 0.15, 0.2, 0.25, 0.3, 0.3, 0.3])   # ends 0.05 above u_l
+    assert check_rates(sc, tight, cruise).ok
+    assert check_rates(sc, _tight(backup=BACKUP), cruise).where == "rate: terminal rest"   # station keeping: at rest

@@ -98,6 +98,25 @@ def test_saturated_ticks_break_inputs(stationary):
     assert not p.ok and p.observed == pytest.approx(1.1)
 
 
+def test_an_applied_surge_below_u_min_breaks_inputs(stationary):
+    """With a minimum surge u_min = 0.1 m/s the surge is bounded below too: one tick at 0.05 m/s is outside V even
+    though |u| <= u_max (observed 1 + (u_min - u) / u_max), a broken promise of the safe tier; at u_min it holds."""
+    keep_moving = stationary.with_changes(**{"limits.u_min": 0.1})
+    run = _run(stationary, scenario=keep_moving)
+    inputs = run.inputs.copy()
+    inputs[:-1, 0] = 0.2
+    assert _promise(replace(run, inputs=inputs), "inputs").ok
+    inputs[7, 0] = 0.05
+    slow = replace(run, inputs=inputs)
+    p = _promise(slow, "inputs")
+    assert not p.ok and p.observed == pytest.approx(1.0 + 0.05 / keep_moving.limits.u_max) and "u_min" in p.detail
+    assert "inputs" in broken_promises(check_promises(slow)) and not slow.checks["inputs_within_limits"]
+    assert _promise(replace(run, inputs=inputs, scenario=stationary), "inputs").ok   # no floor: 0.05 is in V
+    inputs[7, 0] = 0.1
+    assert _promise(replace(run, inputs=inputs), "inputs").ok and replace(run, inputs=inputs).checks[
+        "inputs_within_limits"]
+
+
 @pytest.mark.parametrize("age, replaced0, ok", [
     ([0, 1, 7], False, True),         # N - 1 = 7 periods old: still covered by the candidate
     ([0, 1, 8], False, False),        # older than N - 1

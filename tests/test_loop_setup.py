@@ -25,6 +25,15 @@ def test_saturate_clips_only_outside_the_box_and_says_so():
     assert saturate((0.5, -0.35, 0.2), (0.4, 0.3, 0.5)) == ((0.4, -0.3, 0.2), True)
 
 
+def test_saturate_clips_to_a_surge_floor_as_to_the_upper_corner():
+    """With V's lower corner (u_min = 0.1 m/s) a surge below it is clipped up and counted; None is the symmetric box."""
+    lim, low = (0.4, 0.3, 0.5), (0.1, -0.3, -0.5)
+    assert saturate((0.1, -0.3, 0.5), lim, low) == ((0.1, -0.3, 0.5), False)
+    assert saturate((0.05, -0.35, 0.2), lim, low) == ((0.1, -0.3, 0.2), True)
+    assert saturate((-0.4, 0.0, 0.0), lim, low) == ((0.1, 0.0, 0.0), True)
+    assert saturate((-0.4, 0.0, 0.0), lim, None) == ((-0.4, 0.0, 0.0), False)
+
+
 def test_status_text_reads_enums_and_strings():
     from tubekit.scenario import FhocpMode
     assert status_text(FhocpMode.REALTIME) == "realtime" and status_text("optimal") == "optimal"

@@ -34,6 +34,28 @@ def test_input_limits_validation(kwargs, field):
         InputLimits(**kwargs)
 
 
+@pytest.mark.parametrize("u_min, message", [
+    (-0.1, "limits.u_min"),                 # a floor below rest: the symmetric box is u_min = None
+    (0.4, r"limits\.u_min.*\[0, u_max = 0\.4\)"),   # no room left between the floor and u_max
+    (0.5, "limits.u_min"),
+    ("0.1", "limits.u_min"),
+    (float("nan"), "limits.u_min"),
+])
+def test_a_surge_floor_outside_0_to_u_max_is_refused_by_name(u_min, message):
+    with pytest.raises(ConfigError, match=message):
+        InputLimits(0.4, 0.3, 0.5, u_min=u_min)
+
+
+def test_a_surge_floor_raises_the_lower_corner_of_v_and_nothing_else():
+    """A minimum surge moves only the surge's lower end; the symmetric box keeps -V as its lower corner."""
+    sym, floor = InputLimits(0.4, 0.3, 0.5), InputLimits(0.4, 0.3, 0.5, u_min=0.15)
+    assert sym.surge_floor == -0.4 and list(sym.lower) == [-0.4, -0.3, -0.5]
+    assert floor.surge_floor == 0.15 and list(floor.lower) == [0.15, -0.3, -0.5]
+    assert list(floor.vector) == [0.4, 0.3, 0.5]                  # the upper corner (and the largest |v|) unchanged
+    assert sym.contains([0.0, 0.0, 0.0]) and not floor.contains([0.0, 0.0, 0.0])   # rest is outside V now
+    assert floor.contains([0.15, -0.3, 0.5]) and not floor.contains([0.1499, 0.0, 0.0])
+
+
 def test_input_limits_norm_and_contains():
     lim = InputLimits(0.4, 0.3, 0.5)
     assert lim.norm == pytest.approx(np.sqrt(0.16 + 0.09 + 0.25))

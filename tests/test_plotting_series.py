@@ -62,3 +62,17 @@ def test_an_untightened_axis_is_a_note_not_an_empty_legend_entry():
     labels = [t.get_text() for t in fig.axes[0].get_legend().get_texts()]
     assert not any("bar V" in s for s in labels)
     assert all(any("no tightening" in t.get_text() for t in ax.texts) for ax in fig.axes)
+
+
+def test_a_surge_floor_is_drawn_where_the_lower_bounds_are():
+    """With u_min = 0.1 m/s and V_bar's surge floor 0.15 m/s the surge axis draws V's lower bound at u_min and V_bar's
+    at its floor, not at -u_max and -V_bar_u; the other axes keep the symmetric lines."""
+    sc = paper_scenario().with_changes(**{"limits.u_min": 0.1})
+    base = Tightening.untightened(sc)
+    floor = np.array([0.15, -0.8 * sc.limits.w_max, -0.8 * sc.limits.r_max])
+    tight = replace(base, v_max=base.v_max * 0.8, v_min=floor)
+    fig = inputs_figure(sc, [("tube", _columns())], tightening=tight)
+    levels = [float(ln.get_ydata()[0]) for ln in fig.axes[0].get_lines() if len(set(ln.get_ydata())) == 1]
+    assert 0.1 in levels and 0.15 in levels and -sc.limits.u_max not in levels
+    heave = [float(ln.get_ydata()[0]) for ln in fig.axes[1].get_lines() if len(set(ln.get_ydata())) == 1]
+    assert -sc.limits.w_max in heave and orphan_legend_entries(fig) == []

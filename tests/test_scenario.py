@@ -284,3 +284,27 @@ def test_rate_limit_is_off_by_default_and_in_the_dict_only_when_set(tmp_path):
 def test_rate_limit_errors_name_the_field(rate, match):
     with pytest.raises(ConfigError, match=match):
         scenario_from_dict({"limits": {"rate": rate}})
+
+
+# ---- limits.u_min: a minimum surge ------------------------------------------------------------------------------
+
+def test_a_surge_floor_is_off_by_default_in_the_dict_only_when_set_and_round_trips(tmp_path):
+    """The symmetric box keeps its dict (so every design key of a scenario without a floor is unchanged)."""
+    assert paper_scenario().limits.u_min is None and "u_min" not in paper_scenario().to_dict()["limits"]
+    sc = paper_scenario().with_changes(**{"limits.u_min": 0.1})
+    assert sc.limits.u_min == 0.1 and sc.to_dict()["limits"]["u_min"] == 0.1
+    path = tmp_path / "floored.toml"
+    path.write_text(_to_toml(sc.to_dict()))
+    assert load_scenario(path) == sc
+    assert scenario_from_dict({"limits": {"u_max": 1.5, "u_min": 0.5}}).limits.lower[0] == 0.5
+
+
+@pytest.mark.parametrize("table, match", [
+    ({"u_min": 0.4}, r"^limits\.u_min: expected a surge in \[0, u_max = 0\.4\) m/s"),   # the paper's u_max is 0.4
+    ({"u_min": -0.2}, r"^limits\.u_min"),
+    ({"u_min": "fast"}, r"^limits\.u_min"),
+    ({"u_min": 1.0, "u_max": 0.8}, r"^limits\.u_min"),
+])
+def test_surge_floor_errors_name_the_field(table, match):
+    with pytest.raises(ConfigError, match=match):
+        scenario_from_dict({"limits": table})

@@ -200,3 +200,20 @@ def test_limits_enter_v_bar(pc):
     d = evaluate_design(sc2, reg2, g, 3.125, disturbance_bounds(sc2))
     assert _cond(d, "keep_up[u]").ok is False    # 0.3 - kappa_u < 0.188 + 0.115
     assert np.isclose(_cond(d, "keep_up[u]").rhs, 3 * math.pi / 50 + 0.1 + 0.1 * 0.3 * 0.5)
+
+
+def test_a_surge_floor_is_reserved_kappa_bar_above_u_min_and_fails_when_the_band_closes(keep_moving_cert):
+    """``v_bar[surge_floor]``: the nominal surge lives in [u_min + kappa_u, u_max - kappa_u]; at sigma = 25 1/s the
+    feedback's kappa_u closes the band once u_min reaches u_max - 2 kappa_u."""
+    import verify
+    sc = keep_moving_cert.inputs.scenario.with_changes(**{"controller.sigma": 25.0})
+    cert = verify.certify(sc)
+    kappa = cert.design.tube.kappa[0]
+    floor = {x.condition: x for x in cert.design.conditions}["v_bar[surge_floor]"]
+    assert kappa > 0.0 and floor.ok is True
+    assert floor.lhs == pytest.approx(0.2 + kappa, rel=1e-9) and floor.rhs == pytest.approx(1.0 - kappa, rel=1e-9)
+    closed = verify.certify(sc.with_changes(**{"limits.u_min": 1.0 - 1.5 * kappa}))
+    held = {x.condition: x for x in closed.design.conditions}
+    assert held["v_bar[surge_floor]"].ok is False and not closed.tiers.safe
+    sym = {x.condition for x in verify.certify(sc.with_changes(**{"limits.u_min": None})).design.conditions}
+    assert "v_bar[surge_floor]" not in sym                                        # the symmetric box: no such row

@@ -94,3 +94,14 @@ def test_one_completion_from_the_deviated_set_lands_in_the_set(pc_cert, t, u, a,
     end = unicycle_step(x, row, dt)
     p_end, _ = _circle_target(t + dt)
     assert law.contains(end, p_end), (line_of_sight(end, p_end), law)
+
+
+def test_a_surge_floor_leaves_the_tracking_tier_refused_by_name_and_the_safe_tier_given(keep_moving_cert):
+    """The terminal law's surge is not proved above u_min (a target approaching along the line of sight makes it
+    negative): the tracking tier is refused by ``terminal_surge_floor``, which the safe tier does not read."""
+    c = keep_moving_cert
+    assert c.tiers.safe and not c.tiers.tracking
+    failed = [x for x in c.conditions if x.ok is not True]
+    assert [x.condition for x in failed] == ["terminal_surge_floor"]
+    assert "u_min = 0.2" in failed[0].detail
+    assert "terminal_surge_floor" not in {x.condition for x in c.tier_conditions["safe"]}

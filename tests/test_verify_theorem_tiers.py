@@ -129,3 +129,32 @@ def test_the_backup_is_designed_and_re_proved_through_the_registry(pc_cert):
     assert recertify_backup(sc, b.law, b.safe_set, dist, margins, b.anchor_reach) == b
     with pytest.raises(ConfigError, match=r"backup\.kind"):
         backup_of(sc, dist, margins, kind="hover")
+
+
+# ---- a minimum surge: the backup must keep moving ---------------------------------------------------------------
+
+def test_under_a_surge_floor_station_keeping_is_refused_by_name_and_the_loiter_keeps_its_surge(keep_moving_cert):
+    """examples/keep_moving.toml (u_min 0.2 m/s): station keeping backs up at -u_b, a loiter at u_l >= u_min
+    passes; the certified backup is the loiter and its condition holds with both numbers."""
+    from tubekit.model.loiter import Loiter
+    from verify.theorem.tiers import surge_floor_condition
+    sc = keep_moving_cert.inputs.scenario
+    keep = StationKeeping(surge=0.2, yaw_rate=0.5, yaw_band=0.05, heave=0.3, heave_band=0.01)
+    refused = surge_floor_condition(sc, keep)
+    assert refused.condition == "backup_min_surge" and refused.ok is False
+    assert (refused.lhs, refused.rhs) == (-0.2, 0.2) and "loiter" in refused.detail
+    gains = dict(yaw_rate=0.5, yaw_band=0.1, heave=0.3, heave_band=0.04)
+    assert surge_floor_condition(sc, Loiter(surge=0.2, **gains)).ok is True          # at the floor
+    assert surge_floor_condition(sc, Loiter(surge=0.19, **gains)).ok is False
+    b = keep_moving_cert.backup
+    held = {x.condition: x for x in b.conditions}
+    assert b.certified and b.law.kind == "loiter" and held["backup_min_surge"].ok and b.law.min_surge >= 0.2
+
+
+def test_a_station_keeping_backup_under_a_surge_floor_leaves_no_tier(keep_moving_cert):
+    """The same scenario with controller.backup = "station_keeping": backup_min_surge fails, the safe tier too."""
+    import verify
+    sc = keep_moving_cert.inputs.scenario
+    cert = verify.certify(sc.with_changes(**{"controller.backup": "station_keeping"}))
+    assert cert.tiers == Tiers(False, False)
+    assert "backup_min_surge" in {x.condition for x in cert.tier_conditions["safe"] if x.ok is False}

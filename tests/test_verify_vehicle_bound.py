@@ -218,3 +218,28 @@ def test_a_start_within_j_of_rest_has_almost_no_transient_and_the_bound_holds_at
                                                                       overrides=_BOX_10), truth=truth)
         ratio = corner / np.array(near.error)
         assert np.all(ratio <= 1.0), ratio
+
+
+def test_a_surge_floor_gives_the_fins_their_force_over_the_band_the_loop_keeps():
+    """REMUS 100 (midpoint of Prestero <-> Fossen) at |u| <= 0.6 m/s: without a surge floor the rudder and stern
+    planes give 0 (the band reaches u = 0); with u_min = 0.3 m/s the smallest fin force is the lift at the lowest
+    relative surge the loop allows, |Z_uuds| (u_min - E_u)^2 delta_max, computed here from the vehicle's numbers."""
+    from verify.vehicle.model import nominal_params
+    remus = nominal_params(REMUS100)
+    kw = dict(v_max=(0.6, 0.3, 0.1), tick=H, period=0.1, jump_tick=(0.0, 0.0, 0.0), jump_period=(0.005,) * 3)
+    free, floored = velocity_loop_bound(remus, **kw), velocity_loop_bound(remus, **kw, surge_floor=0.3)
+    sat = {c.condition: c for c in free.conditions}
+    assert free.error == floored.error and math.isfinite(free.error[0])    # the floor changes no loop error
+    assert sat["loop_saturation[Z]"].rhs == 0.0 and sat["loop_saturation[N]"].rhs == 0.0
+    by_name = {c.condition: c for c in floored.conditions}
+    u_low = 0.3 - floored.assumed[0][0]
+    assert 0.25 < u_low < 0.3
+    assert by_name["loop_saturation[Z]"].rhs == pytest.approx(abs(remus.Z_uuds) * u_low ** 2 * remus.fin_max,
+                                                              rel=1e-9)
+    assert by_name["loop_saturation[N]"].rhs == pytest.approx(abs(remus.N_uudr) * u_low ** 2 * remus.fin_max,
+                                                              rel=1e-9)
+    # still far from enough: the heave drag and lift over |w| <= 0.3 m/s need tens of newtons (docs/plant.md §4)
+    assert by_name["loop_saturation[Z]"].ok is False and by_name["loop_saturation[Z]"].lhs > 10.0
+    assert floored.authority[2] > free.authority[2]
+    with pytest.raises(ConfigError, match="surge_floor"):
+        velocity_loop_bound(remus, **kw, surge_floor=-0.1)

@@ -249,3 +249,18 @@ def test_the_loop_ratio_does_not_rise_with_the_level_on_the_slow_scenario(slow_s
         assert all(b <= a for a, b in zip(ratios, ratios[1:]) if math.isfinite(a)), (surge, ratios)
         series += 1
     assert series >= 3
+
+
+def test_the_hand_over_to_a_law_that_does_not_blend_is_charged_its_jump():
+    """A plan ends within J of the law's handover_command; the law's first command then differs from the plan's last
+    row by at most J + (max(u_b - h_u, h_u - min_surge), w_b + |h_w|, k + |h_r|): the loiter's surge does not jump
+    (it is h_u), station keeping without a ramp jumps by up to its u_b from rest."""
+    from tubekit.model.backup import StationKeeping
+    from tubekit.model.loiter import Loiter
+    from verify.vehicle.compose import handover_jump
+    plans = (0.01, 0.02, 0.03)
+    loiter = Loiter(surge=0.5, yaw_rate=0.2, yaw_band=0.1, heave=0.1, heave_band=0.5)
+    assert handover_jump(loiter, plans) == pytest.approx((0.01, 0.12, 0.23), rel=1e-12)
+    keep = StationKeeping(surge=0.2, yaw_rate=0.5, yaw_band=0.05, heave=0.3, heave_band=0.01)
+    assert handover_jump(keep, plans) == pytest.approx((0.21, 0.32, 0.53), rel=1e-12)
+    assert all(j >= x for j, x in zip(handover_jump(loiter, plans), plans))    # never below the plans' own jumps

@@ -180,6 +180,8 @@ class Scenario:
         }
         if self.limits.rate is not None:  # only when set: a scenario without it keeps its dict
             d["limits"]["rate"] = list(self.limits.rate)
+        if self.limits.u_min is not None:  # likewise: a symmetric box keeps its dict (and its design key)
+            d["limits"]["u_min"] = self.limits.u_min
         if self.workspace is not None:
             d["workspace"] = [list(self.workspace[0]), list(self.workspace[1])]
         if self.plant != PlantSettings():  # the default kinematic plant leaves the dict as before
@@ -253,10 +255,10 @@ def scenario_from_dict(d: dict) -> Scenario:
                 built.append(Obstacle(o["center"], o["radius"]))
         kw["obstacles"] = tuple(built)
     if "limits" in d:
-        lim = _table(d, "limits", InputLimits, {"u_max", "w_max", "r_max", "rate"})
+        lim = _table(d, "limits", InputLimits, {"u_max", "w_max", "r_max", "rate", "u_min"})
         b = base.limits
         kw["limits"] = InputLimits(lim.get("u_max", b.u_max), lim.get("w_max", b.w_max), lim.get("r_max", b.r_max),
-                                   lim.get("rate", b.rate))
+                                   lim.get("rate", b.rate), lim.get("u_min", b.u_min))
     for key in ("vehicle_radius", "sensing_range", "epsilon", "duration"):
         if key in d:
             kw[key] = d[key]

@@ -139,6 +139,10 @@ class Tightening:
         The tracking theorem's terminal set and law (``docs/verify.md``, step 17): every accepted plan ends in
         its set X_f, and the candidate is completed by its law, so a plan is always available. Given only with
         the tracking tier; None otherwise (then ``recursive_feasibility`` stays a premise of tracking).
+    v_min : array (3,) or None
+        The nominal box's lower corner (m/s, m/s, rad/s) when it is not −``v_max``: with a minimum surge
+        (``limits.u_min``) v̂_u >= u_min + κ̄_u, so v = v̂ + κ never falls below u_min. None: −``v_max``
+        (read it through :attr:`v_low`).
     """
 
     v_max: np.ndarray
@@ -158,8 +162,14 @@ class Tightening:
     tiers: Tiers = field(default_factory=Tiers)
     velocity_loop: tuple[float, float, float] | None = None
     terminal_law: TerminalLaw | None = None
+    v_min: np.ndarray | None = None
 
     def __post_init__(self) -> None:
+        if self.v_min is not None:
+            low = np.asarray(_numbers("tightening.v_min", self.v_min, 3), dtype=float)
+            if np.any(low > np.asarray(self.v_max, dtype=float)):
+                raise ConfigError("tightening.v_min", "a lower corner <= v_max component-wise", list(low))
+            object.__setattr__(self, "v_min", low)
         if self.terminal_law is not None and not isinstance(self.terminal_law, TerminalLaw):
             raise ConfigError("tightening.terminal_law", "a tubekit.model.terminal_law.TerminalLaw or None",
                               type(self.terminal_law).__name__)
@@ -174,6 +184,16 @@ class Tightening:
             if min(loop) < 0.0:
                 raise ConfigError("tightening.velocity_loop", "three numbers >= 0 (m/s, m/s, rad/s)", loop)
             object.__setattr__(self, "velocity_loop", tuple(loop))
+
+    @property
+    def v_low(self) -> np.ndarray:
+        """The nominal box's lower corner (3,) (m/s, m/s, rad/s): ``v_min``, or −``v_max``."""
+        return -np.asarray(self.v_max, dtype=float) if self.v_min is None else np.asarray(self.v_min, dtype=float)
+
+    @property
+    def surge_floor(self) -> float:
+        """The smallest nominal surge a plan may command (m/s): ``v_low[0]``."""
+        return float(self.v_low[0])
 
     @property
     def certified(self) -> bool:
@@ -251,10 +271,23 @@ class Tightening:
 
     @property
     def terminal_rest(self) -> bool:
-        """True when a plan must end at rest, |v̂_{N−1}| <= J: a terminal backup that starts from 0 instead of
-        blending from the last applied command (:attr:`tubekit.model.backup.StationKeeping.blends`)."""
+        """True when a plan must end near the backup's hand-over command, |v̂_{N−1} − :attr:`terminal_command`| <= J
+        (at rest for station keeping, at the loiter's surge): a terminal backup that starts from its own command
+        instead of blending from the last applied one (:attr:`tubekit.model.backup.StationKeeping.blends`)."""
         backup = self.terminal_backup
         return backup is not None and not backup.law.blends
+
+    @property
+    def terminal_command(self) -> np.ndarray:
+        """(3,) the command a plan's last row must be within J of when :attr:`terminal_rest` (m/s, m/s, rad/s):
+        the terminal backup's ``handover_command`` — 0 for station keeping, (u_l, 0, 0) for the loiter — projected
+        onto the plans' box [:attr:`v_low`, ``v_max``] (a loiter at ū under a tube's κ̄_u is entered from ū − κ̄_u;
+        on the dynamic plant σ = 0 and the box is V, which holds the command: nothing moves there)."""
+        backup = self.terminal_backup
+        if backup is None:
+            return np.clip(np.zeros(3), self.v_low, np.asarray(self.v_max, dtype=float))
+        return np.clip(np.asarray(backup.law.handover_command, dtype=float), self.v_low,
+                       np.asarray(self.v_max, dtype=float))
 
     @property
     def horizon_arcs(self) -> int:
@@ -267,4 +300,5 @@ class Tightening:
         reg = scenario.region
         return cls(v_max=scenario.limits.vector.copy(), e_d_min=scenario.epsilon, e_o_max=reg.e_o_max,
                    e_z_max=reg.e_z_max, e_d_max=reg.e_d_max, obstacle_margin=0.0, sigma=0.0,
-                   region=RegionBounds(scenario.epsilon, reg.e_d_max, reg.e_z_max, reg.e_o_max))
+                   region=RegionBounds(scenario.epsilon, reg.e_d_max, reg.e_z_max, reg.e_o_max),
+                   v_min=None if scenario.limits.u_min is None else scenario.limits.lower)

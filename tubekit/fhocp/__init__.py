@@ -5,7 +5,8 @@ Modules, from the contract outwards:
 * :mod:`~tubekit.fhocp.result` — :class:`FhocpResult`, the :class:`Status` enum,
   :class:`FallbackWarning` and the warm-start shift: what every backend returns and shares;
 * :mod:`~tubekit.fhocp.nlp` — the discretised nonlinear program (:class:`FhocpNlp`):
-  exact step, rollout, linearisations, obstacle selection, evaluation;
+  exact step, rollout, obstacle selection, the input box [v_min, v_max], evaluation;
+* :mod:`~tubekit.fhocp.linearisation` — the first-order models of its step and bearing error (the SCP's data);
 * :mod:`~tubekit.fhocp.convex` — the DPP cvxpy subproblem of one SCP iteration;
 * :mod:`~tubekit.fhocp.fastpath` — the compiled parameter-to-data map, solved by a QP backend;
 * :mod:`~tubekit.fhocp.qp` — the QP backends (Clarabel, PIQP through the relaxation wrapper) by name;

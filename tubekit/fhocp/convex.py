@@ -21,9 +21,11 @@
   exact-penalty slack: each obstacle's half-space with the radius enlarged by the footprint's
   sphere (the same normal as the node's obstacle row), the workspace box shrunk by the
   footprint, and the sensed region as second-order cones; none of it is built without a backup;
-* a box trust region on the input step, intersected with the input box;
+* a box trust region on the input step, intersected with the input box [v_min, v_max] (Parameters
+  ``ulo`` .. ``rhi``, written per linearisation);
 * with a rate limit (``nlp.rate_jump``), the rate rows of :mod:`tubekit.fhocp.rows` (hard): the
-  node-to-node steps and the terminal rest with constant J, the first node against the Parameter
+  node-to-node steps and the terminal rest |v_{N-1} - c| <= J with constant J and constant c
+  (``nlp.terminal_command``, fixed for the problem's life), the first node against the Parameter
   ``vlast`` with the Parameter bound ``jb`` (J, or a non-binding 2 V-bar when no v_last is given);
 * with a rate penalty (``nlp.rate_penalty`` > 0), its quadratic in the objective (``vlast`` again).
 
@@ -208,7 +210,8 @@ class ConvexSubproblem:
         ]
 
     def _rate_rows(self, par: _Par, v: dict) -> list:
-        """|v_{k+1} - v_k| <= J, |v_0 - vlast| <= jb and (terminal rest) |v_{N-1}| <= J, per component."""
+        """|v_{k+1} - v_k| <= J, |v_0 - vlast| <= jb and (terminal rest) |v_{N-1} - c| <= J, per component
+        (c = ``nlp.terminal_command``: constants, as J, so the problem stays DPP)."""
         nlp, N = self.nlp, self.nlp.n
         vlast, jb = self._params["vlast"], par("jb", 3)
         cons = []
@@ -218,7 +221,8 @@ class ConvexSubproblem:
                 cons += [var[1:] - var[:-1] <= jump, var[:-1] - var[1:] <= jump]
             cons += [var[0] - vlast[c] <= jb[c], vlast[c] - var[0] <= jb[c]]
             if nlp.terminal_rest:
-                cons += [var[N - 1] <= jump, -var[N - 1] <= jump]
+                command = float(nlp.terminal_command[c])
+                cons += [var[N - 1] <= command + jump, -var[N - 1] <= jump - command]
         return cons
 
     def _box_rows(self, par: _Par, v: dict, slack: dict) -> list:
@@ -455,10 +459,10 @@ class ConvexSubproblem:
             self.param_vector[gidx["jb"]] = nlp.rate_jump if first_row else 2.0 * nlp.v_max
 
     def _write_input_bounds(self, v: np.ndarray, radius: float) -> None:
-        """The input box V-bar intersected with the trust region |v_new - v| <= radius V-bar."""
+        """The input box [v_min, v_max] intersected with the trust region |v_new - v| <= radius V-bar."""
         vmax = self.nlp.v_max
         bd = np.empty((6, self.nlp.n))
-        bd[0::2] = np.maximum(-vmax, v - radius * vmax).T
+        bd[0::2] = np.maximum(self.nlp.v_min, v - radius * vmax).T
         bd[1::2] = np.minimum(vmax, v + radius * vmax).T
         self.param_vector[self._gidx["bounds"]] = bd.ravel()
 

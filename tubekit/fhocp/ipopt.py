@@ -198,9 +198,8 @@ class IpoptFHOCP:
         nx = x.shape[0]
         self._lbx = np.full(nx, -np.inf)
         self._ubx = np.full(nx, np.inf)
-        vm = np.tile(nlp.v_max, N)
-        self._lbx[:3 * N] = -vm
-        self._ubx[:3 * N] = vm
+        self._lbx[:3 * N] = np.tile(nlp.v_min, N)  # the input box [v_min, v_max]
+        self._ubx[:3 * N] = np.tile(nlp.v_max, N)
         self._lbx[7 * N:] = 0.0  # slacks
         self._lbg = np.array(rows.lbg)
         self._ubg = np.array(rows.ubg)
@@ -278,7 +277,8 @@ class IpoptFHOCP:
         return cost + nlp.penalty * sig_b
 
     def _rate_rows(self, ca: Any, sym: dict, rows: _Rows, cost: Any) -> Any:
-        """The rate rows and the rate penalty (:mod:`tubekit.fhocp.rows`); returns the full cost."""
+        """The rate rows and the rate penalty (:mod:`tubekit.fhocp.rows`; the terminal rest about
+        ``nlp.terminal_command``); returns the full cost."""
         nlp, V, last = self.nlp, sym["V"], sym["last"]
         N = nlp.n
         if nlp.rate_penalty > 0:
@@ -294,7 +294,8 @@ class IpoptFHOCP:
                 rows.nonpositive([V[c, k + 1] - V[c, k] - jump, V[c, k] - V[c, k + 1] - jump])
             rows.nonpositive([V[c, 0] - last[c] - last[3 + c], last[c] - V[c, 0] - last[3 + c]])
             if nlp.terminal_rest:
-                rows.nonpositive([V[c, N - 1] - jump, -V[c, N - 1] - jump])
+                command = float(nlp.terminal_command[c])
+                rows.nonpositive([V[c, N - 1] - command - jump, command - V[c, N - 1] - jump])
         return cost
 
     def _options(self, extra: dict) -> dict:
@@ -350,10 +351,8 @@ class IpoptFHOCP:
             guess = np.asarray(initial_inputs, dtype=float)
         if guess.shape != (N, 3):
             raise ConfigError("initial_inputs", f"an array of shape ({N}, 3)", guess.shape)
-        last = None if v_last is None else np.clip(as_vector("v_last", v_last, 3), -nlp.v_max, nlp.v_max)
-        guess = np.clip(guess, -nlp.v_max, nlp.v_max)
-        if nlp.rate_jump is not None:
-            guess = rate_project(guess, nlp.rate_jump, nlp.v_max, last, nlp.terminal_rest)
+        last = None if v_last is None else nlp.clip(as_vector("v_last", v_last, 3))
+        guess = self._fit(nlp.clip(guess), last)
         anchor = guess[0].copy() if last is None else last
         bound = nlp.rate_jump if last is not None and nlp.rate_jump is not None else 2.0 * nlp.v_max
         self._last = np.concatenate([anchor, bound])
@@ -379,9 +378,7 @@ class IpoptFHOCP:
         else:
             self._lam_x = np.asarray(sol["lam_x"]).ravel()
             self._lam_g = np.asarray(sol["lam_g"]).ravel()
-        v = np.clip(v, -nlp.v_max, nlp.v_max)
-        if nlp.rate_jump is not None:
-            v = rate_project(v, nlp.rate_jump, nlp.v_max, last, nlp.terminal_rest)
+        v = self._fit(nlp.clip(v), last)
         s = rollout(s0, v, nlp.dt)
         ev = nlp.evaluate(s, v, ref, obs, anchor, last is not None)
         self._plan_t, self._plan_inputs = t, v.copy()
@@ -391,6 +388,14 @@ class IpoptFHOCP:
                            max_violation=ev.max_violation, fallback=fallback, merit=ev.merit,
                            violations=ev.violations, solver_time_s=solver_time, t=t,
                            message="" if not fallback else f"IPOPT returned {raw}")
+
+    def _fit(self, v: np.ndarray, last: np.ndarray | None) -> np.ndarray:
+        """``v`` (N, 3), inside the box, projected on the rate rows (:func:`rate_project`; as is without them)."""
+        nlp = self.nlp
+        if nlp.rate_jump is None:
+            return v
+        return rate_project(v, nlp.rate_jump, nlp.v_max, last, nlp.terminal_rest, v_min=nlp.v_min,
+                            target=nlp.terminal_command)
 
     def _initial_point(self, s0: np.ndarray, guess: np.ndarray, ref: np.ndarray, obs: np.ndarray) -> np.ndarray:
         """x0: the guess, its rollout, and the slacks at their optimal values for that plan."""

@@ -29,7 +29,7 @@ NLP (k = 0..N-1 stages, e_k = error_coordinates(s_k, p_d(t + k dt)))::
          + P1 e_d,N^2 + P2 e_z,N^2 + P3 e_o,N^2
          + mu sum_{k=1..N} (sig_ed,k + sig_obs,k + sig_eo,k + sig_box,k)
          + mu_T sig_T                                  (terminal "soft")
-    s.t. s_0 = measured state,  s_{k+1} = F(s_k, v_k),  |v_k| <= v_max,
+    s.t. s_0 = measured state,  s_{k+1} = F(s_k, v_k),  v_min <= v_k <= v_max,
          e_d,k >= e_d_min - sig_ed,k,
          ||p_k - c_j|| >= r_j + r_bar + margin - sig_obs,k     (each obstacle j),
          |e_o,k| <= e_o_max + sig_eo,k,
@@ -49,9 +49,11 @@ of the backup's anchor offsets (``BackupTerminal.best_offset``: 0 without an anc
 radius hypot(R_f, H_f) contains the footprint's cylinder, so a plan meeting these rows meets
 :func:`tubekit.loop.terminal.terminal_condition` about that anchor, which ``tubekit.loop.plan_check`` checks.
 
-With a rate limit the inputs also meet the rate rows of :mod:`tubekit.fhocp.rows` (hard, like the
-input box; family ``rate``); the cost adds the rate penalty lambda sum_c R_c (sum_k (v_k,c -
-v_{k-1},c)^2 + (v_0,c - v_last,c)^2) (lambda = ``rate_penalty``, s; 0 leaves the cost as above).
+The input box's lower corner v_min is -v_max unless the scenario has a minimum surge (``Tightening.v_low``).
+With a rate limit the inputs also meet the rate rows of :mod:`tubekit.fhocp.rows` (hard, like the input box;
+family ``rate``; the terminal rest about ``terminal_command``); the cost adds the rate penalty
+lambda sum_c R_c (sum_k (v_k,c - v_{k-1},c)^2 + (v_0,c - v_last,c)^2) (lambda = ``rate_penalty``, s; 0 leaves
+the cost as above).
 
 Q, R, P are diagonal (the scenario's 3-vectors). The slacks are exact
 (l1) penalties: whenever the hard-constrained problem is feasible and
@@ -71,7 +73,8 @@ import numpy as np
 from tubekit.exceptions import ConfigError, ShapeError
 from tubekit.fhocp.rows import RATE_MARGIN, BackupTerminal, rate_penalty_cost, rate_violation
 from tubekit.model.errors import error_coordinates
-from tubekit.model.kinematics import dsinc, sinc, unicycle_step
+from tubekit.fhocp.linearisation import ED_FLOOR, STEP_LINEARISATION_ROWS, eo_linearisation, step_linearisation
+from tubekit.model.kinematics import sinc, unicycle_step
 from tubekit.scenario import Obstacle, Scenario, TerminalMode
 from tubekit.tightening import Tightening
 from tubekit.validation import as_vector, choice, positive
@@ -81,7 +84,7 @@ __all__ = ["TERMINAL_MODES", "discrete_step", "rollout",
            "select_obstacles", "FhocpNlp", "NlpEvaluation", "BackupTerminal"]
 
 TERMINAL_MODES: tuple[str, ...] = TerminalMode.values()
-_ED_FLOOR = 1e-9  # guards e_o = (...)/e_d against e_d = 0 (m)
+_ED_FLOOR = ED_FLOOR  # guards e_o = (...)/e_d against e_d = 0 (m)
 
 
 #: Exact zero-order-hold step F(s, v, dt) of the nominal kinematics (the model's own exact arc).
@@ -106,86 +109,6 @@ def rollout(s0: np.ndarray, inputs: np.ndarray, dt: float) -> np.ndarray:
     out[1:, 0] = k * np.cos(th)
     out[1:, 1] = k * np.sin(th)
     out[:, :2].cumsum(axis=0, out=out[:, :2])
-    return out
-
-
-#: row order of :func:`step_linearisation`
-STEP_LINEARISATION_ROWS: tuple[str, ...] = ("ax", "bxu", "bxr", "cx", "ay", "byu", "byr", "cy")
-
-
-def step_linearisation(states: np.ndarray, inputs: np.ndarray, dt: float) -> np.ndarray:
-    """Jacobian entries of F at a plan; the only non-constant ones are in the x and y rows.
-
-    The linearised step is::
-
-        x_{k+1} = x_k + ax psi_k + bxu u_k + bxr r_k + cx
-        y_{k+1} = y_k + ay psi_k + byu u_k + byr r_k + cy
-        z_{k+1} = z_k + dt w_k,   psi_{k+1} = psi_k + dt r_k
-
-    exact (value and first derivatives) at the plan.
-
-    Parameters
-    ----------
-    states : array (N+1, 4) or (N, 4)
-        Linearisation states (only the first N are used).
-    inputs : array (N, 3)
-        Linearisation inputs.
-    dt : float
-        Step (s).
-
-    Returns
-    -------
-    array (8, N)
-        Rows ``ax, bxu, bxr, cx, ay, byu, byr, cy`` (:data:`STEP_LINEARISATION_ROWS`).
-    """
-    n = inputs.shape[0]
-    psi = states[:n, 3]
-    u = inputs[:, 0]
-    r = inputs[:, 2]
-    a = 0.5 * dt * r
-    sa = sinc(a)
-    dsa = dsinc(a)
-    th = psi + a
-    c, s = np.cos(th), np.sin(th)
-    out = np.empty((8, n))
-    out[1] = dt * sa * c            # bxu
-    out[5] = dt * sa * s            # byu
-    dx = u * out[1]
-    dy = u * out[5]
-    out[0] = -dy                    # ax
-    out[4] = dx                     # ay
-    half = 0.5 * dt * dt * u
-    out[2] = half * (dsa * c - sa * s)   # bxr
-    out[6] = half * (dsa * s + sa * c)   # byr
-    out[3] = dy * psi - out[2] * r    # cx = dx - ax psi - bxu u - bxr r  (bxu u = dx)
-    out[7] = -dx * psi - out[6] * r   # cy = dy - ay psi - byu u - byr r  (byu u = dy)
-    return out
-
-
-def eo_linearisation(states: np.ndarray, ref: np.ndarray) -> np.ndarray:
-    """First-order model e_o ~ gx x + gy y + gpsi psi + h at ``states`` (K, 4), ``ref`` (K, 3).
-
-    With c = e_x cos psi + e_y sin psi: de_o/dx = e_y c / e_d^3,
-    de_o/dy = -e_x c / e_d^3, de_o/dpsi = c / e_d.
-
-    Returns
-    -------
-    array (5, K)
-        Rows ``gx, gy, gpsi, h, e_o``.
-    """
-    ex = states[:, 0] - ref[:, 0]
-    ey = states[:, 1] - ref[:, 1]
-    psi = states[:, 3]
-    ed = np.maximum(np.sqrt(ex * ex + ey * ey), _ED_FLOOR)
-    cp_, sp_ = np.cos(psi), np.sin(psi)
-    out = np.empty((5, states.shape[0]))
-    c = ex * cp_ + ey * sp_
-    out[4] = (ex * sp_ - ey * cp_) / ed
-    cd = c / (ed * ed * ed)
-    out[0] = ey * cd
-    out[1] = -ex * cd
-    out[2] = c / ed
-    out[3] = out[4] - out[0] * states[:, 0] - out[1] * states[:, 1] - out[2] * psi
     return out
 
 
@@ -273,7 +196,7 @@ class FhocpNlp:
     q, r, p : array (3,)
         Diagonals of Q (on [e_d, e_z, e_o]), R (on [u, w, r]) and P.
     v_max : array (3,)
-        Nominal input box V-bar.
+        Nominal input box V-bar: its upper corner (m/s, m/s, rad/s).
     e_d_min, e_d_max, e_z_max, e_o_max : float
         Tightened state bounds.
     clearance : float
@@ -296,13 +219,20 @@ class FhocpNlp:
     rate_jump : array (3,) or None
         The imposed J (1 - RATE_MARGIN) of the rate rows (None: no rate limit).
     terminal_rest : bool
-        Impose |v_{N-1}| <= J (with a rate limit and a certified backup that starts from rest,
+        Impose |v_{N-1} - terminal_command| <= J (with a rate limit and a certified backup that does not blend,
         ``Tightening.terminal_rest``; a ramped backup blends from the last command instead).
     rate_penalty : float
         lambda (s, >= 0) of the rate penalty.
     tracking_terminal : (d_lo, d_hi, e_o_f, z_f) or None
         The tracking theorem's terminal set X_f at the last node (m, m, -, m): d_lo <= e_d <= d_hi,
         |e_o| <= e_o_f, |e_z| <= z_f (``Tightening.terminal_law``; :meth:`node_bounds`).
+    v_min : array (3,) or None
+        The box's lower corner (m/s, m/s, rad/s), in [-v_max, v_max]: ``Tightening.v_low`` (a surge floor with
+        ``limits.u_min``). None (default): -v_max, the symmetric box; always an array after construction.
+    terminal_command : array (3,) or None
+        The command c of the terminal rest |v_{N-1} - c| <= J (m/s, m/s, rad/s): ``Tightening.terminal_command``
+        (0 for station keeping, (u_l, 0, 0) for the loiter). None (default): zeros; always an array after
+        construction.
     """
 
     dt: float
@@ -326,6 +256,8 @@ class FhocpNlp:
     terminal_rest: bool = False
     rate_penalty: float = 0.0
     tracking_terminal: tuple[float, float, float, float] | None = None
+    v_min: np.ndarray | None = None
+    terminal_command: np.ndarray | None = None
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "dt", positive("dt", self.dt))
@@ -363,7 +295,24 @@ class FhocpNlp:
         if self.rate_penalty < 0 or not math.isfinite(self.rate_penalty):
             raise ConfigError("rate_penalty", "a finite number >= 0", self.rate_penalty)
         object.__setattr__(self, "_rate_w", self.rate_penalty * self.r)
+        self._set_lower_corner()
         object.__setattr__(self, "_nodes", self._node_bounds())
+
+    def _set_lower_corner(self) -> None:
+        """Fill ``v_min`` (-v_max when None) and ``terminal_command`` (zeros when None), validated."""
+        if self.v_min is None:
+            object.__setattr__(self, "v_min", -self.v_max)
+        else:
+            low = as_vector("v_min", self.v_min, 3)
+            if not (np.all(np.isfinite(low)) and np.all(low >= -self.v_max) and np.all(low <= self.v_max)):
+                raise ConfigError("v_min", f"three numbers in [-v_max, v_max], v_max = {self.v_max.tolist()}",
+                                  self.v_min)
+            object.__setattr__(self, "v_min", low)
+        command = np.zeros(3) if self.terminal_command is None else as_vector("terminal_command",
+                                                                              self.terminal_command, 3)
+        if not np.all(np.isfinite(command)):
+            raise ConfigError("terminal_command", "three finite numbers", self.terminal_command)
+        object.__setattr__(self, "terminal_command", command)
 
     @classmethod
     def from_scenario(cls, scenario: Scenario, tightening: Tightening, *, terminal: TerminalMode | str = "soft",
@@ -390,7 +339,8 @@ class FhocpNlp:
                    terminal_penalty=penalty / 20.0 if terminal_penalty is None else terminal_penalty,
                    backup_terminal=backup, rate_jump=None if jump is None else jump * (1.0 - RATE_MARGIN),
                    terminal_rest=jump is not None and tightening.terminal_rest, rate_penalty=rate_penalty,
-                   tracking_terminal=_tracking_terminal(tightening))
+                   tracking_terminal=_tracking_terminal(tightening), v_min=tightening.v_low,
+                   terminal_command=tightening.terminal_command)
 
     def node_bounds(self) -> dict[str, np.ndarray]:
         """Per-node bounds (N,) ``e_d_lo``, ``e_d_hi``, ``e_z``, ``e_o``: the tightened sets, the last node
@@ -406,6 +356,10 @@ class FhocpNlp:
             out["e_d_lo"][-1], out["e_d_hi"][-1] = max(out["e_d_lo"][-1], d_lo), min(out["e_d_hi"][-1], d_hi)
             out["e_o"][-1], out["e_z"][-1] = min(out["e_o"][-1], e_o), min(out["e_z"][-1], z_f)
         return out
+
+    def clip(self, inputs: np.ndarray) -> np.ndarray:
+        """``inputs`` (..., 3) clipped to the input box [v_min, v_max] (m/s, m/s, rad/s); a new array."""
+        return np.clip(inputs, self.v_min, self.v_max)
 
     @property
     def n(self) -> int:
@@ -467,7 +421,7 @@ class FhocpNlp:
         term = 0.0
         if self.terminal != "off":
             term = max(0.0, math.sqrt(float(e2[n] @ self.p)) - self.terminal_level)
-        inp = max(0.0, float((np.abs(inputs) - self.v_max).max()))
+        inp = max(0.0, float(np.maximum(inputs - self.v_max, self.v_min - inputs).max()))
         dyn = float(np.abs(states[1:] - discrete_step(states[:-1], inputs, self.dt)).max())
         vmax = viol.max(axis=1)
         merit = cost + self.penalty * float(viol.sum())
@@ -481,7 +435,7 @@ class FhocpNlp:
             violations["backup_terminal"] = backup
         if self.rate_jump is not None:
             rate = max(rate_violation(inputs, self.rate_jump, v_last if first_row else None,
-                                      self.terminal_rest).values())
+                                      self.terminal_rest, target=self.terminal_command).values())
             merit += self.penalty * rate
             violations["rate"] = rate
         mv = max(violations.values())

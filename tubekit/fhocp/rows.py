@@ -5,8 +5,12 @@ With J = ``scenario.limits.rate`` * dt (per component, m/s, m/s, rad/s) every pl
 
 * (a) |v_{k+1} - v_k| <= J between consecutive nodes;
 * (b) |v_0 - v_last| <= J, v_last the command applied in the last tick before the plan starts;
-* (c) |v_{N-1}| <= J (terminal rest) when the tightening gates plans by a certified backup that starts from
-  rest (``Tightening.terminal_rest``; a ramped backup blends from the last applied command instead).
+* (c) |v_{N-1} - c| <= J (terminal rest) when the tightening gates plans by a certified backup that does not blend
+  (``Tightening.terminal_rest``; a ramped backup blends from the last applied command instead), c its hand-over
+  command ``Tightening.terminal_command``: 0 for station keeping (the plan ends at rest), (u_l, 0, 0) for the loiter.
+
+Every plan also lies in the nominal box [v_min, v_max] (``Tightening.v_low``: -v_max unless the scenario has a
+minimum surge, ``limits.u_min``).
 
 The FHOCP imposes them with J (1 - :data:`RATE_MARGIN`) (room for the solver's tolerance);
 :func:`rate_project` removes what the solver's tolerance leaves over; the exact plan check
@@ -34,11 +38,12 @@ RATE_MARGIN = 1e-4
 
 
 def rate_violation(inputs: np.ndarray, jump: np.ndarray, v_last: np.ndarray | None = None,
-                   rest: bool = False) -> dict[str, float]:
+                   rest: bool = False, *, target: np.ndarray | None = None) -> dict[str, float]:
     """Largest violation (>= 0, input units) of each rate row of ``inputs`` (N, 3) against ``jump`` J (3,).
 
     Keys ``"between nodes"`` (|v_{k+1} - v_k| <= J), ``"first node"`` (|v_0 - v_last| <= J; only with
-    ``v_last``) and ``"terminal rest"`` (|v_{N-1}| <= J; only with ``rest``).
+    ``v_last``) and ``"terminal rest"`` (|v_{N-1} - c| <= J; only with ``rest``), c = ``target`` (3,) (m/s, m/s,
+    rad/s; None: 0, the plan ends at rest).
     """
     v = np.asarray(inputs, dtype=float)
     j = np.asarray(jump, dtype=float)
@@ -47,7 +52,8 @@ def rate_violation(inputs: np.ndarray, jump: np.ndarray, v_last: np.ndarray | No
     if v_last is not None:
         out["first node"] = max(0.0, float((np.abs(v[0] - v_last) - j).max()))
     if rest:
-        out["terminal rest"] = max(0.0, float((np.abs(v[-1]) - j).max()))
+        end = v[-1] if target is None else v[-1] - np.asarray(target, dtype=float)
+        out["terminal rest"] = max(0.0, float((np.abs(end) - j).max()))
     return out
 
 
@@ -57,29 +63,35 @@ REST_ROUNDING = 1e-12
 
 
 def rate_project(inputs: np.ndarray, jump: np.ndarray, v_max: np.ndarray, v_last: np.ndarray | None = None,
-                 rest: bool = False) -> np.ndarray:
-    """``inputs`` (N, 3) made to meet the rate rows (forward clamp), inside the box ``v_max``.
+                 rest: bool = False, *, v_min: np.ndarray | None = None,
+                 target: np.ndarray | None = None) -> np.ndarray:
+    """``inputs`` (N, 3) made to meet the rate rows (forward clamp), inside the box [``v_min``, ``v_max``].
 
     Node k is clipped to [v_{k-1} - J, v_{k-1} + J] (v_{-1} = ``v_last``; none without it), to the box
-    and, with ``rest``, to |v_k| <= (N - k) J, which keeps the terminal rest reachable; when the rest
-    bound and the step bound do not meet (v_last too far from rest) the step bound wins. A plan
-    that already meets every row comes back unchanged. Returns a new array.
+    (``v_min`` (3,): its lower corner, m/s, m/s, rad/s; None: -``v_max``) and, with ``rest``, to
+    |v_k - c| <= (N - k) J (c = ``target``, None: 0), which keeps the terminal rest reachable; when the rest
+    bound and the step bound do not meet (v_last too far from c) the step bound wins. A plan that already
+    meets every row comes back unchanged. Returns a new array.
     """
     v = np.array(inputs, dtype=float)
-    if max(rate_violation(v, jump, v_last, rest).values()) <= 0.0 and (np.abs(v) <= v_max).all():
+    upper = np.asarray(v_max, dtype=float)
+    lower = -upper if v_min is None else np.asarray(v_min, dtype=float)
+    if (max(rate_violation(v, jump, v_last, rest, target=target).values()) <= 0.0
+            and ((v >= lower) & (v <= upper)).all()):
         return v
     n = v.shape[0]
     rows = v.tolist()  # plain floats: N x 3 scalars clamp faster than numpy calls per node
-    js, vm = [float(x) for x in jump], [float(x) for x in v_max]
+    js, vm, vl = [float(x) for x in jump], [float(x) for x in upper], [float(x) for x in lower]
+    tc = [0.0, 0.0, 0.0] if target is None else [float(x) for x in target]
     prev = None if v_last is None else [float(x) for x in v_last]
     for k in range(n):
         for c in range(3):
-            lo, hi = -vm[c], vm[c]
+            lo, hi = vl[c], vm[c]
             if prev is not None:
                 lo, hi = max(lo, prev[c] - js[c]), min(hi, prev[c] + js[c])
             if rest:
                 reach = (n - k) * js[c]
-                r_lo, r_hi = max(lo, -reach), min(hi, reach)
+                r_lo, r_hi = max(lo, tc[c] - reach), min(hi, tc[c] + reach)
                 if r_lo <= r_hi + REST_ROUNDING * max(1.0, reach):  # they meet, up to the rounding of the sums
                     lo, hi = min(r_lo, r_hi), r_hi
             rows[k][c] = min(max(rows[k][c], lo), hi)

@@ -51,7 +51,7 @@ from tubekit.fhocp.rows import rate_project
 __all__ = ["FHOCP", "MODES", "TAIL_GRID", "obstacle_slots", "search_tail"]
 
 MODES: tuple[str, ...] = FhocpMode.values()
-#: grid points per input component [u, w, r] of the fallback's tail search over V-bar
+#: grid points per input component [u, w, r] of the fallback's tail search over V-bar [v_min, v_max]
 TAIL_GRID: tuple[int, int, int] = (7, 5, 7)
 
 
@@ -71,9 +71,9 @@ def obstacle_slots(scenario: Scenario) -> int:
     return int(max(1, meet.sum(axis=1).max()))
 
 
-def _grid(half: np.ndarray) -> np.ndarray:
-    """The :data:`TAIL_GRID` points of the box |v| <= ``half`` (3,), shape (K, 3)."""
-    return np.stack(np.meshgrid(*[np.linspace(-b, b, k) for b, k in zip(half, TAIL_GRID)],
+def _grid(low: np.ndarray, high: np.ndarray) -> np.ndarray:
+    """The :data:`TAIL_GRID` points of the box [``low``, ``high``] (3,) each, shape (K, 3)."""
+    return np.stack(np.meshgrid(*[np.linspace(a, b, k) for a, b, k in zip(low, high, TAIL_GRID)],
                                 indexing="ij"), axis=-1).reshape(-1, 3)
 
 
@@ -81,28 +81,37 @@ def _rate_fit(nlp: FhocpNlp, v: np.ndarray, v_last: np.ndarray | None) -> np.nda
     """``v`` projected on the rate rows (:func:`rate_project`; unchanged without a rate limit)."""
     if nlp.rate_jump is None:
         return v
-    return rate_project(v, nlp.rate_jump, nlp.v_max, v_last, nlp.terminal_rest)
+    return rate_project(v, nlp.rate_jump, nlp.v_max, v_last, nlp.terminal_rest, v_min=nlp.v_min,
+                        target=nlp.terminal_command)
+
+
+def _tail_candidates(nlp: FhocpNlp, grid: np.ndarray, prev: np.ndarray | None) -> np.ndarray:
+    """The inputs the tail search tries after ``prev``: the grid over the box without a rate limit, else the
+    grid of steps +- J about ``prev`` (about the box point nearest 0 without one) clipped to the box."""
+    if nlp.rate_jump is None:
+        return grid
+    centre = nlp.clip(np.zeros(3)) if prev is None else prev
+    return nlp.clip(centre + grid)
 
 
 def search_tail(nlp: FhocpNlp, s0: np.ndarray, v: np.ndarray, kept: int, ref: np.ndarray,
                 obs: np.ndarray, v_last: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray, NlpEvaluation]:
-    """Keep ``v[:kept]`` and choose each later input on a grid over V-bar, one step at a time.
+    """Keep ``v[:kept]`` and choose each later input on a grid over V-bar [v_min, v_max], one step at a time.
 
     Each appended input is the grid point (:data:`TAIL_GRID`) whose plan violates the
     state constraints least (terminal set excluded), ties broken by the merit. With a rate
-    limit the grid spans the previous node +- J instead and the plan is projected on the rate
-    rows (:func:`tubekit.fhocp.rows.rate_project`; the rows are not part of the key).
+    limit the grid spans the previous node +- J instead (clipped to the box) and the plan is projected on
+    the rate rows (:func:`tubekit.fhocp.rows.rate_project`; the rows are not part of the key).
 
     Returns
     -------
     states (N+1, 4), inputs (N, 3), their :class:`NlpEvaluation`
     """
-    v = _rate_fit(nlp, np.clip(v, -nlp.v_max, nlp.v_max), v_last)
-    grid = _grid(nlp.v_max if nlp.rate_jump is None else nlp.rate_jump)
+    v = _rate_fit(nlp, nlp.clip(v), v_last)
+    grid = _grid(nlp.v_min, nlp.v_max) if nlp.rate_jump is None else _grid(-nlp.rate_jump, nlp.rate_jump)
     for j in range(kept, nlp.n):
         best_key, best_u = None, v[j]
-        prev = v[j - 1] if j else v_last
-        cands = grid if nlp.rate_jump is None or prev is None else np.clip(prev + grid, -nlp.v_max, nlp.v_max)
+        cands = _tail_candidates(nlp, grid, v[j - 1] if j else v_last)
         for cand in cands:
             v[j:] = cand
             ev = nlp.evaluate(rollout(s0, v, nlp.dt), v, ref, obs, v_last)
@@ -300,12 +309,12 @@ class FHOCP:
         t_start = time.perf_counter()
         t = finite("t", t)
         s0 = as_vector("state", state, 4)
-        last = None if v_last is None else np.clip(as_vector("v_last", v_last, 3), -self.nlp.v_max, self.nlp.v_max)
+        last = None if v_last is None else self.nlp.clip(as_vector("v_last", v_last, 3))
         obs = self.select_obstacles(s0, obstacles)
         nlp = self.nlp
         ref = nlp.reference(self.scenario.trajectory, t)
         guess, warm = self.warm_start_inputs(t)
-        guess = _rate_fit(nlp, np.clip(guess, -nlp.v_max, nlp.v_max), last)
+        guess = _rate_fit(nlp, nlp.clip(guess), last)
         realtime = warm and self.mode is FhocpMode.REALTIME
         cap = 1 if realtime else (self.max_iterations if warm else self.cold_start_iterations)
         s = rollout(s0, guess, nlp.dt)
@@ -332,7 +341,7 @@ class FHOCP:
         if v_new is None or not np.all(np.isfinite(v_new)):
             it.failure = f"convex subproblem {it.iterations} returned status '{status}'"
             return True
-        v_new = _rate_fit(nlp, np.clip(v_new, -nlp.v_max, nlp.v_max), it.anchor if it.first_row else None)
+        v_new = _rate_fit(nlp, nlp.clip(v_new), it.anchor if it.first_row else None)
         s_new = rollout(s0, v_new, nlp.dt)
         if realtime:
             it.v, it.s, it.accepted, it.status = v_new, s_new, 1, status
@@ -386,8 +395,7 @@ class FHOCP:
         best = (v_new, None, ev_new)
         d = v_new - v
         for j in range(1, 6):
-            cand = _rate_fit(nlp, np.clip(v + (2.0 ** j) * d, -nlp.v_max, nlp.v_max),
-                             it.anchor if it.first_row else None)
+            cand = _rate_fit(nlp, nlp.clip(v + (2.0 ** j) * d), it.anchor if it.first_row else None)
             s_c = rollout(s0, cand, nlp.dt)
             ev_c = nlp.evaluate(s_c, cand, ref, obs, it.anchor, it.first_row)
             if not ev_c.merit < best[2].merit:
@@ -419,7 +427,7 @@ class FHOCP:
         """Tube MPC's candidate at ``t``: the stored plan shifted, its new tail input searched.
 
         The inputs the previous plan still covers are kept; each appended input is
-        the point of a grid over V-bar (7 x 5 x 7) whose plan violates the state
+        the point of a grid over V-bar [v_min, v_max] (7 x 5 x 7) whose plan violates the state
         constraints least (terminal set excluded), ties broken by the merit. Without
         a stored plan the search starts from zero inputs.
 

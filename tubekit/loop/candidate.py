@@ -36,11 +36,17 @@ __all__ = ["candidate_plan", "completion_row", "pursuit_input", "PURSUIT_GAIN"]
 PURSUIT_GAIN = 2.5
 
 
-def pursuit_input(scenario: Scenario, state: np.ndarray, t: float, v_max: np.ndarray, e_d_goal: float
-                  ) -> np.ndarray:
+def _lower(v_max: np.ndarray, v_min: np.ndarray | None) -> np.ndarray:
+    """The box's lower corner (3,): ``v_min``, or −``v_max`` for the symmetric box (m/s, m/s, rad/s)."""
+    return -np.asarray(v_max, dtype=float) if v_min is None else np.asarray(v_min, dtype=float)
+
+
+def pursuit_input(scenario: Scenario, state: np.ndarray, t: float, v_max: np.ndarray, e_d_goal: float, *,
+                  v_min: np.ndarray | None = None) -> np.ndarray:
     """The completion law at the nominal ``state`` [x, y, z, ψ] and time ``t`` (s): turn onto the line of sight
     within one period, surge to bring e_d to ``e_d_goal`` (m) on top of the target's speed along the line of
-    sight, heave to the target's depth; clipped to ``v_max`` (3,) = V̄ (m/s, m/s, rad/s)."""
+    sight, heave to the target's depth; clipped to V̄ = [``v_min``, ``v_max``] (3,) each (m/s, m/s, rad/s;
+    ``v_min`` None: −``v_max``)."""
     dt = scenario.controller.dt
     p = np.asarray(scenario.trajectory.position(t), dtype=float).reshape(3)
     pd_dot = np.asarray(scenario.trajectory.velocity(t), dtype=float).reshape(3)
@@ -53,29 +59,31 @@ def pursuit_input(scenario: Scenario, state: np.ndarray, t: float, v_max: np.nda
     facing = math.cos(alpha)
     u = (along + PURSUIT_GAIN * (e_d - e_d_goal)) / facing if facing > 0.1 else 0.0
     w = pd_dot[2] + PURSUIT_GAIN * (p[2] - state[2])
-    return np.clip(np.array([u, w, r]), -np.asarray(v_max, dtype=float), np.asarray(v_max, dtype=float))
+    return np.clip(np.array([u, w, r]), _lower(v_max, v_min), np.asarray(v_max, dtype=float))
 
 
 def completion_row(scenario: Scenario, law: TerminalLaw | None, end: np.ndarray, t: float, v_max: np.ndarray,
-                   e_d_goal: float) -> np.ndarray:
+                   e_d_goal: float, *, v_min: np.ndarray | None = None) -> np.ndarray:
     """One completion row from the nominal ``end`` (4,) at ``t`` (s): the certified terminal ``law`` when given
-    (inside V̄ by the theorem; the clip to ``v_max`` only absorbs round-off), else :func:`pursuit_input`."""
+    (inside V̄ by the theorem; the clip to [``v_min``, ``v_max``] only absorbs round-off), else
+    :func:`pursuit_input`. ``v_min`` (3,): V̄'s lower corner (m/s, m/s, rad/s; None: −``v_max``)."""
     if law is None:
-        return pursuit_input(scenario, end, t, v_max, e_d_goal)
+        return pursuit_input(scenario, end, t, v_max, e_d_goal, v_min=v_min)
     p = np.asarray(scenario.trajectory.position(t), dtype=float).reshape(3)
     v = np.asarray(scenario.trajectory.velocity(t), dtype=float).reshape(3)
     bound = np.asarray(v_max, dtype=float)
-    return np.clip(law.command(end, p, v, scenario.controller.dt), -bound, bound)
+    return np.clip(law.command(end, p, v, scenario.controller.dt), _lower(bound, v_min), bound)
 
 
 def candidate_plan(scenario: Scenario, plan: np.ndarray | None, age: int, x0: np.ndarray, t0: float,
                    v_max: np.ndarray, jump: np.ndarray | None, e_d_goal: float,
-                   law: TerminalLaw | None = None) -> np.ndarray | None:
+                   law: TerminalLaw | None = None, *, v_min: np.ndarray | None = None) -> np.ndarray | None:
     """The candidate at ``t0`` (s) from the measured ``x0`` (4,): rows ``age + 1 ..`` of the last accepted
-    ``plan`` (N, 3), ``age`` periods old, completed row by row (:func:`completion_row`; each completion row
-    within ``jump`` (3,) of the row before it, when the plans are rate-limited). With the certified terminal
-    ``law`` and no plan (``plan`` None, e.g. at t = 0), the candidate is the law's own N rows; without a law,
-    None when nothing of the plan is left to shift."""
+    ``plan`` (N, 3), ``age`` periods old, completed row by row (:func:`completion_row`, inside V̄ =
+    [``v_min``, ``v_max``], ``v_min`` None: −``v_max``; each completion row within ``jump`` (3,) of the row
+    before it, when the plans are rate-limited). With the certified terminal ``law`` and no plan (``plan`` None,
+    e.g. at t = 0), the candidate is the law's own N rows; without a law, None when nothing of the plan is left
+    to shift."""
     n = scenario.controller.horizon_steps
     if plan is None:
         if law is None:
@@ -90,7 +98,7 @@ def candidate_plan(scenario: Scenario, plan: np.ndarray | None, age: int, x0: np
     dt = scenario.controller.dt
     for _ in range(n - len(rows)):
         end = plan_arcs(x0, np.asarray(rows), dt, 1)[-1, -1] if rows else np.asarray(x0, dtype=float)
-        v = completion_row(scenario, law, end, t0 + dt * len(rows), v_max, e_d_goal)
+        v = completion_row(scenario, law, end, t0 + dt * len(rows), v_max, e_d_goal, v_min=v_min)
         if jump is not None and rows:
             v = np.clip(v, rows[-1] - jump, rows[-1] + jump)
         rows.append(v)

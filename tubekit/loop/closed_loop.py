@@ -9,8 +9,9 @@ Timeline (dt = FHOCP period, h = 1 / ancillary_rate_hz, m = dt / h ticks):
 * the nominal state x̂ is propagated from x(t_k) with v̂ and the nominal
   kinematics (eq. 3), in closed form (exact unicycle arcs, :func:`nominal_arc`);
 * at every tick t_i = i h the ancillary law gives κ(e, ê) (zero-order hold over
-  [t_i, t_i + h)), the applied input is v = v̂ + κ; only when v leaves V is it
-  clipped to V (saturation, counted per tick and per sampling period);
+  [t_i, t_i + h)), the applied input is v = v̂ + κ; only when v leaves V (either corner: with
+  ``limits.u_min`` the surge never goes below it) is it clipped to V (saturation, counted per tick and per
+  sampling period);
 * the plant ẋ = f(x) v + ω(t, x, v) (eq. 11, :class:`tubekit.plant.kinematic.Plant`), or the
   4-DOF vehicle whose velocity loop tracks v (``[plant] kind = "dynamic"``,
   :class:`tubekit.plant.dynamic.DynamicPlant`), is integrated with classical RK4 at a
@@ -142,12 +143,15 @@ class _ClosedLoop:
         self.law, self.sigma, self.plant, self.map = law, sigma, plant, obstacle_map
         self.desired = np.asarray(scenario.trajectory.position(clock.t), dtype=float)
         self.limits = tuple(float(c) for c in scenario.limits.vector)
+        self.lower = tuple(float(c) for c in scenario.limits.lower)  # V's lower corner (the surge floor)
         self.v_bar = np.asarray(tightening.v_max, dtype=float)  # V̄: the plans' box (V for the baseline)
+        self.v_low = np.asarray(tightening.v_low, dtype=float)  # its lower corner
         self.recovers = tightening.recovers and scenario.controller.recovery
         self.memory = PlanMemory()
         self.log = _Log.allocate(clock)
         self.sign = HEMISPHERE_SIGN[scenario.region.heading]
-        self.v_last = None if scenario.limits.rate is None else np.zeros(3)  # the last tick's command (at rest)
+        # the last tick's command: initially the plans' box's point nearest rest (0, or (u_min + κ̄_u, 0, 0))
+        self.v_last = None if scenario.limits.rate is None else np.clip(np.zeros(3), self.v_low, self.v_bar)
         self.passes_v_last = takes_v_last(solver)
         self.t_h, self.v_h = 0.0, (0.0, 0.0, 0.0)  # the last hand-over to the backup: time (s), applied command
 
@@ -223,7 +227,7 @@ class _ClosedLoop:
             return None
         goal = tight.e_d_min + CANDIDATE_GOAL * (tight.e_d_max - tight.e_d_min)
         plan = candidate_plan(self.scenario, previous, memory.age, xk, tk, self.v_bar,
-                              self.scenario.limits.jump(self.scenario.controller.dt), goal, law=law)
+                              self.scenario.limits.jump(self.scenario.controller.dt), goal, law=law, v_min=self.v_low)
         if plan is None:
             return None
         check = check_plan(self.scenario, tight, tk, xk, plan, known, self.sign, v_last=self.v_last)
@@ -235,8 +239,8 @@ class _ClosedLoop:
     def plan_of(self, result: FhocpResult) -> np.ndarray:
         """The plan the loop may use: exactly N finite rows, the first equal to ``first_input``, projected onto V̄.
 
-        The projection (each input clipped to |v_i| <= V̄_i) removes the solver's tolerance: the plan check
-        then verifies, against V̄ exactly, the inputs that run (module doc).
+        The projection (each input clipped to V̄ = [v_low, v_max], ``Tightening.v_low``) removes the solver's
+        tolerance: the plan check then verifies, against V̄ exactly, the inputs that run (module doc).
 
         Raises
         ------
@@ -251,7 +255,7 @@ class _ClosedLoop:
         first = np.asarray(result.first_input, dtype=float).reshape(-1)
         if first.shape != (3,) or not np.array_equal(first, inputs[0]):
             raise SolverError(f"first_input {first.tolist()} differs from the plan's first row {inputs[0].tolist()}")
-        return np.clip(inputs, -self.v_bar, self.v_bar)
+        return np.clip(inputs, self.v_low, self.v_bar)
 
     def backup_anchor(self, k: int, xk: np.ndarray) -> np.ndarray | None:
         """p* (3,) for period ``k`` when the replayed plan is exhausted and a backup exists, else None.
@@ -327,7 +331,7 @@ class _ClosedLoop:
             else:
                 log.kappa[i] = 0.0
                 v = vh
-            v, log.saturated[i] = saturate(v, self.limits)
+            v, log.saturated[i] = saturate(v, self.limits, self.lower)
             log.inputs[i] = v
             x = self.plant.step_tuple(float(clock.t[i]), x, v, h, clock.substeps)
         return x, law_s

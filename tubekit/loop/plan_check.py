@@ -6,13 +6,15 @@ certificate does not rely on that: a plan is *accepted* only when
 (the unicycle arcs of :func:`tubekit.plant.kinematic.nominal_arc`, the same the loop
 follows), that
 
-* the plan has exactly N rows and v̂_j is in V̄ (compared exactly: the loop projects a solver's plan onto
+* the plan has exactly N rows and v̂_j is in V̄ = [``tightening.v_low``, ``tightening.v_max``] (both corners:
+  with a minimum surge the lower one is a surge floor; compared exactly: the loop projects a solver's plan onto
   V̄ first, so no tolerance stands outside the proof);
 * with a rate limit (``scenario.limits.rate``, J = rate · dt per component), the rate rows
   (:func:`check_rates`): |v̂_{j+1} − v̂_j| <= J, |v̂_0 − v_last| <= J (v_last the command applied in the
   last tick before the plan, when given) and, when the tightening gates plans by a certified backup that
-  starts from rest (``tightening.terminal_rest``: no ramp to blend from the last command), the terminal
-  rest |v̂_{n−1}| <= J, each up to the absolute tolerance :data:`RATE_TOLERANCE`;
+  does not blend (``tightening.terminal_rest``: no ramp to blend from the last command), the terminal
+  rest |v̂_{n−1} − c| <= J about the backup's hand-over command c = ``tightening.terminal_command`` (0 for station
+  keeping, (u_l, 0, 0) for the loiter), each up to the absolute tolerance :data:`RATE_TOLERANCE`;
 * ε + M_d[j] <= e_d <= e_d_max - M_d[j], |e_z| <= e_z_max - M_z[j],
   |e_o| <= e_o_max - M_o[j], and the heading stays in the certified hemisphere;
 * the vehicle ball inflated by M_pos[j] is clear of every known obstacle and
@@ -50,7 +52,7 @@ from tubekit.scenario import Obstacle, Scenario
 from tubekit.loop.terminal import terminal_condition
 from tubekit.tightening import Tightening
 
-__all__ = ["PlanCheck", "check_plan", "check_rates", "rate_slacks", "plan_arcs", "tracking_checked",
+__all__ = ["PlanCheck", "check_plan", "check_rates", "rate_slacks", "box_excess", "plan_arcs", "tracking_checked",
            "RATE_TOLERANCE"]
 
 #: Points per arc of the check (plus the arc's end).
@@ -113,16 +115,18 @@ def _plan_arcs_chained(x0: np.ndarray, inputs: np.ndarray, dt: float, samples: i
 
 
 def rate_slacks(inputs: np.ndarray, jump: np.ndarray, v_last: np.ndarray | None,
-                rest: bool) -> dict[str, float]:
+                rest: bool, *, target: np.ndarray | None = None) -> dict[str, float]:
     """Smallest slack (J − |jump|, >= 0 is fine) of each rate row of ``inputs`` (n, 3): "rate: between
-    nodes", "rate: first node" (with ``v_last``) and "rate: terminal rest" (with ``rest``)."""
+    nodes", "rate: first node" (with ``v_last``) and "rate: terminal rest" (with ``rest``: J − |v̂_{n−1} − c|,
+    c = ``target`` (3,), m/s, m/s, rad/s; None: 0, the plan ends at rest)."""
     v = np.asarray(inputs, dtype=float)
     j = np.asarray(jump, dtype=float)
     out = {"rate: between nodes": float(np.min(j - np.abs(v[1:] - v[:-1]), initial=math.inf))}
     if v_last is not None:
         out["rate: first node"] = float(np.min(j - np.abs(v[0] - np.asarray(v_last, dtype=float))))
     if rest:
-        out["rate: terminal rest"] = float(np.min(j - np.abs(v[-1])))
+        end = v[-1] if target is None else v[-1] - np.asarray(target, dtype=float)
+        out["rate: terminal rest"] = float(np.min(j - np.abs(end)))
     return out
 
 
@@ -141,9 +145,18 @@ def check_rates(scenario: Scenario, tight: Tightening, inputs: np.ndarray,
         return PlanCheck(False, -math.inf, "plan shape or values")
     if tight.horizon_arcs:
         v = v[:tight.horizon_arcs]
-    slacks = rate_slacks(v, jump, v_last, tight.terminal_rest)
+    slacks = rate_slacks(v, jump, v_last, tight.terminal_rest, target=tight.terminal_command)
     where, worst = min(slacks.items(), key=lambda kv: kv[1])
     return PlanCheck(worst >= -RATE_TOLERANCE, worst, where)
+
+
+def box_excess(inputs: np.ndarray, tight: Tightening) -> float:
+    """The largest amount (m/s or rad/s; <= 0: inside) by which a row of ``inputs`` (n, 3) leaves V̄ =
+    [``tight.v_low``, ``tight.v_max``], above the upper corner or below the lower one (a surge floor)."""
+    high = np.asarray(tight.v_max, dtype=float)[None, :]
+    if tight.v_min is None:  # the symmetric box: |v̂| <= v_max
+        return float(np.max(np.abs(inputs) - high))
+    return float(np.max(np.maximum(inputs - high, tight.v_low[None, :] - inputs)))
 
 
 def _error_slacks(tight: Tightening, e: np.ndarray, cos_rel: np.ndarray, margins: np.ndarray,
@@ -195,7 +208,7 @@ def check_plan(scenario: Scenario, tight: Tightening, t0: float, x0: np.ndarray,
     n = tight.horizon_arcs
     if inputs.ndim != 2 or inputs.shape[1] != 3 or inputs.shape[0] != n or not np.all(np.isfinite(inputs)):
         return PlanCheck(False, -math.inf, "plan shape or values")
-    over = np.max(np.abs(inputs) - np.asarray(tight.v_max)[None, :])
+    over = box_excess(inputs, tight)
     if over > 0.0:
         return PlanCheck(False, -float(over), "input outside V_bar")
     rates = check_rates(scenario, tight, inputs, v_last)

@@ -6,7 +6,8 @@ Each :class:`Promise` compares an observed figure with the certificate's bound:
   the nominal is logged at its left limit at each sample, so every period is covered) <= 1;
 * ``region`` — e in R at every tick (e_d, e_z, e_o bounds and the heading hemisphere);
 * ``epsilon`` — min e_d >= ε;
-* ``inputs`` — v in V and never clipped (V̄ = V - κ̄ makes saturation impossible);
+* ``inputs`` — v in V and never clipped (V̄ = V - κ̄ makes saturation impossible); with a minimum surge
+  (``limits.u_min``) V's lower corner too: the applied surge never below u_min;
 * ``clearance`` — min vehicle-ball clearance to every obstacle at the ticks, minus the distance the
   vehicle can move in half a tick, >= 0 (so it holds between ticks too); ``workspace`` likewise;
 * ``sway`` — max |v_s| applied <= γ̄ (on the dynamic plant: max |v_b| of the hull, γ̄ its ISS bound);
@@ -180,12 +181,22 @@ def _region(run: RunLog) -> list[Promise]:
 
 
 def _inputs(run: RunLog) -> Promise:
+    """v in V at every tick and never clipped: observed max |v_i| / V_i, and with a minimum surge u_min (where the
+    applied surge fell below it) 1 + (u_min − u) / u_max, so observed <= 1 exactly when v is in V."""
     applied = run.inputs[:-1]
-    lim = run.scenario.limits.vector
+    limits = run.scenario.limits
+    lim = limits.vector
     over = float(np.max(np.abs(applied) / lim)) if len(applied) else 0.0
     sat = int(np.sum(run.saturated))
-    return Promise("inputs", over, 1.0, bool(over <= 1.0 + 1e-12 and sat == 0),
-                   f"max |v_i| / V_i; clipped ticks = {sat} (the certificate promises none)")
+    detail = f"max |v_i| / V_i; clipped ticks = {sat} (the certificate promises none)"
+    if limits.u_min is not None:
+        surge = applied[:, 0]
+        low = float(np.min(surge)) if len(surge) else math.inf
+        if low < limits.u_min:
+            over = max(over, 1.0 + (limits.u_min - low) / limits.u_max)
+        detail = (f"max |v_i| / V_i, or 1 + (u_min - u) / u_max below the surge floor u_min = {limits.u_min:g} m/s "
+                  f"(min applied surge {low:.6g} m/s); clipped ticks = {sat} (the certificate promises none)")
+    return Promise("inputs", over, 1.0, bool(over <= 1.0 + 1e-12 and sat == 0), detail)
 
 
 def _geometry(run: RunLog) -> list[Promise]:

@@ -127,12 +127,15 @@ class Clock:
         return self.h / self.substeps
 
 
-def saturate(v: tuple[float, float, float],
-             limits: tuple[float, float, float]) -> tuple[tuple[float, float, float], bool]:
-    """Clip ``v`` to the box |v_i| <= limits_i (m/s, m/s, rad/s); return (v, whether it was clipped)."""
-    if abs(v[0]) <= limits[0] and abs(v[1]) <= limits[1] and abs(v[2]) <= limits[2]:
+def saturate(v: tuple[float, float, float], limits: tuple[float, float, float],
+             lower: tuple[float, float, float] | None = None) -> tuple[tuple[float, float, float], bool]:
+    """Clip ``v`` to the box lower_i <= v_i <= limits_i (m/s, m/s, rad/s; ``lower`` None: −limits, the box
+    |v_i| <= limits_i); return (v, whether it was clipped)."""
+    if lower is None:
+        lower = (-limits[0], -limits[1], -limits[2])
+    if (lower[0] <= v[0] <= limits[0] and lower[1] <= v[1] <= limits[1] and lower[2] <= v[2] <= limits[2]):
         return v, False
-    return tuple(min(max(vi, -li), li) for vi, li in zip(v, limits)), True
+    return tuple(min(max(vi, lo), li) for vi, lo, li in zip(v, lower, limits)), True
 
 
 def status_text(status: Any) -> str:

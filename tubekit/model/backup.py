@@ -84,6 +84,17 @@ class BackupLaw(Protocol):
         """The largest |u|, |w|, |r| the law commands after its ramp (m/s, m/s, rad/s)."""
         ...
 
+    @property
+    def min_surge(self) -> float:
+        """The smallest surge the law commands after its ramp (m/s; negative: it backs up)."""
+        ...
+
+    @property
+    def handover_command(self) -> tuple[float, float, float]:
+        """(u, w, r) a plan must end within J of when the law does not blend (``Tightening.terminal_command``):
+        the command it starts near (m/s, m/s, rad/s)."""
+        ...
+
     def within(self, u_max: float, w_max: float, r_max: float) -> bool:
         """True when every command of the law lies in V."""
         ...
@@ -201,6 +212,16 @@ class StationKeeping:
     def bounds(self) -> tuple[float, float, float]:
         """(u_b, w_b, k): the largest |u|, |w|, |r| the law commands after its ramp (m/s, m/s, rad/s)."""
         return self.surge, self.heave, self.yaw_rate
+
+    @property
+    def min_surge(self) -> float:
+        """−u_b (m/s): station keeping surges astern as well as ahead."""
+        return -self.surge
+
+    @property
+    def handover_command(self) -> tuple[float, float, float]:
+        """(0, 0, 0): without a ramp a plan ends at rest."""
+        return 0.0, 0.0, 0.0
 
     def command(self, state: tuple[float, float, float, float], anchor: tuple[float, float, float],
                 elapsed: float = math.inf, start: tuple[float, float, float] = (0.0, 0.0, 0.0)

@@ -41,7 +41,7 @@ def _rate_triple(value: object) -> tuple[float, float, float]:
 
 @dataclass(frozen=True)
 class InputLimits:
-    """Box input set V = {|u| <= u_max, |w| <= w_max, |r| <= r_max}.
+    """Box input set V = {u_min <= u <= u_max, |w| <= w_max, |r| <= r_max}.
 
     Parameters
     ----------
@@ -53,18 +53,37 @@ class InputLimits:
         Command-rate limit [rho_u, rho_w, rho_r] (m/s^2, m/s^2, rad/s^2): every plan changes
         its command by at most J = rate * controller.dt per period (``tubekit.fhocp.rows``);
         None (default): no rate limit.
+    u_min : float or None
+        The smallest surge command (m/s), in [0, u_max): a vehicle that must keep moving (fins without
+        authority at rest) never commands less. None (default): the symmetric box, u >= -u_max.
     """
 
     u_max: float
     w_max: float
     r_max: float
     rate: tuple[float, float, float] | None = None
+    u_min: float | None = None
 
     def __post_init__(self) -> None:
         for name in ("u_max", "w_max", "r_max"):
             object.__setattr__(self, name, positive(f"limits.{name}", getattr(self, name)))
         if self.rate is not None:
             object.__setattr__(self, "rate", _rate_triple(self.rate))
+        if self.u_min is not None:
+            floor = nonnegative("limits.u_min", self.u_min)
+            if floor >= self.u_max:
+                raise ConfigError("limits.u_min", f"a surge in [0, u_max = {self.u_max:g}) m/s", self.u_min)
+            object.__setattr__(self, "u_min", floor)
+
+    @property
+    def surge_floor(self) -> float:
+        """The smallest surge command (m/s): ``u_min``, or -u_max for the symmetric box."""
+        return -self.u_max if self.u_min is None else self.u_min
+
+    @property
+    def lower(self) -> np.ndarray:
+        """The box's lower corner ``[surge_floor, -w_max, -r_max]`` (m/s, m/s, rad/s)."""
+        return np.array([self.surge_floor, -self.w_max, -self.r_max])
 
     def jump(self, dt: float) -> np.ndarray | None:
         """J = rate * ``dt`` (3,): the largest command change per period (None without a rate limit)."""
@@ -72,7 +91,7 @@ class InputLimits:
 
     @property
     def vector(self) -> np.ndarray:
-        """The limits as ``[u_max, w_max, r_max]``."""
+        """The limits as ``[u_max, w_max, r_max]``: the upper corner, and the largest |u|, |w|, |r| in V."""
         return np.array([self.u_max, self.w_max, self.r_max])
 
     @property
@@ -81,8 +100,9 @@ class InputLimits:
         return float(np.linalg.norm(self.vector))
 
     def contains(self, v: np.ndarray, tol: float = 1e-9) -> bool:
-        """True when every component of ``v`` is within its limit (plus ``tol``)."""
-        return bool(np.all(np.abs(np.asarray(v)) <= self.vector + tol))
+        """True when every component of ``v`` is within its limits (plus ``tol``), the surge floor included."""
+        v = np.asarray(v, dtype=float)
+        return bool(np.all(np.abs(v) <= self.vector + tol) and np.all(v >= self.lower - tol))
 
 
 @dataclass(frozen=True)

@@ -90,6 +90,12 @@ class Loiter:
         """u_l (m/s): the law never commands less surge."""
         return self.surge
 
+    @property
+    def handover_command(self) -> tuple[float, float, float]:
+        """(u_l, 0, 0): a plan ends at the loiter's surge (within J), so the surge does not jump at the hand-over;
+        the yaw and heave commands start within k and w_b of 0."""
+        return self.surge, 0.0, 0.0
+
     def within(self, u_max: float, w_max: float, r_max: float) -> bool:
         """True when every input of the law lies in V = {|u| <= u_max, |w| <= w_max, |r| <= r_max}."""
         return self.surge <= u_max and self.heave <= w_max and self.yaw_rate <= r_max

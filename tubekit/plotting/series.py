@@ -58,13 +58,18 @@ def period_envelope(columns: Mapping[str, np.ndarray], key: str) -> tuple[np.nda
     return np.r_[t[starts], t[-1]], np.r_[lo, lo[-1:]], np.r_[hi, hi[-1:]]
 
 
-def _bounds(ax: Axes, bound: float, tight: float | None) -> None:
-    """±V on one axis, and ±V̄ where tightened (else a note on the axes: no legend entry without a line)."""
+def _bounds(ax: Axes, bound: float, tight: float | None, low: float | None = None,
+            tight_low: float | None = None) -> None:
+    """V's corners on one axis (``bound`` and ``low``, None: −``bound``), and V̄'s (``tight``, ``tight_low``, None:
+    −``tight``) where tightened (else a note on the axes: no legend entry without a line); units of the axis."""
+    low = -bound if low is None else low
     ax.axhline(bound, color="tab:red", ls="--", lw=1.0, label=r"bound of $V$")
-    ax.axhline(-bound, color="tab:red", ls="--", lw=1.0)
-    if tight is not None and tight < bound - 1e-12:
+    ax.axhline(low, color="tab:red", ls="--", lw=1.0)
+    if tight is not None:
+        tight_low = -tight if tight_low is None else tight_low
+    if tight is not None and (tight < bound - 1e-12 or tight_low > low + 1e-12):
         ax.axhline(tight, color="tab:purple", ls=":", lw=1.2, label=r"bound of $\bar V$ (tightened, for $\hat v$)")
-        ax.axhline(-tight, color="tab:purple", ls=":", lw=1.2)
+        ax.axhline(tight_low, color="tab:purple", ls=":", lw=1.2)
     elif tight is not None:
         ax.text(0.99, 0.985, r"$\bar V = V$ on this axis (no tightening)", transform=ax.transAxes, ha="right",
                 va="top", fontsize=7, color="tab:purple")  # in the band above the bound (ylim ±1.3 V)
@@ -74,6 +79,8 @@ def draw_inputs(axes: Sequence[Axes], scenario: Scenario, runs: Sequence[Run], *
                 tightening: Tightening | None = None, legend: bool = True) -> None:
     """Per axis (u, w, r): v̂ as a line, the per-period min/max envelope of the applied v, the bounds of V and V̄."""
     tight = None if tightening is None else np.asarray(tightening.v_max, dtype=float)
+    tight_low = None if tightening is None else tightening.v_low
+    lows = scenario.limits.lower  # V's lower corner: −V but for a surge floor (limits.u_min)
     for n, (ax, (key, lab), b) in enumerate(zip(axes, _INPUTS, scenario.limits.vector)):
         for i, (label, c) in enumerate(runs):
             colour = run_style(i).get("color")
@@ -82,7 +89,8 @@ def draw_inputs(axes: Sequence[Axes], scenario: Scenario, runs: Sequence[Run], *
                             label=f"{label}: applied v, min-max per period")
             ax.plot(c["t"], c[f"{key}_hat"], drawstyle="steps-post", color=colour, lw=1.2 if i == 0 else 0.9,
                     label=rf"{label}: $\hat v$ (FHOCP)")
-        _bounds(ax, float(b), None if tight is None else float(tight[n]))
+        _bounds(ax, float(b), None if tight is None else float(tight[n]), float(lows[n]),
+                None if tight_low is None else float(tight_low[n]))
         ax.set_ylim(-1.3 * b, 1.3 * b)
         shade_backup(ax, backup_stretches(runs[0][1]) if runs else [], label=n == 0)
         ax.set_ylabel(lab)

@@ -60,6 +60,15 @@ def _input_limits(cert: CertificateRecord, min_input_fraction: float) -> np.ndar
     return np.maximum(v - kappa, floor)
 
 
+def _lower_corner(cert: CertificateRecord, v_max: np.ndarray) -> np.ndarray | None:
+    """The nominal box's lower corner with a minimum surge: V's lower corner raised by what V̄ reserves,
+    limits.lower + (V − V̄) (so v̂ + κ >= u_min); None for the symmetric box (−V̄)."""
+    limits = cert.inputs.scenario.limits
+    if limits.u_min is None:
+        return None
+    return np.minimum(limits.lower + (np.asarray(cert.limits, dtype=float) - v_max), v_max)
+
+
 def _clamped(cert: CertificateRecord, margins: np.ndarray) -> np.ndarray:
     """Best effort: each margin column capped so Ē keeps MIN_KEPT_FRACTION of R (plans can be accepted)."""
     reg = cert.region
@@ -107,7 +116,8 @@ def _safe_only(cert: CertificateRecord) -> Tightening:
     margins = np.column_stack([np.zeros(n), np.zeros(n), np.zeros(n), np.asarray(m.position, dtype=float)])
     rates = np.asarray(d.rates, dtype=float)
     nodes = _safe_only_nodes(cert)
-    return Tightening(v_max=np.asarray(cert.limits, dtype=float), e_d_min=nodes["e_d_min"], e_d_max=nodes["e_d_max"],
+    v_max = np.asarray(cert.limits, dtype=float)
+    return Tightening(v_max=v_max, v_min=_lower_corner(cert, v_max), e_d_min=nodes["e_d_min"], e_d_max=nodes["e_d_max"],
                       e_z_max=nodes["e_z_max"], e_o_max=nodes["e_o_max"],
                       obstacle_margin=float(m.position[-1] + 0.5 * cert.dt * rates[3]), sigma=cert.inputs.sigma,
                       margins=margins, rates=rates, tube=np.zeros(3), **_common(cert))
@@ -147,5 +157,6 @@ def tightening_of(cert: CertificateRecord, min_input_fraction: float = 0.5) -> T
     nodes = _node_bounds(cert, np.where(np.isfinite(margins), margins, 0.0) if margins.size else margins, rates)
     tube = np.asarray(d.tube.rho, dtype=float) if d.tube.certified else np.zeros(3)
     terminal = cert.design.terminal if cert.tiers.tracking else None
-    return Tightening(v_max=_input_limits(cert, min_input_fraction), sigma=cert.inputs.sigma, margins=margins,
+    v_max = _input_limits(cert, min_input_fraction)
+    return Tightening(v_max=v_max, v_min=_lower_corner(cert, v_max), sigma=cert.inputs.sigma, margins=margins,
                       rates=rates, tube=tube, terminal_law=terminal, **_common(cert), **nodes)

@@ -202,14 +202,23 @@ class Design:
         return [c for c in self.conditions if c.ok is False]
 
 
-def input_tightening(p: TubeProblem, tube: PeriodTube, dist: DisturbanceBounds) -> tuple[list[Condition], list]:
-    """V̄ = V - κ̄ (so v̂ + κ never saturates) and the necessary conditions for recursive feasibility."""
+def input_tightening(p: TubeProblem, tube: PeriodTube, dist: DisturbanceBounds,
+                     u_min: float | None = None) -> tuple[list[Condition], list]:
+    """V̄ = V - κ̄ (so v̂ + κ never saturates) and the necessary conditions for recursive feasibility.
+
+    With a minimum surge ``u_min`` (m/s; ``limits.u_min``) the nominal surge lies in [u_min + κ̄_u, u_max − κ̄_u],
+    so v = v̂ + κ never commands less than u_min: condition ``v_bar[surge_floor]`` (that band non-empty)."""
     conds: list[Condition] = []
     vmax = (p.u_max, p.w_max, p.r_max)
     vb = [arb(vmax[i]) - arb(tube.kappa[i]) for i in range(3)]
     for i, ax in enumerate("uwr"):
         conds.append(Condition(f"v_bar[{ax}]", f"{ax}_max - sup|kappa_{ax}| > 0 (V_bar = V - kappa_bar non-empty)",
                                lower(vb[i]), 0.0, bool(vb[i] > 0), f"sup|kappa_{ax}| <= {tube.kappa[i]:.6g}"))
+    if u_min is not None:
+        floor = arb(u_min) + arb(tube.kappa[0])
+        conds.append(Condition("v_bar[surge_floor]", "u_min + sup|kappa_u| < u_max - sup|kappa_u| (the nominal "
+                               "surge band non-empty)", upper(floor), lower(vb[0]), bool(floor < vb[0]),
+                               f"u_min = {u_min:g} m/s, sup|kappa_u| <= {tube.kappa[0]:.6g} m/s"))
     need_u = arb(p.pd_xy) + arb(dist.omega_xy)
     need_w = arb(p.pd_z) + arb(dist.omega_z)
     need_r = arb(dist.omega_xy) / arb(p.eps)
@@ -303,7 +312,7 @@ def evaluate_design(scenario: Scenario, region: Region, gains: GainBounds, sigma
         return Design(sigma=sigma, problem=p, tube=tube, margins=None, v_bar=None, conditions=tuple(conds),
                       score=-math.inf)
     m = horizon_margins(p, tube, scenario.controller.horizon_steps)
-    inp, v_bar = input_tightening(p, tube, dist)
+    inp, v_bar = input_tightening(p, tube, dist, scenario.limits.u_min)
     conds += inp
     conds += state_conditions(scenario, region, p, m, v_bar)
     return Design(sigma=sigma, problem=p, tube=tube, margins=m, v_bar=tuple(v_bar), conditions=tuple(conds),

@@ -261,8 +261,13 @@ def _no_set(b: TerminalBounds) -> Condition:
 
 
 def _not_covered(scenario: Scenario, region: Region) -> tuple[Condition, ...]:
-    """The designs the theorem does not cover yet, named (whatever the backup): rate-limited plans, a region
-    whose heading is not ``toward``."""
+    """The designs the theorem does not cover yet, named (whatever the backup): rate-limited plans, a minimum
+    surge, a region whose heading is not ``toward``."""
+    if scenario.limits.u_min is not None:
+        return (Condition("terminal_surge_floor", "plans without a minimum surge (the terminal law's surge, "
+                          "V_r + lambda (d - d*) over S cos, is not proved above u_min + kappa_u: a target "
+                          "approaching along the line of sight makes it negative)", None, None, False,
+                          f"limits.u_min = {scenario.limits.u_min:g} m/s; the safe tier does not need it"),)
     if scenario.limits.rate is not None:
         return (Condition("terminal_rate", "plans without a rate limit (the completion's row is not proved "
                           "within J of the plan's last)", None, None, False,

@@ -40,7 +40,8 @@ from verify.theorem.terminal import with_terminal
 from verify.theorem.workspace import initial_workspace, target_in_workspace
 
 __all__ = ["SAFE_CONDITIONS", "SAFE_PREFIX", "is_safe_condition", "tracking_design", "position_tube",
-           "safe_only_design", "backup_of", "anchor_reach", "solve_tiers", "recertify_backup", "initial_backup", "tier_conditions",
+           "safe_only_design", "backup_of", "anchor_reach", "solve_tiers", "recertify_backup", "initial_backup",
+           "surge_floor_condition", "tier_conditions",
            "tiers_of"]
 
 #: Names (or name prefixes ending in "[") of the tracking design's conditions the safe tier depends on.
@@ -87,7 +88,7 @@ def safe_only_design(scenario: Scenario, region: Region, gains: GainBounds, dist
     p = tube_problem(scenario, region, gains, 0.0, dist)
     tube = position_tube(p)
     m = horizon_margins(p, tube, scenario.controller.horizon_steps)
-    inp, v_bar = input_tightening(p, tube, dist)
+    inp, v_bar = input_tightening(p, tube, dist, scenario.limits.u_min)
     states = state_conditions(scenario, region, p, m, v_bar)
     pos = m.position[-1]
     conds = [sway_condition(dist),
@@ -220,8 +221,22 @@ def recertify_backup(scenario: Scenario, law: BackupLaw, safe: SafeSet, dist: Di
     return _with_initial(scenario, dataclasses.replace(bc, anchor_reach=anchor_reach) if anchor_reach else bc)
 
 
+def surge_floor_condition(scenario: Scenario, law: BackupLaw) -> Condition:
+    """``backup_min_surge``: with a minimum surge (``limits.u_min``) the backup never commands less,
+    law.min_surge >= u_min (station keeping, which stops and backs up, fails it; the loiter keeps u_l)."""
+    floor = float(scenario.limits.u_min)
+    return Condition("backup_min_surge", "the backup law's smallest surge >= limits.u_min (a vehicle that must "
+                     "keep moving needs a backup that never stops)", float(law.min_surge), floor,
+                     bool(law.min_surge >= floor), f"{law.kind}: smallest surge {law.min_surge:g} m/s" +
+                     ("; controller.backup = \"loiter\" keeps its surge" if law.min_surge < 0 else ""))
+
+
 def _with_initial(scenario: Scenario, bc: BackupCertificate) -> BackupCertificate:
-    return dataclasses.replace(bc, conditions=bc.conditions + (initial_backup(scenario, bc.law, bc.safe_set),))
+    """``bc`` with ``backup_initial`` (and ``backup_min_surge`` under a minimum surge) appended."""
+    extra = (initial_backup(scenario, bc.law, bc.safe_set),)
+    if scenario.limits.u_min is not None:
+        extra += (surge_floor_condition(scenario, bc.law),)
+    return dataclasses.replace(bc, conditions=bc.conditions + extra)
 
 
 def tier_conditions(design: Design, safe_design: Design | None, backup: BackupCertificate | None,

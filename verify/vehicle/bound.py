@@ -232,12 +232,14 @@ def _thrust_peaks(loop: _Loop, box: tuple[float, float, float], gamma: float,
     return [upper(abs(forces[c]) + loop.m_hat[c] * arb(a_bound[c])) for c in range(3)]
 
 
-def actuator_authority(params: VehicleParams, v_max: Sequence[float]) -> tuple[float, float, float]:
+def actuator_authority(params: VehicleParams, v_max: Sequence[float],
+                       surge_floor: float = 0.0) -> tuple[float, float, float]:
     """(a_u, a_w, a_r): a lower bound of the acceleration each channel delivers against drag in V.
 
-    a_c = (smallest limit over |u| <= V_u and Θ − sup|n_c| over V (sway |v| <= γ̄(V)) and Θ) / sup m_c
-    (m/s², m/s², rad/s²): what the thrusters deliver, in either direction, anywhere in V (the corner
-    of V has the largest drag). Negative when the drag (or a fin without speed) wins.
+    a_c = (smallest limit over ``surge_floor`` <= |u| <= V_u and Θ − sup|n_c| over V (sway |v| <= γ̄(V)) and Θ)
+    / sup m_c (m/s², m/s², rad/s²): what the thrusters deliver, in either direction, anywhere in V at a commanded
+    surge of at least ``surge_floor`` (m/s; ``limits.u_min``, 0 without one; the corner of V has the largest
+    drag). Negative when the drag (or a fin without speed) wins.
     """
     v = _triple("v_max", v_max)
     gamma = upper(hull_sway_bound(params, v[0], v[2]))
@@ -245,7 +247,7 @@ def actuator_authority(params: VehicleParams, v_max: Sequence[float]) -> tuple[f
         return (-math.inf,) * 3
     hull = hull_balls(params)
     forces = channel_forces(hull, velocity_box(v[0], gamma, v[1], v[2]))
-    floor = thrust_floor(params, v[0])
+    floor = thrust_floor(params, v[0], surge_floor)
     masses = channel_masses(hull)
     return tuple(lower((arb(floor[c]) - abs(forces[c])) / masses[c]) for c in range(3))
 
@@ -291,7 +293,7 @@ def _validate(params: VehicleParams, v_max: Any, tick: Any, period: Any, jump_ti
 def velocity_loop_bound(params: VehicleParams, *, v_max: Sequence[float], tick: float, period: float,
                         jump_tick: Sequence[float], jump_period: Sequence[float],
                         rate: Sequence[float] | None = None, first_command: Sequence[float] | None = None,
-                        max_iterations: int = LOOP_MAX_ITERATIONS) -> LoopBound:
+                        surge_floor: float = 0.0, max_iterations: int = LOOP_MAX_ITERATIONS) -> LoopBound:
     """The velocity loop's error bound over the command box ``v_max`` (m/s, m/s, rad/s) and Θ.
 
     Parameters
@@ -309,6 +311,10 @@ def velocity_loop_bound(params: VehicleParams, *, v_max: Sequence[float], tick: 
     first_command : (3,) floats, optional
         F: a bound on |u_c|, |w_c|, |r_c| of the first command, at which the run starts trimmed (m/s, m/s,
         rad/s); the start transient W(0) = d(ν(0))/m is bounded over |ν(0)| <= min(F, V), v(0) = 0. Default V.
+    surge_floor : float
+        u_min (m/s): the commanded surge never falls below it (``limits.u_min``; 0: no floor). The fins'
+        limits in ``loop_saturation`` are then taken over u >= u_min − E_u (their force ∝ u², relative to the
+        water) instead of down to u = 0.
     max_iterations : int
         Bound on the fixed-point iterations.
     """
@@ -318,7 +324,8 @@ def velocity_loop_bound(params: VehicleParams, *, v_max: Sequence[float], tick: 
                                                                                       first_command), v))
     loop = _loop_of(params, v, h, ticks)
     start = start_bounds(loop, first)
-    authority = actuator_authority(params, v)
+    floor_u = nonnegative("surge_floor", surge_floor)
+    authority = actuator_authority(params, v, floor_u)
     base = computed_bounds(loop, jt, jp)
     assumed = [[x * (1 + LOOP_INFLATION) + 1e-12 for x in row] for row in base]
     found, k, computed, inputs, growth = False, 0, base, None, None
@@ -337,7 +344,7 @@ def velocity_loop_bound(params: VehicleParams, *, v_max: Sequence[float], tick: 
                 stop = f"the bounds overflow after {k} rounds"
                 break
             assumed = [[max(a, g) for a, g in zip(ra, rg)] for ra, rg in zip(assumed, grown)]
-    return _result(loop, params, (v, h, d, jt, jp, first), assumed, computed, inputs, authority,
+    return _result(loop, params, (v, h, d, jt, jp, first, floor_u), assumed, computed, inputs, authority,
                    (k, max_iterations), found, rho, _why_open(found, stop, growth))
 
 
@@ -357,24 +364,29 @@ def _why_open(found: bool, stop: str, growth: list | None) -> str:
 
 
 def _saturation(loop: _Loop, params: VehicleParams, v: Sequence[float], assumed: list,
-                closed: bool = True) -> list[Condition]:
-    """``loop_saturation[X|Z|N]``: sup|n̂_c| + m̂_c Â_c < the smallest limit over |u| <= V_u + E_u and Θ; not
-    evaluated (no number) when the fixed point did not ``closed`` (its assumed bounds mean nothing then)."""
+                closed: bool = True, surge_floor: float = 0.0) -> list[Condition]:
+    """``loop_saturation[X|Z|N]``: sup|n̂_c| + m̂_c Â_c < the smallest limit over |u| <= V_u + E_u and Θ (and
+    u >= ``surge_floor`` − E_u, the relative surge under a minimum surge command); not evaluated (no number)
+    when the fixed point did not ``closed`` (its assumed bounds mean nothing then)."""
     box, sway = loop.box([r[0] for r in assumed])
     a_assumed = [r[1] for r in assumed]
     finite_box = all(math.isfinite(x) for x in (*box, sway, *a_assumed))
     u_bar = box[0] if finite_box else v[0]
-    floor = thrust_floor(params, u_bar)
+    u_low = max(0.0, lower(arb(surge_floor) - arb(assumed[0][0]))) if finite_box else 0.0
+    floor = thrust_floor(params, u_bar, u_low)
     peaks = _thrust_peaks(loop, box, sway, a_assumed) if finite_box else [math.inf] * 3
     conds = []
     for c, ch in enumerate(_FORCES):
-        why = (f"sup|n_hat_{_CHANNELS[c]}| + m_hat sup|a| over |u| <= {u_bar:.4g} m/s against {floor[c]:.4g}"
+        why = (f"sup|n_hat_{_CHANNELS[c]}| + m_hat sup|a| over {u_low:.4g} <= |u| <= {u_bar:.4g} m/s against "
+               f"{floor[c]:.4g}"
                if floor[c] > 0 else
                f"{_ACTUATOR[ch]} is 0 at u = 0, inside the velocity box |u| <= {u_bar:.4g} m/s: a fin's lift grows "
-               "with u², so this vehicle cannot produce it at rest")
+               "with u², so this vehicle cannot produce it at rest (a minimum surge, limits.u_min, above the loop's "
+               "E_u keeps the vehicle off u = 0)")
         peak = peaks[c]
-        if not closed and floor[c] > 0:
-            peak, why = None, "not evaluated: the loop bound did not close (root cause: loop_fixed_point)"
+        if not closed:  # the assumed bounds of a fixed point that did not close mean nothing: no number
+            peak, why = None, "not evaluated: the loop bound did not close (root cause: loop_fixed_point)" + (
+                "" if floor[c] > 0 else f"; and {why}")
         conds.append(Condition(f"loop_saturation[{ch}]", f"sup|tau_cmd_{ch}| < smallest {ch} limit over the box",
                                peak, floor[c], bool(peak is not None and peak < floor[c]), why))
     return conds
@@ -384,7 +396,7 @@ def _result(loop: _Loop, params: VehicleParams, given: tuple, assumed: list, com
             authority: tuple, iterations: tuple[int, int], found: bool, rho: tuple | None,
             why_open: str = "") -> LoopBound:
     """The :class:`LoopBound` with every condition of the theorem (bounds +inf when not certified)."""
-    v, h, d, jt, jp, first = given
+    v, h, d, jt, jp, first, floor_u = given
     error = tuple(r[0] for r in computed) if found else (math.inf,) * 3
     gamma = upper(hull_sway_bound(params, upper(arb(v[0]) + arb(error[0])), upper(arb(v[2]) + arb(error[2])))) \
         if found else math.inf
@@ -397,7 +409,7 @@ def _result(loop: _Loop, params: VehicleParams, given: tuple, assumed: list, com
     conds.append(Condition("loop_fixed_point", "max computed/assumed of (sup|e|, sup|a|, sup|z|, sup|ydot|) < 1 "
                            "(first exit)", ratio, 1.0, found, f"{iterations[0]} iterations (at most {iterations[1]})"
                            + (f"; {why_open}" if why_open else "")))
-    conds += _saturation(loop, params, v, assumed, closed=found or not loop.stable)
+    conds += _saturation(loop, params, v, assumed, closed=found or not loop.stable, surge_floor=floor_u)
     conds.append(Condition("loop_sway", "gamma_bar finite (sway damped over the box)", gamma, None,
                            math.isfinite(gamma), "hull_sway_bound over |u| <= V_u + E_u, |r| <= V_r + E_r and Θ"
                            if found else "not evaluated: no loop bound E (root cause: loop_fixed_point)"))

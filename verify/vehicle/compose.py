@@ -5,18 +5,22 @@ E = (E_u, E_w, E_r) (:func:`verify.vehicle.bound.velocity_loop_bound`) depends o
 jumps; the command jumps
 
 * at period boundaries by at most J = ρ δ (the plans' rate limit ``limits.rate``, imposed by the FHOCP and
-  checked by the plan check: between nodes and against the last applied command, 0 at t = 0); not at the
-  hand-over, where the ramped backup starts from the last applied command (a backup without a ramp makes
-  plans end at rest instead, ``Tightening.terminal_rest``), and
+  checked by the plan check: between nodes and against the last applied command, at t = 0 the box's point
+  nearest rest, (u_min, 0, 0) under a minimum surge, else 0); not at the hand-over, where the ramped backup
+  starts from the last applied command; a backup without a ramp makes plans end within J of its
+  ``handover_command`` instead (``Tightening.terminal_rest``: at rest for station keeping, at the loiter's
+  surge), and its first command is within :func:`handover_jump` of the plan's last, a jump charged per period;
 * at every tick during the backup by at most the law's proof's ``tick_change`` (station keeping:
   :func:`verify.backup.backup_tick_change`, the command rate × h of :func:`verify.backup.backup_command_rate`,
   finite because the law is faded near its anchor, ramped after the hand-over and, with the continuous yaw law,
   free of the ridge's jump).
 
 The run starts trimmed at its first command (``docs/plant.md`` section 2), so the loop's start transient is
-d(ν(0))/m, which vanishes at rest. With a rate limit that command is within J of rest: the plan check compares a
-plan's first node with the last applied command, 0 at t = 0, and a blending backup starts from that command. The
-start is then bounded over |ν(0)| <= J (``first_command`` of the loop bound); for a law that does not blend, over V.
+d(ν(0))/m, which vanishes at rest. With a rate limit that command is within J of the loop's initial command: the
+plan check compares a plan's first node with the last applied command, initially the box's point nearest rest, and a
+blending backup starts from that command. The start is then bounded over |ν(0)| <= (u_min + J_u, J_w, J_r)
+(``first_command`` of the loop bound, u_min = 0 without a minimum surge); for a law that does not blend, over V.
+Under a minimum surge the fins' authority is taken over u >= u_min − E_u (``surge_floor``, :func:`surge_floor_of`).
 
 E in turn enters ω̄ (:func:`verify.theorem.design.disturbance_bounds`), the tube, the hand-over margins and the
 backup's proof, which fix the backup's command rate. :func:`solve_dynamic` closes this loop as a checked
@@ -59,8 +63,8 @@ from verify.kernel.region import Region
 from verify.theorem.tiers import solve_tiers
 from verify.vehicle.bound import LoopBound, rate_authority_conditions, velocity_loop_bound
 
-__all__ = ["DynamicSolution", "LawLoop", "solve_dynamic", "loop_for_law", "plan_jumps", "FIXED_POINT_ROUNDS",
-           "PLAN_CHECK_TOLERANCE"]
+__all__ = ["DynamicSolution", "LawLoop", "solve_dynamic", "loop_for_law", "plan_jumps", "handover_jump",
+           "surge_floor_of", "FIXED_POINT_ROUNDS", "PLAN_CHECK_TOLERANCE"]
 
 #: The plan check's rate tolerance, carried by the proof (one number: :data:`tubekit.design_inputs.RATE_TOLERANCE`).
 PLAN_CHECK_TOLERANCE = RATE_TOLERANCE
@@ -160,23 +164,49 @@ class _LoopInputs:
     tick: float
     period: float
     plans: tuple[float, float, float]
+    surge_floor: float = 0.0
 
     @classmethod
     def of(cls, scenario: Scenario) -> "_LoopInputs":
         return cls(params=scenario.plant.params, v_max=tuple(float(x) for x in scenario.limits.vector),
                    tick=1.0 / float(scenario.controller.ancillary_rate_hz), period=float(scenario.controller.dt),
-                   plans=plan_jumps(scenario))
+                   plans=plan_jumps(scenario), surge_floor=surge_floor_of(scenario))
+
+    @property
+    def start(self) -> tuple[float, float, float]:
+        """F: the first command lies within J of the loop's initial command, the box's point nearest rest
+        (u_min, 0, 0) under a minimum surge, else 0 (m/s, m/s, rad/s)."""
+        return (upper(arb(self.surge_floor) + arb(self.plans[0])), self.plans[1], self.plans[2])
 
     def loop(self, law: BackupLaw, safe: SafeSet, dist: DisturbanceBounds,
              assumed: tuple[float, float, float]) -> LoopBound:
         """The loop bound for the jump bounds that ``assumed`` implies (plans: J; backup: its proof's
-        :meth:`~verify.backup.BackupProof.tick_change`, the command's rate × h)."""
+        :meth:`~verify.backup.BackupProof.tick_change`, the command's rate × h; a law that does not blend: its
+        hand-over jump, :func:`handover_jump`)."""
         per_tick = proof_for(law).tick_change(law, safe, omega_xy=dist.omega_xy, omega_z=dist.omega_z,
                                               limits=self.v_max, loop_error=assumed, tick=self.tick)
         per_period = tuple(max(j, t) for j, t in zip(self.plans, per_tick))
+        if not law.blends:
+            per_period = tuple(max(p, h) for p, h in zip(per_period, handover_jump(law, self.plans)))
         return velocity_loop_bound(self.params, v_max=self.v_max, tick=self.tick, period=self.period,
                                    jump_tick=per_tick, jump_period=per_period,
-                                   first_command=self.plans if law.blends else None)
+                                   first_command=self.start if law.blends else None, surge_floor=self.surge_floor)
+
+
+def surge_floor_of(scenario: Scenario) -> float:
+    """u_min (m/s) of ``limits.u_min``, 0 without a minimum surge (the loop bound's ``surge_floor``)."""
+    floor = scenario.limits.u_min
+    return 0.0 if floor is None else float(floor)
+
+
+def handover_jump(law: BackupLaw, plans: tuple[float, float, float]) -> tuple[float, float, float]:
+    """The command's jump at the hand-over to a law that does not blend (m/s, m/s, rad/s): the plan's last row is
+    within J of the law's ``handover_command`` h (``Tightening.terminal_rest``) and the law's first command c has
+    min_surge <= c_u <= u_b, |c_w| <= w_b, |c_r| <= k, so |c − v̂_{N−1}| <= J + (max(u_b − h_u, h_u − min_surge),
+    w_b + |h_w|, k + |h_r|) (the loiter: J_u in surge, its surge being h_u)."""
+    h, b = law.handover_command, law.bounds
+    dev = (max(b[0] - h[0], h[0] - law.min_surge), b[1] + abs(h[1]), b[2] + abs(h[2]))
+    return tuple(upper(arb(j) + arb(x)) for j, x in zip(plans, dev))
 
 
 def _loop_at(scenario: Scenario, law: BackupLaw, safe: SafeSet, dist: DisturbanceBounds,
@@ -196,11 +226,10 @@ def _consistent(loop: LoopBound, assumed: tuple[float, float, float]) -> Conditi
 def _plans_only(scenario: Scenario) -> LoopBound:
     """The loop bound for the plans' jumps alone (no backup), the first command within J of rest: the fixed
     point's start (a smaller start transient only lowers the bound, so a failure here is a failure with any law)."""
-    plans = plan_jumps(scenario)
-    return velocity_loop_bound(scenario.plant.params, v_max=tuple(float(x) for x in scenario.limits.vector),
-                               tick=1.0 / float(scenario.controller.ancillary_rate_hz),
-                               period=float(scenario.controller.dt), jump_tick=(0.0, 0.0, 0.0),
-                               jump_period=plans, first_command=plans)
+    inputs = _LoopInputs.of(scenario)
+    return velocity_loop_bound(inputs.params, v_max=inputs.v_max, tick=inputs.tick, period=inputs.period,
+                               jump_tick=(0.0, 0.0, 0.0), jump_period=inputs.plans, first_command=inputs.start,
+                               surge_floor=inputs.surge_floor)
 
 
 def _first_assumption(first: LoopBound) -> tuple[float, float, float] | None:

@@ -140,10 +140,11 @@ def velocity_box(u: float, v: float, w: float, r: float) -> tuple[arb, arb, arb,
     return tuple(enclose(-x, x) for x in (u, v, w, r))
 
 
-def thrust_floor(params: VehicleParams, u_abs_max: float) -> tuple[float, float, float]:
-    """Smallest (X, Z, N) limit over |u| <= ``u_abs_max`` and Θ: ``params.thrust_limit_floor`` or the limits."""
+def thrust_floor(params: VehicleParams, u_abs_max: float, u_abs_min: float = 0.0) -> tuple[float, float, float]:
+    """Smallest (X, Z, N) limit over ``u_abs_min`` <= |u| <= ``u_abs_max`` (m/s) and Θ:
+    ``params.thrust_limit_floor`` or the limits (a fin's force grows with u², so a surge floor gives it one)."""
     floor = getattr(params, "thrust_limit_floor", None)
-    limits = floor(u_abs_max) if callable(floor) else params.thrust_limits
+    limits = floor(u_abs_max, min(max(u_abs_min, 0.0), u_abs_max)) if callable(floor) else params.thrust_limits
     return tuple(float(x) for x in limits)
 
 

@@ -1,0 +1,37 @@
+"""benchmarks/remus_frontier.py: where REMUS 100's velocity loop closes under a minimum surge (docs/plant.md §4)."""
+
+from __future__ import annotations
+
+import pytest
+
+from tubekit.model.vehicles import vehicle_params
+
+from .scripts import load_script
+
+
+def _module():
+    return load_script("benchmarks/remus_frontier.py", "bench_remus_frontier")
+
+
+def test_the_box_is_shrunk_about_its_midpoint_and_points_stay_points():
+    mod = _module()
+    remus = vehicle_params("remus100")
+    lo, hi = remus.to_dict()["N_uudr"]
+    assert mod.shrunk(remus, 0.0).to_dict()["N_uudr"] == pytest.approx((lo + hi) / 2)
+    half = mod.shrunk(remus, 0.5).to_dict()["N_uudr"]
+    assert half == pytest.approx([lo + (hi - lo) / 4, hi - (hi - lo) / 4])
+    assert mod.shrunk(remus, 1.0).to_dict()["N_uudr"] == pytest.approx([lo, hi])
+    assert mod.shrunk(remus, 0.5).to_dict()["fin_max"] == remus.to_dict()["fin_max"]
+
+
+def test_the_midpoint_closes_at_a_crawl_and_diverges_in_yaw_at_survey_speed():
+    """At u_max 0.6 m/s (u_min 0.3) the midpoint vehicle's loop closes, and the fins' floor is positive but far
+    below what the loop commands; at 1.5 m/s the yaw channel's fixed point diverges (the sway coupling)."""
+    mod = _module()
+    params = mod.shrunk(vehicle_params("remus100"), 0.0)
+    slow = mod.cell(params, 0.6, 0.1, 0.02, (0.05, 0.01, 0.02))
+    assert slow.startswith("E = (") and "N need" in slow
+    need, floor = (float(x) for x in slow.split("N need ")[1].split(" vs "))
+    assert 0.0 < floor < need
+    assert mod.cell(params, 1.5, 0.1, 0.02, (0.05, 0.01, 0.02)).startswith("diverges (x")
+    assert "channel r" in mod.cell(params, 1.5, 0.1, 0.02, (0.05, 0.01, 0.02))

@@ -147,3 +147,24 @@ def test_a_vehicle_file_may_start_from_a_shipped_set(tmp_path):
 def test_your_own_vehicle_errors_name_the_field(plant, field):
     with pytest.raises(ConfigError, match=field):
         PlantSettings.from_dict({"kind": "dynamic", **plant})
+
+
+def test_thrusters_live_in_the_vehicle_table_and_replace_its_limits():
+    """[plant.vehicle.thrusters] is part of the vehicle table (``overrides``): PlantSettings takes it there (a table or
+    a ThrusterGeometry), exposes it as ``thrusters``, derives X_max/Z_max/N_max from it and writes back the table."""
+    from tubekit.model.thrusters import ThrusterGeometry
+    # one surge thruster of 30 N, a heave pair of 20 N each, a yaw pair at ±0.25 m of 8 N each: the channels are
+    # independent, so the box is the solo capacities 30 N, 40 N, 2 * 8 * 0.25 = 4 N m
+    table = {"allocation": [[1.0, 0.0, 0.0, 0.0, 0.0], [0.0, 1.0, 1.0, 0.0, 0.0], [0.0, 0.0, 0.0, 0.25, -0.25]],
+             "thrust": [30.0, 20.0, 20.0, 8.0, 8.0]}
+    a = PlantSettings("dynamic", "bluerov2_heavy", overrides={"thrusters": table, "m": 12.0})
+    b = PlantSettings("dynamic", "bluerov2_heavy", overrides={"m": 12.0, "thrusters": ThrusterGeometry.from_dict(table)})
+    assert a == b and hash(a) == hash(b) and a.thrusters == ThrusterGeometry.from_dict(table)
+    assert (a.params.X_max, a.params.Z_max, a.params.N_max) == pytest.approx((30.0, 40.0, 4.0), rel=2e-6)
+    assert a.params.X_max <= 30.0 and a.params.Z_max <= 40.0 and a.params.N_max <= 4.0 and a.params.m == 12.0
+    vehicle = a.to_dict()["vehicle"]
+    assert vehicle["thrusters"]["thrust"] == table["thrust"] and "X_max" not in vehicle
+    assert PlantSettings.from_dict(a.to_dict()) == a
+    assert PlantSettings("dynamic", "bluerov2_heavy").thrusters is None
+    assert PlantSettings("dynamic", "bluerov2_heavy").to_dict() == {"kind": "dynamic",
+                                                                   "vehicle": {"name": "bluerov2_heavy"}}

@@ -11,6 +11,7 @@ from tubekit.model.errors import bearing, error_coordinates, heading_cosine, num
 from tubekit.model.loiter import Loiter  # registers the loiter backup law (kind "loiter")
 from tubekit.model.kinematics import (InputLimits, SwayModel, dsinc, kinematics, nominal_kinematics, sinc,
                                       unicycle_step)
+from tubekit.model.thrusters import ThrusterGeometry
 from tubekit.model.trajectory import Circle, Helix, Line, Trajectory, Waypoints, trajectory_from_dict
 from tubekit.model.vehicles import VEHICLES, PlantSettings, VehicleParams, vehicle_params
 
@@ -19,5 +20,5 @@ __all__ = [
     "error_coordinates", "bearing", "heading_cosine", "numeric",
     "AncillaryLaw", "LAWS", "get_law", "register_law", "jacobian_at",
     "Trajectory", "Circle", "Helix", "Line", "Waypoints", "trajectory_from_dict",
-    "VehicleParams", "VEHICLES", "PlantSettings", "vehicle_params", "Loiter",
+    "VehicleParams", "VEHICLES", "PlantSettings", "vehicle_params", "Loiter", "ThrusterGeometry",
 ]

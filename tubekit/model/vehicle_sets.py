@@ -59,7 +59,8 @@ BLUEROV2_HEAVY = VehicleParams(
     X_uu=(-141.0, -34.96), Y_vv=(-217.0, -103.25), Y_rr=0.0, Z_ww=(-190.0, -74.23), N_vv=0.0,
     N_rr=(-1.5, -0.43),
     Y_uv=0.0, Y_ur_lift=0.0, Z_uw=0.0, N_uv_lift=0.0, N_ur_lift=0.0,  # a box frame: no lift identified
-    X_max=round(_X, 2), Z_max=round(_Z, 2), N_max=round(_N, 3),
+    # rounded down: a limit the certificate reads must be producible (round(4T, 2) = 160.83 > 4T = 160.829 N)
+    X_max=math.floor(_X * 100) / 100, Z_max=math.floor(_Z * 100) / 100, N_max=math.floor(_N * 1000) / 1000,
     Z_uuds=0.0, N_uudr=0.0, fin_max=0.0,
     thruster_time_constant=0.05,                                   # s, assumption (T200 ESC + motor)
     loop_bandwidth=10.0,                                           # rad/s, ω_b T_thr = 0.5 as REMUS

@@ -6,22 +6,25 @@ numeric field a number or an interval [lo, hi]; :data:`VEHICLES`
 propeller, stern planes and rudder) and ``bluerov2_heavy`` (BlueROV2 Heavy: eight T200
 thrusters). Every value, its unit and its sources are listed in ``docs/plant.md``.
 :class:`PlantSettings` is the scenario's ``[plant]`` table (see :mod:`tubekit.scenario`),
-with ``[plant.truth]``: the coefficients of the plant as simulated, a point of the box.
+with ``[plant.truth]``: the coefficients of the plant as simulated, a point of the box, and
+``[plant.vehicle.thrusters]``: a thruster geometry (:mod:`tubekit.model.thrusters`) from which
+X_max, Z_max, N_max are derived instead of given.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass, fields
+from dataclasses import dataclass, field, fields
 from pathlib import Path
 from typing import Any, Mapping
 
 from tubekit.exceptions import ConfigError
+from tubekit.model.thrusters import LIMIT_KEYS, ThrusterGeometry
 from tubekit.model.vehicle_params import ACTUATIONS, VehicleParams
 from tubekit.model.vehicle_sets import BLUEROV2_HEAVY, REMUS100, VEHICLES
 from tubekit.validation import read_toml
 
 __all__ = ["VehicleParams", "VEHICLES", "PlantSettings", "PLANT_KINDS", "vehicle_params", "read_vehicle_file",
-           "CUSTOM", "REMUS100", "BLUEROV2_HEAVY", "ACTUATIONS"]
+           "CUSTOM", "REMUS100", "BLUEROV2_HEAVY", "ACTUATIONS", "ThrusterGeometry"]
 
 PLANT_KINDS = ("kinematic", "dynamic")
 
@@ -60,32 +63,51 @@ class PlantSettings:
     vehicle : str
         Name of the shipped parameter set (:data:`VEHICLES`).
     overrides : mapping or pairs
-        Inline ``[plant.vehicle]`` parameters replacing the shipped ones.
+        Inline ``[plant.vehicle]`` parameters replacing the shipped ones; with ``thrusters`` (a
+        table or a :class:`ThrusterGeometry`): the ``[plant.vehicle.thrusters]`` table.
     truth : mapping or pairs
         ``[plant.truth]``: the value of interval coefficients in the plant as simulated (each
         inside its interval; the others take the midpoint). Default: the nominal vehicle.
+
+    Attributes
+    ----------
+    thrusters : ThrusterGeometry or None
+        ``[plant.vehicle.thrusters]`` (from ``overrides``, where it stays: it is part of the
+        vehicle table, so ``dataclasses.replace`` keeps it): the thruster geometry whose derived
+        box gives X_max, Z_max, N_max (N, N, N m) of :attr:`params`; not with any of them in
+        ``overrides``, not on a finned vehicle. :meth:`to_dict` writes the table, never the
+        derived limits.
     """
 
     kind: str = "kinematic"
     vehicle: str = "remus100"
-    overrides: tuple[tuple[str, float], ...] = ()
+    overrides: tuple[tuple[str, Any], ...] = ()
     truth: tuple[tuple[str, float], ...] = ()
+    thrusters: ThrusterGeometry | None = field(default=None, init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
         if self.kind not in PLANT_KINDS:
             raise ConfigError("plant.kind", f"one of {PLANT_KINDS}", self.kind)
         over = _pairs("plant.vehicle", self.overrides)
-        params = vehicle_params(self.vehicle, over)  # validates the vehicle now, naming the field
-        # stored as validated: numbers, (lo, hi) tuples (hashable; [lo, lo] becomes lo), the actuation
-        object.__setattr__(self, "overrides", tuple(sorted((k, getattr(params, k)) for k in over)))
+        thrusters = over.pop("thrusters", None)
+        if thrusters is not None:
+            _refuse_thrusters(self.vehicle, over, thrusters)  # before any linear program
+            if not isinstance(thrusters, ThrusterGeometry):
+                thrusters = ThrusterGeometry.from_dict(thrusters)
+        object.__setattr__(self, "thrusters", thrusters)
+        params = vehicle_params(self.vehicle, _with_thrusters(self.vehicle, over, thrusters))  # names the field
+        # stored as validated: numbers, (lo, hi) tuples (hashable; [lo, lo] becomes lo), the actuation, the thrusters
+        stored = [(k, getattr(params, k)) for k in over] + ([("thrusters", thrusters)] if thrusters is not None else [])
+        object.__setattr__(self, "overrides", tuple(sorted(stored, key=lambda kv: kv[0])))
         truth = _pairs("plant.truth", self.truth)
         params.with_point(truth)  # every truth value names an interval field and lies inside it
         object.__setattr__(self, "truth", tuple(sorted((k, float(v)) for k, v in truth.items())))
 
     @property
     def params(self) -> VehicleParams:
-        """The vehicle's parameters (shipped set + overrides): a point or a box of coefficients."""
-        return vehicle_params(self.vehicle, dict(self.overrides))
+        """The vehicle's parameters (shipped set + overrides, + the thrusters' derived limits): a point or a box."""
+        over = {k: v for k, v in self.overrides if k != "thrusters"}
+        return vehicle_params(self.vehicle, _with_thrusters(self.vehicle, over, self.thrusters))
 
     @property
     def truth_params(self) -> VehicleParams:
@@ -98,16 +120,18 @@ class PlantSettings:
         return self.kind == "dynamic"
 
     def to_dict(self) -> dict[str, Any]:
-        """The ``[plant]`` table (vehicle overrides under ``vehicle``, with ``name``)."""
-        over = {k: (list(v) if isinstance(v, tuple) else v) for k, v in self.overrides}
+        """The ``[plant]`` table (vehicle overrides under ``vehicle``, with ``name``; ``thrusters`` inside it)."""
+        over = {k: (list(v) if isinstance(v, tuple) else v) for k, v in self.overrides if k != "thrusters"}
         out: dict[str, Any] = {"kind": self.kind, "vehicle": {"name": self.vehicle, **over}}
+        if self.thrusters is not None:
+            out["vehicle"]["thrusters"] = self.thrusters.to_dict()
         if self.truth:
             out["truth"] = dict(self.truth)
         return out
 
     @classmethod
     def from_dict(cls, d: Any) -> PlantSettings:
-        """Parse ``[plant]``: ``vehicle`` is a name, or a table with optional ``name`` plus overrides."""
+        """Parse ``[plant]``: ``vehicle`` is a name, or a table with optional ``name``, ``thrusters`` plus overrides."""
         if not isinstance(d, dict):
             raise ConfigError("plant", "a table", d)
         if "tracking_bound" in d:
@@ -143,7 +167,8 @@ class PlantSettings:
 
 def read_vehicle_file(path: Any) -> dict[str, Any]:
     """The ``[plant.vehicle]`` table a vehicle file holds (``[plant] vehicle_file``): a TOML file of parameters,
-    with ``name`` a shipped set to start from, or without it (or ``name = "custom"``) every parameter.
+    with ``name`` a shipped set to start from, or without it (or ``name = "custom"``) every parameter; its table
+    ``[thrusters]`` is the vehicle's ``[plant.vehicle.thrusters]`` (X_max, Z_max, N_max then derived, not given).
 
     Raises
     ------
@@ -154,6 +179,38 @@ def read_vehicle_file(path: Any) -> dict[str, Any]:
         raise ConfigError("plant.vehicle_file", "the path of a TOML file of vehicle parameters", path)
     table = read_toml(path, "plant.vehicle_file")
     return {"name": CUSTOM, **table}
+
+
+def _refuse_thrusters(name: str, overrides: Mapping[str, Any], table: Any) -> None:
+    """ConfigError naming ``plant.vehicle.thrusters`` when a thruster table (``table``) is given with
+    X_max/Z_max/N_max (one source of limits) or on a finned vehicle (its Z and N come from the fins)."""
+    received = table.to_dict() if isinstance(table, ThrusterGeometry) else table
+    given = [k for k in LIMIT_KEYS if k in overrides]
+    if given:
+        raise ConfigError("plant.vehicle.thrusters", "absent when X_max/Z_max/N_max are given (one source of "
+                          f"limits; {', '.join(given)} given)", received)
+    actuation = overrides.get("actuation", VEHICLES[name].actuation if name in VEHICLES else None)
+    if actuation == "fins":
+        raise ConfigError("plant.vehicle.thrusters", "absent on a finned vehicle (actuation 'fins': its heave force "
+                          "and yaw moment come from the fins; set actuation = 'thrusters')", received)
+
+
+def _with_thrusters(name: str, overrides: dict[str, Any], thrusters: ThrusterGeometry | None) -> dict[str, Any]:
+    """``overrides`` plus X_max, Z_max, N_max derived from ``thrusters`` (unchanged without them).
+
+    Raises
+    ------
+    ConfigError
+        ``plant.vehicle.thrusters.shares`` when a vehicle with actuation "thrusters" gets a limit 0.
+    """
+    if thrusters is None:
+        return overrides
+    actuation = overrides.get("actuation", VEHICLES[name].actuation if name in VEHICLES else None)
+    limits = thrusters.limits()
+    if actuation == "thrusters" and not all(x > 0.0 for x in limits):
+        raise ConfigError("plant.vehicle.thrusters.shares", "3 numbers > 0 (a vehicle with actuation 'thrusters' "
+                          "needs every limit X_max, Z_max, N_max > 0)", list(thrusters.shares))
+    return {**overrides, **dict(zip(LIMIT_KEYS, limits))}
 
 
 def _pairs(field: str, value: Any) -> dict[str, Any]:

@@ -8,8 +8,13 @@ loop's bound is evaluated for the plans' jumps alone (``verify.vehicle.bound.vel
 does not close here cannot certify with any backup. Each cell prints E (m/s, m/s, rad/s) and the fins' need
 against their floor, or why the fixed point diverged (its first-round growth and channel). Nothing is timed.
 
-Usage: ``python benchmarks/remus_frontier.py [--u-max 0.6 1.0 ...] [--spread 0 0.05 1] [--r-max R] [--w-max W]``
-(well under a second per cell).
+``--simulate`` adds what the vehicle does (no bound): the plant as simulated
+(:class:`tubekit.plant.dynamic.DynamicPlant`) at the box's midpoint and at three random points of each box, no
+current, the surge command held at ū and a yaw command sweeping ±``--r-max`` at the yaw rate limit for 60 s; the
+largest loop errors |u_c − u|, |r_c − r| and sway |v| are printed.
+
+Usage: ``python benchmarks/remus_frontier.py [--u-max 0.6 1.0 ...] [--spread 0 0.05 1] [--r-max R] [--w-max W]
+[--simulate]`` (well under a second per cell; about 20 s per simulated cell).
 """
 
 from __future__ import annotations
@@ -18,8 +23,12 @@ import argparse
 import math
 import re
 
+import numpy as np
+
 from tubekit.model.vehicles import vehicle_params
 from tubekit.model.vehicle_params import VehicleParams
+from tubekit.plant.dynamic import DynamicPlant
+from tubekit.scenario import scenario_from_dict
 from verify.vehicle.bound import velocity_loop_bound
 
 U_MAX = (0.6, 0.8, 1.0, 1.5, 2.0)
@@ -55,6 +64,45 @@ def cell(params: VehicleParams, u_max: float, r_max: float, w_max: float, rate: 
     return f"E = ({bound.error[0]:.3f}, {bound.error[1]:.3f}, {bound.error[2]:.3f}); {fins}"
 
 
+def simulated(params: VehicleParams, u_max: float, r_max: float, yaw_rate: float, seed: int | None,
+              seconds: float = 60.0) -> tuple[float, float, float]:
+    """(max |u_c − u|, max |r_c − r|, max |v|) (m/s, rad/s, m/s) of the plant at ``params``' midpoint (``seed``
+    None) or a random point of its box, surge command ``u_max``, yaw command sweeping ±``r_max`` at ``yaw_rate``
+    (rad/s²), reversing every 15 s, no current (module doc)."""
+    scenario = scenario_from_dict({"plant": {"kind": "dynamic", "vehicle": {
+        k: v for k, v in params.to_dict().items() if k != "name"}},
+        "disturbance": {"amplitude": [0.0, 0.0, 0.0], "sway": {"gain": 0.0, "bound": 0.0}}})
+    box = scenario.plant.params
+    truth = box.nominal if seed is None else box.sample(np.random.default_rng(seed))
+    plant = DynamicPlant(scenario, params=truth)
+    pose, command, t, goal, worst = (0.0, 0.0, 0.0, 0.0), [u_max, 0.0, 0.0], 0.0, r_max, [0.0, 0.0, 0.0]
+    for k in range(int(round(seconds / PERIOD))):
+        if k % 150 == 0:
+            goal = -goal
+        command[2] += max(-yaw_rate * PERIOD, min(yaw_rate * PERIOD, goal - command[2]))
+        for _ in range(int(round(PERIOD / TICK))):
+            pose = plant.step_tuple(t, pose, tuple(command), TICK, 1)
+            t += TICK
+            nu = plant.state
+            worst = [max(worst[0], abs(command[0] - nu[0])), max(worst[1], abs(command[2] - nu[3])),
+                     max(worst[2], abs(nu[1]))]
+    return worst[0], worst[1], worst[2]
+
+
+def simulated_rows(u_values, spreads, r_max: float, yaw_rate: float) -> list[str]:
+    """``--simulate``'s rows: the largest errors over the midpoint and three random points of each box."""
+    base = vehicle_params("remus100")
+    rows = [f"simulated: yaw command ±{r_max:g} rad/s at {yaw_rate:g} rad/s², 60 s, no current"]
+    for f in spreads:
+        params = shrunk(base, f)
+        for u in u_values:
+            runs = [simulated(params, u, r_max, yaw_rate, seed) for seed in ([None] if f == 0 else [None, 0, 1, 2])]
+            worst = [max(r[i] for r in runs) for i in range(3)]
+            rows.append(f"{f:>14g} | u_max {u:4.2f} | |u_c - u| <= {worst[0]:.4f} m/s, |r_c - r| <= {worst[1]:.4f} "
+                        f"rad/s, |v| <= {worst[2]:.4f} m/s")
+    return rows
+
+
 def table(u_values, spreads, r_max: float, w_max: float, rate) -> list[str]:
     """The rows (module doc), one per (box, ū)."""
     base = vehicle_params("remus100")
@@ -75,10 +123,13 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--r-max", type=float, default=0.1)
     parser.add_argument("--w-max", type=float, default=0.02)
     parser.add_argument("--rate", type=float, nargs=3, default=[0.05, 0.01, 0.02])
+    parser.add_argument("--simulate", action="store_true", help="add the simulated plant's errors (no bound)")
     args = parser.parse_args(argv)
     if not all(math.isfinite(x) and x > 0 for x in [*args.u_max, args.r_max, args.w_max, *args.rate]):
         parser.error("speeds and rates must be finite and > 0")
     print("\n".join(table(args.u_max, args.spread, args.r_max, args.w_max, tuple(args.rate))))
+    if args.simulate:
+        print("\n".join(simulated_rows(args.u_max, args.spread, args.r_max, args.rate[2])))
     return 0
 
 

@@ -35,3 +35,13 @@ def test_the_midpoint_closes_at_a_crawl_and_diverges_in_yaw_at_survey_speed():
     assert 0.0 < floor < need
     assert mod.cell(params, 1.5, 0.1, 0.02, (0.05, 0.01, 0.02)).startswith("diverges (x")
     assert "channel r" in mod.cell(params, 1.5, 0.1, 0.02, (0.05, 0.01, 0.02))
+
+
+def test_the_simulated_midpoint_follows_a_yaw_sweep_at_survey_speed_within_a_hundredth():
+    """What the vehicle does (no bound): the midpoint REMUS 100 at 1.5 m/s follows a yaw command rising at
+    0.02 rad/s^2 with a lag error of about T_lag x rate (0.1 s x 0.02 = 0.002 rad/s) plus the loop's own, and
+    the hull sways a few cm/s: far inside what the bound cannot close."""
+    mod = _module()
+    params = mod.shrunk(vehicle_params("remus100"), 0.0)
+    du, dr, sway = mod.simulated(params, 1.5, 0.1, 0.02, None, seconds=6.0)
+    assert 0.0 <= du < 0.01 and 0.001 < dr < 0.01 and 0.0 < sway < 0.1

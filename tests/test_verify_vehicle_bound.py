@@ -243,3 +243,24 @@ def test_a_surge_floor_gives_the_fins_their_force_over_the_band_the_loop_keeps()
     assert floored.authority[2] > free.authority[2]
     with pytest.raises(ConfigError, match="surge_floor"):
         velocity_loop_bound(remus, **kw, surge_floor=-0.1)
+
+
+def test_under_a_surge_floor_each_surge_band_is_held_against_its_own_fin_force(monkeypatch):
+    """The fins' condition is taken band by band over the relative surge [u_min - E_u, u_max + E_u]: more bands
+    never raise the worst need/limit ratio (each band's need is over a sub-box, its limit at its own slow end),
+    and one band is the whole surge range against the slowest force."""
+    import verify.vehicle.bound as bound_module
+    from verify.vehicle.model import nominal_params
+    remus = nominal_params(REMUS100)
+    kw = dict(v_max=(0.6, 0.02, 0.1), tick=H, period=0.1, jump_tick=(0.0, 0.0, 0.0),
+              jump_period=(0.005, 0.001, 0.002), surge_floor=0.3)
+
+    def ratios() -> list[float]:
+        by_name = {c.condition: c for c in velocity_loop_bound(remus, **kw).conditions}
+        return [by_name[f"loop_saturation[{ch}]"].lhs / by_name[f"loop_saturation[{ch}]"].rhs for ch in "ZN"]
+
+    banded = ratios()
+    monkeypatch.setattr(bound_module, "SURGE_BANDS", 1)
+    whole = ratios()
+    assert all(0.0 < b <= w * (1 + 1e-12) for b, w in zip(banded, whole))
+    assert banded[1] < 0.8 * whole[1]          # the yaw moment's need shrinks with the band's width

@@ -40,12 +40,13 @@ import math
 from dataclasses import dataclass
 from typing import Any, Sequence
 
+import numpy as np
 from flint import arb, ctx
 
 from tubekit.exceptions import ConfigError
 from tubekit.validation import finite, nonnegative, positive
 from verify.theorem.design import Condition, hull_sway_bound
-from verify.kernel.intervals import lower, upper
+from verify.kernel.intervals import enclose, lower, upper
 from verify.vehicle.result import LoopBound
 from verify.vehicle.model import (arb_body_forces, channel_forces, channel_gradient, channel_masses, channel_mismatch,
                                channel_mismatch_gradient, hull_balls, nominal_balls, nominal_params,
@@ -53,7 +54,8 @@ from verify.vehicle.model import (arb_body_forces, channel_forces, channel_gradi
 from verify.vehicle.response import RESPONSE_PREC, ResponseSums, impulse_sums
 
 __all__ = ["LoopBound", "velocity_loop_bound", "actuator_authority", "loop_matrix", "computed_bounds",
-           "input_bounds", "start_bounds", "Inputs", "rate_authority_conditions", "LOOP_MAX_ITERATIONS", "LOOP_INFLATION"]
+           "input_bounds", "start_bounds", "Inputs", "rate_authority_conditions", "LOOP_MAX_ITERATIONS", "LOOP_INFLATION",
+           "SURGE_BANDS"]
 
 #: Default bound on the fixed-point iterations (a count, not seconds).
 LOOP_MAX_ITERATIONS = 60
@@ -225,9 +227,12 @@ def computed_bounds(loop: _Loop, jump_tick: Sequence[float], jump_period: Sequen
 
 
 def _thrust_peaks(loop: _Loop, box: tuple[float, float, float], gamma: float,
-                  a_bound: Sequence[float]) -> list[float]:
-    """sup|τ_cmd_c| = sup|n̂_c| + m̂_c sup|a| over the velocity box (N, N, N m)."""
+                  a_bound: Sequence[float], surge: tuple[float, float] | None = None) -> list[float]:
+    """sup|τ_cmd_c| = sup|n̂_c| + m̂_c sup|a| over the velocity box (N, N, N m); ``surge`` (lo, hi) (m/s): the
+    surge over that band instead of |u| <= box[0]."""
     nu = velocity_box(box[0], gamma, box[1], box[2])
+    if surge is not None:
+        nu = (enclose(surge[0], surge[1]), *nu[1:])
     forces = channel_forces(loop.nominal, nu)
     return [upper(abs(forces[c]) + loop.m_hat[c] * arb(a_bound[c])) for c in range(3)]
 
@@ -375,10 +380,13 @@ def _saturation(loop: _Loop, params: VehicleParams, v: Sequence[float], assumed:
     u_low = max(0.0, lower(arb(surge_floor) - arb(assumed[0][0]))) if finite_box else 0.0
     floor = thrust_floor(params, u_bar, u_low)
     peaks = _thrust_peaks(loop, box, sway, a_assumed) if finite_box else [math.inf] * 3
+    if finite_box and 0.0 < u_low < u_bar:
+        peaks, floor = _banded(loop, params, box, sway, a_assumed, (u_low, u_bar))
     conds = []
     for c, ch in enumerate(_FORCES):
         why = (f"sup|n_hat_{_CHANNELS[c]}| + m_hat sup|a| over {u_low:.4g} <= |u| <= {u_bar:.4g} m/s against "
-               f"{floor[c]:.4g}"
+               f"{floor[c]:.4g}" + (f" (the worst of {SURGE_BANDS} surge bands, each against its own limit)"
+                                    if 0.0 < u_low < u_bar else "")
                if floor[c] > 0 else
                f"{_ACTUATOR[ch]} is 0 at u = 0, inside the velocity box |u| <= {u_bar:.4g} m/s: a fin's lift grows "
                "with u², so this vehicle cannot produce it at rest (a minimum surge, limits.u_min, above the loop's "
@@ -390,6 +398,28 @@ def _saturation(loop: _Loop, params: VehicleParams, v: Sequence[float], assumed:
         conds.append(Condition(f"loop_saturation[{ch}]", f"sup|tau_cmd_{ch}| < smallest {ch} limit over the box",
                                peak, floor[c], bool(peak is not None and peak < floor[c]), why))
     return conds
+
+
+#: Surge bands of the fins' condition under a minimum surge (:func:`_banded`).
+SURGE_BANDS = 8
+
+
+def _banded(loop: _Loop, params: VehicleParams, box: tuple[float, float, float], sway: float,
+            a_assumed: Sequence[float], surge: tuple[float, float]) -> tuple[list[float], list[float]]:
+    """(need, limit) per channel of the band where need/limit is largest: the relative surge [lo, hi] (m/s) cut into
+    :data:`SURGE_BANDS` bands, in each the need sup|n̂_c| + m̂_c Â_c over the band against the smallest limit over
+    it (a fin's, ∝ u², at the band's slow end): the need and the force both grow with the surge, so a band is
+    compared with its own force, not with the slowest band's (the condition holds iff it holds in every band)."""
+    edges = np.linspace(surge[0], surge[1], SURGE_BANDS + 1)
+    worst: list[tuple[float, float, float]] = [(-math.inf, math.inf, math.inf)] * 3
+    for a, b in zip(edges[:-1], edges[1:]):
+        need = _thrust_peaks(loop, box, sway, a_assumed, surge=(float(a), float(b)))
+        limit = thrust_floor(params, float(b), float(a))
+        for c in range(3):
+            ratio = need[c] / limit[c] if limit[c] > 0 else math.inf
+            if ratio > worst[c][0]:
+                worst[c] = (ratio, need[c], limit[c])
+    return [w[1] for w in worst], [w[2] for w in worst]
 
 
 def _result(loop: _Loop, params: VehicleParams, given: tuple, assumed: list, computed: list, inputs: Inputs | None,

@@ -46,7 +46,8 @@ import scipy.sparse as sp
 
 from tubekit.exceptions import ConfigError
 from tubekit.fhocp.fastpath import CompiledConeProgram
-from tubekit.fhocp.nlp import FhocpNlp, eo_linearisation, rollout, step_linearisation
+from tubekit.fhocp.linearisation import eo_linearisation, step_linearisation
+from tubekit.fhocp.nlp import FhocpNlp, rollout
 from tubekit.fhocp.qp.base import ConeSolution, QpBackend
 from tubekit.fhocp.qp.registry import DEFAULT_QP_BACKEND, make_qp_backend
 from tubekit.fhocp.result import Status, status_from

@@ -73,18 +73,16 @@ import numpy as np
 from tubekit.exceptions import ConfigError, ShapeError
 from tubekit.fhocp.rows import RATE_MARGIN, BackupTerminal, rate_penalty_cost, rate_violation
 from tubekit.model.errors import error_coordinates
-from tubekit.fhocp.linearisation import ED_FLOOR, STEP_LINEARISATION_ROWS, eo_linearisation, step_linearisation
+from tubekit.fhocp.linearisation import ED_FLOOR
 from tubekit.model.kinematics import sinc, unicycle_step
 from tubekit.scenario import Obstacle, Scenario, TerminalMode
 from tubekit.tightening import Tightening
 from tubekit.validation import as_vector, choice, positive
 
-__all__ = ["TERMINAL_MODES", "discrete_step", "rollout",
-           "step_linearisation", "STEP_LINEARISATION_ROWS", "eo_linearisation", "obstacle_array",
-           "select_obstacles", "FhocpNlp", "NlpEvaluation", "BackupTerminal"]
+__all__ = ["TERMINAL_MODES", "discrete_step", "rollout", "obstacle_array", "select_obstacles", "FhocpNlp",
+           "NlpEvaluation", "BackupTerminal"]
 
 TERMINAL_MODES: tuple[str, ...] = TerminalMode.values()
-_ED_FLOOR = ED_FLOOR  # guards e_o = (...)/e_d against e_d = 0 (m)
 
 
 #: Exact zero-order-hold step F(s, v, dt) of the nominal kinematics (the model's own exact arc).
@@ -372,7 +370,7 @@ class FhocpNlp:
 
     def errors(self, states: np.ndarray, ref: np.ndarray) -> np.ndarray:
         """[e_d, e_z, e_o] (K, 3) of ``states`` (K, 4) w.r.t. ``ref`` (K, 3), e_d floored at 1e-9."""
-        return error_coordinates(states, ref, _ED_FLOOR)
+        return error_coordinates(states, ref, ED_FLOOR)
 
     def cost(self, states: np.ndarray, inputs: np.ndarray, ref: np.ndarray, v_last: np.ndarray | None = None) -> float:
         """Stage + terminal cost + the rate penalty (no exact penalties)."""
@@ -398,7 +396,7 @@ class FhocpNlp:
         states = np.asarray(states, dtype=float)
         inputs = np.asarray(inputs, dtype=float)
         n = self.n
-        e = error_coordinates(states, ref, _ED_FLOOR)
+        e = error_coordinates(states, ref, ED_FLOOR)
         e2 = e * e
         cost = float(np.einsum("kc,ck->", e2, self._w) + np.einsum("kc,kc,c->", inputs, inputs, self._dt_r))
         if self.rate_penalty:

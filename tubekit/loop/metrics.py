@@ -299,13 +299,6 @@ def _circle_figures(pos: np.ndarray, des: np.ndarray, scenario: Scenario) -> tup
             obstacle_passes(pos, center, traj.rate, scenario.obstacles))
 
 
-def _above_floor(inputs: np.ndarray, scenario: Scenario, tol: float) -> bool:
-    """True when every applied surge (column 0 of ``inputs``, m/s) is at least ``limits.u_min`` − ``tol`` (always
-    true for the symmetric box, which the ratio to V covers)."""
-    floor = scenario.limits.u_min
-    return floor is None or bool(np.all(inputs[:, 0] >= floor - tol))
-
-
 def compute_metrics(columns: Mapping[str, np.ndarray], scenario: Scenario, *,
                     rho_bound: float | None = None, sway_bound: float | None = None,
                     extra: Mapping[str, Any] | None = None) -> dict[str, Any]:
@@ -354,7 +347,8 @@ def compute_metrics(columns: Mapping[str, np.ndarray], scenario: Scenario, *,
         "e_d_below_epsilon": intervals_below(t, e_d, scenario.epsilon),
         "max_input_ratio": float(np.max(ratio)) if ratio.size else None,
         "input_limits": [float(x) for x in lim],
-        "inputs_within_limits": bool(np.all(ratio <= 1.0 + 1e-9) and _above_floor(inputs[applied], scenario, 1e-9)),
+        "inputs_within_limits": bool(np.all(ratio <= 1.0 + 1e-9) and np.all(inputs[applied] >= scenario.limits.lower
+                                                                               - 1e-9)),
         "saturated_steps": int(np.unique(c["step"][sat]).size),
         "saturated_ticks": int(np.sum(sat)),
         "fallback_steps": int(np.sum((c["fallback"] > 0.5) & first)),

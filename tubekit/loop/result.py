@@ -216,12 +216,10 @@ class SimulationResult(LogArrays):
     def checks(self) -> dict[str, bool]:
         """Self-checks of the run: finiteness and input admissibility of what reached the plant."""
         applied = self.inputs[:-1]
-        limits = self.scenario.limits
         return {
             "inputs_finite": bool(np.all(np.isfinite(applied))),
             "states_finite": bool(np.all(np.isfinite(self.states))),
-            "inputs_within_limits": bool(np.all(np.abs(applied) <= limits.vector + 1e-12)
-                                         and (limits.u_min is None or np.all(applied[:, 0] >= limits.u_min - 1e-12))),
+            "inputs_within_limits": self.scenario.limits.contains(applied, tol=1e-12),
         }
 
     @property

@@ -154,9 +154,7 @@ def box_excess(inputs: np.ndarray, tight: Tightening) -> float:
     """The largest amount (m/s or rad/s; <= 0: inside) by which a row of ``inputs`` (n, 3) leaves V̄ =
     [``tight.v_low``, ``tight.v_max``], above the upper corner or below the lower one (a surge floor)."""
     high = np.asarray(tight.v_max, dtype=float)[None, :]
-    if tight.v_min is None:  # the symmetric box: |v̂| <= v_max
-        return float(np.max(np.abs(inputs) - high))
-    return float(np.max(np.maximum(inputs - high, tight.v_low[None, :] - inputs)))
+    return float(np.max(np.maximum(inputs - high, tight.v_low[None, :] - inputs)))  # |v̂| - v_max when symmetric
 
 
 def _error_slacks(tight: Tightening, e: np.ndarray, cos_rel: np.ndarray, margins: np.ndarray,

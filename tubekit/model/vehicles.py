@@ -181,6 +181,11 @@ def read_vehicle_file(path: Any) -> dict[str, Any]:
     return {"name": CUSTOM, **table}
 
 
+def _actuation(name: str, overrides: Mapping[str, Any]) -> str | None:
+    """The vehicle's actuation: the override, else the shipped set's (None for a custom vehicle without one)."""
+    return overrides.get("actuation", VEHICLES[name].actuation if name in VEHICLES else None)
+
+
 def _refuse_thrusters(name: str, overrides: Mapping[str, Any], table: Any) -> None:
     """ConfigError naming ``plant.vehicle.thrusters`` when a thruster table (``table``) is given with
     X_max/Z_max/N_max (one source of limits) or on a finned vehicle (its Z and N come from the fins)."""
@@ -189,7 +194,7 @@ def _refuse_thrusters(name: str, overrides: Mapping[str, Any], table: Any) -> No
     if given:
         raise ConfigError("plant.vehicle.thrusters", "absent when X_max/Z_max/N_max are given (one source of "
                           f"limits; {', '.join(given)} given)", received)
-    actuation = overrides.get("actuation", VEHICLES[name].actuation if name in VEHICLES else None)
+    actuation = _actuation(name, overrides)
     if actuation == "fins":
         raise ConfigError("plant.vehicle.thrusters", "absent on a finned vehicle (actuation 'fins': its heave force "
                           "and yaw moment come from the fins; set actuation = 'thrusters')", received)
@@ -205,7 +210,7 @@ def _with_thrusters(name: str, overrides: dict[str, Any], thrusters: ThrusterGeo
     """
     if thrusters is None:
         return overrides
-    actuation = overrides.get("actuation", VEHICLES[name].actuation if name in VEHICLES else None)
+    actuation = _actuation(name, overrides)
     limits = thrusters.limits()
     if actuation == "thrusters" and not all(x > 0.0 for x in limits):
         raise ConfigError("plant.vehicle.thrusters.shares", "3 numbers > 0 (a vehicle with actuation 'thrusters' "

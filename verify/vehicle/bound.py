@@ -378,10 +378,11 @@ def _saturation(loop: _Loop, params: VehicleParams, v: Sequence[float], assumed:
     finite_box = all(math.isfinite(x) for x in (*box, sway, *a_assumed))
     u_bar = box[0] if finite_box else v[0]
     u_low = max(0.0, lower(arb(surge_floor) - arb(assumed[0][0]))) if finite_box else 0.0
-    floor = thrust_floor(params, u_bar, u_low)
-    peaks = _thrust_peaks(loop, box, sway, a_assumed) if finite_box else [math.inf] * 3
     if finite_box and 0.0 < u_low < u_bar:
         peaks, floor = _banded(loop, params, box, sway, a_assumed, (u_low, u_bar))
+    else:
+        floor = thrust_floor(params, u_bar, u_low)
+        peaks = _thrust_peaks(loop, box, sway, a_assumed) if finite_box else [math.inf] * 3
     conds = []
     for c, ch in enumerate(_FORCES):
         why = (f"sup|n_hat_{_CHANNELS[c]}| + m_hat sup|a| over {u_low:.4g} <= |u| <= {u_bar:.4g} m/s against "

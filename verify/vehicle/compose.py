@@ -195,8 +195,7 @@ class _LoopInputs:
 
 def surge_floor_of(scenario: Scenario) -> float:
     """u_min (m/s) of ``limits.u_min``, 0 without a minimum surge (the loop bound's ``surge_floor``)."""
-    floor = scenario.limits.u_min
-    return 0.0 if floor is None else float(floor)
+    return max(0.0, scenario.limits.surge_floor)
 
 
 def handover_jump(law: BackupLaw, plans: tuple[float, float, float]) -> tuple[float, float, float]:

@@ -114,11 +114,12 @@ def first_round(sc) -> None:
     plans = velocity_loop_bound(sc.plant.params, v_max=v_max, tick=0.01, period=0.1, jump_tick=(0.0, 0.0, 0.0),
                                 jump_period=compose.plan_jumps(sc))
     assumed = tuple(compose._INFLATE * e for e in plans.error)
+    sway = compose._first_sway(sc, plans)         # the sway loop's first assumption (None: the free hull's sway)
     region = Region.from_scenario(sc)
     gains = gain_bounds(sc.controller.law, region)
-    dist, _, _, _, backup = compose._tiers_at(sc, region, gains, (0.0,), assumed)
+    dist, _, _, _, backup = compose._tiers_at(sc, region, gains, (0.0,), assumed, sway)
     loop = compose._loop_at(sc, backup.law, backup.safe_set, dist, assumed)
-    ratio = max(e / a for e, a in zip(loop.error, assumed))
+    ratio = compose._loop_ratio(loop, assumed, sway)
     law = backup.law
     print(f"{sc.name}: round 1 assumes E = {[round(a, 4) for a in assumed]} -> omega_xy {dist.omega_xy:.4f} "
           f"(gamma {dist.gamma:.4f}); backup u_b {law.surge:.3g} k {law.yaw_rate:.3g} band {law.yaw_band:.3g} "

@@ -49,6 +49,7 @@ bound is strictly below its assumption).
 
 from __future__ import annotations
 
+import dataclasses
 import functools
 import math
 import sys
@@ -440,9 +441,11 @@ def study_bound(params: VehicleParams, v_max: Sequence[float], jump_tick: Sequen
 
 
 def _boxes():
-    """(label, vehicle): von Benzon's point, ±5 %, ±10 %, ±20 %, the published box (benchmarks/dynamic_gap.py)."""
-    yield from ((f"von Benzon ±{round(f * 100)} %", _box(f)) for f in (0.0, 0.05, 0.1, 0.2))
-    yield "published box", VEHICLES["bluerov2_heavy"]
+    """(label, vehicle): von Benzon's point, ±5 %, ±10 %, ±20 %, the published box (benchmarks/dynamic_gap.py), each
+    without lateral thrust (``Y_max`` = 0): this study's channels are u, w, r with the hull's free sway."""
+    yield from ((f"von Benzon ±{round(f * 100)} %", dataclasses.replace(_box(f), Y_max=0.0))
+                for f in (0.0, 0.05, 0.1, 0.2))
+    yield "published box", dataclasses.replace(VEHICLES["bluerov2_heavy"], Y_max=0.0)
 
 
 def main() -> int:

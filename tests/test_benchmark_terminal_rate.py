@@ -13,14 +13,15 @@ def _module():
 
 def test_the_invariant_sets_move_their_rows_by_more_than_j_per_period():
     """On ``examples/bluerov2_slow.toml`` the finer grid finds terminal sets meeting every law condition, and for each
-    of them one period's replay deviation alone moves the yaw and surge rows by more than J = rho delta: what keeps
-    ``terminal_rate`` refused there (docs/verify.md, step 17)."""
+    of them one period's replay deviation alone moves the surge row by more than J = rho delta: what keeps
+    ``terminal_rate`` refused there (docs/verify.md, step 17). Since the sway loop shrank omega_bar the yaw row's
+    least change is below J_r: the surge row alone stands in the way."""
     mod = _module()
     res = mod.study()
     assert res["invariant"] > 0 and res["sets"] > res["invariant"]
     j_u, _, j_r = res["jump"]
     assert math.isclose(j_u, 0.03 * 0.1) and math.isclose(j_r, 0.06 * 0.1)
-    assert res["least_yaw_change"] > j_r and res["least_surge_change"] > j_u
+    assert 0.0 < res["least_yaw_change"] < j_r and res["least_surge_change"] > j_u
 
 
 def test_the_finer_grid_is_put_back():

@@ -23,7 +23,7 @@ from tubekit.design_inputs import DesignInputs
 from tubekit.exceptions import ConfigError
 from tubekit.model.thrusters import ThrusterGeometry
 from tubekit.model.vehicle_sets import (HEAVY_HORIZONTAL_POSITION, STANDARD_GRAVITY, T200_REVERSE_KGF_16V,
-                                        bluerov2_heavy_limits)
+                                        bluerov2_heavy_limits, bluerov2_heavy_sway_limit)
 from tubekit.model.vehicles import PlantSettings
 from tubekit.scenario import load_scenario, scenario_from_dict
 
@@ -66,8 +66,9 @@ def _producible(allocation, thrust, tau) -> bool:
 
 
 def _corners(limits) -> list[np.ndarray]:
-    """The 8 corners (±X, ±Z, ±N) of the box of half-widths ``limits``."""
-    return [np.array(signs) * np.asarray(limits, float) for signs in itertools.product((1.0, -1.0), repeat=3)]
+    """The 2^k corners (±X, ±Z, ±N[, ±Y]) of the box of half-widths ``limits``."""
+    return [np.array(signs) * np.asarray(limits, float)
+            for signs in itertools.product((1.0, -1.0), repeat=len(limits))]
 
 
 # ---- the BlueROV2 Heavy --------------------------------------------------------------------------------------------
@@ -77,7 +78,7 @@ def test_the_heavy_geometry_produces_the_shipped_box(with_sway):
     """The shipped (hand-derived) limits are producible: the LP's box with their proportions contains them, and is
     no larger (the hand allocation f = X/(4c) ± N/(4d) is optimal), with or without requiring zero sway."""
     rows, sway = _heavy_rows()
-    hand = bluerov2_heavy_limits()
+    hand = bluerov2_heavy_limits(surge_share=0.75, sway_share=0.0)   # the whole horizontal thrust to X and N
     solo_hand = _hand_solo()
     shares = [h / s for h, s in zip(hand, solo_hand)]                 # 0.75, 1, 0.25
     geom = ThrusterGeometry(rows, [T200] * 8, shares, sway if with_sway else None)
@@ -87,6 +88,29 @@ def test_the_heavy_geometry_produces_the_shipped_box(with_sway):
         assert derived <= by_hand * (1 + 1e-9)
     assert all(_producible(rows + ([sway] if with_sway else []), [T200] * 8, list(c) + ([0.0] if with_sway else []))
                for c in _corners(geom.limits()))
+    assert geom.sway_limit() == 0.0
+
+
+def test_a_fourth_share_gives_the_heavy_its_shipped_lateral_limit():
+    """With the sway row and a fourth share the box has a lateral half-width: the shipped (X, Z, N, Y) box (65 %
+    surge, 10 % sway, 25 % yaw of each horizontal thruster) is producible at every one of its 16 corners, and the
+    LP's box is no larger than the hand allocation f = X/(4c) ± Y/(4c) ± N/(4d) gives."""
+    rows, sway = _heavy_rows()
+    hand = (*bluerov2_heavy_limits(), bluerov2_heavy_sway_limit())
+    solo_hand = (*_hand_solo(), 4 * T200 * C45)                      # sway alone: 4 T sin 45°
+    geom = ThrusterGeometry(rows, [T200] * 8, [h / s for h, s in zip(hand, solo_hand)], sway)
+    assert geom.solo_capacity() == pytest.approx(solo_hand, rel=1e-9)
+    derived = (*geom.limits(), geom.sway_limit())
+    for d, by_hand in zip(derived, hand):
+        assert by_hand * (1 - SHRINK) * (1 - 1e-9) <= d <= by_hand * (1 + 1e-9)
+    assert all(_producible(rows + [sway], [T200] * 8, [c[0], c[1], c[2], c[3]]) for c in _corners(derived))
+    assert not _producible(rows + [sway], [T200] * 8, [1.01 * x for x in derived])
+
+
+def test_a_fourth_share_needs_the_sway_row():
+    rows, _ = _heavy_rows()
+    with pytest.raises(ConfigError, match=r"shares.*only with a sway row"):
+        ThrusterGeometry(rows, [T200] * 8, [0.65, 1.0, 0.25, 0.1])
 
 
 # ---- small geometries by hand ----------------------------------------------------------------------------------------
@@ -151,7 +175,7 @@ def test_a_bad_thruster_table_names_its_field(table, match):
 HEAVY_TABLE = {"allocation": _heavy_rows()[0], "thrust": [T200] * 8, "shares": [0.75, 1.0, 0.25]}
 BAD_PLANTS = [
     ({"name": "bluerov2_heavy", "X_max": 80.0, "thrusters": HEAVY_TABLE},
-     r"plant\.vehicle\.thrusters: expected absent when X_max/Z_max/N_max are given \(one source of limits"),
+     r"plant\.vehicle\.thrusters: expected absent when X_max/Z_max/N_max/Y_max are given \(one source of limits"),
     ({"name": "bluerov2_heavy", "N_max": [5.0, 6.0], "thrusters": {"allocation": 3}},   # refused before it is parsed
      r"plant\.vehicle\.thrusters: expected absent when X_max/Z_max/N_max"),
     ({"name": "remus100", "thrusters": HEAVY_TABLE}, r"plant\.vehicle\.thrusters: expected absent on a finned vehicle"),
@@ -213,7 +237,8 @@ def test_a_dynamic_scenario_with_thrusters_loads_round_trips_and_keys_its_design
     box = sc.plant.params
     assert (box.X_max, box.Z_max, box.N_max) == (x, z, n) and box.actuation == "thrusters"
     assert sc.plant.truth_params.thrust_limits == (x, z, n)
-    assert (x, z, n) == pytest.approx(bluerov2_heavy_limits(), rel=2 * SHRINK)
+    assert (x, z, n) == pytest.approx(bluerov2_heavy_limits(surge_share=0.75, sway_share=0.0), rel=2 * SHRINK)
+    assert box.Y_max == 0.0 and not box.lateral            # a table with three shares leaves no lateral thrust
     d = sc.to_dict()
     assert set(d["plant"]["vehicle"]) == {"name", "thrusters"}           # the table, not the derived limits
     assert scenario_from_dict(d) == sc
@@ -232,7 +257,7 @@ def test_a_vehicle_file_and_a_custom_vehicle_may_give_thrusters(tmp_path):
     """In a vehicle file the table is [thrusters]; a custom vehicle then needs no X_max, Z_max, N_max."""
     shipped = PlantSettings("dynamic", "bluerov2_heavy").params.to_dict()
     lines = [f"{k} = {v!r}" if not isinstance(v, str) else f'{k} = "{v}"' for k, v in shipped.items()
-             if k not in ("X_max", "Z_max", "N_max")]
+             if k not in ("X_max", "Z_max", "N_max", "Y_max")]
     table = "\n".join(f"{k} = {v!r}" for k, v in HEAVY_TABLE.items())
     (tmp_path / "rov.toml").write_text("\n".join(lines) + "\n\n[thrusters]\n" + table + "\n")
     plant = PlantSettings.from_dict({"kind": "dynamic", "vehicle_file": str(tmp_path / "rov.toml")})
@@ -244,6 +269,8 @@ def test_a_vehicle_file_and_a_custom_vehicle_may_give_thrusters(tmp_path):
 def test_the_documented_heavy_example_gives_the_shipped_limits():
     """docs/plant.md's TOML example of the Heavy's geometry (rounded entries) gives the shipped box to 0.01 %."""
     text = (ROOT / "docs" / "plant.md").read_text()
-    block = next(b for b in re.findall(r"```toml\n(.*?)```", text, flags=re.S) if "[plant.vehicle.thrusters]" in b)
+    block = next(b for b in re.findall(r"```toml\n(.*?)```", text, flags=re.S)
+                 if re.search(r"^\[plant\.vehicle\.thrusters\]", b, flags=re.M))     # the table itself, not a comment
     plant = PlantSettings.from_dict(tomllib.loads(block)["plant"])
     assert plant.params.thrust_limit_floor(1.0) == pytest.approx(bluerov2_heavy_limits(), rel=1e-4)
+    assert plant.params.Y_max == pytest.approx(bluerov2_heavy_sway_limit(), rel=1e-4) and plant.params.lateral

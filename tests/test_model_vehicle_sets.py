@@ -7,7 +7,8 @@ import math
 import numpy as np
 import pytest
 
-from tubekit.model.vehicle_sets import BLUEROV2_HEAVY, REMUS100, VEHICLES, bluerov2_heavy_limits
+from tubekit.model.vehicle_sets import (BLUEROV2_HEAVY, REMUS100, VEHICLES, bluerov2_heavy_limits,
+                                        bluerov2_heavy_sway_limit)
 
 RHO = 1026.0  # kg/m³, Fossen's remus100.m
 
@@ -83,18 +84,23 @@ def test_bluerov2_heavy_limits_by_hand_and_by_allocation():
     thrust = 4.1 * 9.80665                                # T200 reverse thrust at 16 V
     arm = (0.156 + 0.111) / math.sqrt(2)                  # yaw arm of a 45° thruster at (0.156, 0.111)
     x_max, z_max, n_max = bluerov2_heavy_limits()
-    assert (x_max, z_max, n_max) == pytest.approx((0.75 * 4 * thrust / math.sqrt(2), 4 * thrust,
-                                                   0.25 * 4 * thrust * arm))
+    y_max = bluerov2_heavy_sway_limit()
+    assert (x_max, z_max, n_max, y_max) == pytest.approx((0.65 * 4 * thrust / math.sqrt(2), 4 * thrust,
+                                                          0.25 * 4 * thrust * arm, 0.10 * 4 * thrust / math.sqrt(2)))
     assert BLUEROV2_HEAVY.thrust_limit_floor(1.0) == pytest.approx((x_max, z_max, n_max), abs=0.01)
-    # every corner of the (X, N) box is producible: minimum-norm allocation over the 4 horizontal thrusters
+    assert BLUEROV2_HEAVY.Y_max == pytest.approx(y_max, abs=0.01) and BLUEROV2_HEAVY.Y_max <= y_max
+    # every corner of the (X, Y, N) box is producible: minimum-norm allocation over the 4 horizontal thrusters
     positions = [(0.156, 0.111), (0.156, -0.111), (-0.156, 0.111), (-0.156, -0.111)]
     angles = [-math.pi / 4, math.pi / 4, -3 * math.pi / 4, 3 * math.pi / 4]
     b = np.array([[math.cos(a) for a in angles], [math.sin(a) for a in angles],
                   [px * math.sin(a) - py * math.cos(a) for (px, py), a in zip(positions, angles)]])
     for sx in (-1, 1):
-        for sn in (-1, 1):
-            f = np.linalg.pinv(b) @ np.array([sx * x_max, 0.0, sn * n_max])
-            assert np.max(np.abs(f)) <= thrust * (1 + 1e-9)
+        for sy in (-1, 1):
+            for sn in (-1, 1):
+                f = np.linalg.pinv(b) @ np.array([sx * x_max, sy * y_max, sn * n_max])
+                assert np.max(np.abs(f)) <= thrust * (1 + 1e-9)
+    f = np.linalg.pinv(b) @ np.array([x_max, 1.02 * y_max, n_max])       # a box any wider is not producible
+    assert np.max(np.abs(f)) > thrust
 
 
 @pytest.mark.parametrize("vehicle", [REMUS100, BLUEROV2_HEAVY])

@@ -147,5 +147,5 @@ def test_the_theorem_and_the_loop_bound_go_through_the_registry(hover, pc_cert):
     assert hover.calls == ["design", "certify", "certify"] and again == designed
     slow = load_scenario("examples/bluerov2_slow.toml")
     loop = loop_for_law(slow, Hover(**{f.name: getattr(LAW, f.name) for f in dataclasses.fields(LAW)}), SAFE,
-                        (0.05, 0.02, 0.08), 0.0)
+                        (0.05, 0.02, 0.08), 0.0, 0.01)
     assert hover.calls[-1] == "tick_change" and loop.loop.jump_tick != (0.0, 0.0, 0.0)

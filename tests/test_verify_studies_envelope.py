@@ -148,16 +148,19 @@ def test_bad_law():
 @pytest.mark.slow
 def test_a_dynamic_scenario_has_an_envelope_of_dynamic_certificates():
     """Issue 32: ``tubekit envelope`` on the BlueROV2 Heavy (examples/bluerov2_slow.toml) at its own speed: every
-    point a dynamic certificate; its omega_bar_xy holds the hull's sway and the loop error on top of the current."""
+    point a dynamic certificate; its omega_bar_xy holds the sway (the BlueROV2 Heavy's sway loop error) and the
+    velocity loop's error on top of the current."""
     sc = load_scenario(ROOT / "examples" / "bluerov2_slow.toml")
     env = verify.envelope(sc, speeds=[0.079], steps=2)
     assert env.dynamic and env.to_dict()["dynamic"] is True and env.check() == []
     lo, hi = env.certified_amplitude[0], env.refuted_amplitude[0]
     assert 0.0 < lo < hi <= env.necessary_omega[0]                 # a current certifies, a larger one does not
-    assert env.gamma > 0.05                                         # the hull sway alone is several cm/s
-    assert env.certified_omega[0] >= lo + env.gamma - 1e-12         # the non-current part only grows with the current
+    assert env.gamma > 0.02                  # ||(E_u, E_v)|| at zero current: the surge loop's error alone is cm/s
+    # omega_bar holds the current and the derived part on top (not monotone in the current: the backup designed at
+    # each point sets the command's jumps, and so E; measured: 0.042 at a = 0.075 against 0.047 at a = 0)
+    assert env.certified_omega[0] > lo + 0.5 * env.gamma
     assert env.own_certified is True and env.own_current == pytest.approx(0.04, abs=1e-9)
-    assert "hull sway + loop error" in env.summary()
+    assert "sway + loop error" in env.summary()
 
 
 def test_progress_is_reported_once_per_speed_and_changes_nothing(scenario):

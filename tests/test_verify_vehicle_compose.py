@@ -187,7 +187,7 @@ def test_the_loop_for_the_designed_law_is_the_last_round_number_for_number(slow_
     ``tubekit recheck`` evaluates on the stored law."""
     from verify.vehicle.compose import loop_for_law
     sc, sol = slow_solution
-    given = loop_for_law(sc, sol.backup.law, sol.backup.safe_set, sol.assumed, 0.0)
+    given = loop_for_law(sc, sol.backup.law, sol.backup.safe_set, sol.assumed, 0.0, sol.assumed_sway)
     assert given.loop == sol.loop == slow_cert.velocity_loop
     assert given.conditions == sol.conditions == slow_cert.plant_conditions
     assert given.dist == sol.dist == slow_cert.disturbance and given.assumed == sol.assumed
@@ -200,7 +200,7 @@ def test_a_faster_law_is_charged_its_own_command_rate(slow_solution):
     from verify.vehicle.compose import loop_for_law
     sc, sol = slow_solution
     fast = dataclasses.replace(sol.backup.law, heave_band=0.01 * sol.backup.law.heave_band)
-    given = loop_for_law(sc, fast, sol.backup.safe_set, sol.assumed, 0.0)
+    given = loop_for_law(sc, fast, sol.backup.safe_set, sol.assumed, 0.0, sol.assumed_sway)
     assert given.loop.jump_tick[1] > 10 * sol.loop.jump_tick[1]
     assert given.loop.jump_tick[0] == sol.loop.jump_tick[0] and given.loop.jump_tick[2] == sol.loop.jump_tick[2]
     consistent = next(c for c in given.conditions if c.condition == "loop_consistent")
@@ -212,9 +212,13 @@ def test_loop_for_law_refuses_a_bad_assumption(slow_solution):
     from verify.vehicle.compose import loop_for_law
     sc, sol = slow_solution
     with pytest.raises(ConfigError, match=r"assumed\[1\]"):
-        loop_for_law(sc, sol.backup.law, sol.backup.safe_set, (0.05, -1.0, 0.07), 0.0)
+        loop_for_law(sc, sol.backup.law, sol.backup.safe_set, (0.05, -1.0, 0.07), 0.0, 0.01)
     with pytest.raises(ConfigError, match="assumed"):
-        loop_for_law(sc, sol.backup.law, sol.backup.safe_set, (0.05, 0.07), 0.0)
+        loop_for_law(sc, sol.backup.law, sol.backup.safe_set, (0.05, 0.07), 0.0, 0.01)
+    with pytest.raises(ConfigError, match=r"assumed_sway: expected the sway loop's assumed bound"):
+        loop_for_law(sc, sol.backup.law, sol.backup.safe_set, sol.assumed, 0.0)      # lateral thrust: required
+    with pytest.raises(ConfigError, match=r"assumed_sway\b"):
+        loop_for_law(sc, sol.backup.law, sol.backup.safe_set, sol.assumed, 0.0, -0.01)
 
 
 def test_the_last_round_compares_e_with_the_assumption_it_was_derived_with(monkeypatch):
@@ -264,3 +268,20 @@ def test_the_hand_over_to_a_law_that_does_not_blend_is_charged_its_jump():
     keep = StationKeeping(surge=0.2, yaw_rate=0.5, yaw_band=0.05, heave=0.3, heave_band=0.01)
     assert handover_jump(keep, plans) == pytest.approx((0.21, 0.32, 0.53), rel=1e-12)
     assert all(j >= x for j, x in zip(handover_jump(loiter, plans), plans))    # never below the plans' own jumps
+
+
+def test_the_sway_loop_is_what_certifies_the_papers_current():
+    """examples/bluerov2_current.toml (the paper's 0.1 m/s per axis) certifies the safe tier with the Heavy's lateral
+    thrust (γ̄ = the sway loop's E_v, assumed and checked like E: ``loop_consistent`` names it); the same vehicle
+    without lateral thrust (Y_max = 0: the hull's free sway in ω̄) certifies neither tier."""
+    import dataclasses
+    import verify
+    sc = load_scenario("examples/bluerov2_current.toml")
+    cert = verify.certify(sc)
+    assert cert.tiers.safe and cert.velocity_loop.channels == "uvwr"
+    consistent = next(c for c in cert.plant_conditions if c.condition == "loop_consistent")
+    assert consistent.ok and "sway loop E_v" in consistent.detail
+    free = sc.with_changes(plant=dataclasses.replace(sc.plant, overrides=(*sc.plant.overrides, ("Y_max", 0.0))))
+    without = verify.certify(free)
+    assert not without.tiers.safe and without.velocity_loop.channels == "uwr"
+    assert without.disturbance.gamma > 10 * cert.disturbance.gamma

@@ -110,7 +110,7 @@ def _draw_frontiers(ax: Axes, result: EnvelopeResult, s: np.ndarray, top: float)
 def _draw_floors(ax: Axes, result: EnvelopeResult) -> None:
     """The sway bound gamma_bar (where the current is zero) and, with a constant current, the sweep's floor."""
     gamma, offset = result.gamma, result.current_offset
-    what = (f"hull sway + velocity-loop error at zero current, {GAMMA} = {gamma:.3g} m/s (derived by the dynamic "
+    what = (f"sway + velocity-loop error at zero current, {GAMMA} = {gamma:.3g} m/s (derived by the dynamic "
             f"certificate; it grows with the current)" if result.dynamic else
             f"sway bound {GAMMA} = {gamma:.3g} m/s of this scenario (gain u_max r_max + amplitude): "
             f"the current allowed at a speed is the certified {OMEGA} minus {GAMMA}")

@@ -236,8 +236,10 @@ def _sway(run: RunLog) -> Promise:
     gamma = run.tightening.disturbance.sway
     if run.body is not None:
         vb = np.abs(run.body[:, 1])
+        bound = ("the sway loop's error bound: lateral thrust regulates the sway to 0"
+                 if run.scenario.plant.params.lateral else "ISS bound of the hull's free sway")
         return _at_most("sway", float(np.nanmax(vb)) if len(vb) else 0.0, gamma + _TOL,
-                        "max |v_b| of the 4-DOF hull (m/s) vs gamma_bar (ISS bound of the sway dynamics)")
+                        f"max |v_b| of the 4-DOF hull (m/s) vs gamma_bar ({bound})")
     if run.omega_overridden:
         return Promise("sway", math.nan, gamma, True, "not applicable: the disturbance is overridden, "
                                                       "so the sway cannot be separated from it")
@@ -285,7 +287,7 @@ def _disturbance(run: RunLog) -> Promise:
     return _at_most("disturbance", max(cur_xy - bound_xy - _TOL, cur_z - bound_z - _TOL), 0.0,
                     f"premise: max over the whole run (every integrator stage) of ||current_xy|| - {bound_xy:.4g} "
                     f"and |current_z| - {bound_z:.4g} (the water current against the bound the certificate assumes); "
-                    f"peaks {cur_xy:.4g}, {cur_z:.4g} m/s. Not a premise: the total omega (current + hull sway + "
+                    f"peaks {cur_xy:.4g}, {cur_z:.4g} m/s. Not a premise: the total omega (current + sway + "
                     f"loop error, derived) peaks {total_xy:.4g}, {total_z:.4g} m/s vs omega_bar "
                     f"{bound.omega_xy:.4g}, {bound.omega_z:.4g}")
 

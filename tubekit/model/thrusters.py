@@ -7,15 +7,17 @@ The table ``[plant.vehicle.thrusters]`` (also inside a vehicle file) describes n
 * ``thrust``: T, each thruster's largest thrust magnitude (N), symmetric: |f_i| <= T_i (give the
   weaker direction, e.g. a T200's reverse thrust);
 * ``shares`` (optional, default [1, 1, 1]): the box's proportions, as fractions of each channel's
-  solo capacity (only their ratios matter);
-* ``sway`` (optional): n numbers, the sway force (N/N) of each thruster; when given, every force
-  the derivation uses is produced with zero sway force (the 4-DOF plant has none: τ = (X, 0, Z, N)).
+  solo capacity (only their ratios matter); a fourth share, the sway force Y's, with ``sway``;
+* ``sway`` (optional): n numbers, the sway force (N/N) of each thruster; when given with three shares,
+  every force the derivation uses is produced with zero sway force (the vehicle then has no lateral
+  thrust, Y_max = 0); with a fourth share the box has a fourth channel, Y, and Y_max > 0 (the sway is
+  then regulated by a loop of its own, ``tubekit.plant.dynamic``).
 
 :class:`ThrusterGeometry` derives, by linear programs (``scipy.optimize.linprog``, HiGHS):
 
 1. the solo capacity of channel c: C_c = max τ_c s.t. B f = τ_c e_c (sway f = 0), |f_i| <= T_i;
-2. the box's half-widths (X_max, Z_max, N_max) = t* (s_X C_X, s_Z C_Z, s_N C_N), t* the largest t
-   with every corner t·diag(s C)·(±1, ±1, ±1) producible (one LP over t and a thrust vector per
+2. the box's half-widths (X_max, Z_max, N_max[, Y_max]) = t* (s_X C_X, s_Z C_Z, s_N C_N[, s_Y C_Y]), t* the
+   largest t with every corner t·diag(s C)·(±1, ..., ±1) producible (one LP over t and a thrust vector per
    corner; the box is the convex hull of its corners, so all of it is then producible). A channel
    with share 0 gets the limit 0 (its corners ask 0 of it).
 3. soundness: t* is shrunk by a relative :data:`SHRINK`, each corner's thrust vector by the same
@@ -47,8 +49,8 @@ __all__ = ["ThrusterGeometry", "FIELD", "KEYS", "CHANNELS", "LIMIT_KEYS", "SHRIN
 FIELD = "plant.vehicle.thrusters"
 #: The keys of the table.
 KEYS = ("allocation", "thrust", "shares", "sway")
-#: The allocation's rows: the channel each describes.
-CHANNELS = ("surge X", "heave Z", "yaw N")
+#: The allocation's rows (and the sway row's): the channel each describes.
+CHANNELS = ("surge X", "heave Z", "yaw N", "sway Y")
 #: The vehicle parameters the derived box replaces.
 LIMIT_KEYS = ("X_max", "Z_max", "N_max")
 #: Relative shrink of the LP's t* (and of its thrust vectors) before the float check.
@@ -111,12 +113,14 @@ def _allocation(value: Any) -> tuple[tuple[float, ...], ...]:
                             for c in (1, 2))
 
 
-def _shares(value: Any) -> tuple[float, float, float]:
-    """Three numbers >= 0, not all 0, else ConfigError naming ``shares`` or ``shares[i]``."""
+def _shares(value: Any, with_sway: bool) -> tuple[float, ...]:
+    """Three numbers >= 0 (four with a ``sway`` row: the fourth Y's), not all 0, else ConfigError naming ``shares``
+    or ``shares[i]``."""
     field = f"{FIELD}.shares"
     items = _sequence(field, value, "3 numbers >= 0, not all 0")
-    if len(items) != 3:
-        raise ConfigError(field, "3 numbers >= 0 (surge, heave, yaw), not all 0", value)
+    if len(items) not in ((3, 4) if with_sway else (3,)):
+        raise ConfigError(field, "3 numbers >= 0 (surge, heave, yaw), not all 0" + (
+            ", or 4 (and sway Y)" if with_sway else "; a fourth (sway Y) only with a sway row"), value)
     out = tuple(_number(f"{field}[{c}]", x, 0.0, MAX_SHARE, f"a finite number in [0, {MAX_SHARE:g}]")
                 for c, x in enumerate(items))
     if not any(out):
@@ -134,10 +138,12 @@ class ThrusterGeometry:
         B: surge force X (N/N), heave force Z (N/N), yaw moment N (m) per newton of each thruster.
     thrust : n numbers > 0
         T: each thruster's largest thrust magnitude (N), the same in both directions.
-    shares : 3 numbers >= 0, not all 0
-        The box's proportions as fractions of each channel's solo capacity (default [1, 1, 1]).
+    shares : 3 (or 4) numbers >= 0, not all 0
+        The box's proportions as fractions of each channel's solo capacity (default [1, 1, 1]); a fourth, the
+        sway force's, only with ``sway``.
     sway : n numbers or None
-        Sway force (N/N) of each thruster; given, every force used has zero sway.
+        Sway force (N/N) of each thruster; given with three shares, every force used has zero sway; with four,
+        the box has a lateral limit Y_max (:meth:`sway_limit`).
 
     The limits are derived (and checked) once, when the value is built; :meth:`limits` and
     :meth:`solo_capacity` return them. Equality and hashing use the four fields only.
@@ -145,7 +151,7 @@ class ThrusterGeometry:
 
     allocation: tuple[tuple[float, ...], ...]
     thrust: tuple[float, ...]
-    shares: tuple[float, float, float] = (1.0, 1.0, 1.0)
+    shares: tuple[float, ...] = (1.0, 1.0, 1.0)
     sway: tuple[float, ...] | None = None
 
     def __post_init__(self) -> None:
@@ -156,9 +162,9 @@ class ThrusterGeometry:
         for i, t in enumerate(thrust):
             if t <= 0.0:
                 raise ConfigError(f"{FIELD}.thrust[{i}]", f"a finite number of newtons in (0, {MAX_THRUST:g}]", t)
-        shares = _shares(self.shares)
         sway = None if self.sway is None else _row(f"{FIELD}.sway", self.sway, n, -MAX_ENTRY, MAX_ENTRY,
                                                    f"a finite number in [-{MAX_ENTRY:g}, {MAX_ENTRY:g}]")
+        shares = _shares(self.shares, sway is not None)
         for name, value in (("allocation", allocation), ("thrust", thrust), ("shares", shares), ("sway", sway)):
             object.__setattr__(self, name, value)
         solo, limits = _derive(allocation, thrust, shares, sway)
@@ -173,10 +179,15 @@ class ThrusterGeometry:
 
     def limits(self) -> tuple[float, float, float]:
         """(X_max, Z_max, N_max) in N, N, N m: the box every point of which the thrusters produce."""
-        return self._limits  # type: ignore[attr-defined, no-any-return]
+        return self._limits[:3]  # type: ignore[attr-defined, no-any-return]
 
-    def solo_capacity(self) -> tuple[float, float, float]:
-        """(C_X, C_Z, C_N) in N, N, N m: the largest |X|, |Z|, |N| each produced with the other two 0."""
+    def sway_limit(self) -> float:
+        """Y_max (N): the box's lateral half-width with a fourth share, else 0 (the box asks zero sway)."""
+        return self._limits[3] if len(self._limits) > 3 else 0.0  # type: ignore[attr-defined, no-any-return]
+
+    def solo_capacity(self) -> tuple[float, ...]:
+        """(C_X, C_Z, C_N[, C_Y]) in N, N, N m[, N]: the largest |X|, |Z|, |N| (and |Y| with a fourth share) each
+        produced with the others 0."""
         return self._solo  # type: ignore[attr-defined, no-any-return]
 
     @classmethod
@@ -236,29 +247,33 @@ def _solo(a: np.ndarray, channel: int) -> float:
     return float(x[-1])
 
 
-def _corners() -> np.ndarray:
-    """The 8 sign vectors (±1, ±1, ±1), shape (8, 3)."""
-    return np.array(list(itertools.product((1.0, -1.0), repeat=3)))
+def _corners(dims: int = 3) -> np.ndarray:
+    """The 2^dims sign vectors (±1, ..., ±1), shape (2^dims, dims)."""
+    return np.array(list(itertools.product((1.0, -1.0), repeat=dims)))
 
 
 def _box(a: np.ndarray, widths: np.ndarray) -> tuple[float, np.ndarray]:
-    """(t*, g (8, n)): max t such that A g^k = t·(σ_k ∘ widths, 0) for every corner k, |g^k| <= 1."""
+    """(t*, g (K, n)): max t such that A g^k = t·(σ_k ∘ widths, 0) for every corner k of the len(widths)-box,
+    |g^k| <= 1."""
     rows, n = a.shape
-    signs = _corners()
-    a_eq = np.zeros((8 * rows, 1 + 8 * n))
+    dims = len(widths)
+    signs = _corners(dims)
+    count = len(signs)
+    a_eq = np.zeros((count * rows, 1 + count * n))
     for k, sigma in enumerate(signs):
-        a_eq[k * rows:k * rows + 3, 0] = -sigma * widths
+        a_eq[k * rows:k * rows + dims, 0] = -sigma * widths
         a_eq[k * rows:(k + 1) * rows, 1 + k * n:1 + (k + 1) * n] = a
-    cost = np.zeros(1 + 8 * n)
+    cost = np.zeros(1 + count * n)
     cost[0] = -1.0
-    x = _linprog(cost, a_eq, [(0.0, None)] + [(-1.0, 1.0)] * (8 * n), "box of limits")
-    return float(x[0]), x[1:].reshape(8, n)
+    x = _linprog(cost, a_eq, [(0.0, None)] + [(-1.0, 1.0)] * (count * n), "box of limits")
+    return float(x[0]), x[1:].reshape(count, n)
 
 
 def _check_corners(b: np.ndarray, thrust: np.ndarray, limits: np.ndarray, forces: np.ndarray, scale: float) -> None:
-    """Every corner σ ∘ limits (sway 0) is B f for its f (within the residual tolerance), |f_i| <= T_i exactly."""
-    for sigma, f in zip(_corners(), forces):
-        target = np.concatenate([sigma * limits, np.zeros(b.shape[0] - 3)])
+    """Every corner σ ∘ limits (the rows beyond the limits' at 0) is B f for its f (within the residual tolerance),
+    |f_i| <= T_i exactly."""
+    for sigma, f in zip(_corners(len(limits)), forces):
+        target = np.concatenate([sigma * limits, np.zeros(b.shape[0] - len(limits))])
         residual = float(np.max(np.abs(b @ f - target)))
         if residual > RESIDUAL_TOLERANCE * scale or np.any(np.abs(f) > thrust):
             raise SolverError(f"{FIELD}: the corner {tuple(float(x) for x in sigma * limits)} of the derived box "
@@ -267,13 +282,14 @@ def _check_corners(b: np.ndarray, thrust: np.ndarray, limits: np.ndarray, forces
 
 
 @lru_cache(maxsize=256)
-def _derive(allocation: tuple[tuple[float, ...], ...], thrust: tuple[float, ...], shares: tuple[float, float, float],
-            sway: tuple[float, ...] | None) -> tuple[tuple[float, float, float], tuple[float, float, float]]:
-    """((C_X, C_Z, C_N), (X_max, Z_max, N_max)) of validated inputs (module doc, steps 1-3)."""
+def _derive(allocation: tuple[tuple[float, ...], ...], thrust: tuple[float, ...], shares: tuple[float, ...],
+            sway: tuple[float, ...] | None) -> tuple[tuple[float, ...], tuple[float, ...]]:
+    """((C_X, C_Z, C_N[, C_Y]), (X_max, Z_max, N_max[, Y_max])) of validated inputs (module doc, steps 1-3)."""
     b, a, scale = _equalities(allocation, thrust, sway)
-    solo = np.array([_solo(a, c) * scale for c in range(3)])
+    dims = len(shares)
+    solo = np.array([_solo(a, c) * scale for c in range(dims)])
     share = np.array(shares) / max(shares)
-    for c in range(3):
+    for c in range(dims):
         if share[c] > 0.0 and not solo[c] > RESIDUAL_TOLERANCE * scale:
             raise ConfigError(f"{FIELD}.allocation", f"thrusters able to produce the {CHANNELS[c]} channel alone (its "
                               f"share is {shares[c]:g} > 0, but no thrust vector within the limits gives it without "
@@ -286,5 +302,4 @@ def _derive(allocation: tuple[tuple[float, ...], ...], thrust: tuple[float, ...]
     forces = factor * g * np.array(thrust)
     _check_corners(b, np.array(thrust), limits, forces, scale)
     # + 0.0: a channel of share 0 (or an LP's -0.0) reads 0.0
-    return (float(solo[0]) + 0.0, float(solo[1]) + 0.0, float(solo[2]) + 0.0), \
-        (float(limits[0]) + 0.0, float(limits[1]) + 0.0, float(limits[2]) + 0.0)
+    return tuple(float(x) + 0.0 for x in solo), tuple(float(x) + 0.0 for x in limits)

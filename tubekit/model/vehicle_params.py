@@ -37,7 +37,7 @@ ACTUATIONS = ("thrusters", "fins")
 _NONPOSITIVE = ("X_u", "Y_v", "Z_w", "N_r", "X_uu", "Y_vv", "Z_ww", "N_rr")
 _POSITIVE = ("m", "I_zz", "X_max", "thruster_time_constant", "loop_bandwidth")
 #: Fields each actuation leaves unused: they must be 0 (no silent ignore).
-_UNUSED = {"thrusters": ("Z_uuds", "N_uudr", "fin_max"), "fins": ("Z_max", "N_max")}
+_UNUSED = {"thrusters": ("Z_uuds", "N_uudr", "fin_max"), "fins": ("Z_max", "N_max", "Y_max")}
 
 
 def _coefficient(name: str, value: Any) -> Coefficient:
@@ -69,7 +69,9 @@ class VehicleParams:
     [0, m x_g - N_vdot, 0, I_zz - N_rdot]]; symmetric (N_vdot = Y_rdot, one coefficient: tied
     in :meth:`sample`) and positive definite at every point of the box. Lift terms
     (``*_lift``) are fin and body lift only: the added-mass (Munk) parts are in C_A(ν).
-    Actuation ``"thrusters"``: |X| <= X_max, |Z| <= Z_max, |N| <= N_max (N, N, N m);
+    Actuation ``"thrusters"``: |X| <= X_max, |Z| <= Z_max, |N| <= N_max (N, N, N m), and a lateral
+    force |Y| <= Y_max (N) where the thrusters give one (``Y_max`` > 0: the sway is regulated to 0 by its own
+    loop, :attr:`lateral`; 0: no lateral authority, the hull's sway is free);
     ``"fins"``: |X| <= X_max (propeller), |Z| <= |Z_uuds| u² fin_max (stern planes),
     |N| <= |N_uudr| u² fin_max (rudder). Every channel lags by ``thruster_time_constant`` (s).
     """
@@ -100,6 +102,7 @@ class VehicleParams:
     N_ur_lift: Coefficient = -3.93               # kg m/rad, N_ur -2.00 minus N_ura = Y_rdot = 1.93
     X_max: Coefficient = (10.1, 41.2)            # N: Prestero's drag at 2.5 m/s; Fossen's propeller there
     Z_max: Coefficient = 0.0                     # N (thrusters only)
+    Y_max: Coefficient = 0.0                     # N, lateral thrust (thrusters only; 0: none, the sway is free)
     N_max: Coefficient = 0.0                     # N m (thrusters only)
     Z_uuds: Coefficient = (-9.64, -4.77)         # kg/(m rad), stern planes: Prestero; Fossen
     N_uudr: Coefficient = (-6.15, -2.75)         # kg/rad, rudder: Prestero; Fossen (|x_r Y_uudr|)
@@ -125,6 +128,7 @@ class VehicleParams:
             for name in ("Z_uuds", "N_uudr"):
                 lo, hi = self.interval(name)
                 self._require(name, lo > 0.0 or hi < 0.0, "a nonzero fin coefficient (an interval not containing 0)")
+        self._check_lateral()
         self._require("N_vdot", self.interval("N_vdot") == self.interval("Y_rdot"),
                       f"the value of Y_rdot, {self.Y_rdot!r} (M symmetric at every point of the box)")
         self._check_positive_definite()
@@ -134,6 +138,22 @@ class VehicleParams:
     def _require(self, name: str, ok: bool, expected: str) -> None:
         if not ok:
             raise ConfigError(f"plant.vehicle.{name}", expected, getattr(self, name))
+
+    def _check_lateral(self) -> None:
+        """Y_max is 0 or > 0 over the whole box; a sway loop needs sway and yaw decoupled in M (m24 = m42 = 0)."""
+        lo, hi = self.interval("Y_max")
+        self._require("Y_max", lo >= 0.0 and (hi == 0.0 or lo > 0.0), "0 (no lateral thrust) or a number > 0 at "
+                      "every point of the box")
+        if lo > 0.0:
+            for name in ("x_g", "Y_rdot"):
+                self._require(name, self.interval(name) == (0.0, 0.0), "0 when Y_max > 0: the sway loop regulates "
+                              "sway and yaw as separate channels, which needs m x_g - Y_rdot = 0 (M diagonal in sway "
+                              "and yaw); give Y_max = 0 to keep the hull's free sway")
+
+    @property
+    def lateral(self) -> bool:
+        """True when the thrusters give a lateral force (Y_max > 0 over the box): sway is regulated to 0."""
+        return self.interval("Y_max")[0] > 0.0
 
     def _check_positive_definite(self) -> None:
         """M positive definite over the box: smallest diagonal entries against the largest |m24|."""

@@ -190,9 +190,9 @@ def _refuse_thrusters(name: str, overrides: Mapping[str, Any], table: Any) -> No
     """ConfigError naming ``plant.vehicle.thrusters`` when a thruster table (``table``) is given with
     X_max/Z_max/N_max (one source of limits) or on a finned vehicle (its Z and N come from the fins)."""
     received = table.to_dict() if isinstance(table, ThrusterGeometry) else table
-    given = [k for k in LIMIT_KEYS if k in overrides]
+    given = [k for k in (*LIMIT_KEYS, "Y_max") if k in overrides]
     if given:
-        raise ConfigError("plant.vehicle.thrusters", "absent when X_max/Z_max/N_max are given (one source of "
+        raise ConfigError("plant.vehicle.thrusters", "absent when X_max/Z_max/N_max/Y_max are given (one source of "
                           f"limits; {', '.join(given)} given)", received)
     actuation = _actuation(name, overrides)
     if actuation == "fins":
@@ -201,7 +201,7 @@ def _refuse_thrusters(name: str, overrides: Mapping[str, Any], table: Any) -> No
 
 
 def _with_thrusters(name: str, overrides: dict[str, Any], thrusters: ThrusterGeometry | None) -> dict[str, Any]:
-    """``overrides`` plus X_max, Z_max, N_max derived from ``thrusters`` (unchanged without them).
+    """``overrides`` plus X_max, Z_max, N_max and Y_max derived from ``thrusters`` (unchanged without them).
 
     Raises
     ------
@@ -215,7 +215,8 @@ def _with_thrusters(name: str, overrides: dict[str, Any], thrusters: ThrusterGeo
     if actuation == "thrusters" and not all(x > 0.0 for x in limits):
         raise ConfigError("plant.vehicle.thrusters.shares", "3 numbers > 0 (a vehicle with actuation 'thrusters' "
                           "needs every limit X_max, Z_max, N_max > 0)", list(thrusters.shares))
-    return {**overrides, **dict(zip(LIMIT_KEYS, limits))}
+    # the lateral limit too: the table's fourth share, else 0 (a box asking zero sway leaves none for a sway loop)
+    return {**overrides, **dict(zip(LIMIT_KEYS, limits)), "Y_max": thrusters.sway_limit()}
 
 
 def _pairs(field: str, value: Any) -> dict[str, Any]:

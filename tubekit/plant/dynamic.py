@@ -2,7 +2,7 @@
 
 Fossen (2011), body velocities ν = (u, v, w, r) relative to the water (m/s, rad/s):
 
-    M ν̇ + C(ν) ν + D(ν) ν = τ = (X, 0, Z, N),
+    M ν̇ + C(ν) ν + D(ν) ν = τ = (X, Y, Z, N),     Y = 0 without lateral thrust,
 
 * M = M_RB + M_A (rigid body + added mass, :class:`tubekit.model.vehicles.VehicleParams`);
 * C(ν) = C_RB + C_A, skew-symmetric, with the added-mass (Munk) terms:
@@ -22,8 +22,11 @@ the kinematic command v = v̂ + κ = (u_c, w_c, r_c) into τ_cmd: model feedforw
 n̂(ν) = Ĉ(ν)ν + D̂(ν)ν of the NOMINAL vehicle (the midpoints of the coefficient box;
 feedback linearisation, the sway row eliminated from the yaw row) plus PI on
 e = (u_c − u, w_c − w, r_c − r) with k_p = ω_b, k_i = ω_b²/4 and conditional
-integration while saturated. The vehicle itself moves with the TRUTH (a point of the
-box, ``[plant.truth]``). Positions, ν, τ and the integrators are integrated together by
+integration while saturated. A vehicle with lateral thrust (``Y_max`` > 0,
+:attr:`~tubekit.model.vehicle_params.VehicleParams.lateral`; M diagonal in sway and yaw) regulates its sway
+to 0 by a fourth loop of the same form: Y_cmd = n̂_2(ν) + m̂_22 (k_p e_v + k_i ∫e_v), e_v = 0 − v, its
+thrust lagging like the others; without it Y = 0 and the hull's sway is free. The vehicle itself moves
+with the TRUTH (a point of the box, ``[plant.truth]``). Positions, ν, τ and the integrators are integrated together by
 classical RK4 at the closed loop's fixed step.
 """
 
@@ -56,11 +59,12 @@ def body_forces(p: VehicleParams, nu: Sequence[float]) -> Floats4:
     return (-sway_momentum * r + d1, m11 * u * r + d2, d3, sway_momentum * u - m11 * u * v + d4)
 
 
-def body_acceleration(p: VehicleParams, nu: Sequence[float], tau: Sequence[float]) -> Floats4:
-    """ν̇ = M⁻¹(τ − n(ν)) for thrust ``tau`` = (X, Z, N) (N, N, N m); returns (u̇, v̇, ẇ, ṙ)."""
+def body_acceleration(p: VehicleParams, nu: Sequence[float], tau: Sequence[float], sway: float = 0.0) -> Floats4:
+    """ν̇ = M⁻¹(τ − n(ν)) for thrust ``tau`` = (X, Z, N) (N, N, N m) and the lateral force ``sway`` = Y (N; 0 without
+    lateral thrust); returns (u̇, v̇, ẇ, ṙ)."""
     m11, m22, m33, m44, m24, m42 = p.mass_entries
     n1, n2, n3, n4 = body_forces(p, nu)
-    b2, b4 = -n2, tau[2] - n4
+    b2, b4 = sway - n2, tau[2] - n4
     det = m22 * m44 - m24 * m42
     return ((tau[0] - n1) / m11, (m44 * b2 - m24 * b4) / det, (tau[1] - n3) / m33, (m22 * b4 - m42 * b2) / det)
 
@@ -79,7 +83,8 @@ class DynamicPlant:
     (:meth:`step_tuple` on the pose [x, y, z, ψ]); the body velocities, thrusts
     and integrators are internal state, initialised on the first step to the
     trimmed start ν = (u_c, 0, w_c, r_c), τ = sat(n̂(ν)) (the vehicle already
-    moving at the first command, as the kinematic plant assumes). Each call of
+    moving at the first command, as the kinematic plant assumes); with lateral thrust the sway force Y and its
+    integrator follow them in the state (Y starts trimmed too, at sat(n̂_2(ν))). Each call of
     :meth:`step_tuple` (one tick) logs ν and τ at its start (:meth:`history`). The water current it
     applies is reported apart from the total ω = current + hull sway + loop error (:meth:`omega_series`,
     :meth:`omega_peak`): :meth:`current_series` at the ticks and :meth:`current_peak` over every stage.
@@ -115,7 +120,10 @@ class DynamicPlant:
         self._tau_inv = 1.0 / self.params.thruster_time_constant
         # thrusters' limits are constant: read once, not at every integrator stage (fins: per stage)
         self._limits = self.params.thrust_limits if self.params.actuation == "thrusters" else None
-        self.state: tuple[float, ...] | None = None  # (u, v, w, r, X, Z, N, I_u, I_w, I_r)
+        # a sway loop where the vehicle has lateral thrust (the controller's model and the truth share Y_max > 0)
+        self.lateral = self.model.lateral
+        self._sway_limit = float(self.params.Y_max) if self.lateral else 0.0
+        self.state: tuple[float, ...] | None = None  # (u, v, w, r, X, Z, N, I_u, I_w, I_r[, Y, I_v])
         self._log: list[tuple[float, ...]] = []
         # largest ||omega_xy||, |omega_z|, then ||delta_xy||, |delta_z| of the current, over every evaluation (m/s)
         self._peak = [0.0, 0.0, 0.0, 0.0]
@@ -142,20 +150,30 @@ class DynamicPlant:
         sat = tuple(min(max(c, -lim), lim) for c, lim in zip(raw, self._limits or self.params.thrust_limits_at(nu[0])))
         return sat, tuple(s != c for s, c in zip(sat, raw))
 
+    def sway_command(self, nu: Sequence[float], integral: float) -> tuple[float, bool]:
+        """Y_cmd = n̂_2(ν) + m̂_22 (k_p (0 − v) + k_i ∫(0 − v)) saturated at ±Y_max (N), and whether it saturates."""
+        raw = body_forces(self.model, nu)[1] + self._mass[1] * (-self._kp * nu[1] + self._ki * integral)
+        sat = min(max(raw, -self._sway_limit), self._sway_limit)
+        return sat, sat != raw
+
     def _rhs(self, t: float, y: Sequence[float], command: Sequence[float]) -> tuple[float, ...]:
-        """d/dt of (x, y, z, ψ, u, v, w, r, X, Z, N, I_u, I_w, I_r)."""
+        """d/dt of (x, y, z, ψ, u, v, w, r, X, Z, N, I_u, I_w, I_r[, Y, I_v])."""
         psi, nu, tau, integral = y[3], y[4:8], y[8:11], y[11:14]
         c1, c2, c3 = self.current_at(t)
         cp, sp = math.cos(psi), math.sin(psi)
         u, v, w, r = nu
-        acc = body_acceleration(self.params, nu, tau)
+        acc = body_acceleration(self.params, nu, tau, y[14]) if self.lateral else body_acceleration(self.params, nu, tau)
         cmd, saturated = self.thrust_command(nu, command, integral)
         err = (command[0] - u, command[1] - w, command[2] - r)
         # conditional integration: hold the integral while its channel saturates in the error's direction
         integ = tuple(0.0 if s and c * e > 0.0 else e for s, c, e in zip(saturated, cmd, err))
         self._record(c1 - err[0] * cp - v * sp, c2 - err[0] * sp + v * cp, c3 - err[1], c1, c2, c3)
-        return (u * cp - v * sp + c1, u * sp + v * cp + c2, w + c3, r, *acc,
-                *((ci - ti) * self._tau_inv for ci, ti in zip(cmd, tau)), *integ)
+        out = (u * cp - v * sp + c1, u * sp + v * cp + c2, w + c3, r, *acc,
+               *((ci - ti) * self._tau_inv for ci, ti in zip(cmd, tau)), *integ)
+        if not self.lateral:
+            return out
+        y_cmd, y_sat = self.sway_command(nu, y[15])
+        return (*out, (y_cmd - y[14]) * self._tau_inv, 0.0 if y_sat and y_cmd * v < 0.0 else -v)
 
     def _record(self, o1: float, o2: float, o3: float, c1: float, c2: float, c3: float) -> None:
         """Keep the largest ‖ω_xy‖, |ω_z| of ω = ẋ − f(x) v and ‖δ_xy‖, |δ_z| of the current δ (m/s) seen by
@@ -183,6 +201,8 @@ class DynamicPlant:
     def _start(self, command: Sequence[float]) -> tuple[float, ...]:
         nu = (float(command[0]), 0.0, float(command[1]), float(command[2]))
         tau, _ = self.thrust_command(nu, command, (0.0, 0.0, 0.0))
+        if self.lateral:
+            return (*nu, *tau, 0.0, 0.0, 0.0, self.sway_command(nu, 0.0)[0], 0.0)
         return (*nu, *tau, 0.0, 0.0, 0.0)
 
     # ---- the closed loop's interface ----------------------------------------------------

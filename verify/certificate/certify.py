@@ -83,8 +83,8 @@ def _dynamic_assumptions(dist: DisturbanceBounds) -> tuple[str, ...]:
     return ("Dynamic plant: the 4-DOF model of docs/plant.md (surge, sway, heave, yaw; no roll or pitch; the "
             "current's own acceleration neglected in the relative-velocity dynamics) with every hydrodynamic "
             "coefficient anywhere in its interval; the controller's feedforward uses the midpoints. The velocity "
-            "loop's error and the hull's sway are derived from it (verify.vehicle.bound, "
-            f"gamma_bar = {dist.gamma:.4g} m/s), not assumed.",
+            "loop's error and the sway (the hull's free sway, or with lateral thrust the sway loop's error) are "
+            f"derived from it (verify.vehicle.bound, gamma_bar = {dist.gamma:.4g} m/s), not assumed.",
             "Dynamic plant: the run starts trimmed (body velocities equal to the first command, thrust equal to "
             "the feedforward).",
             "The simulator integrates the 4-DOF model with RK4 at a fixed step; the certificate bounds the exact "

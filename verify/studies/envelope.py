@@ -98,7 +98,7 @@ class EnvelopeResult:
     sigma_at_edge : array (k,)
         sigma (1/s) of the certified design at the certified amplitude (NaN: none certifies).
     gamma, current_offset : float
-        gamma_bar (sway; on the dynamic plant: hull sway + loop error at zero current) and ||c_xy|| (constant
+        gamma_bar (sway; on the dynamic plant: the sway (the hull's, or its sway loop's error) + loop error at zero current) and ||c_xy|| (constant
         current), both in omega_bar_xy (m/s).
     dynamic : bool
         The scenario's plant is the dynamic one (module doc).
@@ -200,7 +200,7 @@ class EnvelopeResult:
         """Strict-JSON-ready dict (NaN as None)."""
         return to_jsonable({
             "scenario": self.scenario_name, "law": self.law, "epsilon": self.epsilon,
-            "omega_bar_xy": ("the dynamic certificate's: current + hull sway + velocity-loop error (gamma: the part "
+            "omega_bar_xy": ("the dynamic certificate's: current + sway + velocity-loop error (gamma: the part "
                              "that is not current, at zero current)" if self.dynamic else
                              "current amplitude a + ||c_xy|| + gamma_bar (sway: gain u_max r_max + amplitude)"),
             "dynamic": self.dynamic,
@@ -223,7 +223,7 @@ class EnvelopeResult:
 
         lines = [f"tubekit envelope: scenario '{self.scenario_name}', law '{self.law}', epsilon = {self.epsilon:g} m",
                  f"  omega_bar_xy = horizontal current amplitude + {self.current_offset:.4g} (constant) + "
-                 + (f"hull sway + loop error (derived per certificate; {self.gamma:.4g} at zero current)"
+                 + (f"sway + loop error (derived per certificate; {self.gamma:.4g} at zero current)"
                     if self.dynamic else f"gamma_bar {self.gamma:.4g} (sway)")
                  + f"; vertical amplitude kept at {self.amplitude_z:.4g} m/s",
                  f"  necessary: omega_bar_xy <= min(u_max - speed, r_max epsilon) = min({self.limits[0]:g} - speed, "

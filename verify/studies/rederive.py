@@ -229,7 +229,7 @@ def _plant_bounds(cert: CertificateRecord, scenario: Scenario, region: Region, s
     sol = solve_dynamic(scenario, region, cert.gains, (sigma,))  # E_a: the scenario's fixed point
     dist, loop, plant = sol.dist, sol.loop, sol.conditions
     if cert.backup is not None:  # a missing backup is named by the backup's check
-        given = loop_for_law(scenario, cert.backup.law, cert.backup.safe_set, sol.assumed, sigma)
+        given = loop_for_law(scenario, cert.backup.law, cert.backup.safe_set, sol.assumed, sigma, sol.assumed_sway)
         dist, loop, plant = given.dist, given.loop, given.conditions
     if cert.velocity_loop is None:
         led.check("velocity_loop", False, None, "a velocity_loop block", "a dynamic certificate carries its loop bound")

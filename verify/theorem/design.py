@@ -127,7 +127,8 @@ def hull_sway_bound(params: VehicleParams, u_bar: float, r_bar: float) -> arb:
     return v_star + 2 * abs(m24) * rb / m22
 
 
-def disturbance_bounds(scenario: Scenario, loop_error: tuple[float, float, float] | None = None) -> DisturbanceBounds:
+def disturbance_bounds(scenario: Scenario, loop_error: tuple[float, float, float] | None = None,
+                       loop_sway: float | None = None) -> DisturbanceBounds:
     """ω̄_xy = max(a_x, a_y) + ‖c_xy‖ + γ̄, ω̄_z = a_z + |c_z|, γ̄ = gain ū r̄ + amplitude (over V).
 
     On the dynamic plant (``[plant] kind = "dynamic"``) ω = δ + R(ψ)(u_b − u, v_b) in the
@@ -136,7 +137,8 @@ def disturbance_bounds(scenario: Scenario, loop_error: tuple[float, float, float
     composed by :func:`verify.vehicle.compose.solve_dynamic`): γ̄ = :func:`hull_sway_bound` over
     |u_b| <= ū + E_u, |r_b| <= r̄ + E_r and the vehicle's coefficient box,
     ω̄_xy = max(a_x, a_y) + ‖c_xy‖ + ‖(E_u, γ̄)‖, ω̄_z = a_z + |c_z| + E_w, and the yaw-rate
-    error E_r. The sway table is unused there (declared = γ̄).
+    error E_r. A vehicle with lateral thrust regulates its sway to 0: γ̄ = ``loop_sway``, the sway loop's
+    error bound E_v (m/s, required then). The sway table is unused there (declared = γ̄).
     """
     d, lim = scenario.disturbance, scenario.limits
     a, c = d.amplitude, d.constant
@@ -147,7 +149,13 @@ def disturbance_bounds(scenario: Scenario, loop_error: tuple[float, float, float
             raise ValueError("disturbance_bounds on the dynamic plant needs the velocity loop's error bound "
                              "(verify.vehicle.compose.solve_dynamic composes them)")
         du, dw, dr = (arb(x) for x in loop_error)
-        gamma = hull_sway_bound(scenario.plant.params, upper(arb(lim.u_max) + du), upper(arb(lim.r_max) + dr))
+        if scenario.plant.params.lateral:
+            if loop_sway is None:
+                raise ValueError("disturbance_bounds: a vehicle with lateral thrust needs the sway loop's error bound "
+                                 "(loop_sway, verify.vehicle.compose.solve_dynamic composes it)")
+            gamma = arb(loop_sway)
+        else:
+            gamma = hull_sway_bound(scenario.plant.params, upper(arb(lim.u_max) + du), upper(arb(lim.r_max) + dr))
         wxy = arb(max(a[0], a[1])) + cxy + (du * du + gamma * gamma).sqrt()
         return DisturbanceBounds(omega_xy=upper(wxy), omega_z=upper(wz + dw), gamma=upper(gamma),
                                  declared_sway=upper(gamma), yaw_rate_error=upper(dr))

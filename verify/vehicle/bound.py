@@ -40,18 +40,20 @@ import math
 from dataclasses import dataclass
 from typing import Any, Sequence
 
-import numpy as np
 from flint import arb, ctx
 
 from tubekit.exceptions import ConfigError
 from tubekit.validation import finite, nonnegative, positive
 from verify.theorem.design import Condition, hull_sway_bound
-from verify.kernel.intervals import enclose, lower, upper
+from verify.kernel.intervals import upper
 from verify.vehicle.result import LoopBound
-from verify.vehicle.model import (arb_body_forces, channel_forces, channel_gradient, channel_masses, channel_mismatch,
-                               channel_mismatch_gradient, hull_balls, nominal_balls, nominal_params,
-                               point_time_constant, thrust_floor, velocity_box)
+from tubekit.model.vehicle_params import VehicleParams
+from verify.vehicle.model import (arb_body_forces, channel_gradient, channel_masses, channel_mismatch,
+                                  channel_mismatch_gradient, hull_balls, nominal_balls, nominal_params,
+                                  point_time_constant, velocity_box)
 from verify.vehicle.response import RESPONSE_PREC, ResponseSums, impulse_sums
+from verify.vehicle.saturation import (SURGE_BANDS, actuator_authority, rate_authority_conditions,
+                                       saturation_conditions, triple)
 
 __all__ = ["LoopBound", "velocity_loop_bound", "actuator_authority", "loop_matrix", "computed_bounds",
            "input_bounds", "start_bounds", "Inputs", "rate_authority_conditions", "LOOP_MAX_ITERATIONS", "LOOP_INFLATION",
@@ -62,11 +64,17 @@ LOOP_MAX_ITERATIONS = 60
 #: Each iteration assumes (1 + LOOP_INFLATION) x the bounds it computed.
 LOOP_INFLATION = 0.05
 _CHANNELS = "uwr"
-#: Index in ν = (u, v, w, r) of each channel's own speed.
-_OWN = (0, 2, 3)
-_FORCES = "XZN"
-_ACTUATOR = {"X": "the surge thrust", "Z": "the heave force (stern planes on a finned vehicle)",
-             "N": "the yaw moment (the rudder on a finned vehicle)"}
+
+
+
+def _external(values: Sequence, lateral: bool) -> tuple:
+    """The (u, w, r) entries of a per-channel sequence (the sway channel, index 1, dropped when ``lateral``)."""
+    return (values[0], values[2], values[3]) if lateral else tuple(values)
+
+
+def _internal(values: Sequence, sway: object, lateral: bool) -> tuple:
+    """(u, w, r) values with the sway channel's ``sway`` inserted at index 1 when ``lateral``."""
+    return (values[0], sway, values[1], values[2]) if lateral else tuple(values)
 
 
 def loop_matrix(k_p: float, k_i: float, time_constant: float, slope: float = 0.0) -> list[list[arb]]:
@@ -111,13 +119,21 @@ class _Loop:
 
     def __init__(self, params: VehicleParams, v_max: Sequence[float], tick: float, ticks: int) -> None:
         self.params, self.v_max, self.tick = params, tuple(v_max), tick
+        # with lateral thrust a fourth channel, sway (index 1), regulated to 0: its command box is {0}
+        self.lateral = bool(getattr(params, "lateral", False))
+        self.names = "uvwr" if self.lateral else _CHANNELS
+        self.own = (0, 1, 2, 3) if self.lateral else (0, 2, 3)
+        self.forces = "XYZN" if self.lateral else "XZN"
+        self.v_int = _internal(self.v_max, 0.0, self.lateral)
         self.nominal, self.hull = nominal_balls(params), hull_balls(params)
         nom = nominal_params(params)
         self.k_p, self.k_i = float(nom.loop_bandwidth), 0.25 * float(nom.loop_bandwidth) ** 2
         self.lag = point_time_constant(params)
-        self.m_hat, self.m_true = channel_masses(self.nominal), channel_masses(self.hull)
-        box, gamma = self.box((0.0, 0.0, 0.0))
-        self.slope = tuple(float(x.mid()) for x in self.slopes(box, gamma)) if math.isfinite(gamma) else (0.0,) * 3
+        self.m_hat = channel_masses(self.nominal, self.lateral)
+        self.m_true = channel_masses(self.hull, self.lateral)
+        box, gamma = self.box((0.0,) * len(self.names))
+        self.slope = tuple(float(x.mid()) for x in self.slopes(box, gamma)) if math.isfinite(gamma) \
+            else (0.0,) * len(self.names)
         kp, ki = arb(self.k_p), arb(self.k_i)
         self.sums: tuple[ResponseSums, ...] = tuple(impulse_sums(
             loop_matrix(self.k_p, self.k_i, self.lag, lam), [[0, 1, -kp], [1 / ki, 0, 0], [0, 0, -1]],
@@ -130,14 +146,17 @@ class _Loop:
         return all(s.stable for s in self.sums)
 
     def box(self, error: Sequence[float]) -> tuple[tuple[float, float, float], float]:
-        """(ū, w̄, r̄) = V + E and γ̄ over it (m/s, m/s, rad/s; m/s)."""
-        bar = tuple(upper(arb(v) + arb(e)) for v, e in zip(self.v_max, error))
+        """(ū, w̄, r̄) = V + E and the sway's bound over it (m/s, m/s, rad/s; m/s): with lateral thrust the sway
+        channel's E_v (``error`` then has the sway channel at index 1), else γ̄ of the free hull."""
+        bar = tuple(upper(arb(v) + arb(e)) for v, e in zip(self.v_int, error))
+        if self.lateral:
+            return _external(bar, True), bar[1]
         return bar, upper(hull_sway_bound(self.params, bar[0], bar[2]))
 
     def slopes(self, box: Sequence[float], gamma: float) -> list[arb]:
         """∂n̂_c/∂y_c / m̂_c over the velocity box (1/s): the drag's slope in the channel's own speed."""
-        grads = channel_gradient(self.nominal, velocity_box(box[0], gamma, box[1], box[2]))
-        return [grads[c][_OWN[c]] / self.m_hat[c] for c in range(3)]
+        grads = channel_gradient(self.nominal, velocity_box(box[0], gamma, box[1], box[2]), self.lateral)
+        return [grads[c][self.own[c]] / self.m_hat[c] for c in range(len(self.names))]
 
 
 @functools.lru_cache(maxsize=8)
@@ -157,7 +176,12 @@ def _loop_of(params: VehicleParams, v_max: tuple, tick: float, ticks: int) -> _L
 
 
 def _rates(loop: _Loop, nu: Sequence[arb], accel: Sequence[float]) -> tuple[arb, arb, arb, arb]:
-    """Bounds of |u̇|, |v̇|, |ẇ|, |ṙ|: the channels' Ŷ, and the sway row m22 v̇ = −n2 − m24 ṙ over Θ."""
+    """Bounds of |u̇|, |v̇|, |ẇ|, |ṙ|: the channels' Ŷ, and the sway row m22 v̇ = −n2 − m24 ṙ over Θ (with lateral
+    thrust the sway channel's own Ŷ_v)."""
+    if len(accel) != len(loop.names):
+        raise ValueError(f"_rates: one acceleration bound per channel {loop.names!r}, received {len(accel)}")
+    if loop.lateral:
+        return tuple(arb(a) for a in accel)
     h = loop.hull
     sway = (abs(arb_body_forces(h, nu)[1]) + abs(h["m24"]) * arb(accel[2])) / h["m22"]
     return arb(accel[0]), arb(upper(sway)), arb(accel[1]), arb(accel[2])
@@ -167,8 +191,8 @@ def start_bounds(loop: _Loop, first_command: Sequence[float]) -> tuple[float, fl
     """sup|W(0)| = sup|d_c|/m_c over the first command's box |y_c| <= F_c, v = 0, and Θ (m/s², m/s², rad/s²): the
     start transient of the trimmed start (module doc); it does not depend on the fixed point's assumption."""
     d = channel_mismatch(loop.nominal, loop.hull,
-                         velocity_box(first_command[0], 0.0, first_command[1], first_command[2]))
-    return tuple(upper(abs(d[c]) / loop.m_true[c]) for c in range(3))
+                         velocity_box(first_command[0], 0.0, first_command[1], first_command[2]), loop.lateral)
+    return tuple(upper(abs(d[c]) / loop.m_true[c]) for c in range(len(loop.names)))
 
 
 def input_bounds(loop: _Loop, error: Sequence[float], z_bound: Sequence[float],
@@ -180,16 +204,18 @@ def input_bounds(loop: _Loop, error: Sequence[float], z_bound: Sequence[float],
     sup|Ẇ| = sup|μ − 1| (Ẑ/T_thr + |λ_c| Ŷ_c + ŵ_n) + Σ_j sup|∂d_c/∂ν_j| |ν̇_j| / m_c.
     """
     box, gamma = loop.box(error)
+    n = len(loop.names)
     if not math.isfinite(gamma) or not all(math.isfinite(x) for x in (*box, *z_bound, *accel)):
-        inf = (math.inf,) * 3
+        inf = (math.inf,) * n
         return Inputs(start=inf, rate=inf, drag=inf, mismatch=inf, sway=math.inf)
     nu = velocity_box(box[0], gamma, box[1], box[2])
     rates = _rates(loop, nu, accel)
-    grads = channel_gradient(loop.nominal, nu)
-    d, d_grad = channel_mismatch(loop.nominal, loop.hull, nu), channel_mismatch_gradient(loop.nominal, loop.hull, nu)
+    grads = channel_gradient(loop.nominal, nu, loop.lateral)
+    d = channel_mismatch(loop.nominal, loop.hull, nu, loop.lateral)
+    d_grad = channel_mismatch_gradient(loop.nominal, loop.hull, nu, loop.lateral)
     rate, drag, mismatch = [], [], []
-    for c in range(3):
-        own, lam, y_dot = _OWN[c], arb(loop.slope[c]), arb(accel[c])
+    for c in range(n):
+        own, lam, y_dot = loop.own[c], arb(loop.slope[c]), arb(accel[c])
         cross = sum((abs(g) * x for j, (g, x) in enumerate(zip(grads[c], rates)) if j != own), arb(0))
         w_n = (abs(grads[c][own] - lam * loop.m_hat[c]) * y_dot + cross) / loop.m_hat[c]
         s_dot = arb(z_bound[c]) / arb(loop.lag) + abs(lam) * y_dot + w_n
@@ -199,7 +225,7 @@ def input_bounds(loop: _Loop, error: Sequence[float], z_bound: Sequence[float],
         drag.append(upper(w_n))
         mismatch.append(upper(abs(1 - 1 / mu) * y_dot + abs(d[c]) / loop.m_hat[c]))
     if start is None:
-        start = tuple(upper(abs(d[c]) / loop.m_true[c]) for c in range(3))
+        start = tuple(upper(abs(d[c]) / loop.m_true[c]) for c in range(n))
     return Inputs(start=tuple(start), rate=tuple(rate), drag=tuple(drag), mismatch=tuple(mismatch), sway=gamma)
 
 
@@ -212,7 +238,7 @@ def computed_bounds(loop: _Loop, jump_tick: Sequence[float], jump_period: Sequen
     """
     h = arb(loop.tick)
     out = []
-    for c in range(3):
+    for c in range(len(loop.names)):
         s = loop.sums[c]
         jt, jp = arb(jump_tick[c]), arb(jump_period[c])
         row = []
@@ -226,69 +252,21 @@ def computed_bounds(loop: _Loop, jump_tick: Sequence[float], jump_period: Sequen
     return out
 
 
-def _thrust_peaks(loop: _Loop, box: tuple[float, float, float], gamma: float,
-                  a_bound: Sequence[float], surge: tuple[float, float] | None = None) -> list[float]:
-    """sup|τ_cmd_c| = sup|n̂_c| + m̂_c sup|a| over the velocity box (N, N, N m); ``surge`` (lo, hi) (m/s): the
-    surge over that band instead of |u| <= box[0]."""
-    nu = velocity_box(box[0], gamma, box[1], box[2])
-    if surge is not None:
-        nu = (enclose(surge[0], surge[1]), *nu[1:])
-    forces = channel_forces(loop.nominal, nu)
-    return [upper(abs(forces[c]) + loop.m_hat[c] * arb(a_bound[c])) for c in range(3)]
-
-
-def actuator_authority(params: VehicleParams, v_max: Sequence[float],
-                       surge_floor: float = 0.0) -> tuple[float, float, float]:
-    """(a_u, a_w, a_r): a lower bound of the acceleration each channel delivers against drag in V.
-
-    a_c = (smallest limit over ``surge_floor`` <= |u| <= V_u and Θ − sup|n_c| over V (sway |v| <= γ̄(V)) and Θ)
-    / sup m_c (m/s², m/s², rad/s²): what the thrusters deliver, in either direction, anywhere in V at a commanded
-    surge of at least ``surge_floor`` (m/s; ``limits.u_min``, 0 without one; the corner of V has the largest
-    drag). Negative when the drag (or a fin without speed) wins.
-    """
-    v = _triple("v_max", v_max)
-    gamma = upper(hull_sway_bound(params, v[0], v[2]))
-    if not math.isfinite(gamma):
-        return (-math.inf,) * 3
-    hull = hull_balls(params)
-    forces = channel_forces(hull, velocity_box(v[0], gamma, v[1], v[2]))
-    floor = thrust_floor(params, v[0], surge_floor)
-    masses = channel_masses(hull)
-    return tuple(lower((arb(floor[c]) - abs(forces[c])) / masses[c]) for c in range(3))
-
-
-def rate_authority_conditions(authority: Sequence[float], rate: Sequence[float]) -> list[Condition]:
-    """``rate_authority[c]``: a plan's rate limit ρ_c is something the vehicle can do, ρ_c <= a_c."""
-    units = ("m/s^2", "m/s^2", "rad/s^2")
-    return [Condition(f"rate_authority[{ax}]", f"rho_{ax} <= a_{ax} (acceleration deliverable against drag in V)",
-                      float(rate[c]), float(authority[c]), bool(rate[c] <= authority[c]),
-                      f"a_{ax} = {authority[c]:.4g} {units[c]} over V and the coefficient box")
-            for c, ax in enumerate(_CHANNELS)]
-
-
-def _triple(name: str, value: Any, strict: bool = False) -> tuple[float, float, float]:
-    """Three finite numbers >= 0 (> 0 when ``strict``), else ConfigError naming ``name[i]``."""
-    if isinstance(value, (str, bytes)) or not hasattr(value, "__len__") or len(value) != 3:
-        raise ConfigError(name, "three numbers (u, w, r)", value)
-    check = positive if strict else nonnegative
-    return tuple(check(f"{name}[{i}]", finite(f"{name}[{i}]", x)) for i, x in enumerate(value))
-
-
 def _validate(params: VehicleParams, v_max: Any, tick: Any, period: Any, jump_tick: Any, jump_period: Any,
               rate: Any, max_iterations: Any) -> tuple:
     if not hasattr(params, "loop_bandwidth") or not hasattr(params, "interval"):
         raise ConfigError("params", "a VehicleParams", type(params).__name__)
-    v = _triple("v_max", v_max)
+    v = triple("v_max", v_max)
     h, d = positive("tick", finite("tick", tick)), positive("period", finite("period", period))
     ticks = round(d / h)
     if ticks < 1 or abs(ticks * h - d) > 1e-9 * d:
         raise ConfigError("period", f"a whole number >= 1 of ticks of {h} s", period)
-    jt, jp = _triple("jump_tick", jump_tick), _triple("jump_period", jump_period)
+    jt, jp = triple("jump_tick", jump_tick), triple("jump_period", jump_period)
     for c in range(3):
         if jp[c] < jt[c]:
             raise ConfigError(f"jump_period[{c}]", f">= jump_tick[{c}] = {jt[c]} (the total jump at a period "
                               "boundary)", jp[c])
-    rho = None if rate is None else _triple("rate", rate)
+    rho = None if rate is None else triple("rate", rate)
     if isinstance(max_iterations, bool) or not isinstance(max_iterations, int) or max_iterations < 1:
         raise ConfigError("max_iterations", "an integer >= 1", max_iterations)
     point_time_constant(params)
@@ -325,13 +303,15 @@ def velocity_loop_bound(params: VehicleParams, *, v_max: Sequence[float], tick: 
     """
     v, h, d, ticks, jt, jp, rho = _validate(params, v_max, tick, period, jump_tick, jump_period, rate,
                                             max_iterations)
-    first = v if first_command is None else tuple(min(f, x) for f, x in zip(_triple("first_command",
+    first = v if first_command is None else tuple(min(f, x) for f, x in zip(triple("first_command",
                                                                                       first_command), v))
     loop = _loop_of(params, v, h, ticks)
     start = start_bounds(loop, first)
     floor_u = nonnegative("surge_floor", surge_floor)
-    authority = actuator_authority(params, v, floor_u)
-    base = computed_bounds(loop, jt, jp)
+    # the sway channel's command is 0 at all times: it never jumps
+    jt_int, jp_int = _internal(jt, 0.0, loop.lateral), _internal(jp, 0.0, loop.lateral)
+    n = len(loop.names)
+    base = computed_bounds(loop, jt_int, jp_int)
     assumed = [[x * (1 + LOOP_INFLATION) + 1e-12 for x in row] for row in base]
     found, k, computed, inputs, growth = False, 0, base, None, None
     stop = f"no closing after {max_iterations} rounds"
@@ -339,88 +319,36 @@ def velocity_loop_bound(params: VehicleParams, *, v_max: Sequence[float], tick: 
         k += 1
         inputs = input_bounds(loop, [r[0] for r in assumed], [r[2] for r in assumed], [r[3] for r in assumed],
                               start)
-        computed = computed_bounds(loop, jt, jp, inputs)
-        found = all(computed[c][o] < assumed[c][o] for c in range(3) for o in range(4))
+        computed = computed_bounds(loop, jt_int, jp_int, inputs)
+        found = all(computed[c][o] < assumed[c][o] for c in range(n) for o in range(4))
         if growth is None:
-            growth = [[computed[c][o] / assumed[c][o] for o in range(4)] for c in range(3)]
+            growth = [[computed[c][o] / assumed[c][o] for o in range(4)] for c in range(n)]
         if not found:
             grown = [[x * (1 + LOOP_INFLATION) for x in row] for row in computed]
             if not all(math.isfinite(x) for row in grown for x in row):
                 stop = f"the bounds overflow after {k} rounds"
                 break
             assumed = [[max(a, g) for a, g in zip(ra, rg)] for ra, rg in zip(assumed, grown)]
+    sway = computed[1][0] if loop.lateral and found else None
+    authority = actuator_authority(params, v, floor_u, sway if loop.lateral else None) \
+        if found or not loop.lateral else (-math.inf,) * 3
     return _result(loop, params, (v, h, d, jt, jp, first, floor_u), assumed, computed, inputs, authority,
-                   (k, max_iterations), found, rho, _why_open(found, stop, growth))
+                   (k, max_iterations), found, rho, _why_open(loop, found, stop, growth))
 
 
 #: What the fixed point bounds, per channel, in the order of :func:`computed_bounds`' rows.
 _QUANTITIES = ("sup|e|", "sup|a|", "sup|z|", "sup|ydot|")
 
 
-def _why_open(found: bool, stop: str, growth: list | None) -> str:
+def _why_open(loop: _Loop, found: bool, stop: str, growth: list | None) -> str:
     """The root cause of a fixed point that did not close (empty when it closed), in words an owner can act on."""
     if found or growth is None:
         return ""
-    c, o = max(((c, o) for c in range(3) for o in range(4)), key=lambda co: growth[co[0]][co[1]])
+    c, o = max(((c, o) for c in range(len(growth)) for o in range(4)), key=lambda co: growth[co[0]][co[1]])
     return (f"diverged ({stop}); the first round multiplied the bounds by up to {growth[c][o]:.3g} "
-            f"({_QUANTITIES[o]} of channel {_CHANNELS[c]}): the small-gain loop's gain is not below 1 here, the "
+            f"({_QUANTITIES[o]} of channel {loop.names[c]}): the small-gain loop's gain is not below 1 here, the "
             "coefficient mismatch entering it as an input that grows with E (docs/plant.md, section 4); a narrower "
             "coefficient box, a smaller V or smaller command jumps (a gentler backup, a lower plan rate) lower it")
-
-
-def _saturation(loop: _Loop, params: VehicleParams, v: Sequence[float], assumed: list,
-                closed: bool = True, surge_floor: float = 0.0) -> list[Condition]:
-    """``loop_saturation[X|Z|N]``: sup|n̂_c| + m̂_c Â_c < the smallest limit over |u| <= V_u + E_u and Θ (and
-    u >= ``surge_floor`` − E_u, the relative surge under a minimum surge command); not evaluated (no number)
-    when the fixed point did not ``closed`` (its assumed bounds mean nothing then)."""
-    box, sway = loop.box([r[0] for r in assumed])
-    a_assumed = [r[1] for r in assumed]
-    finite_box = all(math.isfinite(x) for x in (*box, sway, *a_assumed))
-    u_bar = box[0] if finite_box else v[0]
-    u_low = max(0.0, lower(arb(surge_floor) - arb(assumed[0][0]))) if finite_box else 0.0
-    if finite_box and 0.0 < u_low < u_bar:
-        peaks, floor = _banded(loop, params, box, sway, a_assumed, (u_low, u_bar))
-    else:
-        floor = thrust_floor(params, u_bar, u_low)
-        peaks = _thrust_peaks(loop, box, sway, a_assumed) if finite_box else [math.inf] * 3
-    conds = []
-    for c, ch in enumerate(_FORCES):
-        why = (f"sup|n_hat_{_CHANNELS[c]}| + m_hat sup|a| over {u_low:.4g} <= |u| <= {u_bar:.4g} m/s against "
-               f"{floor[c]:.4g}" + (f" (the worst of {SURGE_BANDS} surge bands, each against its own limit)"
-                                    if 0.0 < u_low < u_bar else "")
-               if floor[c] > 0 else
-               f"{_ACTUATOR[ch]} is 0 at u = 0, inside the velocity box |u| <= {u_bar:.4g} m/s: a fin's lift grows "
-               "with u², so this vehicle cannot produce it at rest (a minimum surge, limits.u_min, above the loop's "
-               "E_u keeps the vehicle off u = 0)")
-        peak = peaks[c]
-        if not closed:  # the assumed bounds of a fixed point that did not close mean nothing: no number
-            peak, why = None, "not evaluated: the loop bound did not close (root cause: loop_fixed_point)" + (
-                "" if floor[c] > 0 else f"; and {why}")
-        conds.append(Condition(f"loop_saturation[{ch}]", f"sup|tau_cmd_{ch}| < smallest {ch} limit over the box",
-                               peak, floor[c], bool(peak is not None and peak < floor[c]), why))
-    return conds
-
-
-#: Surge bands of the fins' condition under a minimum surge (:func:`_banded`).
-SURGE_BANDS = 8
-
-
-def _banded(loop: _Loop, params: VehicleParams, box: tuple[float, float, float], sway: float,
-            a_assumed: Sequence[float], surge: tuple[float, float]) -> tuple[list[float], list[float]]:
-    """(need, limit) per channel of the band where need/limit is largest: the relative surge [lo, hi] (m/s) cut into
-    :data:`SURGE_BANDS` bands, in each the need sup|n̂_c| + m̂_c Â_c over the band against the smallest limit over
-    it (a fin's, ∝ u², at the band's slow end): the need and the force both grow with the surge, so a band is
-    compared with its own force, not with the slowest band's (the condition holds iff it holds in every band)."""
-    edges = np.linspace(surge[0], surge[1], SURGE_BANDS + 1)
-    worst: list[tuple[float, float, float]] = [(-math.inf, math.inf, math.inf)] * 3
-    for a, b in zip(edges[:-1], edges[1:]):
-        need = _thrust_peaks(loop, box, sway, a_assumed, surge=(float(a), float(b)))
-        limit = thrust_floor(params, float(b), float(a))
-        for c in range(3):
-            ratio = need[c] / limit[c] if limit[c] > 0 else math.inf
-            if ratio > worst[c][0]:
-                worst[c] = (ratio, need[c], limit[c])
-    return [w[1] for w in worst], [w[2] for w in worst]
 
 
 def _result(loop: _Loop, params: VehicleParams, given: tuple, assumed: list, computed: list, inputs: Inputs | None,
@@ -428,31 +356,41 @@ def _result(loop: _Loop, params: VehicleParams, given: tuple, assumed: list, com
             why_open: str = "") -> LoopBound:
     """The :class:`LoopBound` with every condition of the theorem (bounds +inf when not certified)."""
     v, h, d, jt, jp, first, floor_u = given
-    error = tuple(r[0] for r in computed) if found else (math.inf,) * 3
-    gamma = upper(hull_sway_bound(params, upper(arb(v[0]) + arb(error[0])), upper(arb(v[2]) + arb(error[2])))) \
-        if found else math.inf
+    lat = loop.lateral
+    error = _external(tuple(r[0] for r in computed), lat) if found else (math.inf,) * 3
+    if not found:
+        gamma = math.inf
+    elif lat:  # the sway loop's own error bound E_v (its command is 0)
+        gamma = computed[1][0]
+    else:
+        gamma = upper(hull_sway_bound(params, upper(arb(v[0]) + arb(error[0])), upper(arb(v[2]) + arb(error[2]))))
     conds = [Condition(f"loop_stable[{ax}]", "||A_d^K||_inf < 1 (the sampled loop is stable; geometric tail)",
                        s.rho, 1.0, s.stable, f"K = {s.terms} ticks summed term by term, A_d = exp(A h) in Arb, "
-                       f"lambda_{ax} = {lam:.4g} 1/s") for ax, s, lam in zip(_CHANNELS, loop.sums, loop.slope)]
-    ratio = max(computed[c][o] / assumed[c][o] for c in range(3) for o in range(4)) if loop.stable else None
+                       f"lambda_{ax} = {lam:.4g} 1/s") for ax, s, lam in zip(loop.names, loop.sums, loop.slope)]
+    ratio = max(computed[c][o] / assumed[c][o] for c in range(len(loop.names)) for o in range(4)) \
+        if loop.stable else None
     if ratio is not None and not math.isfinite(ratio):
         ratio = None
     conds.append(Condition("loop_fixed_point", "max computed/assumed of (sup|e|, sup|a|, sup|z|, sup|ydot|) < 1 "
                            "(first exit)", ratio, 1.0, found, f"{iterations[0]} iterations (at most {iterations[1]})"
                            + (f"; {why_open}" if why_open else "")))
-    conds += _saturation(loop, params, v, assumed, closed=found or not loop.stable, surge_floor=floor_u)
-    conds.append(Condition("loop_sway", "gamma_bar finite (sway damped over the box)", gamma, None,
-                           math.isfinite(gamma), "hull_sway_bound over |u| <= V_u + E_u, |r| <= V_r + E_r and Θ"
-                           if found else "not evaluated: no loop bound E (root cause: loop_fixed_point)"))
+    conds += saturation_conditions(loop, params, v, assumed, closed=found or not loop.stable, surge_floor=floor_u)
+    how = ("E_v of the sway loop (lateral thrust regulates the sway to 0)" if lat else
+           "hull_sway_bound over |u| <= V_u + E_u, |r| <= V_r + E_r and Θ")
+    conds.append(Condition("loop_sway", "gamma_bar finite (sway damped over the box)" if not lat else
+                           "gamma_bar = E_v finite (the sway loop's error bound)", gamma, None, math.isfinite(gamma),
+                           how if found else "not evaluated: no loop bound E (root cause: loop_fixed_point)"))
     if rho is not None:
         conds += rate_authority_conditions(authority, rho)
     failed = [c.condition for c in conds if c.ok is not True]
     inf = (math.inf,) * 3
-    pick = (lambda o: tuple(r[o] for r in computed) if found else inf)
+    pick = (lambda o: _external(tuple(r[o] for r in computed), lat) if found else inf)
+    per = (lambda x: _external(x, lat) if inputs else inf)
     return LoopBound(v_max=v, tick=h, period=d, jump_tick=jt, jump_period=jp, error=error, sway=gamma,
                      a_bound=pick(1), z_bound=pick(2), accel_bound=pick(3), assumed=tuple(tuple(r) for r in assumed),
-                     w_start=inputs.start if inputs else inf, w_rate=inputs.rate if inputs else inf,
-                     w_n=inputs.drag if inputs else inf, gains=loop.sums, slope=loop.slope,
+                     w_start=per(inputs.start if inputs else None), w_rate=per(inputs.rate if inputs else None),
+                     w_n=per(inputs.drag if inputs else None), gains=loop.sums, slope=loop.slope,
+                     channels=loop.names,
                      authority=tuple(authority),
                      thrust_peak=tuple(c.lhs if c.lhs is not None else math.inf for c in conds
                                        if c.condition.startswith("loop_saturation")),

@@ -22,6 +22,9 @@ blending backup starts from that command. The start is then bounded over |ν(0)|
 (``first_command`` of the loop bound, u_min = 0 without a minimum surge); for a law that does not blend, over V.
 Under a minimum surge the fins' authority is taken over u >= u_min − E_u (``surge_floor``, :func:`surge_floor_of`).
 
+A vehicle with lateral thrust regulates its sway by a loop of its own (command 0, never jumping): its error bound
+E_v is the sway γ̄ in ω̄, assumed like E (``assumed_sway``) and checked the same way (E_v < its assumption).
+
 E in turn enters ω̄ (:func:`verify.theorem.design.disturbance_bounds`), the tube, the hand-over margins and the
 backup's proof, which fix the backup's command rate. :func:`solve_dynamic` closes this loop as a checked
 fixed point: it *assumes* a bound E_a, derives everything from it (the backup designed so that its command
@@ -87,6 +90,8 @@ class DynamicSolution:
         The velocity loop's bound computed from the jump bounds of the last round.
     assumed : (3,) floats
         E_a (m/s, m/s, rad/s): the bound ω̄, the tube and the backup were derived with.
+    assumed_sway : float or None
+        With lateral thrust, the sway loop's assumed bound (m/s), ω̄'s γ̄; None: the free hull's γ̄.
     dist : DisturbanceBounds
         ω̄ with E_a.
     designs, best, safe, backup
@@ -103,6 +108,7 @@ class DynamicSolution:
     safe: Design | None
     backup: BackupCertificate
     conditions: tuple[Condition, ...]
+    assumed_sway: float | None = None
 
 
 def plan_jumps(scenario: Scenario) -> tuple[float, float, float]:
@@ -134,24 +140,32 @@ def _kappa_condition(sigma: float) -> Condition:
 
 
 def _tiers_at(scenario: Scenario, region: Region, gains: GainBounds, sigmas: tuple[float, ...],
-              assumed: tuple[float, float, float]):
-    dist = disturbance_bounds(scenario, loop_error=assumed)
-    return (dist, *solve_tiers(scenario, region, gains, sigmas, dist, fits=_fits(scenario, dist, assumed)))
+              assumed: tuple[float, float, float], sway: float | None = None):
+    dist = disturbance_bounds(scenario, loop_error=assumed, loop_sway=sway)
+    return (dist, *solve_tiers(scenario, region, gains, sigmas, dist, fits=_fits(scenario, dist, assumed, sway)))
 
 
-def _ratio(error: tuple[float, ...], assumed: tuple[float, float, float]) -> float:
-    """max over u, w, r of E / E_a (inf when E is not finite or E_a is 0 with E > 0)."""
+def _ratio(error: tuple[float, ...], assumed: tuple[float, ...]) -> float:
+    """max over the channels of E / E_a (inf when E is not finite or E_a is 0 with E > 0)."""
     return max((e / a if a > 0 else (math.inf if e > 0 else 0.0)) for e, a in zip(error, assumed))
 
 
-def _fits(scenario: Scenario, dist: DisturbanceBounds, assumed: tuple[float, float, float]) -> Fits:
+def _loop_ratio(loop: LoopBound, assumed: tuple[float, float, float], sway: float | None) -> float:
+    """:func:`_ratio` over u, w, r and, with a sway loop (``sway`` its assumed bound), E_v / its assumption."""
+    if sway is None:
+        return _ratio(loop.error, assumed)
+    return _ratio((*loop.error, loop.sway), (*assumed, sway))
+
+
+def _fits(scenario: Scenario, dist: DisturbanceBounds, assumed: tuple[float, float, float],
+          sway: float | None = None) -> Fits:
     """``fits(law, safe)`` for :func:`verify.backup.design_backup`: E / E_a of the loop bound the candidate's
     command rate gives (inf when the loop bound fails). The scenario's part is read once, not per candidate."""
     fixed = _LoopInputs.of(scenario)
 
     def ratio(law: BackupLaw, safe: SafeSet) -> float:
         loop = fixed.loop(law, safe, dist, assumed)
-        return _ratio(loop.error, assumed) if loop.certified else math.inf
+        return _loop_ratio(loop, assumed, sway) if loop.certified else math.inf
     return ratio
 
 
@@ -214,12 +228,14 @@ def _loop_at(scenario: Scenario, law: BackupLaw, safe: SafeSet, dist: Disturbanc
     return _LoopInputs.of(scenario).loop(law, safe, dist, assumed)
 
 
-def _consistent(loop: LoopBound, assumed: tuple[float, float, float]) -> Condition:
-    ratio = _ratio(loop.error, assumed)
+def _consistent(loop: LoopBound, assumed: tuple[float, float, float], sway: float | None = None) -> Condition:
+    ratio = _loop_ratio(loop, assumed, sway)
     ok = bool(loop.certified and ratio < 1.0)
+    lateral = "" if sway is None else f"; sway loop E_v = {loop.sway:.6g}, assumed {sway:.6g}"
     return Condition("loop_consistent", "E derived from the jump bounds < E assumed by omega_bar, the tube and the "
-                     "backup (largest ratio over u, w, r)", ratio if math.isfinite(ratio) else None, 1.0, ok,
-                     f"E = {[round(x, 6) for x in loop.error]}, assumed {[round(x, 6) for x in assumed]}")
+                     "backup (largest ratio over u, w, r" + ("" if sway is None else " and the sway loop") + ")",
+                     ratio if math.isfinite(ratio) else None, 1.0, ok,
+                     f"E = {[round(x, 6) for x in loop.error]}, assumed {[round(x, 6) for x in assumed]}{lateral}")
 
 
 def _plans_only(scenario: Scenario) -> LoopBound:
@@ -238,10 +254,16 @@ def _first_assumption(first: LoopBound) -> tuple[float, float, float] | None:
     return assumed if all(math.isfinite(a) for a in assumed) else None
 
 
+def _first_sway(scenario: Scenario, first: LoopBound) -> float | None:
+    """The sway loop's first assumed bound (:data:`_INFLATE` × the plans-only E_v); None without lateral thrust."""
+    return _INFLATE * first.sway if scenario.plant.params.lateral else None
+
+
 def _plant_conditions(scenario: Scenario, loop: LoopBound, assumed: tuple[float, float, float],
-                      sigma: float) -> tuple[Condition, ...]:
+                      sigma: float, sway: float | None = None) -> tuple[Condition, ...]:
     """The loop's conditions, ``loop_consistent``, ``limits_rate`` / ``rate_authority[c]`` and ``loop_kappa``."""
-    return (*loop.conditions, _consistent(loop, assumed), *_rate_conditions(scenario, loop), _kappa_condition(sigma))
+    return (*loop.conditions, _consistent(loop, assumed, sway), *_rate_conditions(scenario, loop),
+            _kappa_condition(sigma))
 
 
 @dataclass(frozen=True)
@@ -265,10 +287,11 @@ class LawLoop:
     dist: DisturbanceBounds
     loop: LoopBound
     conditions: tuple[Condition, ...]
+    assumed_sway: float | None = None
 
 
 def loop_for_law(scenario: Scenario, law: BackupLaw, safe: SafeSet, assumed: tuple[float, float, float],
-                 sigma: float) -> LawLoop:
+                 sigma: float, assumed_sway: float | None = None) -> LawLoop:
     """The fixed point's check for a *given* backup law and safe set at the assumed E_a (no design).
 
     ω̄ = :func:`verify.theorem.design.disturbance_bounds` with E_a; the backup's per-tick jumps from the law's
@@ -288,14 +311,22 @@ def loop_for_law(scenario: Scenario, law: BackupLaw, safe: SafeSet, assumed: tup
         E_a (m/s, m/s, rad/s), finite and >= 0.
     sigma : float
         σ (1/s) of the design (the dynamic plant requires 0).
+    assumed_sway : float, optional
+        The sway loop's assumed bound (m/s): required with lateral thrust, refused without.
     """
     if len(tuple(assumed)) != 3:
         raise ConfigError("assumed", "three loop-error bounds (E_u, E_w, E_r)", assumed)
     e_a = tuple(nonnegative(f"assumed[{i}]", a) for i, a in enumerate(assumed))
-    dist = disturbance_bounds(scenario, loop_error=e_a)
+    lateral = scenario.plant.params.lateral
+    if lateral != (assumed_sway is not None):
+        raise ConfigError("assumed_sway", "the sway loop's assumed bound (m/s) with lateral thrust, None without",
+                          assumed_sway)
+    sway = None if assumed_sway is None else nonnegative("assumed_sway", assumed_sway)
+    dist = disturbance_bounds(scenario, loop_error=e_a, loop_sway=sway)
     first = _plans_only(scenario)
     loop = first if _first_assumption(first) is None else _LoopInputs.of(scenario).loop(law, safe, dist, e_a)
-    return LawLoop(assumed=e_a, dist=dist, loop=loop, conditions=_plant_conditions(scenario, loop, e_a, sigma))
+    return LawLoop(assumed=e_a, dist=dist, loop=loop, assumed_sway=sway,
+                   conditions=_plant_conditions(scenario, loop, e_a, sigma, sway))
 
 
 #: The last fixed points solved in this process, by their inputs (:func:`solve_dynamic` is a pure function of them;
@@ -340,18 +371,23 @@ def _solve_dynamic(scenario: Scenario, region: Region, gains: GainBounds,
     """:func:`solve_dynamic` without the memo."""
     first = _plans_only(scenario)
     assumed = _first_assumption(first)
+    sway = _first_sway(scenario, first)
     if assumed is None:  # the plans' jumps alone already break the loop: report with a finite stand-in
         v_max = tuple(float(x) for x in scenario.limits.vector)
         assumed = tuple(e if math.isfinite(e) else x for e, x in zip(first.error, v_max))
-        dist, designs, best, safe, backup = _tiers_at(scenario, region, gains, sigmas, assumed)
+        sway = None if sway is None else (sway if math.isfinite(sway) else v_max[0])
+        dist, designs, best, safe, backup = _tiers_at(scenario, region, gains, sigmas, assumed, sway)
         return DynamicSolution(loop=first, assumed=assumed, dist=dist, designs=designs, best=best, safe=safe,
-                               backup=backup, conditions=_plant_conditions(scenario, first, assumed, best.sigma))
+                               backup=backup, assumed_sway=sway,
+                               conditions=_plant_conditions(scenario, first, assumed, best.sigma, sway))
     fixed = _LoopInputs.of(scenario)
     for rounds in range(1, FIXED_POINT_ROUNDS + 1):
-        dist, designs, best, safe, backup = _tiers_at(scenario, region, gains, sigmas, assumed)
+        dist, designs, best, safe, backup = _tiers_at(scenario, region, gains, sigmas, assumed, sway)
         loop = fixed.loop(backup.law, backup.safe_set, dist, assumed)
-        if not loop.certified or all(e < a for e, a in zip(loop.error, assumed)) or rounds == FIXED_POINT_ROUNDS:
+        if not loop.certified or _loop_ratio(loop, assumed, sway) < 1.0 or rounds == FIXED_POINT_ROUNDS:
             break  # the last round keeps its E_a: raising it now would compare E with a bound ω̄ never used
         assumed = tuple(max(a, _STEP * e) for a, e in zip(assumed, loop.error))
+        sway = None if sway is None else max(sway, _STEP * loop.sway)
     return DynamicSolution(loop=loop, assumed=assumed, dist=dist, designs=designs, best=best, safe=safe,
-                           backup=backup, conditions=_plant_conditions(scenario, loop, assumed, best.sigma))
+                           backup=backup, assumed_sway=sway,
+                           conditions=_plant_conditions(scenario, loop, assumed, best.sigma, sway))

@@ -9,7 +9,9 @@ coefficients (m11, m22, m24, X_u, X_u|u|, ...): so n(ν; θ̂) − n(ν; θ) = n
 :func:`channel_mismatch` evaluates with the difference balls, free of the dependency problem.
 
 Channels c ∈ (u, w, r): m_u = m11, n_u = n1; m_w = m33, n_w = n3; yaw with the sway row eliminated
-(m22 v̇ + m24 ṙ + n2 = 0): m_r = m44 − m24 m42 / m22, n_r = n4 − (m42 / m22) n2.
+(m22 v̇ + m24 ṙ + n2 = 0): m_r = m44 − m24 m42 / m22, n_r = n4 − (m42 / m22) n2. A vehicle with lateral
+thrust (``lateral``: its sway regulated by a loop of its own, M diagonal in sway and yaw, m24 = m42 = 0) has a
+fourth channel, sway: m_v = m22, n_v = n2, inserted at index 1, channels (u, v, w, r); its yaw formula is then n4.
 """
 
 from __future__ import annotations
@@ -95,44 +97,50 @@ def body_force_gradient(c: Mapping[str, arb], nu: Sequence[arb]) -> tuple[tuple[
     return g1, g2, g3, g4
 
 
-def channel_forces(c: Mapping[str, arb], nu: Sequence[arb]) -> tuple[arb, arb, arb]:
-    """(n_u, n_w, n_r) = (n1, n3, n4 − (m42/m22) n2) (N, N, N m)."""
+def _with_sway(channels: tuple, sway: object, lateral: bool) -> tuple:
+    """``channels`` (u, w, r), with ``sway`` inserted at index 1 when ``lateral``."""
+    return (channels[0], sway, channels[1], channels[2]) if lateral else channels
+
+
+def channel_forces(c: Mapping[str, arb], nu: Sequence[arb], lateral: bool = False) -> tuple[arb, ...]:
+    """(n_u, n_w, n_r) = (n1, n3, n4 − (m42/m22) n2) (N, N, N m); ``lateral``: (n_u, n2, n_w, n_r)."""
     n1, n2, n3, n4 = arb_body_forces(c, nu)
-    return n1, n3, n4 - c["m42"] / c["m22"] * n2
+    return _with_sway((n1, n3, n4 - c["m42"] / c["m22"] * n2), n2, lateral)
 
 
-def channel_gradient(c: Mapping[str, arb], nu: Sequence[arb]) -> tuple[tuple[arb, ...], ...]:
-    """∂(n_u, n_w, n_r)/∂(u, v, w, r)."""
+def channel_gradient(c: Mapping[str, arb], nu: Sequence[arb], lateral: bool = False) -> tuple[tuple[arb, ...], ...]:
+    """∂(n_u, n_w, n_r)/∂(u, v, w, r) (``lateral``: with the sway row ∂n2/∂ν at index 1)."""
     g1, g2, g3, g4 = body_force_gradient(c, nu)
     k = c["m42"] / c["m22"]
-    return g1, g3, tuple(a - k * b for a, b in zip(g4, g2))
+    return _with_sway((g1, g3, tuple(a - k * b for a, b in zip(g4, g2))), g2, lateral)
 
 
-def channel_masses(c: Mapping[str, arb]) -> tuple[arb, arb, arb]:
-    """(m_u, m_w, m_r) = (m11, m33, m44 − m24 m42 / m22) (kg, kg, kg m²)."""
-    return c["m11"], c["m33"], c["m44"] - c["m24"] * c["m42"] / c["m22"]
+def channel_masses(c: Mapping[str, arb], lateral: bool = False) -> tuple[arb, ...]:
+    """(m_u, m_w, m_r) = (m11, m33, m44 − m24 m42 / m22) (kg, kg, kg m²); ``lateral``: with m22 at index 1."""
+    return _with_sway((c["m11"], c["m33"], c["m44"] - c["m24"] * c["m42"] / c["m22"]), c["m22"], lateral)
 
 
-def channel_mismatch(nominal: Mapping[str, arb], hull: Mapping[str, arb], nu: Sequence[arb]) -> tuple[arb, ...]:
+def channel_mismatch(nominal: Mapping[str, arb], hull: Mapping[str, arb], nu: Sequence[arb],
+                     lateral: bool = False) -> tuple[arb, ...]:
     """d_c = n̂_c(ν) − n_c(ν; θ) over ν and θ ∈ Θ, by linearity: n(ν; θ̂) − n(ν; θ) = n(ν; θ̂ − θ).
 
-    Yaw: n̂_r − n_r = Δn4 − k̂ Δn2 − (k̂ − k) n2(ν; θ), k = m42/m22.
+    Yaw: n̂_r − n_r = Δn4 − k̂ Δn2 − (k̂ − k) n2(ν; θ), k = m42/m22. ``lateral``: with Δn2 at index 1.
     """
     delta = {key: nominal[key] - hull[key] for key in nominal}
     d1, d2, d3, d4 = arb_body_forces(delta, nu)
     k_hat, k = nominal["m42"] / nominal["m22"], hull["m42"] / hull["m22"]
     n2 = arb_body_forces(hull, nu)[1]
-    return d1, d3, d4 - k_hat * d2 - (k_hat - k) * n2
+    return _with_sway((d1, d3, d4 - k_hat * d2 - (k_hat - k) * n2), d2, lateral)
 
 
 def channel_mismatch_gradient(nominal: Mapping[str, arb], hull: Mapping[str, arb],
-                              nu: Sequence[arb]) -> tuple[tuple[arb, ...], ...]:
+                              nu: Sequence[arb], lateral: bool = False) -> tuple[tuple[arb, ...], ...]:
     """∂d_c/∂(u, v, w, r) of :func:`channel_mismatch`, by the same linearity (the gradient is linear in θ too)."""
     delta = {key: nominal[key] - hull[key] for key in nominal}
     g1, g2, g3, g4 = body_force_gradient(delta, nu)
     k_hat, k = nominal["m42"] / nominal["m22"], hull["m42"] / hull["m22"]
     t2 = body_force_gradient(hull, nu)[1]
-    return g1, g3, tuple(a - k_hat * b - (k_hat - k) * t for a, b, t in zip(g4, g2, t2))
+    return _with_sway((g1, g3, tuple(a - k_hat * b - (k_hat - k) * t for a, b, t in zip(g4, g2, t2))), g2, lateral)
 
 
 def velocity_box(u: float, v: float, w: float, r: float) -> tuple[arb, arb, arb, arb]:
@@ -140,12 +148,15 @@ def velocity_box(u: float, v: float, w: float, r: float) -> tuple[arb, arb, arb,
     return tuple(enclose(-x, x) for x in (u, v, w, r))
 
 
-def thrust_floor(params: VehicleParams, u_abs_max: float, u_abs_min: float = 0.0) -> tuple[float, float, float]:
+def thrust_floor(params: VehicleParams, u_abs_max: float, u_abs_min: float = 0.0,
+                 lateral: bool = False) -> tuple[float, ...]:
     """Smallest (X, Z, N) limit over ``u_abs_min`` <= |u| <= ``u_abs_max`` (m/s) and Θ:
-    ``params.thrust_limit_floor`` or the limits (a fin's force grows with u², so a surge floor gives it one)."""
+    ``params.thrust_limit_floor`` or the limits (a fin's force grows with u², so a surge floor gives it one);
+    ``lateral``: (X, Y, Z, N), Y the smallest lateral limit over Θ (N)."""
     floor = getattr(params, "thrust_limit_floor", None)
     limits = floor(u_abs_max, min(max(u_abs_min, 0.0), u_abs_max)) if callable(floor) else params.thrust_limits
-    return tuple(float(x) for x in limits)
+    out = tuple(float(x) for x in limits)
+    return _with_sway(out, float(params.interval("Y_max")[0]), lateral)
 
 
 def point_time_constant(params: VehicleParams) -> float:

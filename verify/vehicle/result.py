@@ -15,7 +15,7 @@ from verify.theorem.design import Condition
 from verify.vehicle.response import ResponseSums
 from verify.kernel.parts import block, bound, integer, item, number, numbers, text
 
-__all__ = ["LoopBound"]
+__all__ = ["LoopBound", "CHANNEL_SETS"]
 
 _ROWS = ("e", "a", "z", "ydot")
 _INPUTS = ("jump", "w_dot", "w_n")
@@ -37,10 +37,14 @@ def _sums_from_dict(d: Any, where: str) -> ResponseSums:
                         rho=bound(d, "rho", where), terms=integer(d, "terms", where))
 
 
-def _gains_from(v: Any, where: str) -> tuple[ResponseSums, ...]:
-    """Three :class:`ResponseSums` (u, w, r)."""
-    if not isinstance(v, list) or len(v) != 3:
-        raise ConfigError(where, "a list of 3 response sums (u, w, r)", v)
+#: The loop's channels: (u, w, r), or (u, v, w, r) with a sway loop (lateral thrust).
+CHANNEL_SETS = ("uwr", "uvwr")
+
+
+def _gains_from(v: Any, where: str, count: int) -> tuple[ResponseSums, ...]:
+    """``count`` :class:`ResponseSums`, one per channel."""
+    if not isinstance(v, list) or len(v) != count:
+        raise ConfigError(where, f"a list of {count} response sums, one per channel", v)
     return tuple(_sums_from_dict(g, f"{where}[{i}]") for i, g in enumerate(v))
 
 
@@ -55,22 +59,23 @@ class LoopBound:
     error : (3,) floats
         E = (E_u, E_w, E_r): sup |u_b − u_c|, |w_b − w_c|, |r_b − r_c| (+inf when not certified).
     sway : float
-        γ̄ (m/s): sup |v_b| over |u| <= V_u + E_u, |r| <= V_r + E_r and the coefficient box.
+        γ̄ (m/s): sup |v_b|; with a sway loop (``channels`` "uvwr") its error bound E_v, else the free hull's sway
+        over |u| <= V_u + E_u, |r| <= V_r + E_r and the coefficient box.
     a_bound, z_bound, accel_bound : (3,) floats
         sup|a| = sup|k_p e + k_i I|, sup|z| = sup|τ − τ_cmd|/m̂ and sup|ẏ| (the body acceleration)
         (m/s², m/s², rad/s²).
-    assumed : (3, 4) floats
-        The assumed (E, sup|a|, sup|z|, sup|ẏ|) per channel the fixed point was checked at.
+    assumed : (n, 4) floats
+        The assumed (E, sup|a|, sup|z|, sup|ẏ|) per channel (n = len(channels)) the fixed point was checked at.
     w_start, w_rate, w_n : (3,) floats
         Input bounds: |W(0)| <= sup|d|/m (m/s²), sup|Ẇ| and sup|ṅ̂/m̂ − λ ẏ| (m/s³).
-    gains : tuple of 3 ResponseSums
+    gains : tuple of n ResponseSums
         The impulse-response sums per channel (rows e, a + W, z, ẏ; inputs jump, Ẇ (and x(0)), w_n).
-    slope : (3,) floats
+    slope : (n,) floats
         λ_c (1/s): the drag slope ∂n̂_c/∂y_c / m̂_c moved into the loop's matrix A.
     authority : (3,) floats
         Acceleration deliverable against drag anywhere in V (m/s², m/s², rad/s²).
-    thrust_peak, thrust_floor : (3,) floats
-        sup|τ_cmd| against the smallest actuator limit over the box (N, N, N m).
+    thrust_peak, thrust_floor : (n,) floats
+        sup|τ_cmd| against the smallest actuator limit over the box (N, [N,] N, N m): X, [Y,] Z, N.
     iterations : int
         Fixed-point iterations used.
     conditions : tuple of Condition
@@ -81,6 +86,8 @@ class LoopBound:
     first_command : (3,) floats or None
         The box |u_c|, |w_c|, |r_c| <= F of the first command the start transient ``w_start`` is taken over
         (m/s, m/s, rad/s; V when no smaller box was given; None only in a file that predates it: read as V).
+    channels : str
+        "uwr", or "uvwr" when a sway loop regulates the sway (lateral thrust): the order of the per-channel fields.
     """
 
     v_max: tuple[float, float, float]
@@ -106,6 +113,7 @@ class LoopBound:
     conditions: tuple[Condition, ...]
     reason: str = ""
     first_command: tuple[float, float, float] | None = None
+    channels: str = "uwr"
 
     @property
     def certified(self) -> bool:
@@ -123,7 +131,7 @@ class LoopBound:
             "v_max", "jump_tick", "jump_period", "error", "a_bound", "z_bound", "accel_bound", "w_start", "w_rate", "w_n",
             "authority",
             "thrust_peak", "thrust_floor")}
-        out.update(tick=self.tick, period=self.period, sway=self.sway, iterations=self.iterations,
+        out.update(tick=self.tick, period=self.period, sway=self.sway, iterations=self.iterations, channels=self.channels,
                    assumed=[list(r) for r in self.assumed], gains=[_sums_to_dict(g) for g in self.gains], slope=list(self.slope), reason=self.reason,
                    certified=self.certified, conditions=[c.to_dict() for c in self.conditions],
                    first_command=None if self.first_command is None else list(self.first_command))
@@ -133,18 +141,22 @@ class LoopBound:
     def from_dict(cls, d: Any, where: str = "certificate.velocity_loop") -> "LoopBound":
         """Inverse of :meth:`to_dict` (ConfigError naming the key)."""
         conds, assumed = item(d, "conditions", where), item(d, "assumed", where)
+        channels = d.get("channels", "uwr") if isinstance(d, dict) else "uwr"
+        if channels not in CHANNEL_SETS:
+            raise ConfigError(f"{where}.channels", f"one of {CHANNEL_SETS}", channels)
+        n = len(channels)
         if not isinstance(conds, list):
             raise ConfigError(f"{where}.conditions", "a list of conditions", type(conds).__name__)
-        if not isinstance(assumed, list) or len(assumed) != 3:
-            raise ConfigError(f"{where}.assumed", "3 rows of 4 numbers", assumed)
+        if not isinstance(assumed, list) or len(assumed) != n:
+            raise ConfigError(f"{where}.assumed", f"{n} rows of 4 numbers", assumed)
         triples = {k: numbers(d, k, where, 3) for k in ("v_max", "jump_tick", "jump_period", "error", "a_bound",
-                                                         "z_bound", "accel_bound", "w_start", "w_rate", "w_n",
-                                                         "thrust_peak", "thrust_floor")}
-        return cls(**triples, authority=numbers(d, "authority", where, 3, none=-math.inf),
+                                                         "z_bound", "accel_bound", "w_start", "w_rate", "w_n")}
+        per_channel = {k: numbers(d, k, where, n) for k in ("thrust_peak", "thrust_floor")}
+        return cls(**triples, **per_channel, channels=channels, authority=numbers(d, "authority", where, 3, none=-math.inf),
                    tick=number(d, "tick", where), period=number(d, "period", where), sway=bound(d, "sway", where),
                    assumed=tuple(numbers({"row": r}, "row", f"{where}.assumed[{i}]", 4) for i, r in enumerate(assumed)),
-                   gains=_gains_from(item(d, "gains", where), f"{where}.gains"),
-                   slope=numbers(d, "slope", where, 3),
+                   gains=_gains_from(item(d, "gains", where), f"{where}.gains", n),
+                   slope=numbers(d, "slope", where, n),
                    iterations=integer(d, "iterations", where), reason=text(d, "reason", where),
                    first_command=None if d.get("first_command") is None else numbers(d, "first_command", where, 3),
                    conditions=tuple(Condition.from_dict(c, f"{where}.conditions[{i}]") for i, c in enumerate(conds)))
@@ -159,7 +171,8 @@ class LoopBound:
                  f"  over V = {tuple(self.v_max)}, jumps {tuple(self.jump_tick)} per tick, {tuple(self.jump_period)} "
                  f"per period (h = {self.tick:g} s, δ = {self.period:g} s)",
                  f"  authority against drag in V: ({a[0]:.4g} m/s², {a[1]:.4g} m/s², {a[2]:.4g} rad/s²)",
-                 f"  thrust peak / limit: X {p[0]:.4g}/{f[0]:.4g} N, Z {p[1]:.4g}/{f[1]:.4g} N, "
-                 f"N {p[2]:.4g}/{f[2]:.4g} N m"]
+                 "  thrust peak / limit: " + ", ".join(
+                     f"{ch} {pk:.4g}/{fl:.4g} {'N m' if ch == 'N' else 'N'}"
+                     for ch, pk, fl in zip("XYZN" if self.channels == "uvwr" else "XZN", p, f))]
         lines += [f"  failed {c.condition}: {c.detail}" for c in self.failures]
         return lines

@@ -1,0 +1,60 @@
+"""What the actuators can do for the velocity loop (verify.vehicle.saturation): saturation and authority."""
+
+from __future__ import annotations
+
+import dataclasses
+
+import pytest
+
+from tubekit.exceptions import ConfigError
+from tubekit.model.vehicle_sets import BLUEROV2_HEAVY
+from tubekit.plant.dynamic import body_forces
+from verify.vehicle.bound import velocity_loop_bound
+from verify.vehicle.saturation import actuator_authority, triple
+
+V, H, TICKS = (0.4, 0.3, 0.5), 0.01, 10
+JT, JP = (0.002, 0.002, 0.002), (0.02, 0.02, 0.02)
+
+
+@pytest.fixture(scope="module")
+def bluerov_point():
+    return velocity_loop_bound(BLUEROV2_HEAVY.nominal, v_max=V, tick=H, period=H * TICKS, jump_tick=JT,
+                               jump_period=JP)
+
+
+@pytest.mark.parametrize("value, match", [
+    ((0.1, 0.2), r"v_max: expected three numbers \(u, w, r\)"),
+    ("abc", r"v_max: expected three numbers"),
+    ((0.1, -0.2, 0.3), r"v_max\[1\]"),
+    ((0.1, float("nan"), 0.3), r"v_max\[1\]"),
+])
+def test_three_numbers_are_validated_by_name(value, match):
+    with pytest.raises(ConfigError, match=match):
+        triple("v_max", value)
+    with pytest.raises(ConfigError, match=match):
+        actuator_authority(BLUEROV2_HEAVY.nominal, value)
+
+
+def test_a_smaller_sway_box_gives_at_least_the_authority_of_the_hulls():
+    """The authority is taken over |v| <= sway: the sway loop's small E_v leaves the yaw channel more than the free
+    hull's γ̄ does (here the Heavy has no sway-yaw drag coupling, so they are equal; surge and heave too)."""
+    p = BLUEROV2_HEAVY.nominal
+    hull = actuator_authority(p, V)
+    tight = actuator_authority(p, V, sway=0.001)
+    assert all(t >= h for t, h in zip(tight, hull))
+    n1, _, _, _ = body_forces(p, (V[0], 0.001, 0.0, V[2]))
+    assert tight[0] <= (p.X_max - abs(n1)) / p.mass_entries[0]
+
+
+def test_the_lateral_thrust_limit_is_the_sway_loops_saturation_condition(bluerov_point):
+    """The sway loop's need sup|n̂_2| + m̂_22 sup|a_v| against Y_max: a lateral limit below the need fails
+    ``loop_saturation[Y]`` by name (the hand check: the Coriolis force m̂_11 u r alone at the box's corner)."""
+    import dataclasses
+    sat = {c.condition: c for c in bluerov_point.conditions}["loop_saturation[Y]"]
+    p = BLUEROV2_HEAVY.nominal
+    coriolis = p.mass_entries[0] * V[0] * V[2]
+    assert sat.ok and coriolis <= sat.lhs < sat.rhs == p.Y_max
+    weak = dataclasses.replace(p, Y_max=0.5 * coriolis)
+    b = velocity_loop_bound(weak, v_max=V, tick=H, period=H * TICKS, jump_tick=JT, jump_period=JP)
+    assert not b.certified
+    assert {c.condition: c.ok for c in b.conditions}["loop_saturation[Y]"] is False

@@ -1,0 +1,147 @@
+"""What the actuators can do for the velocity loop: saturation, the fins over the surge band, the authority.
+
+The conditions ``loop_saturation[X|(Y|)Z|N]`` of :func:`verify.vehicle.bound.velocity_loop_bound` (Step 7 of
+``docs/verify.md`` section 9: the command never saturates, so the loop's linear model holds) and the acceleration
+each channel delivers against drag in V (``rate_authority[c]``: a plan's rate limit is something the vehicle can
+do). Each takes the loop's fixed data (:class:`verify.vehicle.bound._Loop`, read through the protocol
+:class:`_Loop`: its channels, nominal balls and masses).
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any, Mapping, Protocol, Sequence
+
+import numpy as np
+from flint import arb
+
+from tubekit.exceptions import ConfigError
+from tubekit.model.vehicle_params import VehicleParams
+from tubekit.validation import finite, nonnegative, positive
+from verify.kernel.intervals import enclose, lower, upper
+from verify.theorem.design import Condition, hull_sway_bound
+from verify.vehicle.model import channel_forces, channel_masses, hull_balls, thrust_floor, velocity_box
+
+
+
+class _Loop(Protocol):
+    """What these conditions read of the loop's fixed data (:class:`verify.vehicle.bound._Loop`)."""
+
+    lateral: bool
+    names: str
+    forces: str
+    nominal: Mapping[str, arb]
+    m_hat: tuple[arb, ...]
+
+    def box(self, error: Sequence[float]) -> tuple[tuple[float, float, float], float]: ...
+
+__all__ = ["actuator_authority", "rate_authority_conditions", "saturation_conditions", "thrust_peaks",
+           "SURGE_BANDS", "triple"]
+
+_CHANNELS = "uwr"
+_ACTUATOR = {"X": "the surge thrust", "Y": "the lateral thrust", "Z": "the heave force (stern planes on a finned "
+             "vehicle)", "N": "the yaw moment (the rudder on a finned vehicle)"}
+
+
+def thrust_peaks(loop: _Loop, box: tuple[float, float, float], gamma: float,
+                  a_bound: Sequence[float], surge: tuple[float, float] | None = None) -> list[float]:
+    """sup|τ_cmd_c| = sup|n̂_c| + m̂_c sup|a| over the velocity box (N, N, N m); ``surge`` (lo, hi) (m/s): the
+    surge over that band instead of |u| <= box[0]."""
+    nu = velocity_box(box[0], gamma, box[1], box[2])
+    if surge is not None:
+        nu = (enclose(surge[0], surge[1]), *nu[1:])
+    forces = channel_forces(loop.nominal, nu, loop.lateral)
+    return [upper(abs(forces[c]) + loop.m_hat[c] * arb(a_bound[c])) for c in range(len(loop.names))]
+
+
+def actuator_authority(params: VehicleParams, v_max: Sequence[float], surge_floor: float = 0.0,
+                       sway: float | None = None) -> tuple[float, float, float]:
+    """(a_u, a_w, a_r): a lower bound of the acceleration each channel delivers against drag in V.
+
+    a_c = (smallest limit over ``surge_floor`` <= |u| <= V_u and Θ − sup|n_c| over V (sway |v| <= ``sway``, by
+    default γ̄(V) of the free hull) and Θ) / sup m_c (m/s², m/s², rad/s²): what the thrusters deliver, in either
+    direction, anywhere in V at a commanded surge of at least ``surge_floor`` (m/s; ``limits.u_min``, 0 without
+    one; the corner of V has the largest drag). Negative when the drag (or a fin without speed) wins.
+    """
+    v = triple("v_max", v_max)
+    gamma = upper(hull_sway_bound(params, v[0], v[2])) if sway is None else float(sway)
+    if not math.isfinite(gamma):
+        return (-math.inf,) * 3
+    hull = hull_balls(params)
+    forces = channel_forces(hull, velocity_box(v[0], gamma, v[1], v[2]))
+    floor = thrust_floor(params, v[0], surge_floor)
+    masses = channel_masses(hull)
+    return tuple(lower((arb(floor[c]) - abs(forces[c])) / masses[c]) for c in range(3))
+
+
+def rate_authority_conditions(authority: Sequence[float], rate: Sequence[float]) -> list[Condition]:
+    """``rate_authority[c]``: a plan's rate limit ρ_c is something the vehicle can do, ρ_c <= a_c."""
+    units = ("m/s^2", "m/s^2", "rad/s^2")
+    return [Condition(f"rate_authority[{ax}]", f"rho_{ax} <= a_{ax} (acceleration deliverable against drag in V)",
+                      float(rate[c]), float(authority[c]), bool(rate[c] <= authority[c]),
+                      f"a_{ax} = {authority[c]:.4g} {units[c]} over V and the coefficient box")
+            for c, ax in enumerate(_CHANNELS)]
+
+
+def saturation_conditions(loop: _Loop, params: VehicleParams, v: Sequence[float], assumed: list,
+                closed: bool = True, surge_floor: float = 0.0) -> list[Condition]:
+    """``loop_saturation[X|Z|N]``: sup|n̂_c| + m̂_c Â_c < the smallest limit over |u| <= V_u + E_u and Θ (and
+    u >= ``surge_floor`` − E_u, the relative surge under a minimum surge command); not evaluated (no number)
+    when the fixed point did not ``closed`` (its assumed bounds mean nothing then)."""
+    box, sway = loop.box([r[0] for r in assumed])
+    a_assumed = [r[1] for r in assumed]
+    finite_box = all(math.isfinite(x) for x in (*box, sway, *a_assumed))
+    u_bar = box[0] if finite_box else v[0]
+    u_low = max(0.0, lower(arb(surge_floor) - arb(assumed[0][0]))) if finite_box else 0.0
+    if finite_box and 0.0 < u_low < u_bar:
+        peaks, floor = _banded(loop, params, box, sway, a_assumed, (u_low, u_bar))
+    else:
+        floor = thrust_floor(params, u_bar, u_low, loop.lateral)
+        peaks = thrust_peaks(loop, box, sway, a_assumed) if finite_box else [math.inf] * len(loop.names)
+    conds = []
+    for c, ch in enumerate(loop.forces):
+        why = (f"sup|n_hat_{loop.names[c]}| + m_hat sup|a| over {u_low:.4g} <= |u| <= {u_bar:.4g} m/s against "
+               f"{floor[c]:.4g}" + (f" (the worst of {SURGE_BANDS} surge bands, each against its own limit)"
+                                    if 0.0 < u_low < u_bar else "")
+               if floor[c] > 0 else
+               f"{_ACTUATOR[ch]} is 0 at u = 0, inside the velocity box |u| <= {u_bar:.4g} m/s: a fin's lift grows "
+               "with u², so this vehicle cannot produce it at rest (a minimum surge, limits.u_min, above the loop's "
+               "E_u keeps the vehicle off u = 0)")
+        peak = peaks[c]
+        if not closed:  # the assumed bounds of a fixed point that did not close mean nothing: no number
+            peak, why = None, "not evaluated: the loop bound did not close (root cause: loop_fixed_point)" + (
+                "" if floor[c] > 0 else f"; and {why}")
+        conds.append(Condition(f"loop_saturation[{ch}]", f"sup|tau_cmd_{ch}| < smallest {ch} limit over the box",
+                               peak, floor[c], bool(peak is not None and peak < floor[c]), why))
+    return conds
+
+
+#: Surge bands of the fins' condition under a minimum surge (:func:`_banded`).
+SURGE_BANDS = 8
+
+
+def _banded(loop: _Loop, params: VehicleParams, box: tuple[float, float, float], sway: float,
+            a_assumed: Sequence[float], surge: tuple[float, float]) -> tuple[list[float], list[float]]:
+    """(need, limit) per channel of the band where need/limit is largest: the relative surge [lo, hi] (m/s) cut into
+    :data:`SURGE_BANDS` bands, in each the need sup|n̂_c| + m̂_c Â_c over the band against the smallest limit over
+    it (a fin's, ∝ u², at the band's slow end): the need and the force both grow with the surge, so a band is
+    compared with its own force, not with the slowest band's (the condition holds iff it holds in every band)."""
+    edges = np.linspace(surge[0], surge[1], SURGE_BANDS + 1)
+    worst: list[tuple[float, float, float]] = [(-math.inf, math.inf, math.inf)] * len(loop.names)
+    for a, b in zip(edges[:-1], edges[1:]):
+        need = thrust_peaks(loop, box, sway, a_assumed, surge=(float(a), float(b)))
+        limit = thrust_floor(params, float(b), float(a), loop.lateral)
+        for c in range(len(loop.names)):
+            ratio = need[c] / limit[c] if limit[c] > 0 else math.inf
+            if ratio > worst[c][0]:
+                worst[c] = (ratio, need[c], limit[c])
+    return [w[1] for w in worst], [w[2] for w in worst]
+
+
+
+def triple(name: str, value: Any, strict: bool = False) -> tuple[float, float, float]:
+    """Three finite numbers >= 0 (> 0 when ``strict``), else ConfigError naming ``name[i]``."""
+    if isinstance(value, (str, bytes)) or not hasattr(value, "__len__") or len(value) != 3:
+        raise ConfigError(name, "three numbers (u, w, r)", value)
+    check = positive if strict else nonnegative
+    return tuple(check(f"{name}[{i}]", finite(f"{name}[{i}]", x)) for i, x in enumerate(value))

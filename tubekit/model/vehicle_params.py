@@ -187,9 +187,10 @@ class VehicleParams:
         """True when no field is an interval."""
         return not self._intervals  # type: ignore[attr-defined]
 
-    @property
+    @cached_property
     def nominal(self) -> VehicleParams:
-        """Every interval replaced by its midpoint (the controller's model)."""
+        """Every interval replaced by its midpoint (the controller's model); built once per vehicle (the velocity
+        loop's bound reads it at every evaluation)."""
         mid = {n: 0.5 * (self.interval(n)[0] + self.interval(n)[1]) for n in self.interval_fields}
         return replace(self, **mid) if mid else self
 

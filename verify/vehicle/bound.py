@@ -139,6 +139,11 @@ class _Loop:
             loop_matrix(self.k_p, self.k_i, self.lag, lam), [[0, 1, -kp], [1 / ki, 0, 0], [0, 0, -1]],
             [[0, 1, 0], [ki, kp, 0], [0, 0, 1], [ki, kp, 1]], tick=tick, ticks_per_period=ticks)
             for lam in self.slope)
+        h = arb(tick)
+        # the sums as balls, per channel and output row: (jump per tick, jump per period, h Ẇ, h w_n, start peak)
+        self.gain_balls = tuple(tuple((arb(s.tick[o][0]), arb(s.period[o][0]), h * arb(s.tick[o][1]),
+                                       h * arb(s.tick[o][2]), arb(s.peak[o][1])) for o in range(4))
+                                for s in self.sums)
 
     @property
     def stable(self) -> bool:
@@ -236,17 +241,16 @@ def computed_bounds(loop: _Loop, jump_tick: Sequence[float], jump_period: Sequen
     Row o (e, a + W, z, ẏ): J_tick Σ g_J + (J_period − J_tick) max_phase Σ_period g_J + h Σ g_W sup|Ẇ|
     + h Σ g_n sup|w_n| + peak g_W sup|W(0)|; sup|a| adds sup|W|.
     """
-    h = arb(loop.tick)
     out = []
     for c in range(len(loop.names)):
-        s = loop.sums[c]
         jt, jp = arb(jump_tick[c]), arb(jump_period[c])
+        if inputs is not None:
+            rate, drag, start = arb(inputs.rate[c]), arb(inputs.drag[c]), arb(inputs.start[c])
         row = []
-        for o in range(4):
-            x = jt * arb(s.tick[o][0]) + (jp - jt) * arb(s.period[o][0])
+        for o, (g_tick, g_period, h_rate, h_drag, peak) in enumerate(loop.gain_balls[c]):
+            x = jt * g_tick + (jp - jt) * g_period
             if inputs is not None:
-                x += (h * arb(s.tick[o][1]) * arb(inputs.rate[c]) + h * arb(s.tick[o][2]) * arb(inputs.drag[c])
-                      + arb(s.peak[o][1]) * arb(inputs.start[c]) + (arb(inputs.mismatch[c]) if o == 1 else 0))
+                x += h_rate * rate + h_drag * drag + peak * start + (arb(inputs.mismatch[c]) if o == 1 else 0)
             row.append(upper(x))
         out.append(row)
     return out

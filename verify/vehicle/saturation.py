@@ -9,11 +9,12 @@ do). Each takes the loop's fixed data (:class:`verify.vehicle.bound._Loop`, read
 
 from __future__ import annotations
 
+import functools
 import math
 from typing import Any, Mapping, Protocol, Sequence
 
 import numpy as np
-from flint import arb
+from flint import arb, ctx
 
 from tubekit.exceptions import ConfigError
 from tubekit.model.vehicle_params import VehicleParams
@@ -58,13 +59,38 @@ def actuator_authority(params: VehicleParams, v_max: Sequence[float], surge_floo
                        sway: float | None = None) -> tuple[float, float, float]:
     """(a_u, a_w, a_r): a lower bound of the acceleration each channel delivers against drag in V.
 
-    a_c = (smallest limit over ``surge_floor`` <= |u| <= V_u and Θ − sup|n_c| over V (sway |v| <= ``sway``, by
-    default γ̄(V) of the free hull) and Θ) / sup m_c (m/s², m/s², rad/s²): what the thrusters deliver, in either
+    a_c = (smallest limit over ``surge_floor`` <= |u| <= V_u and Θ − sup|n_c| over V (sway |v| <= ``sway`` rounded
+    up to :data:`SWAY_GRID`, by default γ̄(V) of the free hull) and Θ) / sup m_c (m/s², m/s², rad/s²): what the thrusters deliver, in either
     direction, anywhere in V at a commanded surge of at least ``surge_floor`` (m/s; ``limits.u_min``, 0 without
     one; the corner of V has the largest drag). Negative when the drag (or a fin without speed) wins.
     """
     v = triple("v_max", v_max)
-    gamma = upper(hull_sway_bound(params, v[0], v[2])) if sway is None else float(sway)
+    key = (v, float(surge_floor), None if sway is None else _grid_up(float(sway)), ctx.prec)
+    try:
+        return _authority(params, *key)
+    except TypeError:  # an unhashable stand-in for a vehicle: computed without the memo
+        return _authority.__wrapped__(params, *key)
+
+
+#: The sway box of the authority is rounded up to a multiple of this (m/s): a wider box only lowers the bound, and
+#: the fixed point's candidates then share one evaluation.
+SWAY_GRID = 1e-3
+
+
+def _grid_up(sway: float) -> float:
+    """``sway`` rounded up to a multiple of :data:`SWAY_GRID` (never below ``sway``; +inf stays +inf)."""
+    if not math.isfinite(sway):
+        return sway
+    up = math.ceil(sway / SWAY_GRID) * SWAY_GRID
+    return up if up >= sway else math.nextafter(up, math.inf)
+
+
+@functools.lru_cache(maxsize=256)
+def _authority(params: VehicleParams, v: tuple[float, float, float], surge_floor: float, sway: float | None,
+               prec: int) -> tuple[float, float, float]:
+    """:func:`actuator_authority` of validated inputs, memoised (the fixed point asks it once per candidate backup
+    with the same vehicle and box); ``prec`` keys the working precision it is computed at."""
+    gamma = upper(hull_sway_bound(params, v[0], v[2])) if sway is None else sway
     if not math.isfinite(gamma):
         return (-math.inf,) * 3
     hull = hull_balls(params)

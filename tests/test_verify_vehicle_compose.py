@@ -285,3 +285,16 @@ def test_the_sway_loop_is_what_certifies_the_papers_current():
     without = verify.certify(free)
     assert not without.tiers.safe and without.velocity_loop.channels == "uwr"
     assert without.disturbance.gamma > 10 * cert.disturbance.gamma
+
+
+def test_a_target_at_two_tenths_of_a_metre_per_second_certifies_the_safe_tier_on_the_heavy():
+    """examples/bluerov2_brisk.toml: a 0.2 m/s target (2.5x bluerov2_slow's) in 0.05 m/s of current per axis; the
+    safe tier holds, tracking refused only for ``terminal_rate``; the same scenario in 0.1 m/s fails ``keep_up[u]``
+    (the target and the current outrun u_max 0.35 m/s)."""
+    import verify
+    sc = load_scenario("examples/bluerov2_brisk.toml")
+    assert sc.trajectory.rate * sc.trajectory.radius == pytest.approx(0.2)
+    cert = verify.certify(sc)
+    assert cert.tiers.safe and [c.condition for c in cert.failures] == ["terminal_rate"]
+    stronger = verify.certify(sc.with_changes(**{"disturbance.amplitude": (0.1, 0.1, 0.1)}))
+    assert not stronger.tiers.tracking and "keep_up[u]" in [c.condition for c in stronger.failures]

@@ -132,3 +132,12 @@ def test_the_keep_moving_campaign_samples_currents_within_what_its_scenario_cert
     assert spec.base["limits"]["u_min"] == 0.2 and spec.base["controller"]["backup"] == "loiter"
     high = dict(spec.sample)["disturbance.amplitude"].to_dict()["uniform"][1]
     assert all(h <= a for h, a in zip(high, spec.base["disturbance"]["amplitude"]))
+
+
+def test_the_bluerov2_current_campaign_draws_only_the_truth_of_its_certified_box():
+    """examples/bluerov2_current_campaign.toml: one certificate (the paper's current on the Heavy), 200 runs that
+    differ only in the vehicle as simulated, a point of the certificate's coefficient box."""
+    from tubekit.app.campaign_spec import load_spec
+    spec = load_spec(ROOT / "examples" / "bluerov2_current_campaign.toml")
+    assert spec.runs == 200 and [k for k, _ in spec.sample] == ["plant.truth"]
+    assert spec.base["disturbance"]["amplitude"] == [0.1, 0.1, 0.1] and spec.base["plant"]["kind"] == "dynamic"

@@ -2,10 +2,12 @@
 
 from __future__ import annotations
 
+import functools
 import math
 
 import numpy as np
 import pytest
+from hypothesis import given, settings, strategies as st
 from scipy.linalg import expm
 
 from tubekit import paper_scenario
@@ -316,6 +318,40 @@ def test_the_sway_loop_keeps_the_simulated_sway_within_its_bound_at_the_corners_
             free = dataclasses.replace(truth, Y_max=0.0)
             free_settings = PlantSettings("dynamic", vehicle="bluerov2_heavy", overrides={"Y_max": 0.0})
             assert _largest_sway(commands, free_settings, free) > 5 * sway
+
+
+@st.composite
+def _box_points_and_commands(draw):
+    """A truth point of the ±5 % box (each interval coefficient anywhere in its interval) and 150 ticks of commands
+    whose per-tick and per-period jumps stay within the bound's jump model, inside V."""
+    box = _five_percent_box()
+    point = {k: draw(st.floats(*box.interval(k))) for k in box.interval_fields}
+    signs = draw(st.lists(st.tuples(*(st.sampled_from((-1.0, 0.0, 1.0)),) * 3), min_size=150, max_size=150))
+    cmd, commands = [0.0, 0.0, 0.0], []
+    for k, sign in enumerate(signs):
+        jump = JP if k % TICKS == 0 else JT
+        cmd = [min(max(c + j * s, -v), v) for c, j, s, v in zip(cmd, jump, sign, V)]
+        commands.append(tuple(cmd))
+    return box.with_point(point), commands
+
+
+@settings(max_examples=6)
+@given(_box_points_and_commands())
+def test_the_sway_loops_bound_holds_for_any_point_of_the_box_and_any_command_within_the_jump_model(case):
+    """Property: for every truth of the ±5 % box and every command sequence the jump model allows, the simulated
+    sway of the Heavy (its lateral thrust regulating it) stays within the certified E_v, and the three other
+    channels within E."""
+    truth, commands = case
+    b = _sway_loop_bound()
+    settings_ = PlantSettings("dynamic", vehicle="bluerov2_heavy")
+    assert _largest_sway(commands, settings_, truth) <= b.sway
+    assert np.all(_largest_error(commands, plant_settings=settings_, truth=truth) <= np.array(b.error))
+
+
+@functools.lru_cache(maxsize=1)
+def _sway_loop_bound():
+    """The loop bound of the ±5 % box (with the sway loop), computed once."""
+    return velocity_loop_bound(_five_percent_box(), v_max=V, tick=H, period=H * TICKS, jump_tick=JT, jump_period=JP)
 
 
 def test_without_lateral_thrust_the_loop_keeps_three_channels_and_the_hulls_sway():

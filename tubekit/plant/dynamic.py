@@ -136,23 +136,25 @@ class DynamicPlant:
             return float(o[0]), float(o[1]), float(o[2])
         return self._current_model.current_at(t)
 
-    def thrust_command(self, nu: Sequence[float], command: Sequence[float],
-                       integral: Sequence[float]) -> tuple[tuple[float, float, float], tuple[bool, bool, bool]]:
+    def thrust_command(self, nu: Sequence[float], command: Sequence[float], integral: Sequence[float],
+                       forces: Floats4 | None = None) -> tuple[tuple[float, float, float], tuple[bool, bool, bool]]:
         """τ_cmd (saturated at the truth's limits at surge ``nu[0]``) and which channels saturate.
 
-        Feedforward n̂(ν) + M̂ (k_p e + k_i ∫e) of the nominal model.
+        Feedforward n̂(ν) + M̂ (k_p e + k_i ∫e) of the nominal model (``forces``: n̂(ν) already evaluated).
         """
         m11, m22, m33, m44, m24, m42 = self._mass
-        n1, n2, n3, n4 = body_forces(self.model, nu)
+        n1, n2, n3, n4 = forces if forces is not None else body_forces(self.model, nu)
         e = (command[0] - nu[0], command[1] - nu[2], command[2] - nu[3])
         a = [self._kp * ei + self._ki * ii for ei, ii in zip(e, integral)]
         raw = (n1 + m11 * a[0], n3 + m33 * a[1], n4 - m42 * n2 / m22 + (m44 - m42 * m24 / m22) * a[2])
         sat = tuple(min(max(c, -lim), lim) for c, lim in zip(raw, self._limits or self.params.thrust_limits_at(nu[0])))
         return sat, tuple(s != c for s, c in zip(sat, raw))
 
-    def sway_command(self, nu: Sequence[float], integral: float) -> tuple[float, bool]:
-        """Y_cmd = n̂_2(ν) + m̂_22 (k_p (0 − v) + k_i ∫(0 − v)) saturated at ±Y_max (N), and whether it saturates."""
-        raw = body_forces(self.model, nu)[1] + self._mass[1] * (-self._kp * nu[1] + self._ki * integral)
+    def sway_command(self, nu: Sequence[float], integral: float, forces: Floats4 | None = None) -> tuple[float, bool]:
+        """Y_cmd = n̂_2(ν) + m̂_22 (k_p (0 − v) + k_i ∫(0 − v)) saturated at ±Y_max (N), and whether it saturates
+        (``forces``: n̂(ν) already evaluated)."""
+        n2 = (forces if forces is not None else body_forces(self.model, nu))[1]
+        raw = n2 + self._mass[1] * (-self._kp * nu[1] + self._ki * integral)
         sat = min(max(raw, -self._sway_limit), self._sway_limit)
         return sat, sat != raw
 
@@ -163,7 +165,8 @@ class DynamicPlant:
         cp, sp = math.cos(psi), math.sin(psi)
         u, v, w, r = nu
         acc = body_acceleration(self.params, nu, tau, y[14]) if self.lateral else body_acceleration(self.params, nu, tau)
-        cmd, saturated = self.thrust_command(nu, command, integral)
+        model_forces = body_forces(self.model, nu)
+        cmd, saturated = self.thrust_command(nu, command, integral, model_forces)
         err = (command[0] - u, command[1] - w, command[2] - r)
         # conditional integration: hold the integral while its channel saturates in the error's direction
         integ = tuple(0.0 if s and c * e > 0.0 else e for s, c, e in zip(saturated, cmd, err))
@@ -172,7 +175,7 @@ class DynamicPlant:
                *((ci - ti) * self._tau_inv for ci, ti in zip(cmd, tau)), *integ)
         if not self.lateral:
             return out
-        y_cmd, y_sat = self.sway_command(nu, y[15])
+        y_cmd, y_sat = self.sway_command(nu, y[15], model_forces)
         return (*out, (y_cmd - y[14]) * self._tau_inv, 0.0 if y_sat and y_cmd * v < 0.0 else -v)
 
     def _record(self, o1: float, o2: float, o3: float, c1: float, c2: float, c3: float) -> None:

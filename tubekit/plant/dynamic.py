@@ -164,7 +164,7 @@ class DynamicPlant:
         c1, c2, c3 = self.current_at(t)
         cp, sp = math.cos(psi), math.sin(psi)
         u, v, w, r = nu
-        acc = body_acceleration(self.params, nu, tau, y[14]) if self.lateral else body_acceleration(self.params, nu, tau)
+        acc = body_acceleration(self.params, nu, tau, y[14] if self.lateral else 0.0)
         model_forces = body_forces(self.model, nu)
         cmd, saturated = self.thrust_command(nu, command, integral, model_forces)
         err = (command[0] - u, command[1] - w, command[2] - r)

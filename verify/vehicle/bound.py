@@ -50,7 +50,7 @@ from verify.vehicle.result import LoopBound
 from tubekit.model.vehicle_params import VehicleParams
 from verify.vehicle.model import (arb_body_forces, channel_gradient, channel_masses, channel_mismatch,
                                   channel_mismatch_gradient, hull_balls, nominal_balls, nominal_params,
-                                  point_time_constant, velocity_box)
+                                  point_time_constant, velocity_box, with_sway, without_sway)
 from verify.vehicle.response import RESPONSE_PREC, ResponseSums, impulse_sums
 from verify.vehicle.saturation import (SURGE_BANDS, actuator_authority, rate_authority_conditions,
                                        saturation_conditions, triple)
@@ -64,17 +64,6 @@ LOOP_MAX_ITERATIONS = 60
 #: Each iteration assumes (1 + LOOP_INFLATION) x the bounds it computed.
 LOOP_INFLATION = 0.05
 _CHANNELS = "uwr"
-
-
-
-def _external(values: Sequence, lateral: bool) -> tuple:
-    """The (u, w, r) entries of a per-channel sequence (the sway channel, index 1, dropped when ``lateral``)."""
-    return (values[0], values[2], values[3]) if lateral else tuple(values)
-
-
-def _internal(values: Sequence, sway: object, lateral: bool) -> tuple:
-    """(u, w, r) values with the sway channel's ``sway`` inserted at index 1 when ``lateral``."""
-    return (values[0], sway, values[1], values[2]) if lateral else tuple(values)
 
 
 def loop_matrix(k_p: float, k_i: float, time_constant: float, slope: float = 0.0) -> list[list[arb]]:
@@ -124,7 +113,7 @@ class _Loop:
         self.names = "uvwr" if self.lateral else _CHANNELS
         self.own = (0, 1, 2, 3) if self.lateral else (0, 2, 3)
         self.forces = "XYZN" if self.lateral else "XZN"
-        self.v_int = _internal(self.v_max, 0.0, self.lateral)
+        self.v_int = with_sway(self.v_max, 0.0, self.lateral)
         self.nominal, self.hull = nominal_balls(params), hull_balls(params)
         nom = nominal_params(params)
         self.k_p, self.k_i = float(nom.loop_bandwidth), 0.25 * float(nom.loop_bandwidth) ** 2
@@ -155,7 +144,7 @@ class _Loop:
         channel's E_v (``error`` then has the sway channel at index 1), else γ̄ of the free hull."""
         bar = tuple(upper(arb(v) + arb(e)) for v, e in zip(self.v_int, error))
         if self.lateral:
-            return _external(bar, True), bar[1]
+            return without_sway(bar, True), bar[1]
         return bar, upper(hull_sway_bound(self.params, bar[0], bar[2]))
 
     def slopes(self, box: Sequence[float], gamma: float) -> list[arb]:
@@ -313,7 +302,7 @@ def velocity_loop_bound(params: VehicleParams, *, v_max: Sequence[float], tick: 
     start = start_bounds(loop, first)
     floor_u = nonnegative("surge_floor", surge_floor)
     # the sway channel's command is 0 at all times: it never jumps
-    jt_int, jp_int = _internal(jt, 0.0, loop.lateral), _internal(jp, 0.0, loop.lateral)
+    jt_int, jp_int = with_sway(jt, 0.0, loop.lateral), with_sway(jp, 0.0, loop.lateral)
     n = len(loop.names)
     base = computed_bounds(loop, jt_int, jp_int)
     assumed = [[x * (1 + LOOP_INFLATION) + 1e-12 for x in row] for row in base]
@@ -333,9 +322,10 @@ def velocity_loop_bound(params: VehicleParams, *, v_max: Sequence[float], tick: 
                 stop = f"the bounds overflow after {k} rounds"
                 break
             assumed = [[max(a, g) for a, g in zip(ra, rg)] for ra, rg in zip(assumed, grown)]
-    sway = computed[1][0] if loop.lateral and found else None
-    authority = actuator_authority(params, v, floor_u, sway if loop.lateral else None) \
-        if found or not loop.lateral else (-math.inf,) * 3
+    if loop.lateral and not found:  # no sway bound to take the authority over
+        authority = (-math.inf,) * 3
+    else:  # over |v| <= E_v with a sway loop, else the free hull's γ̄
+        authority = actuator_authority(params, v, floor_u, computed[1][0] if loop.lateral else None)
     return _result(loop, params, (v, h, d, jt, jp, first, floor_u), assumed, computed, inputs, authority,
                    (k, max_iterations), found, rho, _why_open(loop, found, stop, growth))
 
@@ -361,7 +351,7 @@ def _result(loop: _Loop, params: VehicleParams, given: tuple, assumed: list, com
     """The :class:`LoopBound` with every condition of the theorem (bounds +inf when not certified)."""
     v, h, d, jt, jp, first, floor_u = given
     lat = loop.lateral
-    error = _external(tuple(r[0] for r in computed), lat) if found else (math.inf,) * 3
+    error = without_sway(tuple(r[0] for r in computed), lat) if found else (math.inf,) * 3
     if not found:
         gamma = math.inf
     elif lat:  # the sway loop's own error bound E_v (its command is 0)
@@ -388,8 +378,8 @@ def _result(loop: _Loop, params: VehicleParams, given: tuple, assumed: list, com
         conds += rate_authority_conditions(authority, rho)
     failed = [c.condition for c in conds if c.ok is not True]
     inf = (math.inf,) * 3
-    pick = (lambda o: _external(tuple(r[o] for r in computed), lat) if found else inf)
-    per = (lambda x: _external(x, lat) if inputs else inf)
+    pick = (lambda o: without_sway(tuple(r[o] for r in computed), lat) if found else inf)
+    per = (lambda x: without_sway(x, lat) if inputs else inf)
     return LoopBound(v_max=v, tick=h, period=d, jump_tick=jt, jump_period=jp, error=error, sway=gamma,
                      a_bound=pick(1), z_bound=pick(2), accel_bound=pick(3), assumed=tuple(tuple(r) for r in assumed),
                      w_start=per(inputs.start if inputs else None), w_rate=per(inputs.rate if inputs else None),

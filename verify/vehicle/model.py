@@ -16,7 +16,7 @@ fourth channel, sway: m_v = m22, n_v = n2, inserted at index 1, channels (u, v, 
 
 from __future__ import annotations
 
-from typing import Any, Mapping, Sequence
+from typing import Mapping, Sequence
 
 from flint import arb
 
@@ -25,7 +25,8 @@ from verify.kernel.intervals import _abs, enclose, point, upper
 
 __all__ = ["COEFFICIENTS", "MASS_FIELDS", "field_ball", "nominal_params", "hull_balls", "nominal_balls",
            "arb_body_forces", "body_force_gradient", "channel_forces", "channel_gradient", "channel_masses",
-           "channel_mismatch", "channel_mismatch_gradient", "velocity_box", "thrust_floor", "point_time_constant"]
+           "channel_mismatch", "channel_mismatch_gradient", "velocity_box", "thrust_floor", "point_time_constant",
+           "with_sway", "without_sway"]
 
 #: Hydrodynamic coefficients of n(ν) (``tubekit.model.vehicles.VehicleParams`` field names).
 COEFFICIENTS = ("X_u", "X_uu", "Y_v", "Y_vv", "Y_rr", "Y_uv", "Y_ur_lift", "Z_w", "Z_ww", "Z_uw",
@@ -97,27 +98,32 @@ def body_force_gradient(c: Mapping[str, arb], nu: Sequence[arb]) -> tuple[tuple[
     return g1, g2, g3, g4
 
 
-def _with_sway(channels: tuple, sway: object, lateral: bool) -> tuple:
-    """``channels`` (u, w, r), with ``sway`` inserted at index 1 when ``lateral``."""
-    return (channels[0], sway, channels[1], channels[2]) if lateral else channels
+def with_sway(channels: Sequence, sway: object, lateral: bool) -> tuple:
+    """Per-channel values (u, w, r), with the sway channel's ``sway`` inserted at index 1 when ``lateral``."""
+    return (channels[0], sway, channels[1], channels[2]) if lateral else tuple(channels)
+
+
+def without_sway(channels: Sequence, lateral: bool) -> tuple:
+    """The (u, w, r) entries of per-channel values: the sway channel (index 1) dropped when ``lateral``."""
+    return (channels[0], channels[2], channels[3]) if lateral else tuple(channels)
 
 
 def channel_forces(c: Mapping[str, arb], nu: Sequence[arb], lateral: bool = False) -> tuple[arb, ...]:
     """(n_u, n_w, n_r) = (n1, n3, n4 − (m42/m22) n2) (N, N, N m); ``lateral``: (n_u, n2, n_w, n_r)."""
     n1, n2, n3, n4 = arb_body_forces(c, nu)
-    return _with_sway((n1, n3, n4 - c["m42"] / c["m22"] * n2), n2, lateral)
+    return with_sway((n1, n3, n4 - c["m42"] / c["m22"] * n2), n2, lateral)
 
 
 def channel_gradient(c: Mapping[str, arb], nu: Sequence[arb], lateral: bool = False) -> tuple[tuple[arb, ...], ...]:
     """∂(n_u, n_w, n_r)/∂(u, v, w, r) (``lateral``: with the sway row ∂n2/∂ν at index 1)."""
     g1, g2, g3, g4 = body_force_gradient(c, nu)
     k = c["m42"] / c["m22"]
-    return _with_sway((g1, g3, tuple(a - k * b for a, b in zip(g4, g2))), g2, lateral)
+    return with_sway((g1, g3, tuple(a - k * b for a, b in zip(g4, g2))), g2, lateral)
 
 
 def channel_masses(c: Mapping[str, arb], lateral: bool = False) -> tuple[arb, ...]:
     """(m_u, m_w, m_r) = (m11, m33, m44 − m24 m42 / m22) (kg, kg, kg m²); ``lateral``: with m22 at index 1."""
-    return _with_sway((c["m11"], c["m33"], c["m44"] - c["m24"] * c["m42"] / c["m22"]), c["m22"], lateral)
+    return with_sway((c["m11"], c["m33"], c["m44"] - c["m24"] * c["m42"] / c["m22"]), c["m22"], lateral)
 
 
 def channel_mismatch(nominal: Mapping[str, arb], hull: Mapping[str, arb], nu: Sequence[arb],
@@ -130,7 +136,7 @@ def channel_mismatch(nominal: Mapping[str, arb], hull: Mapping[str, arb], nu: Se
     d1, d2, d3, d4 = arb_body_forces(delta, nu)
     k_hat, k = nominal["m42"] / nominal["m22"], hull["m42"] / hull["m22"]
     n2 = arb_body_forces(hull, nu)[1]
-    return _with_sway((d1, d3, d4 - k_hat * d2 - (k_hat - k) * n2), d2, lateral)
+    return with_sway((d1, d3, d4 - k_hat * d2 - (k_hat - k) * n2), d2, lateral)
 
 
 def channel_mismatch_gradient(nominal: Mapping[str, arb], hull: Mapping[str, arb],
@@ -140,7 +146,7 @@ def channel_mismatch_gradient(nominal: Mapping[str, arb], hull: Mapping[str, arb
     g1, g2, g3, g4 = body_force_gradient(delta, nu)
     k_hat, k = nominal["m42"] / nominal["m22"], hull["m42"] / hull["m22"]
     t2 = body_force_gradient(hull, nu)[1]
-    return _with_sway((g1, g3, tuple(a - k_hat * b - (k_hat - k) * t for a, b, t in zip(g4, g2, t2))), g2, lateral)
+    return with_sway((g1, g3, tuple(a - k_hat * b - (k_hat - k) * t for a, b, t in zip(g4, g2, t2))), g2, lateral)
 
 
 def velocity_box(u: float, v: float, w: float, r: float) -> tuple[arb, arb, arb, arb]:
@@ -156,7 +162,7 @@ def thrust_floor(params: VehicleParams, u_abs_max: float, u_abs_min: float = 0.0
     floor = getattr(params, "thrust_limit_floor", None)
     limits = floor(u_abs_max, min(max(u_abs_min, 0.0), u_abs_max)) if callable(floor) else params.thrust_limits
     out = tuple(float(x) for x in limits)
-    return _with_sway(out, float(params.interval("Y_max")[0]), lateral)
+    return with_sway(out, float(params.interval("Y_max")[0]), lateral)
 
 
 def point_time_constant(params: VehicleParams) -> float:

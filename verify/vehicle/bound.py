@@ -50,7 +50,8 @@ from verify.vehicle.result import LoopBound
 from tubekit.model.vehicle_params import VehicleParams
 from verify.vehicle.model import (arb_body_forces, channel_gradient, channel_masses, channel_mismatch,
                                   channel_mismatch_gradient, hull_balls, nominal_balls, nominal_params,
-                                  point_time_constant, velocity_box, with_sway, without_sway)
+                                  point_time_constant, velocity_box, with_sway, without_sway,
+                                  CHANNELS, LATERAL_CHANNELS)
 from verify.vehicle.response import RESPONSE_PREC, ResponseSums, impulse_sums
 from verify.vehicle.saturation import (SURGE_BANDS, actuator_authority, rate_authority_conditions,
                                        saturation_conditions, triple)
@@ -63,7 +64,6 @@ __all__ = ["LoopBound", "velocity_loop_bound", "actuator_authority", "loop_matri
 LOOP_MAX_ITERATIONS = 60
 #: Each iteration assumes (1 + LOOP_INFLATION) x the bounds it computed.
 LOOP_INFLATION = 0.05
-_CHANNELS = "uwr"
 
 
 def loop_matrix(k_p: float, k_i: float, time_constant: float, slope: float = 0.0) -> list[list[arb]]:
@@ -110,7 +110,7 @@ class _Loop:
         self.params, self.v_max, self.tick = params, tuple(v_max), tick
         # with lateral thrust a fourth channel, sway (index 1), regulated to 0: its command box is {0}
         self.lateral = bool(getattr(params, "lateral", False))
-        self.names = "uvwr" if self.lateral else _CHANNELS
+        self.names = LATERAL_CHANNELS if self.lateral else CHANNELS
         self.own = (0, 1, 2, 3) if self.lateral else (0, 2, 3)
         self.forces = "XYZN" if self.lateral else "XZN"
         self.v_int = with_sway(self.v_max, 0.0, self.lateral)

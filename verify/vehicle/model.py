@@ -26,7 +26,7 @@ from verify.kernel.intervals import _abs, enclose, point, upper
 __all__ = ["COEFFICIENTS", "MASS_FIELDS", "field_ball", "nominal_params", "hull_balls", "nominal_balls",
            "arb_body_forces", "body_force_gradient", "channel_forces", "channel_gradient", "channel_masses",
            "channel_mismatch", "channel_mismatch_gradient", "velocity_box", "thrust_floor", "point_time_constant",
-           "with_sway", "without_sway"]
+           "with_sway", "without_sway", "CHANNELS", "LATERAL_CHANNELS"]
 
 #: Hydrodynamic coefficients of n(ν) (``tubekit.model.vehicles.VehicleParams`` field names).
 COEFFICIENTS = ("X_u", "X_uu", "Y_v", "Y_vv", "Y_rr", "Y_uv", "Y_ur_lift", "Z_w", "Z_ww", "Z_uw",
@@ -96,6 +96,10 @@ def body_force_gradient(c: Mapping[str, arb], nu: Sequence[arb]) -> tuple[tuple[
           (m22 - m11 - c["N_uv_lift"]) * u - 2 * c["N_vv"] * av, zero,
           (m24 - c["N_ur_lift"]) * u - c["N_r"] - 2 * c["N_rr"] * ar)
     return g1, g2, g3, g4
+
+
+#: The commanded channels (u, w, r), and with a sway loop (u, v, w, r): the order of every per-channel tuple.
+CHANNELS, LATERAL_CHANNELS = "uwr", "uvwr"
 
 
 def with_sway(channels: Sequence, sway: object, lateral: bool) -> tuple:

@@ -21,7 +21,7 @@ from tubekit.model.vehicle_params import VehicleParams
 from tubekit.validation import finite, nonnegative, positive
 from verify.kernel.intervals import enclose, lower, upper
 from verify.theorem.design import Condition, hull_sway_bound
-from verify.vehicle.model import channel_forces, channel_masses, hull_balls, thrust_floor, velocity_box
+from verify.vehicle.model import CHANNELS, channel_forces, channel_masses, hull_balls, thrust_floor, velocity_box
 
 
 
@@ -39,7 +39,6 @@ class _Loop(Protocol):
 __all__ = ["actuator_authority", "rate_authority_conditions", "saturation_conditions", "thrust_peaks",
            "SURGE_BANDS", "triple"]
 
-_CHANNELS = "uwr"
 _ACTUATOR = {"X": "the surge thrust", "Y": "the lateral thrust", "Z": "the heave force (stern planes on a finned "
              "vehicle)", "N": "the yaw moment (the rudder on a finned vehicle)"}
 
@@ -106,7 +105,7 @@ def rate_authority_conditions(authority: Sequence[float], rate: Sequence[float])
     return [Condition(f"rate_authority[{ax}]", f"rho_{ax} <= a_{ax} (acceleration deliverable against drag in V)",
                       float(rate[c]), float(authority[c]), bool(rate[c] <= authority[c]),
                       f"a_{ax} = {authority[c]:.4g} {units[c]} over V and the coefficient box")
-            for c, ax in enumerate(_CHANNELS)]
+            for c, ax in enumerate(CHANNELS)]
 
 
 def saturation_conditions(loop: _Loop, params: VehicleParams, v: Sequence[float], assumed: list,

@@ -6,9 +6,10 @@ shipped), and the table says ``both`` (both tiers certified) or the first failed
 
 ``--spread F`` certifies every cell over von Benzon's values ±F (a fraction) instead of ±2 %; ``--spread published``
 over the bundled vehicle's own box, the published spread between identifications (von Benzon ↔ Einarsson).
+``--bandwidth W`` runs the velocity loop at W rad/s (``loop_bandwidth``; the bundled file's 10).
 
-Usage: ``python benchmarks/dynamic_frontier.py [--u-max 0.2 0.3 ...] [--current 0.02 0.04 ...] [--spread F|published]``
-(about 4 s per cell).
+Usage: ``python benchmarks/dynamic_frontier.py [--u-max 0.2 0.3 ...] [--current 0.02 0.04 ...] [--spread F|published]
+[--bandwidth W]`` (about 1-4 s per cell).
 """
 
 from __future__ import annotations
@@ -40,7 +41,7 @@ def plant_overrides(spread: str | None) -> tuple | None:
     return tuple(sorted((k, (v * (1 + f), v * (1 - f)) if (v and f) else v) for k, v in VON_BENZON.items()))
 
 
-def cell(u_max: float, current: float, spread: str | None = None) -> str:
+def cell(u_max: float, current: float, spread: str | None = None, bandwidth: float | None = None) -> str:
     """``both`` when the scenario with ``u_max`` (m/s) and the current amplitude ``current`` (m/s per axis)
     certifies both tiers; ``safe`` when the safe tier holds and tracking fails only for ``terminal_rate`` (the
     tracking theorem does not cover rate-limited plans yet, which every dynamic design has); else its first three
@@ -49,8 +50,11 @@ def cell(u_max: float, current: float, spread: str | None = None) -> str:
     sc = load_scenario(SCENARIO).with_changes(**{"limits.u_max": u_max,
                                                  "disturbance.amplitude": (current, current, current)})
     overrides = plant_overrides(spread)
-    if overrides is not None:
-        sc = sc.with_changes(plant=dataclasses.replace(sc.plant, overrides=overrides))
+    if overrides is None:
+        overrides = sc.plant.overrides
+    if bandwidth is not None:
+        overrides = (*(o for o in overrides if o[0] != "loop_bandwidth"), ("loop_bandwidth", float(bandwidth)))
+    sc = sc.with_changes(plant=dataclasses.replace(sc.plant, overrides=tuple(overrides)))
     cert = verify.certify(sc)
     if cert.certified:
         return "both"
@@ -60,12 +64,12 @@ def cell(u_max: float, current: float, spread: str | None = None) -> str:
     return ", ".join(names[:3]) + (", ..." if len(names) > 3 else "")
 
 
-def table(u_values, currents, spread: str | None = None) -> list[str]:
+def table(u_values, currents, spread: str | None = None, bandwidth: float | None = None) -> list[str]:
     """The markdown table: one row per u_max, one column per current."""
     lines = ["| u_max (m/s) \\ current (m/s) | " + " | ".join(f"{c:g}" for c in currents) + " |",
              "|---" * (len(currents) + 1) + "|"]
     for u in u_values:
-        lines.append(f"| {u:g} | " + " | ".join(cell(u, c, spread) for c in currents) + " |")
+        lines.append(f"| {u:g} | " + " | ".join(cell(u, c, spread, bandwidth) for c in currents) + " |")
     return lines
 
 
@@ -74,8 +78,9 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--u-max", type=float, nargs="+", default=list(U_MAX))
     parser.add_argument("--current", type=float, nargs="+", default=list(CURRENT))
     parser.add_argument("--spread", help="a fraction F (von Benzon ±F) or 'published' (the bundled box)")
+    parser.add_argument("--bandwidth", type=float, help="the velocity loop's bandwidth (rad/s)")
     args = parser.parse_args(argv)
-    for line in table(args.u_max, args.current, args.spread):
+    for line in table(args.u_max, args.current, args.spread, args.bandwidth):
         print(line, flush=True)
     return 0
 

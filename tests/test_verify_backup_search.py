@@ -98,6 +98,25 @@ def test_when_nothing_fits_the_closest_candidate_is_returned_proved():
     assert {c.condition for c in cert.conditions} >= {"backup_level_set", "backup_ramp"}
 
 
+def test_when_only_the_gentlest_shape_keeps_the_loop_bounded_the_fallback_returns_it():
+    """Nothing fits, and every shape but the gentlest (β = MIN_SHAPE) breaks the loop bound (ratio inf): the fallback
+    returns a candidate with a finite ratio, so the dynamic fixed point can raise its assumption and go on. Before
+    the fix it returned a best-shape candidate whose loop bound failed, and the fixed point stopped there
+    (examples/bluerov2_spread.toml was refused for ``loop_fixed_point`` at that stand-in)."""
+    from verify.backup.search import MIN_SHAPE
+    seen: list[tuple[float, float]] = []
+
+    def fits(law, safe: SafeSet) -> float:
+        ratio = 2.0 + 1.0 / safe.level if safe.shape == MIN_SHAPE else math.inf
+        seen.append((safe.shape, ratio))
+        return ratio
+
+    cert = design_backup(**PAPER, smooth=True, fits=fits)
+    assert any(math.isinf(r) for _, r in seen)  # best shapes were tried, and broke the loop
+    assert cert.safe_set.shape == MIN_SHAPE
+    assert math.isfinite(fits(cert.law, cert.safe_set))
+
+
 def test_fits_is_not_asked_without_the_smooth_design():
     def boom(law, safe):
         raise AssertionError("fits called for a kinematic design")

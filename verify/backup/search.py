@@ -217,12 +217,17 @@ class _Search:
                 continue
             if law not in family or ratio < family[law][0]:
                 family[law] = (ratio, level)
+        gentlest = None  # the first family's gentlest shape: its ratio is known (a best shape may break the loop)
         for law, (ratio, level) in sorted(family.items(), key=lambda t: t[1][0]):
             if self.closest is not None and ratio >= self.closest[0]:
                 break
+            if gentlest is None and math.isfinite(ratio):
+                gentlest = (ratio, *self._candidate(law, level, MIN_SHAPE))
             shape = _best_shape(law, level, self.wxy, self.handover[0], self.e_r)
             if shape is not None:
                 self._fits(*self._candidate(law, level, shape))
+        if gentlest is not None and (self.closest is None or not math.isfinite(self.closest[0])):
+            self.closest = gentlest  # every best shape broke the loop: the fixed point needs a finite E to go on
         if self.closest is not None:
             return self._certify(self.closest[1], self.closest[2])
         if self.last is not None:

@@ -44,8 +44,8 @@ def plant_overrides(spread: str | None) -> tuple | None:
 def cell(u_max: float, current: float, spread: str | None = None, bandwidth: float | None = None) -> str:
     """``both`` when the scenario with ``u_max`` (m/s) and the current amplitude ``current`` (m/s per axis)
     certifies both tiers; ``safe`` when the safe tier holds and tracking fails only for ``terminal_rate`` (the
-    tracking theorem does not cover rate-limited plans yet, which every dynamic design has); else its first three
-    failed conditions."""
+    tracking theorem does not cover rate-limited plans yet, which every dynamic design has), ``safe; tracking: ...``
+    when tracking fails for more; else its first three failed conditions."""
     import verify
     sc = load_scenario(SCENARIO).with_changes(**{"limits.u_max": u_max,
                                                  "disturbance.amplitude": (current, current, current)})
@@ -61,6 +61,8 @@ def cell(u_max: float, current: float, spread: str | None = None, bandwidth: flo
     names = [c.condition for c in cert.failures]
     if cert.tiers.safe and names == ["terminal_rate"]:
         return "safe"
+    if cert.tiers.safe:  # tracking refused for more than the rate-limited plans: say for what
+        return "safe; tracking: " + ", ".join(n for n in names if n != "terminal_rate")
     return ", ".join(names[:3]) + (", ..." if len(names) > 3 else "")
 
 

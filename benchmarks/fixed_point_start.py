@@ -26,17 +26,17 @@ __all__ = ["cell", "main", "STARTS", "SCENARIOS"]
 
 def cell(path: Path, start: float) -> tuple[bool, float, float, list[str]]:
     """(safe tier, the backup's safe radius in m, omega_bar_xy in m/s, failed conditions) of ``path`` certified with
-    the fixed point started at ``start`` x the plans-only bound (the module's start restored after)."""
+    the fixed point started at ``start`` x the plans-only bound and no other start (the module's restored after)."""
     import verify
     import verify.vehicle.compose as compose
     from tubekit.scenario import load_scenario
-    before = compose._INFLATE
-    compose._INFLATE = float(start)
+    before, restarts = compose._INFLATE, compose.FIXED_POINT_RESTARTS
+    compose._INFLATE, compose.FIXED_POINT_RESTARTS = float(start), ()  # this one start only
     compose._SOLVED.clear()
     try:
         cert = verify.certify(load_scenario(path))
     finally:
-        compose._INFLATE = before
+        compose._INFLATE, compose.FIXED_POINT_RESTARTS = before, restarts
         compose._SOLVED.clear()
     return (bool(cert.tiers.safe), float(cert.backup.safe_set.level), float(cert.disturbance.omega_xy),
             [c.condition for c in cert.failures])

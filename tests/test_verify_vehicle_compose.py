@@ -233,6 +233,35 @@ def test_the_last_round_compares_e_with_the_assumption_it_was_derived_with(monke
     assert not cert.certified and not cert.tiers.safe
 
 
+def _widened(sc, fraction: float):
+    """``sc`` with every coefficient interval of its vehicle table replaced by its midpoint ± ``fraction``."""
+    import dataclasses
+    over = tuple((k, tuple(sorted(((v[0] + v[1]) / 2 * (1 - fraction), (v[0] + v[1]) / 2 * (1 + fraction))))
+                  if isinstance(v, tuple) else v) for k, v in sc.plant.overrides)
+    return sc.with_changes(plant=dataclasses.replace(sc.plant, overrides=over))
+
+
+def test_a_start_that_does_not_close_is_followed_by_the_next_start(monkeypatch):
+    """bluerov2_slow over von Benzon's values ±5 %: from the first start (1.25 × the plans-only bound) the fixed point
+    ends 0.2 % above its assumption (``loop_consistent``); a later start of ``FIXED_POINT_RESTARTS`` closes, and that
+    certificate is what ``certify`` returns and what ``recheck`` re-derives, number for number."""
+    import verify.vehicle.compose as compose
+    sc = _widened(load_scenario(SLOW), 0.05)
+    monkeypatch.setattr(compose, "FIXED_POINT_RESTARTS", ())
+    compose._SOLVED.clear()
+    single = certify(sc)
+    consistent = next(c for c in single.plant_conditions if c.condition == "loop_consistent")
+    assert not single.tiers.safe and consistent.ok is False and 1.0 < consistent.lhs < 1.01
+    monkeypatch.undo()
+    compose._SOLVED.clear()
+    cert = certify(sc)
+    assert cert.tiers.safe and [c.condition for c in cert.failures] == ["terminal_rate"]
+    assert cert.velocity_loop.certified and max(cert.velocity_loop.error) < math.inf
+    compose._SOLVED.clear()
+    report = recheck(json.loads(json.dumps(cert.to_dict())))
+    assert report.ok, report.failed[:3]
+
+
 def test_the_loop_ratio_does_not_rise_with_the_level_on_the_slow_scenario(slow_solution):
     """What the gentle search's bisection rests on, measured on the shipped dynamic scenario: at the gentlest shape,
     the loop error ratio E / E_a of every law of the grid (widest yaw band) never rises as the safe set's level

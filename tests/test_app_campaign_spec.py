@@ -141,3 +141,17 @@ def test_the_bluerov2_current_campaign_draws_only_the_truth_of_its_certified_box
     spec = load_spec(ROOT / "examples" / "bluerov2_current_campaign.toml")
     assert spec.runs == 200 and [k for k, _ in spec.sample] == ["plant.truth"]
     assert spec.base["disturbance"]["amplitude"] == [0.1, 0.1, 0.1] and spec.base["plant"]["kind"] == "dynamic"
+
+
+@pytest.mark.parametrize("name, spread", [("bluerov2_spread", 0.2), ("bluerov2_brisk_current", 0.1)])
+def test_the_spread_campaigns_draw_only_the_truth_of_their_wider_boxes(name, spread):
+    """examples/bluerov2_spread_campaign.toml and bluerov2_brisk_current_campaign.toml: 200 runs that differ only in
+    the vehicle as simulated, drawn in a box of von Benzon's values ± ``spread`` (X_uu = -141 kg/m at the centre)
+    with the velocity loop at 20 rad/s."""
+    from tubekit.app.campaign_spec import load_spec
+    spec = load_spec(ROOT / "examples" / f"{name}_campaign.toml")
+    assert spec.runs == 200 and [k for k, _ in spec.sample] == ["plant.truth"]
+    vehicle = spec.base["plant"]["vehicle"]
+    assert vehicle["loop_bandwidth"] == 20.0
+    assert vehicle["X_uu"] == pytest.approx([-141.0 * (1 + spread), -141.0 * (1 - spread)])
+

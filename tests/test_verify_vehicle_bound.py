@@ -186,6 +186,7 @@ def test_a_diverging_fixed_point_is_one_root_cause_and_no_astronomical_number():
     by_name = {c.condition: c for c in bound.conditions}
     fixed = by_name["loop_fixed_point"]
     assert fixed.ok is False and "diverged" in fixed.detail and "first round multiplied the bounds by" in fixed.detail
+    assert "loop_bandwidth" in fixed.detail  # the knobs an owner has, the loop's speed among them
     for name in ("loop_saturation[X]", "loop_saturation[Z]", "loop_saturation[N]", "loop_sway"):
         assert by_name[name].ok is False and "root cause: loop_fixed_point" in by_name[name].detail
     numbers = [x for c in bound.conditions for x in (c.lhs, c.rhs) if x is not None]

@@ -342,7 +342,8 @@ def _why_open(loop: _Loop, found: bool, stop: str, growth: list | None) -> str:
     return (f"diverged ({stop}); the first round multiplied the bounds by up to {growth[c][o]:.3g} "
             f"({_QUANTITIES[o]} of channel {loop.names[c]}): the small-gain loop's gain is not below 1 here, the "
             "coefficient mismatch entering it as an input that grows with E (docs/plant.md, section 4); a narrower "
-            "coefficient box, a smaller V or smaller command jumps (a gentler backup, a lower plan rate) lower it")
+            "coefficient box, a smaller V, smaller command jumps (a gentler backup, a lower plan rate) or a faster "
+            "loop (plant.vehicle.loop_bandwidth, where the thrusters' lag and limits allow it) lower it")
 
 
 def _result(loop: _Loop, params: VehicleParams, given: tuple, assumed: list, computed: list, inputs: Inputs | None,

@@ -75,11 +75,10 @@ PLAN_CHECK_TOLERANCE = RATE_TOLERANCE
 FIXED_POINT_ROUNDS = 10
 #: The first round's assumed bound over the plans-only one.
 _INFLATE = 1.25
-#: Further starts (× the plans-only bound) tried in turn when the fixed point from :data:`_INFLATE` ends with a finite
-#: loop bound but does not close: the gentle search and the 5 % steps make the end path-dependent
-#: (``benchmarks/fixed_point_start.py``), and every start that closes is a certificate. The first that closes is kept;
-#: when none does, the first start's failure is reported. Not tried when the loop bound itself failed (measured: no
-#: start closed one; they only cost). A work unit, not a time budget.
+#: Further starts (× the plans-only bound) tried in turn when the fixed point from :data:`_INFLATE` does not close:
+#: the gentle search and the 5 % steps make the end path-dependent (``benchmarks/fixed_point_start.py``), and every
+#: start that closes is a certificate. The first that closes is kept; when none does, the first start's failure is
+#: reported. Not tried when the plans' jumps alone break the loop (no round is run). A work unit, not a time budget.
 FIXED_POINT_RESTARTS = (1.5, 1.65, 1.8)
 #: Growth of the assumed bound over the derived one between rounds (small: a larger E_a widens ω̄ and the yaw
 #: error, and the gentle backups that fit at E_a may no longer certify at a much larger one).
@@ -383,12 +382,11 @@ def _closed(solution: DynamicSolution) -> bool:
 
 def _solve_dynamic(scenario: Scenario, region: Region, gains: GainBounds,
                    sigmas: tuple[float, ...]) -> DynamicSolution:
-    """:func:`solve_dynamic` without the memo: from :data:`_INFLATE`, then, when that start ended with a finite loop
-    bound but did not close (``loop_consistent`` or the backup), each of :data:`FIXED_POINT_RESTARTS` until one
-    closes."""
+    """:func:`solve_dynamic` without the memo: from :data:`_INFLATE`, then, when that start did not close, each of
+    :data:`FIXED_POINT_RESTARTS` until one closes."""
     plans = _plans_only(scenario)
     first = _solve_from(scenario, region, gains, sigmas, plans, _INFLATE)
-    if _closed(first) or not first.loop.certified:  # a loop bound that failed outright: no start has closed it
+    if _closed(first) or _first_assumption(plans) is None:  # no round was run: another start changes nothing
         return first
     for start in FIXED_POINT_RESTARTS:
         again = _solve_from(scenario, region, gains, sigmas, plans, start)

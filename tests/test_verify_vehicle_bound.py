@@ -362,3 +362,39 @@ def test_without_lateral_thrust_the_loop_keeps_three_channels_and_the_hulls_sway
     assert b.certified and b.channels == "uwr" and len(b.gains) == 3 and len(b.thrust_floor) == 3
     hull = float(hull_sway_bound(free, V[0] + b.error[0], V[2] + b.error[2]).mid())
     assert b.sway == pytest.approx(hull, rel=1e-9)
+
+
+def test_over_twenty_percent_on_a_twenty_rad_per_second_loop_the_bound_holds_at_the_corners_of_the_box():
+    """Property: examples/bluerov2_spread.toml's regime (every drag and added mass ±20 % about the nominal point,
+    the loop at 20 rad/s, its command box V = (0.3, 0.15, 0.2) and jumps the size of its backup's and plans') has a
+    certified bound, and the simulated plant keeps |u − u_c|, |w − w_c|, |r − r_c| within E and the sway within
+    E_v at three corners of the box, under commands whose jumps add up against the nominal loop's response (the
+    worst case of the jump model) and under random ones; the controller's feedforward keeps the box's centre."""
+    p = BLUEROV2_HEAVY.nominal
+    widened = {k: tuple(sorted((0.8 * getattr(p, k), 1.2 * getattr(p, k))))
+               for k in ("X_uu", "Y_vv", "Z_ww", "N_rr", "X_udot", "Y_vdot", "Z_wdot", "N_rdot", "X_u", "Z_w")}
+    box = p.with_overrides({**widened, "loop_bandwidth": 20.0})
+    v, jt, jp = (0.3, 0.15, 0.2), (0.001, 0.0002, 0.003), (0.003, 0.003, 0.006)
+    b = velocity_loop_bound(box, v_max=v, tick=H, period=H * TICKS, jump_tick=jt, jump_period=jp)
+    assert b.certified, b.reason
+    signs = _response_signs(20.0, 100.0, p.thruster_time_constant, 400)
+
+    def commands(sign_of) -> list[tuple[float, float, float]]:
+        cmd, out = [0.0, 0.0, 0.0], []
+        for k in range(250):
+            jump = jp if k % TICKS == 0 else jt
+            cmd = [min(max(x + j * sign_of(k, c), -lim), lim) for c, (x, j, lim) in enumerate(zip(cmd, jump, v))]
+            out.append(tuple(cmd))
+        return out
+    rng = np.random.default_rng(7)
+    runs = [commands(lambda k, c: signs[250 - k] if k else 0.0), commands(lambda k, c: rng.choice([-1.0, 1.0]))]
+    settings_ = PlantSettings("dynamic", vehicle="bluerov2_heavy", overrides={**widened, "loop_bandwidth": 20.0})
+    low = {k: box.interval(k)[0] for k in box.interval_fields}
+    high = {k: box.interval(k)[1] for k in box.interval_fields}
+    for corner in (low, high, {**low, "X_udot": high["X_udot"], "N_rdot": high["N_rdot"], "Y_vdot": high["Y_vdot"]}):
+        truth = box.with_point(corner)
+        for run in runs:
+            error = _largest_error(run, plant_settings=settings_, truth=truth)
+            assert np.all(error <= np.array(b.error)), (corner, error, b.error)
+            assert _largest_sway(run, settings_, truth) <= b.sway
+            assert error.max() > 0.0

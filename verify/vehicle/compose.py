@@ -344,9 +344,9 @@ _SOLVED_KEEP = 4
 
 
 def _solved_key(scenario: Scenario, region: Region, gains: GainBounds, sigmas: tuple[float, ...]) -> str:
-    """A canonical text of everything :func:`solve_dynamic` reads (the round limit included)."""
+    """A canonical text of everything :func:`solve_dynamic` reads (the round limit and the starts included)."""
     return json.dumps([scenario.to_dict(), region.to_dict(), gains.to_dict(), [float(s) for s in sigmas],
-                       FIXED_POINT_ROUNDS], sort_keys=True, default=str)
+                       FIXED_POINT_ROUNDS, _INFLATE, list(FIXED_POINT_RESTARTS)], sort_keys=True, default=str)
 
 
 def solve_dynamic(scenario: Scenario, region: Region, gains: GainBounds,

@@ -114,7 +114,7 @@ def first_round(sc) -> None:
     plans = velocity_loop_bound(sc.plant.params, v_max=v_max, tick=0.01, period=0.1, jump_tick=(0.0, 0.0, 0.0),
                                 jump_period=compose.plan_jumps(sc))
     assumed = tuple(compose._INFLATE * e for e in plans.error)
-    sway = compose._first_sway(sc, plans)         # the sway loop's first assumption (None: the free hull's sway)
+    sway = compose._first_sway(sc, plans, compose._INFLATE)  # the first assumed sway (None: the free hull's)
     region = Region.from_scenario(sc)
     gains = gain_bounds(sc.controller.law, region)
     dist, _, _, _, backup = compose._tiers_at(sc, region, gains, (0.0,), assumed, sway)

@@ -51,8 +51,8 @@ FIELD = "plant.vehicle.thrusters"
 KEYS = ("allocation", "thrust", "shares", "sway")
 #: The allocation's rows (and the sway row's): the channel each describes.
 CHANNELS = ("surge X", "heave Z", "yaw N", "sway Y")
-#: The vehicle parameters the derived box replaces.
-LIMIT_KEYS = ("X_max", "Z_max", "N_max")
+#: The vehicle parameters the derived box replaces (Y_max 0 without a fourth share: the box asks zero sway).
+LIMIT_KEYS = ("X_max", "Z_max", "N_max", "Y_max")
 #: Relative shrink of the LP's t* (and of its thrust vectors) before the float check.
 SHRINK = 1e-6
 #: Largest residual |B f − corner| accepted, relative to the scale max_c Σ_i |B_ci| T_i.
@@ -184,6 +184,10 @@ class ThrusterGeometry:
     def sway_limit(self) -> float:
         """Y_max (N): the box's lateral half-width with a fourth share, else 0 (the box asks zero sway)."""
         return self._limits[3] if len(self._limits) > 3 else 0.0  # type: ignore[attr-defined, no-any-return]
+
+    def vehicle_limits(self) -> dict[str, float]:
+        """{X_max, Z_max, N_max, Y_max}: the vehicle parameters the box replaces (:data:`LIMIT_KEYS`)."""
+        return dict(zip(LIMIT_KEYS, (*self.limits(), self.sway_limit())))
 
     def solo_capacity(self) -> tuple[float, ...]:
         """(C_X, C_Z, C_N[, C_Y]) in N, N, N m[, N]: the largest |X|, |Z|, |N| (and |Y| with a fourth share) each

@@ -188,11 +188,11 @@ def _actuation(name: str, overrides: Mapping[str, Any]) -> str | None:
 
 def _refuse_thrusters(name: str, overrides: Mapping[str, Any], table: Any) -> None:
     """ConfigError naming ``plant.vehicle.thrusters`` when a thruster table (``table``) is given with
-    X_max/Z_max/N_max (one source of limits) or on a finned vehicle (its Z and N come from the fins)."""
+    X_max/Z_max/N_max/Y_max (one source of limits) or on a finned vehicle (its Z and N come from the fins)."""
     received = table.to_dict() if isinstance(table, ThrusterGeometry) else table
-    given = [k for k in (*LIMIT_KEYS, "Y_max") if k in overrides]
+    given = [k for k in LIMIT_KEYS if k in overrides]
     if given:
-        raise ConfigError("plant.vehicle.thrusters", "absent when X_max/Z_max/N_max/Y_max are given (one source of "
+        raise ConfigError("plant.vehicle.thrusters", f"absent when {'/'.join(LIMIT_KEYS)} are given (one source of "
                           f"limits; {', '.join(given)} given)", received)
     actuation = _actuation(name, overrides)
     if actuation == "fins":
@@ -216,7 +216,7 @@ def _with_thrusters(name: str, overrides: dict[str, Any], thrusters: ThrusterGeo
         raise ConfigError("plant.vehicle.thrusters.shares", "3 numbers > 0 (a vehicle with actuation 'thrusters' "
                           "needs every limit X_max, Z_max, N_max > 0)", list(thrusters.shares))
     # the lateral limit too: the table's fourth share, else 0 (a box asking zero sway leaves none for a sway loop)
-    return {**overrides, **dict(zip(LIMIT_KEYS, limits)), "Y_max": thrusters.sway_limit()}
+    return {**overrides, **thrusters.vehicle_limits()}
 
 
 def _pairs(field: str, value: Any) -> dict[str, Any]:

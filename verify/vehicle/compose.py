@@ -252,19 +252,16 @@ def _plans_only(scenario: Scenario) -> LoopBound:
                                surge_floor=inputs.surge_floor)
 
 
-def _first_assumption(first: LoopBound, start: float | None = None) -> tuple[float, float, float] | None:
-    """E_a of the first round (``start``, default :data:`_INFLATE`, × the plans-only E), None when the plans' jumps
-    alone break the loop (no finite E: no round is run and the plans-only bound is reported)."""
-    factor = _INFLATE if start is None else start
-    assumed = tuple(factor * e if math.isfinite(e) else math.inf for e in first.error)
+def _first_assumption(first: LoopBound, start: float = _INFLATE) -> tuple[float, float, float] | None:
+    """E_a of the first round (``start`` × the plans-only E), None when the plans' jumps alone break the loop (no
+    finite E: no round is run and the plans-only bound is reported)."""
+    assumed = tuple(start * e if math.isfinite(e) else math.inf for e in first.error)
     return assumed if all(math.isfinite(a) for a in assumed) else None
 
 
-def _first_sway(scenario: Scenario, first: LoopBound, start: float | None = None) -> float | None:
-    """The sway loop's first assumed bound (``start``, default :data:`_INFLATE`, × the plans-only E_v); None without
-    lateral thrust."""
-    factor = _INFLATE if start is None else start
-    return factor * first.sway if scenario.plant.params.lateral else None
+def _first_sway(scenario: Scenario, first: LoopBound, start: float) -> float | None:
+    """The sway loop's first assumed bound (``start`` × the plans-only E_v); None without lateral thrust."""
+    return start * first.sway if scenario.plant.params.lateral else None
 
 
 def _plant_conditions(scenario: Scenario, loop: LoopBound, assumed: tuple[float, float, float],

@@ -190,28 +190,54 @@ def solver_floor(scenario, tightening) -> dict:
             "glue_now_ms_per_step": 1e3 * (wall - total["solver_s"]) / max(1, total["steps"])}
 
 
-def compare_previous(repeat: int = 4) -> dict:
-    """Interleaved runs with the previous code paths (RK4 through ``rk4_tuple(plant._rhs)``, arcs chained
-    one by one) against the current ones: wall medians, their ratio, and whether the logs are identical."""
+def _uncompiled_rollout(s0: np.ndarray, inputs: np.ndarray, dt: float) -> np.ndarray:
+    """A plan's rollout as a chain of the model's numpy step (the reference of the compiled rollout)."""
+    from tubekit.model.kinematics import unicycle_step
+
+    out = np.empty((len(inputs) + 1, 4))
+    out[0] = s0
+    for k, v in enumerate(inputs):
+        out[k + 1] = unicycle_step(out[k], v, dt)
+    return out
+
+
+def compare_previous(repeat: int = 4, duration: float | None = None) -> dict:
+    """Interleaved runs with the uncompiled code paths (RK4 through ``rk4_tuple(plant._rhs)``; the rollout, the
+    nominal arc, the plan's arcs, the dynamics residual and the error coordinates through the model's numpy
+    formulas) against the compiled ones: wall medians, their ratio, and whether the logs are identical. The
+    arc's Jacobian and the bearing error's model stay compiled on both sides (they have no numpy twin)."""
     import contextlib
 
     from tubekit.loop import plan_check
+    from tubekit.model import compiled_arcs
+    from tubekit.model.errors import error_coordinates
+    from tubekit.model.kinematics import unicycle_step
     from tubekit.plant import kinematic
     scenario = paper_scenario()
+    if duration is not None:
+        scenario = scenario.with_changes(duration=float(duration))
     tightening = verify.certify(scenario, law=scenario.controller.law).best_effort_tightening()
     _solver_import_s()
-    new_step, new_arcs = kinematic.Plant.step_tuple, plan_check.plan_arcs
+    uncompiled = {"rollout": _uncompiled_rollout, "unicycle_steps": unicycle_step, "arc": unicycle_step,
+                  "error_coordinates": error_coordinates,
+                  "plan_arcs": lambda x0, v, tau: plan_check._plan_arcs_chained(x0, v, tau[-1], len(tau) - 1)}
+    compiled = {name: getattr(compiled_arcs, name) for name in uncompiled}
+    new_step = kinematic.Plant.step_tuple
 
     def old_step(self, t, x, v, h, n):
         return kinematic.rk4_tuple(self._rhs, t, tuple(x), v, h, n)
 
     @contextlib.contextmanager
     def previous():
-        kinematic.Plant.step_tuple, plan_check.plan_arcs = old_step, plan_check._plan_arcs_chained
+        kinematic.Plant.step_tuple = old_step
+        for name, fn in uncompiled.items():
+            setattr(compiled_arcs, name, fn)
         try:
             yield
         finally:
-            kinematic.Plant.step_tuple, plan_check.plan_arcs = new_step, new_arcs
+            kinematic.Plant.step_tuple = new_step
+            for name, fn in compiled.items():
+                setattr(compiled_arcs, name, fn)
 
     walls: dict[str, list[float]] = {"previous": [], "current": []}
     runs: dict = {}
@@ -240,7 +266,7 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--floor", action="store_true",
                         help="add one run with the bare Clarabel time summed: the real-time factor's ceiling")
     parser.add_argument("--compare-previous", action="store_true",
-                        help="interleave the previous plant step and arc evaluation with the current ones instead")
+                        help="interleave the uncompiled plant step, arcs and errors (numpy, Python) with the compiled ones instead")
     args = parser.parse_args(argv)
     out = compare_previous() if args.compare_previous else measure(args.duration, args.profile, args.repeat)
     if args.floor and not args.compare_previous:

@@ -47,3 +47,11 @@ def test_the_solver_floor_is_a_ceiling_of_the_real_time_factor():
     assert 0.0 < floor["clarabel_solve_s"] < floor["fhocp_step_s"] < floor["wall_s"]
     assert floor["floor_realtime_factor"] > floor["realtime_factor"]
     assert floor["floor_realtime_factor"] == pytest.approx(1.0 / floor["clarabel_solve_s"])
+
+
+def test_the_compiled_loop_logs_the_very_floats_of_the_uncompiled_one():
+    """Over a 3 s tube run, the compiled plant, arcs, rollout and error coordinates leave every logged float of
+    the run (states, plans, inputs, rejections, slacks, nominal) as the numpy and Python references give it."""
+    out = _module().compare_previous(repeat=2, duration=3.0)
+    assert out["identical_logs"] is True
+    assert len(out["walls_s"]["previous"]) == len(out["walls_s"]["current"]) == 2

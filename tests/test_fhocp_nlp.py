@@ -8,9 +8,8 @@ import math
 import numpy as np
 import pytest
 
-from tubekit.model.kinematics import dsinc
-from tubekit.fhocp.nlp import BackupTerminal, FhocpNlp, discrete_step, obstacle_array, rollout, select_obstacles, sinc
-from tubekit.model.kinematics import nominal_kinematics
+from tubekit.fhocp.nlp import BackupTerminal, FhocpNlp, discrete_step, obstacle_array, rollout, select_obstacles
+from tubekit.model.kinematics import dsinc, nominal_kinematics, sinc
 from tubekit.exceptions import ConfigError
 from tubekit.scenario import Obstacle, paper_scenario
 from tubekit.tightening import Tightening

@@ -3,14 +3,13 @@
 (:func:`step_linearisation`) and the bearing error's (:func:`eo_linearisation`).
 
 Both are exact to first order (value and first derivatives) at the plan they are taken at; the step itself
-is :func:`tubekit.fhocp.nlp.discrete_step` (the model's exact zero-order-hold arc).
+is :func:`tubekit.fhocp.nlp.discrete_step` (the model's exact zero-order-hold arc). Both are computed by the
+compiled routines of :mod:`tubekit.model.compiled_arcs` (numba, imported at the first call).
 """
 
 from __future__ import annotations
 
 import numpy as np
-
-from tubekit.model.kinematics import dsinc, sinc
 
 __all__ = ["STEP_LINEARISATION_ROWS", "step_linearisation", "eo_linearisation", "ED_FLOOR"]
 
@@ -47,28 +46,9 @@ def step_linearisation(states: np.ndarray, inputs: np.ndarray, dt: float) -> np.
     array (8, N)
         Rows ``ax, bxu, bxr, cx, ay, byu, byr, cy`` (:data:`STEP_LINEARISATION_ROWS`).
     """
-    n = inputs.shape[0]
-    psi = states[:n, 3]
-    u = inputs[:, 0]
-    r = inputs[:, 2]
-    a = 0.5 * dt * r
-    sa = sinc(a)
-    dsa = dsinc(a)
-    th = psi + a
-    c, s = np.cos(th), np.sin(th)
-    out = np.empty((8, n))
-    out[1] = dt * sa * c            # bxu
-    out[5] = dt * sa * s            # byu
-    dx = u * out[1]
-    dy = u * out[5]
-    out[0] = -dy                    # ax
-    out[4] = dx                     # ay
-    half = 0.5 * dt * dt * u
-    out[2] = half * (dsa * c - sa * s)   # bxr
-    out[6] = half * (dsa * s + sa * c)   # byr
-    out[3] = dy * psi - out[2] * r    # cx = dx - ax psi - bxu u - bxr r  (bxu u = dx)
-    out[7] = -dx * psi - out[6] * r   # cy = dy - ay psi - byu u - byr r  (byu u = dy)
-    return out
+    from tubekit.model import compiled_arcs
+
+    return compiled_arcs.step_linearisation(states, inputs, float(dt))
 
 
 def eo_linearisation(states: np.ndarray, ref: np.ndarray) -> np.ndarray:
@@ -82,17 +62,6 @@ def eo_linearisation(states: np.ndarray, ref: np.ndarray) -> np.ndarray:
     array (5, K)
         Rows ``gx, gy, gpsi, h, e_o``.
     """
-    ex = states[:, 0] - ref[:, 0]
-    ey = states[:, 1] - ref[:, 1]
-    psi = states[:, 3]
-    ed = np.maximum(np.sqrt(ex * ex + ey * ey), ED_FLOOR)
-    cp_, sp_ = np.cos(psi), np.sin(psi)
-    out = np.empty((5, states.shape[0]))
-    c = ex * cp_ + ey * sp_
-    out[4] = (ex * sp_ - ey * cp_) / ed
-    cd = c / (ed * ed * ed)
-    out[0] = ey * cd
-    out[1] = -ex * cd
-    out[2] = c / ed
-    out[3] = out[4] - out[0] * states[:, 0] - out[1] * states[:, 1] - out[2] * psi
-    return out
+    from tubekit.model import compiled_arcs
+
+    return compiled_arcs.eo_linearisation(states, ref, ED_FLOOR)

@@ -72,9 +72,8 @@ import numpy as np
 
 from tubekit.exceptions import ConfigError, ShapeError
 from tubekit.fhocp.rows import RATE_MARGIN, BackupTerminal, rate_penalty_cost, rate_violation
-from tubekit.model.errors import error_coordinates
 from tubekit.fhocp.linearisation import ED_FLOOR
-from tubekit.model.kinematics import sinc, unicycle_step
+from tubekit.model.kinematics import unicycle_step
 from tubekit.scenario import Obstacle, Scenario, TerminalMode
 from tubekit.tightening import Tightening
 from tubekit.validation import as_vector, choice, positive
@@ -90,24 +89,11 @@ discrete_step = unicycle_step
 
 
 def rollout(s0: np.ndarray, inputs: np.ndarray, dt: float) -> np.ndarray:
-    """States (N+1, 4) obtained by applying ``inputs`` (N, 3) from ``s0`` (4,) with :func:`discrete_step`.
+    """States (N+1, 4) obtained by applying ``inputs`` (N, 3) from ``s0`` (4,) with :func:`discrete_step`
+    (compiled: :func:`tubekit.model.compiled_arcs.rollout`, the same floats as chaining the step)."""
+    from tubekit.model import compiled_arcs
 
-    Vectorised: psi and z are cumulative sums, then so are the x, y increments.
-    """
-    inputs = np.asarray(inputs, dtype=float)
-    n = inputs.shape[0]
-    out = np.empty((n + 1, 4))
-    out[0] = s0
-    a = (0.5 * dt) * inputs[:, 2]
-    out[1:, 3] = dt * inputs[:, 2]
-    out[1:, 2] = dt * inputs[:, 1]
-    out[:, 2:].cumsum(axis=0, out=out[:, 2:])
-    th = out[:-1, 3] + a
-    k = (dt * inputs[:, 0]) * sinc(a)
-    out[1:, 0] = k * np.cos(th)
-    out[1:, 1] = k * np.sin(th)
-    out[:, :2].cumsum(axis=0, out=out[:, :2])
-    return out
+    return compiled_arcs.rollout(np.asarray(s0, dtype=float), np.asarray(inputs, dtype=float), float(dt))
 
 
 def obstacle_array(obstacles: Sequence[Obstacle] | np.ndarray) -> np.ndarray:
@@ -370,7 +356,9 @@ class FhocpNlp:
 
     def errors(self, states: np.ndarray, ref: np.ndarray) -> np.ndarray:
         """[e_d, e_z, e_o] (K, 3) of ``states`` (K, 4) w.r.t. ``ref`` (K, 3), e_d floored at 1e-9."""
-        return error_coordinates(states, ref, ED_FLOOR)
+        from tubekit.model import compiled_arcs
+
+        return compiled_arcs.error_coordinates(np.asarray(states, dtype=float), np.asarray(ref, dtype=float), ED_FLOOR)
 
     def cost(self, states: np.ndarray, inputs: np.ndarray, ref: np.ndarray, v_last: np.ndarray | None = None) -> float:
         """Stage + terminal cost + the rate penalty (no exact penalties)."""
@@ -393,10 +381,12 @@ class FhocpNlp:
         v_last : array (3,), optional
             The command before the plan (rate penalty; with ``first_row``, the rate row (b)).
         """
+        from tubekit.model import compiled_arcs
+
         states = np.asarray(states, dtype=float)
         inputs = np.asarray(inputs, dtype=float)
         n = self.n
-        e = error_coordinates(states, ref, ED_FLOOR)
+        e = compiled_arcs.error_coordinates(states, ref, ED_FLOOR)
         e2 = e * e
         cost = float(np.einsum("kc,ck->", e2, self._w) + np.einsum("kc,kc,c->", inputs, inputs, self._dt_r))
         if self.rate_penalty:
@@ -420,7 +410,7 @@ class FhocpNlp:
         if self.terminal != "off":
             term = max(0.0, math.sqrt(float(e2[n] @ self.p)) - self.terminal_level)
         inp = max(0.0, float(np.maximum(inputs - self.v_max, self.v_min - inputs).max()))
-        dyn = float(np.abs(states[1:] - discrete_step(states[:-1], inputs, self.dt)).max())
+        dyn = float(np.abs(states[1:] - compiled_arcs.unicycle_steps(states[:-1], inputs, self.dt)).max())
         vmax = viol.max(axis=1)
         merit = cost + self.penalty * float(viol.sum())
         if self.terminal == "soft":

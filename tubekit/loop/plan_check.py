@@ -45,9 +45,8 @@ from typing import Sequence
 import numpy as np
 
 from tubekit.design_inputs import ARC_SAMPLES, RATE_TOLERANCE
-from tubekit.model.errors import error_coordinates, heading_cosine
-from tubekit.model.kinematics import sinc, unicycle_step
-from tubekit.plant.kinematic import nominal_arc
+from tubekit.model.errors import heading_cosine
+from tubekit.model.kinematics import unicycle_step
 from tubekit.scenario import Obstacle, Scenario
 from tubekit.loop.terminal import terminal_condition
 from tubekit.tightening import Tightening
@@ -80,36 +79,24 @@ class PlanCheck:
 def plan_arcs(x0: np.ndarray, inputs: np.ndarray, dt: float, samples: int) -> np.ndarray:
     """States (N, samples + 1, 4) along the exact nominal arcs of ``inputs`` (N, 3) from ``x0``.
 
-    One vectorised pass: the arcs' start states are the running sums (``np.cumsum``: the same sequential
-    additions as chaining :func:`~tubekit.plant.kinematic.nominal_arc` arc by arc) of each arc's exact
-    increment, then every arc is evaluated at once with the same element-wise formula.
+    One compiled pass (:func:`tubekit.model.compiled_arcs.plan_arcs`): each arc starts at the running sum (the
+    same sequential additions as chaining :func:`~tubekit.plant.kinematic.nominal_arc` arc by arc) of the
+    previous arcs' exact increments, and is evaluated with the same formula.
     """
+    from tubekit.model import compiled_arcs
+
     tau = np.linspace(0.0, dt, samples + 1)
-    v = np.asarray(inputs, dtype=float).reshape(-1, 3)
-    x = np.asarray(x0, dtype=float)
-    n = len(v)
-    if n == 0:
-        return np.empty((0, samples + 1, 4))
-    span = tau[-1]
-    u, w, r = v[:, 0], v[:, 1], v[:, 2]
-    psi = np.cumsum(np.concatenate(([x[3]], span * r)))[:-1]
-    a = 0.5 * span * r
-    k = span * u * sinc(a)
-    starts = np.empty((n, 4))
-    starts[:, 0] = np.cumsum(np.concatenate(([x[0]], k * np.cos(psi + a))))[:-1]
-    starts[:, 1] = np.cumsum(np.concatenate(([x[1]], k * np.sin(psi + a))))[:-1]
-    starts[:, 2] = np.cumsum(np.concatenate(([x[2]], span * w)))[:-1]
-    starts[:, 3] = psi
-    return unicycle_step(starts[:, None, :], v[:, None, :], tau[None, :])
+    return compiled_arcs.plan_arcs(np.asarray(x0, dtype=float), np.asarray(inputs, dtype=float).reshape(-1, 3), tau)
 
 
 def _plan_arcs_chained(x0: np.ndarray, inputs: np.ndarray, dt: float, samples: int) -> np.ndarray:
-    """:func:`plan_arcs` arc by arc with :func:`nominal_arc` (the reference the vectorised pass must equal)."""
+    """:func:`plan_arcs` arc by arc with the model's numpy formula, :func:`tubekit.model.kinematics.unicycle_step`
+    (the reference the compiled pass must equal)."""
     tau = np.linspace(0.0, dt, samples + 1)
     out = np.empty((len(inputs), samples + 1, 4))
     x = np.asarray(x0, dtype=float)
-    for j, v in enumerate(inputs):
-        out[j] = nominal_arc(x, v, tau)
+    for j, v in enumerate(np.asarray(inputs, dtype=float)):
+        out[j] = unicycle_step(x, v, tau)
         x = out[j, -1]
     return out
 
@@ -202,6 +189,8 @@ def check_plan(scenario: Scenario, tight: Tightening, t0: float, x0: np.ndarray,
                v_last: np.ndarray | None = None) -> PlanCheck:
     """Verify a plan (module doc). ``sign`` is the certified hemisphere (-1 toward, +1 away, 0 both);
     ``v_last`` (3,) the command before the plan (rate row (b); None: not checked)."""
+    from tubekit.model import compiled_arcs
+
     inputs = np.asarray(inputs, dtype=float)
     n = tight.horizon_arcs
     if inputs.ndim != 2 or inputs.shape[1] != 3 or inputs.shape[0] != n or not np.all(np.isfinite(inputs)):
@@ -216,7 +205,7 @@ def check_plan(scenario: Scenario, tight: Tightening, t0: float, x0: np.ndarray,
     arcs = plan_arcs(x0, inputs, dt, samples)
     times = t0 + dt * (np.arange(n)[:, None] + np.linspace(0.0, 1.0, samples + 1)[None, :])
     desired = np.asarray(scenario.trajectory.position(times.reshape(-1)), dtype=float).reshape(n, samples + 1, 3)
-    e = error_coordinates(arcs, desired)
+    e = compiled_arcs.error_coordinates(arcs.reshape(-1, 4), desired.reshape(-1, 3), 0.0).reshape(n, samples + 1, 3)
     cos_rel = heading_cosine(arcs, desired)
     pad = 0.5 * (dt / samples) * np.asarray(tight.rates, dtype=float)
     m = np.asarray(tight.margins, dtype=float)

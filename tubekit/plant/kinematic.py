@@ -25,7 +25,6 @@ from typing import Callable, Sequence
 
 import numpy as np
 
-from tubekit.model.kinematics import unicycle_step
 from tubekit.plant.base import OmegaOverride
 from tubekit.scenario import Disturbance, Scenario
 
@@ -69,6 +68,7 @@ class Plant:
         sway = disturbance.sway
         self._sway_gain, self._sway_amplitude = float(sway.gain), float(sway.amplitude)
         self._sway_rate = 2.0 * math.pi / sway.period
+        self._current_parameters = (*self._amplitude, *self._constant, self._current_rate)
         self._peak = [0.0, 0.0]  # largest ||omega_xy||, |omega_z| over every evaluation (m/s)
 
     @classmethod
@@ -103,7 +103,7 @@ class Plant:
         psi = x[3]
         o1, o2, o3 = self._omega(t, psi, u, r)
         peak = self._peak
-        oxy = math.hypot(o1, o2)
+        oxy = math.sqrt(o1 * o1 + o2 * o2)  # the compiled RK4 takes the same operations
         if oxy > peak[0]:
             peak[0] = oxy
         if abs(o3) > peak[1]:
@@ -162,53 +162,16 @@ class Plant:
         return rk4_tuple(self._rhs, t, tuple(x), v, h, n)
 
     def _rk4_fused(self, t: float, y: tuple, v: Sequence[float], h: float, n: int) -> Floats4:
-        """``n`` RK4 steps of :meth:`_rhs` (no override), unrolled on scalars; δ(t) and the wave sway are
-        evaluated once per distinct stage time (the midpoint serves k2 and k3; a step's end serves the next
-        step's start, the same float t + h), and k3 is k2 (ψ's rate is r at every stage, so both stages sit
-        at the same ψ and time)."""
+        """``n`` RK4 steps of :meth:`_rhs` (no override) in one compiled routine,
+        :func:`tubekit.plant.compiled_rk4.rk4_current` (the same floats as :func:`rk4_tuple` of :meth:`_rhs`)."""
+        from tubekit.plant.compiled_rk4 import rk4_current
+
         u, w, r = v
-        (a0, a1, a2), (c0, c1, c2) = self._amplitude, self._constant
-        rate, samp, srate, peak = self._current_rate, self._sway_amplitude, self._sway_rate, self._peak
-        sw = self._sway_gain * u * r
-        sin, cos, hypot = math.sin, math.cos, math.hypot
-        x0, x1, x2, x3 = y
-        hh, h6 = 0.5 * h, h / 6.0
-        p0, p1 = peak
-        s, c = sin(rate * t), cos(rate * t)
-        e1, e2, e3, es = a0 * s + c0, a1 * c + c1, a2 * s + c2, sw + samp * sin(srate * t)
-        for _ in range(n):
-            tm, te = t + 0.5 * h, t + h
-            d1, d2, d3, vs = e1, e2, e3, es
-            s, c = sin(rate * tm), cos(rate * tm)
-            m1, m2, m3, ms = a0 * s + c0, a1 * c + c1, a2 * s + c2, sw + samp * sin(srate * tm)
-            s, c = sin(rate * te), cos(rate * te)
-            e1, e2, e3, es = a0 * s + c0, a1 * c + c1, a2 * s + c2, sw + samp * sin(srate * te)
-            # k1 at (t, y)
-            sp, cp = sin(x3), cos(x3)
-            o1, o2 = d1 - vs * sp, d2 + vs * cp
-            p0, p1 = max(p0, hypot(o1, o2)), max(p1, abs(d3))
-            k10, k11, k12 = u * cp + o1, u * sp + o2, w + d3
-            # k2 at (t + h/2, y + h/2 k1)
-            q3 = x3 + hh * r
-            sp, cp = sin(q3), cos(q3)
-            o1, o2 = m1 - ms * sp, m2 + ms * cp
-            p0, p1 = max(p0, hypot(o1, o2)), max(p1, abs(m3))
-            k20, k21, k22 = u * cp + o1, u * sp + o2, w + m3
-            # k3 at (t + h/2, y + h/2 k2) = k2: the same ψ (x3 + h/2 r) and the same time
-            k30, k31, k32 = k20, k21, k22
-            # k4 at (t + h, y + h k3)
-            q3 = x3 + h * r
-            sp, cp = sin(q3), cos(q3)
-            o1, o2 = e1 - es * sp, e2 + es * cp
-            p0, p1 = max(p0, hypot(o1, o2)), max(p1, abs(e3))
-            k40, k41, k42 = u * cp + o1, u * sp + o2, w + e3
-            x0 = x0 + h6 * (k10 + 2.0 * k20 + 2.0 * k30 + k40)
-            x1 = x1 + h6 * (k11 + 2.0 * k21 + 2.0 * k31 + k41)
-            x2 = x2 + h6 * (k12 + 2.0 * k22 + 2.0 * k32 + k42)
-            x3 = x3 + h6 * (r + 2.0 * r + 2.0 * r + r)
-            t += h
-        peak[0], peak[1] = p0, p1
-        return x0, x1, x2, x3
+        state, peak = rk4_current(t, y, (u, w, r), h, n, self._current_parameters,
+                                  (self._sway_gain * u * r, self._sway_amplitude, self._sway_rate),
+                                  (self._peak[0], self._peak[1]))
+        self._peak[0], self._peak[1] = peak
+        return state
 
     def omega_peak(self) -> tuple[float, float]:
         """Largest ‖ω_xy‖ and |ω_z| (m/s) over every evaluation the integrator made (every RK4 stage)."""
@@ -274,6 +237,8 @@ def nominal_arc(x0: np.ndarray, v: np.ndarray, tau: np.ndarray) -> np.ndarray:
     array (n, 4)
         States at ``tau``.
     """
-    tau = np.asarray(tau, dtype=float)
-    return unicycle_step(np.asarray(x0, dtype=float), np.asarray(v, dtype=float), tau)
+    from tubekit.model import compiled_arcs
+
+    return compiled_arcs.arc(np.asarray(x0, dtype=float), np.asarray(v, dtype=float),
+                             np.asarray(tau, dtype=float).reshape(-1))
 

@@ -1,0 +1,95 @@
+"""The kinematic plant's RK4 under the modelled current and sway, as one compiled routine (numba).
+
+:func:`rk4_current` integrates ẋ = f(x) v + [δ(t) + v_s (−sin ψ, cos ψ, 0), 0] (eq. 11; the formulas of
+:class:`tubekit.plant.kinematic.Plant`) over ``n`` classical RK4 steps with the input held. It performs the
+floating-point operations of :func:`tubekit.plant.kinematic.rk4_tuple` applied to ``Plant._rhs`` in the same
+order (k3 equals k2 there: ψ's rate is r at every stage, so both stages sit at the same ψ and time; the current
+and the wave sway are evaluated once per distinct stage time), so the states and the disturbance's peaks are
+bit for bit the same (``tests/test_plant_compiled_rk4.py``).
+
+Importing this module imports numba (:class:`~tubekit.plant.kinematic.Plant` imports it at its first step); the
+machine code is cached beside this file.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numba
+
+__all__ = ["rk4_current"]
+
+Floats2 = tuple[float, float]
+Floats3 = tuple[float, float, float]
+Floats4 = tuple[float, float, float, float]
+
+
+@numba.njit(cache=True, nogil=True, error_model="numpy")
+def rk4_current(t: float, y: Floats4, v: Floats3, h: float, n: int,
+                current: tuple[float, float, float, float, float, float, float], sway: Floats3,
+                peak: Floats2) -> tuple[Floats4, Floats2]:
+    """``n`` RK4 steps of ``h`` (s) from ``y`` = (x, y, z, ψ) at ``t`` (s) under ``v`` = (u, w, r) held.
+
+    Parameters
+    ----------
+    current : tuple
+        (a_1, a_2, a_3, c_1, c_2, c_3, ω_c): δ(t) = (a_1 sin ω_c t + c_1, a_2 cos ω_c t + c_2, a_3 sin ω_c t + c_3)
+        (m/s, rad/s).
+    sway : tuple
+        (g u r, A_s, ω_s): v_s(t) = g u r + A_s sin ω_s t (m/s, m/s, rad/s).
+    peak : tuple
+        The largest ‖ω_xy‖ and |ω_z| so far (m/s).
+
+    Returns
+    -------
+    state (4,) after the steps and the peaks (2,) including every stage evaluated.
+    """
+    u, w, r = v
+    a0, a1, a2, c0, c1, c2, rate = current
+    sw, samp, srate = sway
+    x0, x1, x2, x3 = y
+    hh, h6 = 0.5 * h, h / 6.0
+    p0, p1 = peak
+    s, c = math.sin(rate * t), math.cos(rate * t)
+    e1, e2, e3, es = a0 * s + c0, a1 * c + c1, a2 * s + c2, sw + samp * math.sin(srate * t)
+    for _ in range(n):
+        tm, te = t + 0.5 * h, t + h
+        d1, d2, d3, vs = e1, e2, e3, es
+        s, c = math.sin(rate * tm), math.cos(rate * tm)
+        m1, m2, m3, ms = a0 * s + c0, a1 * c + c1, a2 * s + c2, sw + samp * math.sin(srate * tm)
+        s, c = math.sin(rate * te), math.cos(rate * te)
+        e1, e2, e3, es = a0 * s + c0, a1 * c + c1, a2 * s + c2, sw + samp * math.sin(srate * te)
+        # k1 at (t, y)
+        sp, cp = math.sin(x3), math.cos(x3)
+        o1, o2 = d1 - vs * sp, d2 + vs * cp
+        p0, p1 = _peaks(p0, p1, o1, o2, d3)
+        k10, k11, k12 = u * cp + o1, u * sp + o2, w + d3
+        # k2 = k3 at (t + h/2, ψ + h/2 r)
+        q3 = x3 + hh * r
+        sp, cp = math.sin(q3), math.cos(q3)
+        o1, o2 = m1 - ms * sp, m2 + ms * cp
+        p0, p1 = _peaks(p0, p1, o1, o2, m3)
+        k20, k21, k22 = u * cp + o1, u * sp + o2, w + m3
+        # k4 at (t + h, ψ + h r)
+        q3 = x3 + h * r
+        sp, cp = math.sin(q3), math.cos(q3)
+        o1, o2 = e1 - es * sp, e2 + es * cp
+        p0, p1 = _peaks(p0, p1, o1, o2, e3)
+        k40, k41, k42 = u * cp + o1, u * sp + o2, w + e3
+        x0 = x0 + h6 * (k10 + 2.0 * k20 + 2.0 * k20 + k40)
+        x1 = x1 + h6 * (k11 + 2.0 * k21 + 2.0 * k21 + k41)
+        x2 = x2 + h6 * (k12 + 2.0 * k22 + 2.0 * k22 + k42)
+        x3 = x3 + h6 * (r + 2.0 * r + 2.0 * r + r)
+        t += h
+    return (x0, x1, x2, x3), (p0, p1)
+
+
+@numba.njit(cache=True, nogil=True, error_model="numpy")
+def _peaks(p0: float, p1: float, o1: float, o2: float, o3: float) -> Floats2:
+    """The peaks (‖ω_xy‖, |ω_z|) with one more evaluation ω = (o1, o2, o3) (a NaN peak stays NaN, as max does)."""
+    q = math.sqrt(o1 * o1 + o2 * o2)  # as Plant._rhs (libm's hypot and Python's differ in the last bit)
+    if q > p0:
+        p0 = q
+    if abs(o3) > p1:
+        p1 = abs(o3)
+    return p0, p1

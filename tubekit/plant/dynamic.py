@@ -127,6 +127,7 @@ class DynamicPlant:
         self._log: list[tuple[float, ...]] = []
         # largest ||omega_xy||, |omega_z|, then ||delta_xy||, |delta_z| of the current, over every evaluation (m/s)
         self._peak = [0.0, 0.0, 0.0, 0.0]
+        self._compiled: tuple | None = None  # the compiled RK4's arrays, packed at the first step
 
     # ---- the model ---------------------------------------------------------------------
     def current_at(self, t: float) -> tuple[float, float, float]:
@@ -182,7 +183,7 @@ class DynamicPlant:
         """Keep the largest ‖ω_xy‖, |ω_z| of ω = ẋ − f(x) v and ‖δ_xy‖, |δ_z| of the current δ (m/s) seen by
         the integrator (one call per stage: the hot loop pays one call for both)."""
         peak = self._peak
-        oxy, cxy = math.hypot(o1, o2), math.hypot(c1, c2)
+        oxy, cxy = math.sqrt(o1 * o1 + o2 * o2), math.sqrt(c1 * c1 + c2 * c2)  # as the compiled RK4
         if oxy > peak[0]:
             peak[0] = oxy
         if abs(o3) > peak[1]:
@@ -214,9 +215,32 @@ class DynamicPlant:
         if self.state is None:
             self.state = self._start(v)
         self._log.append(self.state[:7])
-        y = rk4_tuple(self._rhs, t, (*x, *self.state), v, h, n)
-        self.state = y[4:]
-        return y[0], y[1], y[2], y[3]
+        if self.override is not None:
+            y = rk4_tuple(self._rhs, t, (*x, *self.state), v, h, n)
+            self.state = y[4:]
+            return y[0], y[1], y[2], y[3]
+        return self._compiled_step(t, x, v, h, n)
+
+    def _compiled_step(self, t: float, x: Sequence[float], v: Sequence[float], h: float, n: int) -> Floats4:
+        """:func:`rk4_tuple` of :meth:`_rhs` (no override) in one compiled routine,
+        :func:`tubekit.plant.compiled_dynamic.rk4_dynamic` (the same floats)."""
+        from tubekit.plant import compiled_dynamic
+
+        if self._compiled is None:
+            current = self._current_model
+            self._compiled = (compiled_dynamic.coefficients(self.params), compiled_dynamic.coefficients(self.model),
+                              np.array([self._kp, self._ki, self._tau_inv]),
+                              compiled_dynamic.actuator_limits(self.params, self._sway_limit),
+                              np.array([*current._amplitude, *current._constant, current._current_rate]))
+        truth, model, control, limits, current = self._compiled
+        peak = np.array(self._peak)
+        y = compiled_dynamic.rk4_dynamic(float(t), np.array((*x, *self.state), dtype=float),
+                                         np.array(v, dtype=float), float(h), int(n), truth, model, control, limits,
+                                         current, self.lateral, peak)
+        self._peak[:] = peak.tolist()
+        values = y.tolist()
+        self.state = tuple(values[4:])
+        return values[0], values[1], values[2], values[3]
 
     def step(self, t: float, x: np.ndarray, v: np.ndarray, h: float, n: int) -> np.ndarray:
         """:meth:`step_tuple` on arrays."""

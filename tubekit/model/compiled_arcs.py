@@ -26,22 +26,19 @@ from __future__ import annotations
 
 import math
 
-import numba
 import numpy as np
 
+from tubekit.model.jit import routine
 from tubekit.model.kinematics import SINC_SERIES_THRESHOLD
 
 __all__ = ["rollout", "unicycle_steps", "plan_arcs", "arc", "step_linearisation", "eo_linearisation",
            "error_coordinates"]
 
-#: every routine: compiled once per machine, IEEE operations in source order, IEEE division (0/0 is NaN, as
-#: numpy's, instead of Python's ZeroDivisionError)
-_compile = numba.njit(cache=True, nogil=True, error_model="numpy")
 
 _SERIES_LIMIT = SINC_SERIES_THRESHOLD ** 2
 
 
-@_compile
+@routine
 def _sinc(a: float) -> float:
     """sin(a)/a with S(0) = 1 (as :func:`tubekit.model.kinematics.sinc`: sin(1e-300)/1e-300 is 1.0)."""
     if a == 0.0:
@@ -49,7 +46,7 @@ def _sinc(a: float) -> float:
     return math.sin(a) / a
 
 
-@_compile
+@routine
 def _dsinc(a: float) -> float:
     """S'(a) as :func:`tubekit.model.kinematics.dsinc` (the Taylor series below the threshold)."""
     a2 = a * a
@@ -59,7 +56,7 @@ def _dsinc(a: float) -> float:
     return (a * math.cos(a) - math.sin(a)) / (a * a)
 
 
-@_compile
+@routine
 def rollout(s0: np.ndarray, inputs: np.ndarray, dt: float) -> np.ndarray:
     """States (N+1, 4) of the exact steps of ``inputs`` (N, 3) from ``s0`` (4,), ``dt`` (s) each."""
     n = inputs.shape[0]
@@ -79,7 +76,7 @@ def rollout(s0: np.ndarray, inputs: np.ndarray, dt: float) -> np.ndarray:
     return out
 
 
-@_compile
+@routine
 def unicycle_steps(states: np.ndarray, inputs: np.ndarray, dt: float) -> np.ndarray:
     """The exact step (N, 4) of every row of ``states`` (N, 4) under the same row of ``inputs`` (N, 3)."""
     n = inputs.shape[0]
@@ -97,7 +94,7 @@ def unicycle_steps(states: np.ndarray, inputs: np.ndarray, dt: float) -> np.ndar
     return out
 
 
-@_compile
+@routine
 def _arc_into(x: float, y: float, z: float, psi: float, u: float, w: float, r: float, tau: np.ndarray,
               out: np.ndarray) -> None:
     """The exact arc from (x, y, z, ψ) under (u, w, r) at the elapsed times ``tau``, written into ``out``."""
@@ -112,7 +109,7 @@ def _arc_into(x: float, y: float, z: float, psi: float, u: float, w: float, r: f
         out[j, 3] = psi + t * r
 
 
-@_compile
+@routine
 def arc(x0: np.ndarray, v: np.ndarray, tau: np.ndarray) -> np.ndarray:
     """States (len(tau), 4) of the exact arc from ``x0`` (4,) under ``v`` (3,) at the times ``tau`` (s)."""
     out = np.empty((tau.shape[0], 4))
@@ -120,7 +117,7 @@ def arc(x0: np.ndarray, v: np.ndarray, tau: np.ndarray) -> np.ndarray:
     return out
 
 
-@_compile
+@routine
 def plan_arcs(x0: np.ndarray, inputs: np.ndarray, tau: np.ndarray) -> np.ndarray:
     """States (N, len(tau), 4) along the arcs of ``inputs`` (N, 3) from ``x0``; each arc lasts ``tau[-1]``.
 
@@ -144,7 +141,7 @@ def plan_arcs(x0: np.ndarray, inputs: np.ndarray, tau: np.ndarray) -> np.ndarray
     return out
 
 
-@_compile
+@routine
 def step_linearisation(states: np.ndarray, inputs: np.ndarray, dt: float) -> np.ndarray:
     """Rows ``ax, bxu, bxr, cx, ay, byu, byr, cy`` (8, N) of the exact step's Jacobian at a plan."""
     n = inputs.shape[0]
@@ -169,7 +166,7 @@ def step_linearisation(states: np.ndarray, inputs: np.ndarray, dt: float) -> np.
     return out
 
 
-@_compile
+@routine
 def eo_linearisation(states: np.ndarray, ref: np.ndarray, floor: float) -> np.ndarray:
     """Rows ``gx, gy, gpsi, h, e_o`` (5, K) of the bearing error's first-order model, e_d floored at ``floor``."""
     k_all = states.shape[0]
@@ -191,7 +188,7 @@ def eo_linearisation(states: np.ndarray, ref: np.ndarray, floor: float) -> np.nd
     return out
 
 
-@_compile
+@routine
 def error_coordinates(states: np.ndarray, ref: np.ndarray, floor: float) -> np.ndarray:
     """[e_d, e_z, e_o] (K, 3) of ``states`` (K, 4) w.r.t. ``ref`` (K, 3), e_d = sqrt(max(e_x² + e_y², floor²))."""
     k_all = states.shape[0]

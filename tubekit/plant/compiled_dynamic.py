@@ -16,9 +16,9 @@ from __future__ import annotations
 
 import math
 
-import numba
 import numpy as np
 
+from tubekit.model.jit import routine
 from tubekit.model.vehicle_params import VehicleParams
 
 __all__ = ["COEFFICIENTS", "coefficients", "actuator_limits", "rk4_dynamic"]
@@ -28,7 +28,6 @@ COEFFICIENTS: tuple[str, ...] = ("X_u", "X_uu", "Y_v", "Y_vv", "Y_rr", "Y_uv", "
                                  "N_r", "N_rr", "N_vv", "N_uv_lift", "N_ur_lift")
 _M11, _M22, _M33, _M44, _M24, _M42 = range(len(COEFFICIENTS), len(COEFFICIENTS) + 6)
 
-_compile = numba.njit(cache=True, nogil=True, error_model="numpy")
 
 
 def coefficients(params: VehicleParams) -> np.ndarray:
@@ -45,7 +44,7 @@ def actuator_limits(params: VehicleParams, sway_limit: float) -> np.ndarray:
                      float(params.fin_max), abs(float(params.Z_uuds)), abs(float(params.N_uudr)), float(sway_limit)])
 
 
-@_compile
+@routine
 def _forces(p: np.ndarray, u: float, v: float, w: float, r: float) -> tuple[float, float, float, float]:
     """n(ν) = C(ν)ν + D(ν)ν of the vehicle ``p`` (:func:`tubekit.plant.dynamic.body_forces`)."""
     sway_momentum = p[_M22] * v + p[_M24] * r
@@ -56,14 +55,14 @@ def _forces(p: np.ndarray, u: float, v: float, w: float, r: float) -> tuple[floa
     return (-sway_momentum * r + d1, p[_M11] * u * r + d2, d3, sway_momentum * u - p[_M11] * u * v + d4)
 
 
-@_compile
+@routine
 def _saturate(c: float, lim: float) -> float:
     """min(max(c, −lim), lim) with Python's tie and NaN rules."""
     x = -lim if -lim > c else c
     return lim if lim < x else x
 
 
-@_compile
+@routine
 def _rhs(t: float, y: np.ndarray, command: np.ndarray, truth: np.ndarray, model: np.ndarray, control: np.ndarray,
          limits: np.ndarray, current: np.ndarray, lateral: bool, out: np.ndarray, peak: np.ndarray) -> None:
     """d/dt of ``y`` into ``out`` (``DynamicPlant._rhs``); ``control`` = (k_p, k_i, 1/T_thr)."""
@@ -107,7 +106,7 @@ def _rhs(t: float, y: np.ndarray, command: np.ndarray, truth: np.ndarray, model:
         out[15] = 0.0 if sat != raw and sat * v < 0.0 else -v
 
 
-@_compile
+@routine
 def _record(peak: np.ndarray, o1: float, o2: float, o3: float, c1: float, c2: float, c3: float) -> None:
     """The largest ‖ω_xy‖, |ω_z|, ‖δ_xy‖, |δ_z| so far (``DynamicPlant._record``)."""
     oxy, cxy = math.sqrt(o1 * o1 + o2 * o2), math.sqrt(c1 * c1 + c2 * c2)
@@ -121,7 +120,7 @@ def _record(peak: np.ndarray, o1: float, o2: float, o3: float, c1: float, c2: fl
         peak[3] = abs(c3)
 
 
-@_compile
+@routine
 def rk4_dynamic(t: float, y0: np.ndarray, command: np.ndarray, h: float, n: int, truth: np.ndarray,
                 model: np.ndarray, control: np.ndarray, limits: np.ndarray, current: np.ndarray, lateral: bool,
                 peak: np.ndarray) -> np.ndarray:

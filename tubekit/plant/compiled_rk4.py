@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import math
 
-import numba
+from tubekit.model.jit import routine
 
 __all__ = ["rk4_current"]
 
@@ -24,7 +24,7 @@ Floats3 = tuple[float, float, float]
 Floats4 = tuple[float, float, float, float]
 
 
-@numba.njit(cache=True, nogil=True, error_model="numpy")
+@routine
 def rk4_current(t: float, y: Floats4, v: Floats3, h: float, n: int,
                 current: tuple[float, float, float, float, float, float, float], sway: Floats3,
                 peak: Floats2) -> tuple[Floats4, Floats2]:
@@ -84,7 +84,7 @@ def rk4_current(t: float, y: Floats4, v: Floats3, h: float, n: int,
     return (x0, x1, x2, x3), (p0, p1)
 
 
-@numba.njit(cache=True, nogil=True, error_model="numpy")
+@routine
 def _peaks(p0: float, p1: float, o1: float, o2: float, o3: float) -> Floats2:
     """The peaks (‖ω_xy‖, |ω_z|) with one more evaluation ω = (o1, o2, o3) (a NaN peak stays NaN, as max does)."""
     q = math.sqrt(o1 * o1 + o2 * o2)  # as Plant._rhs (libm's hypot and Python's differ in the last bit)

@@ -34,16 +34,14 @@ def test_the_compiled_rk4_is_the_generic_rk4_of_the_plant_bit_for_bit(plant, t, 
     """Property: rk4_current returns the very state of rk4_tuple on Plant._rhs, and the very peaks it records."""
     generic = rk4_tuple(plant._rhs, t, y, v, h, n)
     u, _, r = v
-    current = (*plant._amplitude, *plant._constant, plant._current_rate)
-    sway = (plant._sway_gain * u * r, plant._sway_amplitude, plant._sway_rate)
-    state, peak = rk4_current(t, y, v, h, n, current, sway, (0.0, 0.0))
+    state, peak = rk4_current(t, y, v, h, n, plant.current_parameters, plant.sway_parameters(u, r), (0.0, 0.0))
     assert state == generic
     assert peak == plant.omega_peak()
 
 
 def test_the_peaks_carry_over_between_calls_and_a_nan_peak_stays_nan():
     plant = Plant(Disturbance(amplitude=(0.1, 0.1, 0.05), period=10.0))
-    current = (*plant._amplitude, *plant._constant, plant._current_rate)
+    current = plant.current_parameters
     _, peak = rk4_current(0.0, (0.0, 0.0, 0.0, 0.0), (0.3, 0.0, 0.2), 0.01, 2, current, (0.0, 0.0, 1.0), (5.0, 4.0))
     assert peak == (5.0, 4.0)
     _, peak = rk4_current(0.0, (0.0, 0.0, 0.0, 0.0), (0.3, 0.0, 0.2), 0.01, 2, current, (0.0, 0.0, 1.0),

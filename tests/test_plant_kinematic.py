@@ -125,8 +125,8 @@ def test_step_is_rk4_hold_and_step_tuple():
 
 @given(t=st.floats(0.0, 200.0), psi=st.floats(-4.0, 4.0), u=st.floats(-0.5, 0.5), w=st.floats(-0.3, 0.3),
        r=st.floats(-0.6, 0.6), n=st.integers(1, 4))
-def test_fused_step_equals_the_generic_rk4_bit_for_bit(t, psi, u, w, r, n):
-    """Property: step_tuple (the unrolled RK4) returns the very floats, and records the very omega peak, of
+def test_the_compiled_step_equals_the_generic_rk4_bit_for_bit(t, psi, u, w, r, n):
+    """Property: step_tuple (the compiled RK4) returns the very floats, and records the very omega peak, of
     rk4_tuple on the plant's _rhs (the generic integrator it replaces in the loop)."""
     from tubekit.plant.kinematic import rk4_tuple
     fused, generic = _plant(), _plant()

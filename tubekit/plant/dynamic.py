@@ -227,11 +227,10 @@ class DynamicPlant:
         from tubekit.plant import compiled_dynamic
 
         if self._compiled is None:
-            current = self._current_model
             self._compiled = (compiled_dynamic.coefficients(self.params), compiled_dynamic.coefficients(self.model),
                               np.array([self._kp, self._ki, self._tau_inv]),
                               compiled_dynamic.actuator_limits(self.params, self._sway_limit),
-                              np.array([*current._amplitude, *current._constant, current._current_rate]))
+                              np.array(self._current_model.current_parameters))
         truth, model, control, limits, current = self._compiled
         peak = np.array(self._peak)
         y = compiled_dynamic.rk4_dynamic(float(t), np.array((*x, *self.state), dtype=float),

@@ -13,7 +13,8 @@ inertial disturbance (m/s)
 
 Everything here is evaluated in one place, :class:`Plant`, whose inner loop is
 scalar and allocation-free (plain float tuples, :mod:`math`): the closed loop
-integrates it with classical RK4 at a fixed step (:meth:`Plant.step_tuple`).
+integrates it with classical RK4 at a fixed step (:meth:`Plant.step_tuple`; without an override, the same
+operations compiled, :mod:`tubekit.plant.compiled_rk4`).
 :func:`nominal_arc` is the exact solution of the nominal kinematics (eq. 3)
 under a constant input, used to propagate the nominal state between samples.
 """
@@ -68,7 +69,6 @@ class Plant:
         sway = disturbance.sway
         self._sway_gain, self._sway_amplitude = float(sway.gain), float(sway.amplitude)
         self._sway_rate = 2.0 * math.pi / sway.period
-        self._current_parameters = (*self._amplitude, *self._constant, self._current_rate)
         self._peak = [0.0, 0.0]  # largest ||omega_xy||, |omega_z| over every evaluation (m/s)
 
     @classmethod
@@ -111,6 +111,17 @@ class Plant:
         return (u * math.cos(psi) + o1, u * math.sin(psi) + o2, w + o3, r)
 
     # ---- public API ---------------------------------------------------------------------
+    @property
+    def current_parameters(self) -> tuple[float, float, float, float, float, float, float]:
+        """(a_1, a_2, a_3, c_1, c_2, c_3, ω_c) of δ(t) = (a_1 sin ω_c t + c_1, a_2 cos ω_c t + c_2, a_3 sin ω_c t + c_3)
+        (m/s, rad/s): the current as the compiled RK4s take it."""
+        return (*self._amplitude, *self._constant, self._current_rate)
+
+    def sway_parameters(self, u: float, r: float) -> Floats3:
+        """(g u r, A_s, ω_s) of v_s(t) = g u r + A_s sin ω_s t at the input's ``u`` (m/s) and ``r`` (rad/s): the sway as
+        the compiled RK4 takes it (m/s, m/s, rad/s)."""
+        return self._sway_gain * u * r, self._sway_amplitude, self._sway_rate
+
     def current_at(self, t: float) -> Floats3:
         """δ(t) (m/s) as three floats; ``t`` in s."""
         return self._current(t)
@@ -154,21 +165,20 @@ class Plant:
     def step_tuple(self, t: float, x: Sequence[float], v: Sequence[float], h: float, n: int) -> Floats4:
         """:meth:`step` on float tuples, without arrays (the closed loop's inner loop).
 
-        Without an override this is :meth:`_rk4_fused`: :func:`rk4_tuple` of :meth:`_rhs` with the
-        calls inlined, the same floating-point operations in the same order (bit-identical results).
+        Without an override this is :meth:`_compiled_step`: :func:`rk4_tuple` of :meth:`_rhs` as one compiled
+        routine, the same floating-point operations in the same order (bit-identical results).
         """
         if self.override is None:
-            return self._rk4_fused(t, tuple(x), v, h, n)
+            return self._compiled_step(t, tuple(x), v, h, n)
         return rk4_tuple(self._rhs, t, tuple(x), v, h, n)
 
-    def _rk4_fused(self, t: float, y: tuple, v: Sequence[float], h: float, n: int) -> Floats4:
+    def _compiled_step(self, t: float, y: tuple, v: Sequence[float], h: float, n: int) -> Floats4:
         """``n`` RK4 steps of :meth:`_rhs` (no override) in one compiled routine,
         :func:`tubekit.plant.compiled_rk4.rk4_current` (the same floats as :func:`rk4_tuple` of :meth:`_rhs`)."""
         from tubekit.plant.compiled_rk4 import rk4_current
 
         u, w, r = v
-        state, peak = rk4_current(t, y, (u, w, r), h, n, self._current_parameters,
-                                  (self._sway_gain * u * r, self._sway_amplitude, self._sway_rate),
+        state, peak = rk4_current(t, y, (u, w, r), h, n, self.current_parameters, self.sway_parameters(u, r),
                                   (self._peak[0], self._peak[1]))
         self._peak[0], self._peak[1] = peak
         return state

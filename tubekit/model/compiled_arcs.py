@@ -1,25 +1,26 @@
 """The period's arc numerics as compiled routines (numba): the exact unicycle arc, a plan's rollout and arcs,
 the arc's Jacobian, the bearing error's first-order model and the error coordinates.
 
-Each routine performs the floating-point operations of its numpy counterpart in the same order (no fast-math,
+Each routine performs the floating-point operations of its numpy reference in the same order (no fast-math,
 no reassociation, libm's sin and cos as numpy's float64 ufuncs call them), so its results are bit for bit
-those of the counterpart; ``tests/test_model_compiled_arcs.py`` checks every pair on random inputs:
+those of the reference (``tests/test_model_compiled_arcs.py``, ``tests/test_benchmark_compiled_period.py``):
 
-========================  =====================================================
-routine                   numpy counterpart
-========================  =====================================================
-:func:`rollout`           :func:`tubekit.fhocp.nlp.rollout` before compilation (a chain of exact steps)
-:func:`unicycle_steps`    :func:`tubekit.model.kinematics.unicycle_step` on (N, 4), (N, 3), a scalar dt
-:func:`plan_arcs`         :func:`tubekit.loop.plan_check.plan_arcs` (chained :func:`~tubekit.plant.kinematic.nominal_arc`)
-:func:`arc`               :func:`tubekit.plant.kinematic.nominal_arc`
-:func:`step_linearisation`  :func:`tubekit.fhocp.linearisation.step_linearisation` before compilation
-:func:`eo_linearisation`  :func:`tubekit.fhocp.linearisation.eo_linearisation` before compilation
-:func:`error_coordinates`  :func:`tubekit.model.errors.error_coordinates` on (K, 4), (K, 3)
-========================  =====================================================
+==========================  =====================================================================================
+routine                     numpy reference
+==========================  =====================================================================================
+:func:`rollout`             :func:`tubekit.model.kinematics.unicycle_step` chained step by step (and the vectorised
+                            rollout it replaced, ``numpy_rollout`` of ``benchmarks/compiled_period.py``)
+:func:`unicycle_steps`      :func:`tubekit.model.kinematics.unicycle_step` on (N, 4), (N, 3), a scalar dt
+:func:`plan_arcs`           the arcs of ``unicycle_step`` chained (``tubekit.loop.plan_check._plan_arcs_chained``)
+:func:`arc`                 ``unicycle_step`` at every elapsed time
+:func:`step_linearisation`  ``numpy_step_linearisation`` of ``benchmarks/compiled_period.py`` (the code it replaced;
+                            its columns are dt S(a) (cos, sin)(ψ + a) and the derivatives of the model's ``sinc``)
+:func:`eo_linearisation`    ``numpy_eo_linearisation`` of the same benchmark (its e_o row is ``error_coordinates``')
+:func:`error_coordinates`   :func:`tubekit.model.errors.error_coordinates` on (K, 4), (K, 3)
+==========================  =====================================================================================
 
 Importing this module imports numba; the callers import it when they first run (``tubekit certify`` loads no
-numba). The machine code is cached beside this file (``cache=True``), so a process compiles only once per
-machine.
+numba). The machine code is cached (:func:`tubekit.model.jit.routine`), so a machine compiles each routine once.
 """
 
 from __future__ import annotations

@@ -9,7 +9,8 @@ so the states and the four peaks it records are bit for bit the same (``tests/te
 A plant with a current override (a Python callable) keeps the Python path.
 
 The vehicles enter as :func:`coefficients` arrays (the truth moves the hull, the nominal model drives the
-loop's feedforward); importing this module imports numba, and the machine code is cached beside this file.
+loop's feedforward); importing this module imports numba, and the machine code is cached
+(:func:`tubekit.model.jit.routine`).
 """
 
 from __future__ import annotations

@@ -8,7 +8,7 @@ and the wave sway are evaluated once per distinct stage time), so the states and
 bit for bit the same (``tests/test_plant_compiled_rk4.py``).
 
 Importing this module imports numba (:class:`~tubekit.plant.kinematic.Plant` imports it at its first step); the
-machine code is cached beside this file.
+machine code is cached (:func:`tubekit.model.jit.routine`).
 """
 
 from __future__ import annotations

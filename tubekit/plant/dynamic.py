@@ -27,7 +27,8 @@ integration while saturated. A vehicle with lateral thrust (``Y_max`` > 0,
 to 0 by a fourth loop of the same form: Y_cmd = n̂_2(ν) + m̂_22 (k_p e_v + k_i ∫e_v), e_v = 0 − v, its
 thrust lagging like the others; without it Y = 0 and the hull's sway is free. The vehicle itself moves
 with the TRUTH (a point of the box, ``[plant.truth]``). Positions, ν, τ and the integrators are integrated together by
-classical RK4 at the closed loop's fixed step.
+classical RK4 at the closed loop's fixed step; without a current override as one compiled routine
+(:mod:`tubekit.plant.compiled_dynamic`, the very floats of :func:`~tubekit.plant.kinematic.rk4_tuple` on ``_rhs``).
 """
 
 from __future__ import annotations
@@ -127,7 +128,7 @@ class DynamicPlant:
         self._log: list[tuple[float, ...]] = []
         # largest ||omega_xy||, |omega_z|, then ||delta_xy||, |delta_z| of the current, over every evaluation (m/s)
         self._peak = [0.0, 0.0, 0.0, 0.0]
-        self._compiled: tuple | None = None  # the compiled RK4's arrays, packed at the first step
+        self._compiled: tuple[np.ndarray, ...] | None = None  # the compiled RK4's arrays, packed at the first step
 
     # ---- the model ---------------------------------------------------------------------
     def current_at(self, t: float) -> tuple[float, float, float]:

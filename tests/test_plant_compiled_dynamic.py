@@ -30,7 +30,7 @@ def plant_pairs(draw) -> tuple[DynamicPlant, DynamicPlant]:
                                                        st.floats(-7, 7)),
        st.lists(st.tuples(SPEED, st.floats(-0.3, 0.3), st.floats(-0.5, 0.5)), min_size=1, max_size=6),
        st.sampled_from([0.005, 0.01, 0.02]), st.integers(1, 3))
-def test_the_compiled_rk4_is_the_generic_rk4_of_the_dynamic_plant_bit_for_bit(pair, t, pose, commands, h, n):
+def test_the_compiled_kinematic_is_the_generic_rk4_of_the_dynamic_plant_bit_for_bit(pair, t, pose, commands, h, n):
     """Property: over a sequence of held commands, step_tuple (compiled) gives the very pose, internal state and
     peaks of rk4_tuple on DynamicPlant._rhs (the Python path the loop takes under a current override)."""
     compiled, generic = pair
@@ -60,3 +60,32 @@ def test_the_actuator_limits_say_whether_the_fins_scale_with_the_surge(name, fin
     limits = actuator_limits(params, 7.5)
     assert limits[3] == fins and limits[7] == 7.5
     assert limits[0] == params.X_max
+
+
+def test_the_compiled_current_and_omega_series_are_their_formulas_tick_by_tick():
+    """After a few steps, current_series is current_at at every time and omega_series is δ + R(ψ)(u_b − u_c, v_b),
+    δ_z + w_b − w_c from the logged body velocities (NaN where the command is NaN or past the log)."""
+    import math
+
+    scenario = SCENARIOS["bluerov2_spread"]
+    plant = DynamicPlant(scenario)
+    rng = np.random.default_rng(3)
+    t, pose, states, inputs = 0.0, (0.0, 0.0, 0.0, 0.3), [], []
+    for _ in range(12):
+        v = tuple(rng.uniform(-0.2, 0.2, 3).tolist())
+        states.append(pose)
+        inputs.append(v)
+        pose, t = plant.step_tuple(t, pose, v, 0.005, 2), t + 0.01
+    times = 0.01 * np.arange(14)
+    states, inputs = np.array(states + [pose, pose]), np.array(inputs + [(math.nan,) * 3, (0.1, 0.0, 0.0)])
+    body, _ = plant.history()
+    current = np.array([plant.current_at(float(ti)) for ti in times])
+    np.testing.assert_array_equal(plant.current_series(times), current)
+    expected = np.full((14, 3), np.nan)
+    for i in range(len(body)):
+        if np.isfinite(inputs[i, 0]):
+            c1, c2, c3 = current[i]
+            du, vb, cp, sp = body[i, 0] - inputs[i, 0], body[i, 1], math.cos(states[i, 3]), math.sin(states[i, 3])
+            expected[i] = (c1 + du * cp - vb * sp, c2 + du * sp + vb * cp, c3 + body[i, 2] - inputs[i, 1])
+    np.testing.assert_array_equal(plant.omega_series(times, states, inputs), expected)
+    assert len(body) == 13 and np.isnan(expected[12:]).all()

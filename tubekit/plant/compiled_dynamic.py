@@ -1,4 +1,5 @@
-"""The dynamic plant's RK4 (hull, thrusters, velocity loop, current) as one compiled routine (numba).
+"""The dynamic plant compiled (numba): its RK4 (hull, thrusters, velocity loop, current) as one routine, and the
+current and ω at the logged ticks.
 
 :func:`rk4_dynamic` integrates the state (x, y, z, ψ, u, v, w, r, X, Z, N, I_u, I_w, I_r[, Y, I_v]) of
 :class:`tubekit.plant.dynamic.DynamicPlant` over ``n`` classical RK4 steps with the command held, under the
@@ -6,7 +7,8 @@ scenario's current. It performs the floating-point operations of :func:`tubekit.
 applied to ``DynamicPlant._rhs`` (with :func:`~tubekit.plant.dynamic.body_forces`,
 :func:`~tubekit.plant.dynamic.body_acceleration`, ``thrust_command`` and ``sway_command``) in the same order,
 so the states and the four peaks it records are bit for bit the same (``tests/test_plant_compiled_dynamic.py``).
-A plant with a current override (a Python callable) keeps the Python path.
+:func:`current_at_ticks` and :func:`omega_at_ticks` are ``DynamicPlant.current_series`` and ``omega_series``, the
+same floats. A plant with a current override (a Python callable) keeps the Python path.
 
 The vehicles enter as :func:`coefficients` arrays (the truth moves the hull, the nominal model drives the
 loop's feedforward); importing this module imports numba, and the machine code is cached
@@ -22,7 +24,7 @@ import numpy as np
 from tubekit.model.jit import routine
 from tubekit.model.vehicle_params import VehicleParams
 
-__all__ = ["COEFFICIENTS", "coefficients", "actuator_limits", "rk4_dynamic"]
+__all__ = ["COEFFICIENTS", "coefficients", "actuator_limits", "rk4_dynamic", "current_at_ticks", "omega_at_ticks"]
 
 #: the hull's coefficients in the order :func:`coefficients` packs them, then the six mass entries
 COEFFICIENTS: tuple[str, ...] = ("X_u", "X_uu", "Y_v", "Y_vv", "Y_rr", "Y_uv", "Y_ur_lift", "Z_w", "Z_ww", "Z_uw",
@@ -137,7 +139,7 @@ def rk4_dynamic(t: float, y0: np.ndarray, command: np.ndarray, h: float, n: int,
     limits : array (8,)
         :func:`actuator_limits` of the vehicle as simulated.
     current : array (7,)
-        (a_1, a_2, a_3, c_1, c_2, c_3, ω_c) of δ(t) (:mod:`tubekit.plant.compiled_rk4`).
+        (a_1, a_2, a_3, c_1, c_2, c_3, ω_c) of δ(t) (:mod:`tubekit.plant.compiled_kinematic`).
     """
     size = y0.shape[0]
     y, tmp = y0.copy(), np.empty(size)
@@ -157,3 +159,38 @@ def rk4_dynamic(t: float, y0: np.ndarray, command: np.ndarray, h: float, n: int,
             y[i] = y[i] + h / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i])
         t += h
     return y
+
+
+@routine
+def _current(current: np.ndarray, t: float) -> tuple[float, float, float]:
+    """δ(t) (m/s) of the packed ``current`` (a_1, a_2, a_3, c_1, c_2, c_3, ω_c)."""
+    a = current[6] * t
+    sa, ca = math.sin(a), math.cos(a)
+    return current[0] * sa + current[3], current[1] * ca + current[4], current[2] * sa + current[5]
+
+
+@routine
+def current_at_ticks(t: np.ndarray, current: np.ndarray) -> np.ndarray:
+    """The water current δ (m/s) at the times ``t`` (s), shape (len(t), 3)."""
+    out = np.empty((t.shape[0], 3))
+    for i in range(t.shape[0]):
+        out[i, 0], out[i, 1], out[i, 2] = _current(current, t[i])
+    return out
+
+
+@routine
+def omega_at_ticks(t: np.ndarray, states: np.ndarray, inputs: np.ndarray, body: np.ndarray,
+                   current: np.ndarray) -> np.ndarray:
+    """ω = δ + R(ψ)(u_b − u_c, v_b), δ_z + w_b − w_c (m/s) at every tick (len(t), 3) from the logged body velocities
+    ``body`` (K, 4); NaN where u_c or r_c is NaN or past the log."""
+    out = np.full((t.shape[0], 3), np.nan)
+    for i in range(min(t.shape[0], body.shape[0])):
+        if not (math.isfinite(inputs[i, 0]) and math.isfinite(inputs[i, 2])):
+            continue
+        c1, c2, c3 = _current(current, t[i])
+        du, vb = body[i, 0] - inputs[i, 0], body[i, 1]
+        cp, sp = math.cos(states[i, 3]), math.sin(states[i, 3])
+        out[i, 0] = c1 + du * cp - vb * sp
+        out[i, 1] = c2 + du * sp + vb * cp
+        out[i, 2] = c3 + body[i, 2] - inputs[i, 1]
+    return out

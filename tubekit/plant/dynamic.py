@@ -254,12 +254,21 @@ class DynamicPlant:
 
     def current_series(self, t: np.ndarray) -> np.ndarray:
         """The water current δ (m/s) the plant applied at the times ``t`` (s), shape (len(t), 3): the override or
-        the scenario's current (computed after the run, nothing in the integrator)."""
+        the scenario's current (computed after the run, nothing in the integrator; compiled without an override)."""
+        if self.override is None:
+            from tubekit.plant.compiled_dynamic import current_at_ticks
+
+            return current_at_ticks(np.asarray(t, dtype=float).reshape(-1), np.array(self._current_model.current_parameters))
         return np.array([self.current_at(float(ti)) for ti in np.asarray(t, dtype=float)], dtype=float).reshape(-1, 3)
 
     def omega_series(self, t: np.ndarray, states: np.ndarray, inputs: np.ndarray) -> np.ndarray:
         """ω = ẋ − f(x) v at every tick (K + 1, 3), m/s: δ + R(ψ)(u_b − u_c, v_b), δ_z + w_b − w_c."""
         body, _ = self.history()
+        if self.override is None:
+            from tubekit.plant.compiled_dynamic import omega_at_ticks
+
+            return omega_at_ticks(np.asarray(t, dtype=float), np.asarray(states, dtype=float),
+                                  np.asarray(inputs, dtype=float), body, np.array(self._current_model.current_parameters))
         out = np.full((len(t), 3), np.nan)
         for i, ti in enumerate(t):
             if i < len(body) and np.isfinite(inputs[i, 0]) and np.isfinite(inputs[i, 2]):

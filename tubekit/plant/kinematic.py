@@ -14,7 +14,7 @@ inertial disturbance (m/s)
 Everything here is evaluated in one place, :class:`Plant`, whose inner loop is
 scalar and allocation-free (plain float tuples, :mod:`math`): the closed loop
 integrates it with classical RK4 at a fixed step (:meth:`Plant.step_tuple`; without an override, the same
-operations compiled, :mod:`tubekit.plant.compiled_rk4`).
+operations compiled, :mod:`tubekit.plant.compiled_kinematic`).
 :func:`nominal_arc` is the exact solution of the nominal kinematics (eq. 3)
 under a constant input, used to propagate the nominal state between samples.
 """
@@ -127,7 +127,14 @@ class Plant:
         return self._current(t)
 
     def omega_series(self, t: np.ndarray, states: np.ndarray, inputs: np.ndarray) -> np.ndarray:
-        """ω (m/s) at every logged tick (len(t), 3); NaN where the input is NaN."""
+        """ω (m/s) at every logged tick (len(t), 3); NaN where the input is NaN (without an override, compiled:
+        :func:`tubekit.plant.compiled_kinematic.omega_at_ticks`, the same floats as :meth:`omega` tick by tick)."""
+        if self.override is None:
+            from tubekit.plant.compiled_kinematic import omega_at_ticks
+
+            return omega_at_ticks(np.asarray(t, dtype=float), np.asarray(states, dtype=float),
+                                  np.asarray(inputs, dtype=float), self.current_parameters,
+                                  (self._sway_gain, self._sway_amplitude, self._sway_rate))
         out = np.full((len(t), 3), np.nan)
         for i, ti in enumerate(t):
             if np.isfinite(inputs[i, 0]) and np.isfinite(inputs[i, 2]):
@@ -174,8 +181,8 @@ class Plant:
 
     def _compiled_step(self, t: float, y: tuple, v: Sequence[float], h: float, n: int) -> Floats4:
         """``n`` RK4 steps of :meth:`_rhs` (no override) in one compiled routine,
-        :func:`tubekit.plant.compiled_rk4.rk4_current` (the same floats as :func:`rk4_tuple` of :meth:`_rhs`)."""
-        from tubekit.plant.compiled_rk4 import rk4_current
+        :func:`tubekit.plant.compiled_kinematic.rk4_current` (the same floats as :func:`rk4_tuple` of :meth:`_rhs`)."""
+        from tubekit.plant.compiled_kinematic import rk4_current
 
         u, w, r = v
         state, peak = rk4_current(t, y, (u, w, r), h, n, self.current_parameters, self.sway_parameters(u, r),

@@ -1,11 +1,12 @@
-"""The kinematic plant's RK4 under the modelled current and sway, as one compiled routine (numba).
+"""The kinematic plant compiled (numba): its RK4 under the modelled current and sway, and its ω at the logged ticks.
 
 :func:`rk4_current` integrates ẋ = f(x) v + [δ(t) + v_s (−sin ψ, cos ψ, 0), 0] (eq. 11; the formulas of
 :class:`tubekit.plant.kinematic.Plant`) over ``n`` classical RK4 steps with the input held. It performs the
 floating-point operations of :func:`tubekit.plant.kinematic.rk4_tuple` applied to ``Plant._rhs`` in the same
 order (k3 equals k2 there: ψ's rate is r at every stage, so both stages sit at the same ψ and time; the current
 and the wave sway are evaluated once per distinct stage time), so the states and the disturbance's peaks are
-bit for bit the same (``tests/test_plant_compiled_rk4.py``).
+bit for bit the same (``tests/test_plant_compiled_kinematic.py``). :func:`omega_at_ticks` is ``Plant.omega`` at
+every logged tick (``Plant.omega_series``), the same floats.
 
 Importing this module imports numba (:class:`~tubekit.plant.kinematic.Plant` imports it at its first step); the
 machine code is cached (:func:`tubekit.model.jit.routine`).
@@ -15,9 +16,11 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
+
 from tubekit.model.jit import routine
 
-__all__ = ["rk4_current"]
+__all__ = ["rk4_current", "omega_at_ticks"]
 
 Floats2 = tuple[float, float]
 Floats3 = tuple[float, float, float]
@@ -93,3 +96,27 @@ def _peaks(p0: float, p1: float, o1: float, o2: float, o3: float) -> Floats2:
     if abs(o3) > p1:
         p1 = abs(o3)
     return p0, p1
+
+
+@routine
+def omega_at_ticks(t: np.ndarray, states: np.ndarray, inputs: np.ndarray,
+                   current: tuple[float, float, float, float, float, float, float], sway: Floats3) -> np.ndarray:
+    """ω = δ(t) + v_s (−sin ψ, cos ψ, 0) (m/s) at every tick (len(t), 3); NaN where u or r is NaN.
+
+    ``current`` as :func:`rk4_current` takes it; ``sway`` = (g, A_s, ω_s): v_s = g u r + A_s sin ω_s t.
+    """
+    a0, a1, a2, c0, c1, c2, rate = current
+    gain, samp, srate = sway
+    out = np.full((t.shape[0], 3), np.nan)
+    for i in range(t.shape[0]):
+        u, r = inputs[i, 0], inputs[i, 2]
+        if not (math.isfinite(u) and math.isfinite(r)):
+            continue
+        a = rate * t[i]
+        s, c = math.sin(a), math.cos(a)
+        vs = gain * u * r + samp * math.sin(srate * t[i])
+        psi = states[i, 3]
+        out[i, 0] = a0 * s + c0 - vs * math.sin(psi)
+        out[i, 1] = a1 * c + c1 + vs * math.cos(psi)
+        out[i, 2] = a2 * s + c2
+    return out

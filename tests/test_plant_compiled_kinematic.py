@@ -1,15 +1,17 @@
-"""Tests of tubekit.plant.compiled_rk4: the compiled RK4 is the generic RK4 of the plant's right-hand side, bit for
-bit (states and the disturbance's peaks), on currents, sways and steps drawn at random."""
+"""Tests of tubekit.plant.compiled_kinematic: the compiled RK4 is the generic RK4 of the plant's right-hand side, bit for
+bit (states and the disturbance's peaks), and the compiled ω series is ω tick by tick, on currents, sways and
+steps drawn at random."""
 
 from __future__ import annotations
 
 import math
 
+import numpy as np
 import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from tubekit.plant.compiled_rk4 import rk4_current
+from tubekit.plant.compiled_kinematic import rk4_current
 from tubekit.plant.kinematic import Plant, rk4_tuple
 from tubekit.settings import Disturbance
 from tubekit.model.kinematics import SwayModel
@@ -30,7 +32,7 @@ def plants(draw) -> Plant:
 @given(plants(), st.floats(0.0, 500.0), st.tuples(st.floats(-20, 20), st.floats(-20, 20), st.floats(-5, 5),
                                                    st.floats(-7, 7)),
        st.tuples(SPEED, SPEED, st.floats(-1.0, 1.0)), st.floats(1e-4, 0.1), st.integers(1, 6))
-def test_the_compiled_rk4_is_the_generic_rk4_of_the_plant_bit_for_bit(plant, t, y, v, h, n):
+def test_the_compiled_kinematic_is_the_generic_rk4_of_the_plant_bit_for_bit(plant, t, y, v, h, n):
     """Property: rk4_current returns the very state of rk4_tuple on Plant._rhs, and the very peaks it records."""
     generic = rk4_tuple(plant._rhs, t, y, v, h, n)
     u, _, r = v
@@ -47,3 +49,17 @@ def test_the_peaks_carry_over_between_calls_and_a_nan_peak_stays_nan():
     _, peak = rk4_current(0.0, (0.0, 0.0, 0.0, 0.0), (0.3, 0.0, 0.2), 0.01, 2, current, (0.0, 0.0, 1.0),
                           (math.nan, 0.0))
     assert math.isnan(peak[0]) and peak[1] == pytest.approx(0.05 * math.sin(2 * math.pi * 0.02 / 10.0), rel=1e-14)
+
+
+@given(plants(), st.integers(1, 40), st.integers(0, 2 ** 32 - 1))
+def test_the_compiled_omega_series_is_omega_tick_by_tick(plant, ticks, seed):
+    """Property: Plant.omega_series (compiled) equals Plant.omega at every tick, NaN rows where u or r is NaN."""
+    rng = np.random.default_rng(seed)
+    t = np.sort(rng.uniform(0.0, 200.0, ticks))
+    states, inputs = rng.uniform(-5.0, 5.0, (ticks, 4)), rng.uniform(-0.8, 0.8, (ticks, 3))
+    inputs[rng.random(ticks) < 0.2, rng.integers(0, 3)] = np.nan
+    expected = np.full((ticks, 3), np.nan)
+    for i in range(ticks):
+        if np.isfinite(inputs[i, 0]) and np.isfinite(inputs[i, 2]):
+            expected[i] = plant.omega(float(t[i]), states[i], inputs[i])
+    np.testing.assert_array_equal(plant.omega_series(t, states, inputs), expected)

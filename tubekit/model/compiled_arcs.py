@@ -58,40 +58,36 @@ def _dsinc(a: float) -> float:
 
 
 @routine
+def _exact_step(x: float, y: float, z: float, psi: float, u: float, w: float, r: float,
+                dt: float) -> tuple[float, float, float, float]:
+    """The exact arc's end after ``dt`` (s) from (x, y, z, ψ) under (u, w, r) held
+    (:func:`tubekit.model.kinematics.unicycle_step`'s operations: a = (dt/2) r, x + dt u S(a) cos(ψ + a), ...)."""
+    a = (0.5 * dt) * r
+    th = psi + a
+    step = (dt * u) * _sinc(a)
+    return x + step * math.cos(th), y + step * math.sin(th), z + dt * w, psi + dt * r
+
+
+@routine
 def rollout(s0: np.ndarray, inputs: np.ndarray, dt: float) -> np.ndarray:
     """States (N+1, 4) of the exact steps of ``inputs`` (N, 3) from ``s0`` (4,), ``dt`` (s) each."""
-    n = inputs.shape[0]
-    out = np.empty((n + 1, 4))
-    for c in range(4):
-        out[0, c] = s0[c]
-    half = 0.5 * dt
-    for k in range(n):
-        u, w, r = inputs[k, 0], inputs[k, 1], inputs[k, 2]
-        a = half * r
-        th = out[k, 3] + a
-        step = (dt * u) * _sinc(a)
-        out[k + 1, 0] = out[k, 0] + step * math.cos(th)
-        out[k + 1, 1] = out[k, 1] + step * math.sin(th)
-        out[k + 1, 2] = out[k, 2] + dt * w
-        out[k + 1, 3] = out[k, 3] + dt * r
+    out = np.empty((inputs.shape[0] + 1, 4))
+    x, y, z, psi = s0[0], s0[1], s0[2], s0[3]
+    out[0, 0], out[0, 1], out[0, 2], out[0, 3] = x, y, z, psi
+    for k in range(inputs.shape[0]):
+        x, y, z, psi = _exact_step(x, y, z, psi, inputs[k, 0], inputs[k, 1], inputs[k, 2], dt)
+        out[k + 1, 0], out[k + 1, 1], out[k + 1, 2], out[k + 1, 3] = x, y, z, psi
     return out
 
 
 @routine
 def unicycle_steps(states: np.ndarray, inputs: np.ndarray, dt: float) -> np.ndarray:
     """The exact step (N, 4) of every row of ``states`` (N, 4) under the same row of ``inputs`` (N, 3)."""
-    n = inputs.shape[0]
-    out = np.empty((n, 4))
-    half = 0.5 * dt
-    for k in range(n):
-        u, w, r = inputs[k, 0], inputs[k, 1], inputs[k, 2]
-        a = half * r
-        th = states[k, 3] + a
-        step = (dt * u) * _sinc(a)
-        out[k, 0] = states[k, 0] + step * math.cos(th)
-        out[k, 1] = states[k, 1] + step * math.sin(th)
-        out[k, 2] = states[k, 2] + dt * w
-        out[k, 3] = states[k, 3] + dt * r
+    out = np.empty((inputs.shape[0], 4))
+    for k in range(inputs.shape[0]):
+        out[k, 0], out[k, 1], out[k, 2], out[k, 3] = _exact_step(states[k, 0], states[k, 1], states[k, 2],
+                                                                 states[k, 3], inputs[k, 0], inputs[k, 1],
+                                                                 inputs[k, 2], dt)
     return out
 
 
@@ -100,14 +96,7 @@ def _arc_into(x: float, y: float, z: float, psi: float, u: float, w: float, r: f
               out: np.ndarray) -> None:
     """The exact arc from (x, y, z, ψ) under (u, w, r) at the elapsed times ``tau``, written into ``out``."""
     for j in range(tau.shape[0]):
-        t = tau[j]
-        a = (0.5 * t) * r
-        th = psi + a
-        step = (t * u) * _sinc(a)
-        out[j, 0] = x + step * math.cos(th)
-        out[j, 1] = y + step * math.sin(th)
-        out[j, 2] = z + t * w
-        out[j, 3] = psi + t * r
+        out[j, 0], out[j, 1], out[j, 2], out[j, 3] = _exact_step(x, y, z, psi, u, w, r, tau[j])
 
 
 @routine
@@ -122,23 +111,15 @@ def arc(x0: np.ndarray, v: np.ndarray, tau: np.ndarray) -> np.ndarray:
 def plan_arcs(x0: np.ndarray, inputs: np.ndarray, tau: np.ndarray) -> np.ndarray:
     """States (N, len(tau), 4) along the arcs of ``inputs`` (N, 3) from ``x0``; each arc lasts ``tau[-1]``.
 
-    An arc starts where the previous one's exact increment over ``tau[-1]`` ends (running sums, as chaining
-    the arcs does).
+    An arc starts where the previous one's exact step over ``tau[-1]`` ends (as chaining the arcs does).
     """
-    n = inputs.shape[0]
-    out = np.empty((n, tau.shape[0], 4))
+    out = np.empty((inputs.shape[0], tau.shape[0], 4))
     span = tau[tau.shape[0] - 1]
-    half = 0.5 * span
     x, y, z, psi = x0[0], x0[1], x0[2], x0[3]
-    for k in range(n):
+    for k in range(inputs.shape[0]):
         u, w, r = inputs[k, 0], inputs[k, 1], inputs[k, 2]
         _arc_into(x, y, z, psi, u, w, r, tau, out[k])
-        a = half * r
-        step = (span * u) * _sinc(a)
-        x = x + step * math.cos(psi + a)
-        y = y + step * math.sin(psi + a)
-        z = z + span * w
-        psi = psi + span * r
+        x, y, z, psi = _exact_step(x, y, z, psi, u, w, r, span)
     return out
 
 

@@ -40,3 +40,11 @@ def test_step_and_eo_linearisations_match_finite_differences():
         s2[:, col] += h
         assert np.allclose((nlp.errors(s2, ref)[:, 2] - e0) / h, g[row], atol=1e-5)
 
+
+
+def test_nested_lists_are_taken_as_the_arrays_they_spell():
+    """The compiled routines type their arguments; the public functions hand them float arrays."""
+    states, inputs, ref = [[0.0, 0.0, 0.0, 0.1]] * 3, [[0.3, 0.0, 0.1]] * 2, [[1, 1, 0]] * 3
+    np.testing.assert_array_equal(step_linearisation(states, inputs, 0.1),
+                                  step_linearisation(np.array(states), np.array(inputs), 0.1))
+    np.testing.assert_array_equal(eo_linearisation(states, ref), eo_linearisation(np.array(states), np.array(ref, float)))

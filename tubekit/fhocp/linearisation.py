@@ -48,7 +48,7 @@ def step_linearisation(states: np.ndarray, inputs: np.ndarray, dt: float) -> np.
     """
     from tubekit.model import compiled_arcs
 
-    return compiled_arcs.step_linearisation(states, inputs, float(dt))
+    return compiled_arcs.step_linearisation(np.asarray(states, dtype=float), np.asarray(inputs, dtype=float), float(dt))
 
 
 def eo_linearisation(states: np.ndarray, ref: np.ndarray) -> np.ndarray:
@@ -64,4 +64,4 @@ def eo_linearisation(states: np.ndarray, ref: np.ndarray) -> np.ndarray:
     """
     from tubekit.model import compiled_arcs
 
-    return compiled_arcs.eo_linearisation(states, ref, ED_FLOOR)
+    return compiled_arcs.eo_linearisation(np.asarray(states, dtype=float), np.asarray(ref, dtype=float), ED_FLOOR)

@@ -386,7 +386,7 @@ class FhocpNlp:
         states = np.asarray(states, dtype=float)
         inputs = np.asarray(inputs, dtype=float)
         n = self.n
-        e = compiled_arcs.error_coordinates(states, ref, ED_FLOOR)
+        e = compiled_arcs.error_coordinates(states, np.asarray(ref, dtype=float), ED_FLOOR)
         e2 = e * e
         cost = float(np.einsum("kc,ck->", e2, self._w) + np.einsum("kc,kc,c->", inputs, inputs, self._dt_r))
         if self.rate_penalty:

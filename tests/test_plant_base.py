@@ -1,5 +1,6 @@
 """The plant contract (:class:`tubekit.plant.base.PlantModel`): both plants offer every method of
-the Protocol with its parameters, and behave as it documents on a case worked out by hand."""
+the Protocol with its parameters, and behave as it documents on a case worked out by hand; the
+piecewise-constant override's validation and indexing rule."""
 
 from __future__ import annotations
 
@@ -11,7 +12,7 @@ import numpy as np
 import pytest
 
 from tubekit.model.vehicles import PlantSettings
-from tubekit.plant.base import PlantModel
+from tubekit.plant.base import PiecewiseOmega, PlantModel
 from tubekit.plant.dynamic import DynamicPlant
 from tubekit.plant.kinematic import Plant
 from tubekit.scenario import paper_scenario
@@ -151,3 +152,17 @@ def test_only_the_dynamic_plant_reports_the_water_current_apart(kind):
     assert plant.current_series(t).shape == (2, 3) and np.all(plant.current_series(t) == WATER)
     assert plant.current_peak() == (math.hypot(WATER[0], WATER[1]), abs(WATER[2]))
     assert plant.omega_peak() != plant.current_peak()  # ω also holds the hull's sway and the loop error
+
+
+@pytest.mark.parametrize("period, table", [(0.0, ((0.0, 0.0, 0.0),)), (-1.0, ((0.0, 0.0, 0.0),)),
+                                           (math.nan, ((0.0, 0.0, 0.0),)), (0.1, ()), (0.1, ((0.0, 0.0),))])
+def test_a_piecewise_override_needs_a_positive_period_and_rows_of_three(period, table):
+    with pytest.raises(ValueError, match="PiecewiseOmega"):
+        PiecewiseOmega(table, period)
+
+
+def test_a_piecewise_override_holds_its_last_row_after_the_table_and_counts_a_rounding_below_a_boundary_as_on_it():
+    omega = PiecewiseOmega(((1.0, 0.0, 0.0), (2.0, 0.0, 0.0)), 0.1)
+    assert omega(0.0)[0] == 1.0 and omega(0.0999999)[0] == 1.0
+    assert omega(3 * 0.1 - 0.2 - 1e-12)[0] == 2.0     # 0.1 less a rounding: already the second period
+    assert omega(50.0)[0] == 2.0

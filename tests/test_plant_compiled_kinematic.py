@@ -11,7 +11,8 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from tubekit.plant.compiled_kinematic import rk4_current
+from tubekit.plant.base import PiecewiseOmega
+from tubekit.plant.compiled_kinematic import NO_TABLE, rk4_current
 from tubekit.plant.kinematic import Plant, rk4_tuple
 from tubekit.settings import Disturbance
 from tubekit.model.kinematics import SwayModel
@@ -36,7 +37,8 @@ def test_the_compiled_kinematic_is_the_generic_rk4_of_the_plant_bit_for_bit(plan
     """Property: rk4_current returns the very state of rk4_tuple on Plant._rhs, and the very peaks it records."""
     generic = rk4_tuple(plant._rhs, t, y, v, h, n)
     u, _, r = v
-    state, peak = rk4_current(t, y, v, h, n, plant.current_parameters, plant.sway_parameters(u, r), (0.0, 0.0))
+    state, peak = rk4_current(t, y, v, h, n, plant.current_parameters, plant.sway_parameters(u, r), (0.0, 0.0),
+                              NO_TABLE, 1.0)
     assert state == generic
     assert peak == plant.omega_peak()
 
@@ -44,10 +46,11 @@ def test_the_compiled_kinematic_is_the_generic_rk4_of_the_plant_bit_for_bit(plan
 def test_the_peaks_carry_over_between_calls_and_a_nan_peak_stays_nan():
     plant = Plant(Disturbance(amplitude=(0.1, 0.1, 0.05), period=10.0))
     current = plant.current_parameters
-    _, peak = rk4_current(0.0, (0.0, 0.0, 0.0, 0.0), (0.3, 0.0, 0.2), 0.01, 2, current, (0.0, 0.0, 1.0), (5.0, 4.0))
+    _, peak = rk4_current(0.0, (0.0, 0.0, 0.0, 0.0), (0.3, 0.0, 0.2), 0.01, 2, current, (0.0, 0.0, 1.0), (5.0, 4.0),
+                          NO_TABLE, 1.0)
     assert peak == (5.0, 4.0)
     _, peak = rk4_current(0.0, (0.0, 0.0, 0.0, 0.0), (0.3, 0.0, 0.2), 0.01, 2, current, (0.0, 0.0, 1.0),
-                          (math.nan, 0.0))
+                          (math.nan, 0.0), NO_TABLE, 1.0)
     assert math.isnan(peak[0]) and peak[1] == pytest.approx(0.05 * math.sin(2 * math.pi * 0.02 / 10.0), rel=1e-14)
 
 
@@ -63,3 +66,22 @@ def test_the_compiled_omega_series_is_omega_tick_by_tick(plant, ticks, seed):
         if np.isfinite(inputs[i, 0]) and np.isfinite(inputs[i, 2]):
             expected[i] = plant.omega(float(t[i]), states[i], inputs[i])
     np.testing.assert_array_equal(plant.omega_series(t, states, inputs), expected)
+
+
+@st.composite
+def piecewise_overrides(draw) -> PiecewiseOmega:
+    """A piecewise-constant ω (m/s) of 1 to 6 periods of 0.05 to 0.5 s, rows drawn in ±0.3 m/s."""
+    rows = draw(st.integers(1, 6))
+    table = tuple(tuple(draw(st.floats(-0.3, 0.3)) for _ in range(3)) for _ in range(rows))
+    return PiecewiseOmega(table, draw(st.floats(0.05, 0.5)))
+
+
+@given(piecewise_overrides(), st.floats(0.0, 3.0), st.tuples(SPEED, SPEED, st.floats(-1.0, 1.0)),
+       st.floats(-7.0, 7.0), st.sampled_from([0.005, 0.01, 0.05]), st.integers(1, 6))
+def test_a_piecewise_override_is_integrated_compiled_as_the_generic_rk4_does(override, t, v, psi, h, n):
+    """Property: under a PiecewiseOmega override the plant's step (compiled) returns the very state and peaks of
+    rk4_tuple on the plant's _rhs, including steps that cross a period's boundary."""
+    compiled, generic = Plant(Disturbance(), override), Plant(Disturbance(), override)
+    y = (0.3, -1.2, 0.4, psi)
+    assert compiled.step_tuple(t, y, v, h, n) == rk4_tuple(generic._rhs, t, y, v, h, n)
+    assert compiled.omega_peak() == generic.omega_peak()

@@ -11,15 +11,39 @@ vehicle both satisfy it; the loop never asks which one it has.
 
 from __future__ import annotations
 
+import math
+from dataclasses import dataclass
 from typing import Any, Callable, Protocol, Sequence
 
 import numpy as np
 
 
-__all__ = ["PlantModel", "OmegaOverride"]
+__all__ = ["PlantModel", "OmegaOverride", "PiecewiseOmega"]
 
 #: ``override(t) -> omega`` (3,), m/s: a disturbance replacing the scenario's current + sway.
 OmegaOverride = Callable[[float], Any]
+
+
+@dataclass(frozen=True)
+class PiecewiseOmega:
+    """An override constant over each period: ω(t) = ``table[k]`` (m/s), k = min(int(t / period + 1e-9), K − 1)
+    (a time a rounding below k·period counts as k·period; the last entry holds after the table).
+
+    The falsifiers' adversarial sequences (one ω per FHOCP period); the kinematic plant integrates it in its
+    compiled RK4 (any other callable override takes the Python path).
+    """
+
+    table: tuple[tuple[float, float, float], ...]
+    period: float
+
+    def __post_init__(self) -> None:
+        if not (math.isfinite(self.period) and self.period > 0.0):
+            raise ValueError(f"PiecewiseOmega.period: a finite number > 0 (s), received {self.period!r}")
+        if not self.table or any(len(row) != 3 for row in self.table):
+            raise ValueError("PiecewiseOmega.table: one or more (omega_x, omega_y, omega_z) rows (m/s)")
+
+    def __call__(self, t: float) -> tuple[float, float, float]:
+        return self.table[min(int(t / self.period + 1e-9), len(self.table) - 1)]
 
 
 class PlantModel(Protocol):

@@ -20,17 +20,43 @@ import numpy as np
 
 from tubekit.model.jit import routine
 
-__all__ = ["rk4_current", "omega_at_ticks"]
+__all__ = ["rk4_current", "omega_at_ticks", "NO_TABLE"]
 
 Floats2 = tuple[float, float]
 Floats3 = tuple[float, float, float]
 Floats4 = tuple[float, float, float, float]
 
 
+#: the table argument of :func:`rk4_current` when the scenario's current and sway apply (no override)
+NO_TABLE = np.empty((0, 3))
+
+
+@routine
+def _stage(t: float, current: tuple[float, float, float, float, float, float, float], sway: Floats3,
+           table: np.ndarray, period: float) -> Floats4:
+    """(δ_1, δ_2, δ_3, v_s) at ``t`` (s): the override's row (no sway) when ``table`` has rows, else the current
+    and the sway."""
+    if table.shape[0] > 0:
+        k = min(int(t / period + 1e-9), table.shape[0] - 1)
+        return table[k, 0], table[k, 1], table[k, 2], 0.0
+    a0, a1, a2, c0, c1, c2, rate = current
+    sw, samp, srate = sway
+    s, c = math.sin(rate * t), math.cos(rate * t)
+    return a0 * s + c0, a1 * c + c1, a2 * s + c2, sw + samp * math.sin(srate * t)
+
+
+@routine
+def _horizontal(d1: float, d2: float, vs: float, sp: float, cp: float, override: bool) -> Floats2:
+    """ω_xy at a stage: δ_xy + v_s (−sin ψ, cos ψ), or the override's δ_xy as it is."""
+    if override:
+        return d1, d2
+    return d1 - vs * sp, d2 + vs * cp
+
+
 @routine
 def rk4_current(t: float, y: Floats4, v: Floats3, h: float, n: int,
                 current: tuple[float, float, float, float, float, float, float], sway: Floats3,
-                peak: Floats2) -> tuple[Floats4, Floats2]:
+                peak: Floats2, table: np.ndarray, period: float) -> tuple[Floats4, Floats2]:
     """``n`` RK4 steps of ``h`` (s) from ``y`` = (x, y, z, ψ) at ``t`` (s) under ``v`` = (u, w, r) held.
 
     Parameters
@@ -42,41 +68,39 @@ def rk4_current(t: float, y: Floats4, v: Floats3, h: float, n: int,
         (g u r, A_s, ω_s): v_s(t) = g u r + A_s sin ω_s t (m/s, m/s, rad/s).
     peak : tuple
         The largest ‖ω_xy‖ and |ω_z| so far (m/s).
+    table, period : array (K, 3), float
+        A :class:`~tubekit.plant.base.PiecewiseOmega` override replacing current and sway (ω = ``table[k]``, m/s;
+        ``period`` s), or :data:`NO_TABLE` (K = 0) for the scenario's current and sway.
 
     Returns
     -------
     state (4,) after the steps and the peaks (2,) including every stage evaluated.
     """
     u, w, r = v
-    a0, a1, a2, c0, c1, c2, rate = current
-    sw, samp, srate = sway
+    override = table.shape[0] > 0
     x0, x1, x2, x3 = y
     hh, h6 = 0.5 * h, h / 6.0
     p0, p1 = peak
-    s, c = math.sin(rate * t), math.cos(rate * t)
-    e1, e2, e3, es = a0 * s + c0, a1 * c + c1, a2 * s + c2, sw + samp * math.sin(srate * t)
+    e1, e2, e3, es = _stage(t, current, sway, table, period)
     for _ in range(n):
-        tm, te = t + 0.5 * h, t + h
         d1, d2, d3, vs = e1, e2, e3, es
-        s, c = math.sin(rate * tm), math.cos(rate * tm)
-        m1, m2, m3, ms = a0 * s + c0, a1 * c + c1, a2 * s + c2, sw + samp * math.sin(srate * tm)
-        s, c = math.sin(rate * te), math.cos(rate * te)
-        e1, e2, e3, es = a0 * s + c0, a1 * c + c1, a2 * s + c2, sw + samp * math.sin(srate * te)
+        m1, m2, m3, ms = _stage(t + 0.5 * h, current, sway, table, period)
+        e1, e2, e3, es = _stage(t + h, current, sway, table, period)
         # k1 at (t, y)
         sp, cp = math.sin(x3), math.cos(x3)
-        o1, o2 = d1 - vs * sp, d2 + vs * cp
+        o1, o2 = _horizontal(d1, d2, vs, sp, cp, override)
         p0, p1 = _peaks(p0, p1, o1, o2, d3)
         k10, k11, k12 = u * cp + o1, u * sp + o2, w + d3
         # k2 = k3 at (t + h/2, ψ + h/2 r)
         q3 = x3 + hh * r
         sp, cp = math.sin(q3), math.cos(q3)
-        o1, o2 = m1 - ms * sp, m2 + ms * cp
+        o1, o2 = _horizontal(m1, m2, ms, sp, cp, override)
         p0, p1 = _peaks(p0, p1, o1, o2, m3)
         k20, k21, k22 = u * cp + o1, u * sp + o2, w + m3
         # k4 at (t + h, ψ + h r)
         q3 = x3 + h * r
         sp, cp = math.sin(q3), math.cos(q3)
-        o1, o2 = e1 - es * sp, e2 + es * cp
+        o1, o2 = _horizontal(e1, e2, es, sp, cp, override)
         p0, p1 = _peaks(p0, p1, o1, o2, e3)
         k40, k41, k42 = u * cp + o1, u * sp + o2, w + e3
         x0 = x0 + h6 * (k10 + 2.0 * k20 + 2.0 * k20 + k40)

@@ -26,7 +26,7 @@ from typing import Callable, Sequence
 
 import numpy as np
 
-from tubekit.plant.base import OmegaOverride
+from tubekit.plant.base import OmegaOverride, PiecewiseOmega
 from tubekit.scenario import Disturbance, Scenario
 
 __all__ = [
@@ -69,6 +69,7 @@ class Plant:
         sway = disturbance.sway
         self._sway_gain, self._sway_amplitude = float(sway.gain), float(sway.amplitude)
         self._sway_rate = 2.0 * math.pi / sway.period
+        self._table: tuple[np.ndarray, float] | None = None  # a PiecewiseOmega override, packed at the first step
         self._peak = [0.0, 0.0]  # largest ||omega_xy||, |omega_z| over every evaluation (m/s)
 
     @classmethod
@@ -175,20 +176,27 @@ class Plant:
         Without an override this is :meth:`_compiled_step`: :func:`rk4_tuple` of :meth:`_rhs` as one compiled
         routine, the same floating-point operations in the same order (bit-identical results).
         """
-        if self.override is None:
+        if self.override is None or isinstance(self.override, PiecewiseOmega):
             return self._compiled_step(t, tuple(x), v, h, n)
         return rk4_tuple(self._rhs, t, tuple(x), v, h, n)
 
     def _compiled_step(self, t: float, y: tuple, v: Sequence[float], h: float, n: int) -> Floats4:
         """``n`` RK4 steps of :meth:`_rhs` (no override) in one compiled routine,
         :func:`tubekit.plant.compiled_kinematic.rk4_current` (the same floats as :func:`rk4_tuple` of :meth:`_rhs`)."""
-        from tubekit.plant.compiled_kinematic import rk4_current
+        from tubekit.plant.compiled_kinematic import NO_TABLE, rk4_current
 
         u, w, r = v
+        table, period = (NO_TABLE, 1.0) if self.override is None else self._override_table()
         state, peak = rk4_current(t, y, (u, w, r), h, n, self.current_parameters, self.sway_parameters(u, r),
-                                  (self._peak[0], self._peak[1]))
+                                  (self._peak[0], self._peak[1]), table, period)
         self._peak[0], self._peak[1] = peak
         return state
+
+    def _override_table(self) -> tuple[np.ndarray, float]:
+        """The :class:`~tubekit.plant.base.PiecewiseOmega` override's rows (K, 3) and period (s), packed once."""
+        if self._table is None:
+            self._table = (np.array(self.override.table, dtype=float).reshape(-1, 3), float(self.override.period))
+        return self._table
 
     def omega_peak(self) -> tuple[float, float]:
         """Largest ‖ω_xy‖ and |ω_z| (m/s) over every evaluation the integrator made (every RK4 stage)."""

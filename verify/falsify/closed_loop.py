@@ -33,6 +33,7 @@ from tubekit.model.ancillary import LAWS, AncillaryLaw, get_law
 from tubekit.model.errors import error_coordinates, numeric
 from tubekit.exceptions import ConfigError
 from tubekit.loop.pipeline import certified_run
+from tubekit.plant.base import PiecewiseOmega
 from verify.falsify.outcome import SearchOutcome
 from tubekit.loop.promises import PREMISES, Promise
 from tubekit.scenario import HEMISPHERE_SIGN, Scenario
@@ -181,14 +182,9 @@ def _omega_from_unit(omega_xy: float, omega_z: float, u: np.ndarray) -> tuple[fl
     return mag * math.cos(a), mag * math.sin(a), omega_z * (2.0 * float(u[2]) - 1.0)
 
 
-def piecewise_disturbance(omega_xy: float, omega_z: float, dt: float, units: np.ndarray) -> Callable:
+def piecewise_disturbance(omega_xy: float, omega_z: float, dt: float, units: np.ndarray) -> PiecewiseOmega:
     """``disturbance(t)``: one ω per FHOCP period (``units`` (periods, 3) in [0,1])."""
-    table = [_omega_from_unit(omega_xy, omega_z, u) for u in np.clip(units, 0.0, 1.0)]
-
-    def omega(t: float) -> tuple[float, float, float]:
-        return table[min(int(t / dt + 1e-9), len(table) - 1)]
-    omega.table = table  # type: ignore[attr-defined]
-    return omega
+    return PiecewiseOmega(tuple(_omega_from_unit(omega_xy, omega_z, u) for u in np.clip(units, 0.0, 1.0)), dt)
 
 
 @dataclass(frozen=True)

@@ -54,9 +54,11 @@ def test_the_peaks_carry_over_between_calls_and_a_nan_peak_stays_nan():
     assert math.isnan(peak[0]) and peak[1] == pytest.approx(0.05 * math.sin(2 * math.pi * 0.02 / 10.0), rel=1e-14)
 
 
-@given(plants(), st.integers(1, 40), st.integers(0, 2 ** 32 - 1))
+@given(st.one_of(plants(), st.builds(lambda o: Plant(Disturbance(), o), st.deferred(lambda: piecewise_overrides()))),
+       st.integers(1, 40), st.integers(0, 2 ** 32 - 1))
 def test_the_compiled_omega_series_is_omega_tick_by_tick(plant, ticks, seed):
-    """Property: Plant.omega_series (compiled) equals Plant.omega at every tick, NaN rows where u or r is NaN."""
+    """Property: Plant.omega_series (compiled) equals Plant.omega at every tick, NaN rows where u or r is NaN,
+    under the modelled current and sway and under a piecewise-constant override."""
     rng = np.random.default_rng(seed)
     t = np.sort(rng.uniform(0.0, 200.0, ticks))
     states, inputs = rng.uniform(-5.0, 5.0, (ticks, 4)), rng.uniform(-0.8, 0.8, (ticks, 3))

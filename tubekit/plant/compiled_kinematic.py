@@ -124,23 +124,23 @@ def _peaks(p0: float, p1: float, o1: float, o2: float, o3: float) -> Floats2:
 
 @routine
 def omega_at_ticks(t: np.ndarray, states: np.ndarray, inputs: np.ndarray,
-                   current: tuple[float, float, float, float, float, float, float], sway: Floats3) -> np.ndarray:
-    """ω = δ(t) + v_s (−sin ψ, cos ψ, 0) (m/s) at every tick (len(t), 3); NaN where u or r is NaN.
+                   current: tuple[float, float, float, float, float, float, float], sway: Floats3,
+                   table: np.ndarray, period: float) -> np.ndarray:
+    """ω = δ(t) + v_s (−sin ψ, cos ψ, 0) (m/s) at every tick (len(t), 3), or the override's row; NaN where u or r
+    is NaN.
 
-    ``current`` as :func:`rk4_current` takes it; ``sway`` = (g, A_s, ω_s): v_s = g u r + A_s sin ω_s t.
+    ``current``, ``table`` and ``period`` as :func:`rk4_current` takes them; ``sway`` = (g, A_s, ω_s):
+    v_s = g u r + A_s sin ω_s t.
     """
-    a0, a1, a2, c0, c1, c2, rate = current
     gain, samp, srate = sway
+    override = table.shape[0] > 0
     out = np.full((t.shape[0], 3), np.nan)
     for i in range(t.shape[0]):
         u, r = inputs[i, 0], inputs[i, 2]
         if not (math.isfinite(u) and math.isfinite(r)):
             continue
-        a = rate * t[i]
-        s, c = math.sin(a), math.cos(a)
-        vs = gain * u * r + samp * math.sin(srate * t[i])
+        d1, d2, d3, vs = _stage(t[i], current, (gain * u * r, samp, srate), table, period)
         psi = states[i, 3]
-        out[i, 0] = a0 * s + c0 - vs * math.sin(psi)
-        out[i, 1] = a1 * c + c1 + vs * math.cos(psi)
-        out[i, 2] = a2 * s + c2
+        out[i, 0], out[i, 1] = _horizontal(d1, d2, vs, math.sin(psi), math.cos(psi), override)
+        out[i, 2] = d3
     return out

@@ -128,14 +128,16 @@ class Plant:
         return self._current(t)
 
     def omega_series(self, t: np.ndarray, states: np.ndarray, inputs: np.ndarray) -> np.ndarray:
-        """ω (m/s) at every logged tick (len(t), 3); NaN where the input is NaN (without an override, compiled:
-        :func:`tubekit.plant.compiled_kinematic.omega_at_ticks`, the same floats as :meth:`omega` tick by tick)."""
-        if self.override is None:
-            from tubekit.plant.compiled_kinematic import omega_at_ticks
+        """ω (m/s) at every logged tick (len(t), 3); NaN where the input is NaN (without an override or under a
+        :class:`~tubekit.plant.base.PiecewiseOmega`, compiled: :func:`tubekit.plant.compiled_kinematic.omega_at_ticks`,
+        the same floats as :meth:`omega` tick by tick)."""
+        if self.override is None or isinstance(self.override, PiecewiseOmega):
+            from tubekit.plant.compiled_kinematic import NO_TABLE, omega_at_ticks
 
+            table, period = (NO_TABLE, 1.0) if self.override is None else self._override_table()
             return omega_at_ticks(np.asarray(t, dtype=float), np.asarray(states, dtype=float),
                                   np.asarray(inputs, dtype=float), self.current_parameters,
-                                  (self._sway_gain, self._sway_amplitude, self._sway_rate))
+                                  (self._sway_gain, self._sway_amplitude, self._sway_rate), table, period)
         out = np.full((len(t), 3), np.nan)
         for i, ti in enumerate(t):
             if np.isfinite(inputs[i, 0]) and np.isfinite(inputs[i, 2]):

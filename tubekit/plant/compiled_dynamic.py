@@ -23,6 +23,7 @@ import numpy as np
 
 from tubekit.model.jit import routine
 from tubekit.model.vehicle_params import VehicleParams
+from tubekit.plant.compiled_kinematic import current_at
 
 __all__ = ["COEFFICIENTS", "coefficients", "actuator_limits", "rk4_dynamic", "current_at_ticks", "omega_at_ticks"]
 
@@ -70,9 +71,7 @@ def _rhs(t: float, y: np.ndarray, command: np.ndarray, truth: np.ndarray, model:
          limits: np.ndarray, current: np.ndarray, lateral: bool, out: np.ndarray, peak: np.ndarray) -> None:
     """d/dt of ``y`` into ``out`` (``DynamicPlant._rhs``); ``control`` = (k_p, k_i, 1/T_thr)."""
     kp, ki, tau_inv = control[0], control[1], control[2]
-    a = current[6] * t
-    sa, ca = math.sin(a), math.cos(a)
-    c1, c2, c3 = current[0] * sa + current[3], current[1] * ca + current[4], current[2] * sa + current[5]
+    c1, c2, c3 = current_at(current, t)
     psi, u, v, w, r = y[3], y[4], y[5], y[6], y[7]
     cp, sp = math.cos(psi), math.sin(psi)
     # the hull (truth): ν̇ = M⁻¹(τ − n(ν))
@@ -139,7 +138,7 @@ def rk4_dynamic(t: float, y0: np.ndarray, command: np.ndarray, h: float, n: int,
     limits : array (8,)
         :func:`actuator_limits` of the vehicle as simulated.
     current : array (7,)
-        (a_1, a_2, a_3, c_1, c_2, c_3, ω_c) of δ(t) (:mod:`tubekit.plant.compiled_kinematic`).
+        (a_1, a_2, a_3, c_1, c_2, c_3, ω_c) of δ(t) (:func:`tubekit.plant.compiled_kinematic.current_at`).
     """
     size = y0.shape[0]
     y, tmp = y0.copy(), np.empty(size)
@@ -162,19 +161,11 @@ def rk4_dynamic(t: float, y0: np.ndarray, command: np.ndarray, h: float, n: int,
 
 
 @routine
-def _current(current: np.ndarray, t: float) -> tuple[float, float, float]:
-    """δ(t) (m/s) of the packed ``current`` (a_1, a_2, a_3, c_1, c_2, c_3, ω_c)."""
-    a = current[6] * t
-    sa, ca = math.sin(a), math.cos(a)
-    return current[0] * sa + current[3], current[1] * ca + current[4], current[2] * sa + current[5]
-
-
-@routine
 def current_at_ticks(t: np.ndarray, current: np.ndarray) -> np.ndarray:
     """The water current δ (m/s) at the times ``t`` (s), shape (len(t), 3)."""
     out = np.empty((t.shape[0], 3))
     for i in range(t.shape[0]):
-        out[i, 0], out[i, 1], out[i, 2] = _current(current, t[i])
+        out[i, 0], out[i, 1], out[i, 2] = current_at(current, t[i])
     return out
 
 
@@ -187,7 +178,7 @@ def omega_at_ticks(t: np.ndarray, states: np.ndarray, inputs: np.ndarray, body: 
     for i in range(min(t.shape[0], body.shape[0])):
         if not (math.isfinite(inputs[i, 0]) and math.isfinite(inputs[i, 2])):
             continue
-        c1, c2, c3 = _current(current, t[i])
+        c1, c2, c3 = current_at(current, t[i])
         du, vb = body[i, 0] - inputs[i, 0], body[i, 1]
         cp, sp = math.cos(states[i, 3]), math.sin(states[i, 3])
         out[i, 0] = c1 + du * cp - vb * sp

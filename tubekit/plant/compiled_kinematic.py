@@ -20,7 +20,7 @@ import numpy as np
 
 from tubekit.model.jit import routine
 
-__all__ = ["rk4_current", "omega_at_ticks", "NO_TABLE"]
+__all__ = ["rk4_current", "omega_at_ticks", "current_at", "NO_TABLE"]
 
 Floats2 = tuple[float, float]
 Floats3 = tuple[float, float, float]
@@ -32,6 +32,14 @@ NO_TABLE = np.empty((0, 3))
 
 
 @routine
+def current_at(current: tuple[float, float, float, float, float, float, float], t: float) -> Floats3:
+    """δ(t) (m/s) of the packed ``current`` (a_1, a_2, a_3, c_1, c_2, c_3, ω_c) (``Plant._current``'s operations)."""
+    a = current[6] * t
+    s, c = math.sin(a), math.cos(a)
+    return current[0] * s + current[3], current[1] * c + current[4], current[2] * s + current[5]
+
+
+@routine
 def _stage(t: float, current: tuple[float, float, float, float, float, float, float], sway: Floats3,
            table: np.ndarray, period: float) -> Floats4:
     """(δ_1, δ_2, δ_3, v_s) at ``t`` (s): the override's row (no sway) when ``table`` has rows, else the current
@@ -39,10 +47,9 @@ def _stage(t: float, current: tuple[float, float, float, float, float, float, fl
     if table.shape[0] > 0:
         k = min(int(t / period + 1e-9), table.shape[0] - 1)
         return table[k, 0], table[k, 1], table[k, 2], 0.0
-    a0, a1, a2, c0, c1, c2, rate = current
+    d1, d2, d3 = current_at(current, t)
     sw, samp, srate = sway
-    s, c = math.sin(rate * t), math.cos(rate * t)
-    return a0 * s + c0, a1 * c + c1, a2 * s + c2, sw + samp * math.sin(srate * t)
+    return d1, d2, d3, sw + samp * math.sin(srate * t)
 
 
 @routine

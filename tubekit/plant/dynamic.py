@@ -227,12 +227,7 @@ class DynamicPlant:
         :func:`tubekit.plant.compiled_dynamic.rk4_dynamic` (the same floats)."""
         from tubekit.plant import compiled_dynamic
 
-        if self._compiled is None:
-            self._compiled = (compiled_dynamic.coefficients(self.params), compiled_dynamic.coefficients(self.model),
-                              np.array([self._kp, self._ki, self._tau_inv]),
-                              compiled_dynamic.actuator_limits(self.params, self._sway_limit),
-                              np.array(self._current_model.current_parameters))
-        truth, model, control, limits, current = self._compiled
+        truth, model, control, limits, current = self._packed()
         peak = np.array(self._peak)
         y = compiled_dynamic.rk4_dynamic(float(t), np.array((*x, *self.state), dtype=float),
                                          np.array(v, dtype=float), float(h), int(n), truth, model, control, limits,
@@ -241,6 +236,18 @@ class DynamicPlant:
         values = y.tolist()
         self.state = tuple(values[4:])
         return values[0], values[1], values[2], values[3]
+
+    def _packed(self) -> tuple[np.ndarray, ...]:
+        """The compiled routines' arrays, packed once: the truth's and the model's coefficients, (k_p, k_i, 1/T),
+        the actuator limits and the current."""
+        if self._compiled is None:
+            from tubekit.plant import compiled_dynamic
+
+            self._compiled = (compiled_dynamic.coefficients(self.params), compiled_dynamic.coefficients(self.model),
+                              np.array([self._kp, self._ki, self._tau_inv]),
+                              compiled_dynamic.actuator_limits(self.params, self._sway_limit),
+                              np.array(self._current_model.current_parameters))
+        return self._compiled
 
     def step(self, t: float, x: np.ndarray, v: np.ndarray, h: float, n: int) -> np.ndarray:
         """:meth:`step_tuple` on arrays."""
@@ -258,7 +265,7 @@ class DynamicPlant:
         if self.override is None:
             from tubekit.plant.compiled_dynamic import current_at_ticks
 
-            return current_at_ticks(np.asarray(t, dtype=float).reshape(-1), np.array(self._current_model.current_parameters))
+            return current_at_ticks(np.asarray(t, dtype=float).reshape(-1), self._packed()[4])
         return np.array([self.current_at(float(ti)) for ti in np.asarray(t, dtype=float)], dtype=float).reshape(-1, 3)
 
     def omega_series(self, t: np.ndarray, states: np.ndarray, inputs: np.ndarray) -> np.ndarray:
@@ -268,7 +275,7 @@ class DynamicPlant:
             from tubekit.plant.compiled_dynamic import omega_at_ticks
 
             return omega_at_ticks(np.asarray(t, dtype=float), np.asarray(states, dtype=float),
-                                  np.asarray(inputs, dtype=float), body, np.array(self._current_model.current_parameters))
+                                  np.asarray(inputs, dtype=float), body, self._packed()[4])
         out = np.full((len(t), 3), np.nan)
         for i, ti in enumerate(t):
             if i < len(body) and np.isfinite(inputs[i, 0]) and np.isfinite(inputs[i, 2]):

@@ -69,7 +69,8 @@ class Plant:
         sway = disturbance.sway
         self._sway_gain, self._sway_amplitude = float(sway.gain), float(sway.amplitude)
         self._sway_rate = 2.0 * math.pi / sway.period
-        self._table: tuple[np.ndarray, float] | None = None  # a PiecewiseOmega override, packed at the first step
+        self._current_parameters = (*self._amplitude, *self._constant, self._current_rate)
+        self._table: tuple[np.ndarray, float] | None = None  # the compiled routines' (table, period), packed once
         self._peak = [0.0, 0.0]  # largest ||omega_xy||, |omega_z| over every evaluation (m/s)
 
     @classmethod
@@ -116,7 +117,7 @@ class Plant:
     def current_parameters(self) -> tuple[float, float, float, float, float, float, float]:
         """(a_1, a_2, a_3, c_1, c_2, c_3, ω_c) of δ(t) = (a_1 sin ω_c t + c_1, a_2 cos ω_c t + c_2, a_3 sin ω_c t + c_3)
         (m/s, rad/s): the current as the compiled RK4s take it."""
-        return (*self._amplitude, *self._constant, self._current_rate)
+        return self._current_parameters
 
     def sway_parameters(self, u: float, r: float) -> Floats3:
         """(g u r, A_s, ω_s) of v_s(t) = g u r + A_s sin ω_s t at the input's ``u`` (m/s) and ``r`` (rad/s): the sway as
@@ -132,9 +133,9 @@ class Plant:
         :class:`~tubekit.plant.base.PiecewiseOmega`, compiled: :func:`tubekit.plant.compiled_kinematic.omega_at_ticks`,
         the same floats as :meth:`omega` tick by tick)."""
         if self.override is None or isinstance(self.override, PiecewiseOmega):
-            from tubekit.plant.compiled_kinematic import NO_TABLE, omega_at_ticks
+            from tubekit.plant.compiled_kinematic import omega_at_ticks
 
-            table, period = (NO_TABLE, 1.0) if self.override is None else self._override_table()
+            table, period = self._override_table()
             return omega_at_ticks(np.asarray(t, dtype=float), np.asarray(states, dtype=float),
                                   np.asarray(inputs, dtype=float), self.current_parameters,
                                   (self._sway_gain, self._sway_amplitude, self._sway_rate), table, period)
@@ -185,19 +186,23 @@ class Plant:
     def _compiled_step(self, t: float, y: tuple, v: Sequence[float], h: float, n: int) -> Floats4:
         """``n`` RK4 steps of :meth:`_rhs` (no override) in one compiled routine,
         :func:`tubekit.plant.compiled_kinematic.rk4_current` (the same floats as :func:`rk4_tuple` of :meth:`_rhs`)."""
-        from tubekit.plant.compiled_kinematic import NO_TABLE, rk4_current
+        from tubekit.plant.compiled_kinematic import rk4_current
 
         u, w, r = v
-        table, period = (NO_TABLE, 1.0) if self.override is None else self._override_table()
+        table, period = self._override_table()
         state, peak = rk4_current(t, y, (u, w, r), h, n, self.current_parameters, self.sway_parameters(u, r),
                                   (self._peak[0], self._peak[1]), table, period)
         self._peak[0], self._peak[1] = peak
         return state
 
     def _override_table(self) -> tuple[np.ndarray, float]:
-        """The :class:`~tubekit.plant.base.PiecewiseOmega` override's rows (K, 3) and period (s), packed once."""
+        """The compiled routines' (table, period), packed once: a :class:`~tubekit.plant.base.PiecewiseOmega`
+        override's rows (K, 3) and period (s), or no rows (the scenario's current and sway) without an override."""
         if self._table is None:
-            self._table = (np.array(self.override.table, dtype=float).reshape(-1, 3), float(self.override.period))
+            from tubekit.plant.compiled_kinematic import NO_TABLE
+
+            self._table = ((NO_TABLE, 1.0) if self.override is None else
+                           (np.array(self.override.table, dtype=float).reshape(-1, 3), float(self.override.period)))
         return self._table
 
     def omega_peak(self) -> tuple[float, float]:

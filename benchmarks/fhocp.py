@@ -23,7 +23,8 @@ Usage::
 
 Methods: ``scp_realtime`` (ours, one convex solve), ``scp_converged`` (ours, SCP
 to convergence), opt-in beside them (:data:`OPT_IN`) ``scp_realtime_piqp`` (``--piqp``),
-``scp_realtime_qoco`` (``--qoco``: the QOCO backend) and ``scp_realtime_1e7`` (``--clarabel-1e7``:
+``scp_realtime_qoco`` (``--qoco``: the QOCO backend), ``scp_realtime_qocogen`` (``--qocogen``: QOCO generated
+as C for the subproblem's pattern; its build, seconds the first time on a machine, is in the untimed cold start) and ``scp_realtime_1e7`` (``--clarabel-1e7``:
 Clarabel at 1e-7 with refinement, the real-time setting before ``REALTIME_CLARABEL_SETTINGS``), ``ipopt`` (CasADi + IPOPT, tuned: tol 1e-8, adaptive mu,
 warm start with multipliers), ``sqpmethod_qrqp`` (CasADi ``sqpmethod``, exact
 Hessian with eigenvalue clipping, ``qrqp``).
@@ -78,6 +79,7 @@ CLARABEL_1E7 = {"tol_gap_abs": 1e-7, "tol_gap_rel": 1e-7, "tol_feas": 1e-7, "ite
 OPT_IN: dict[str, tuple[str, dict, str]] = {
     "piqp": ("scp_realtime_piqp", {"qp_solver": "piqp"}, "real-time SCP, PIQP path"),
     "qoco": ("scp_realtime_qoco", {"qp_solver": "qoco"}, "real-time SCP, QOCO backend"),
+    "qocogen": ("scp_realtime_qocogen", {"qp_solver": "qocogen"}, "real-time SCP, generated QOCO (qocogen)"),
     "clarabel_1e7": ("scp_realtime_1e7", {"clarabel_settings": CLARABEL_1E7}, "real-time SCP, Clarabel 1e-7"),
 }
 

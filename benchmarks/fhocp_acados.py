@@ -5,7 +5,8 @@ u_0) and, beside it, the bare solver (Clarabel's ``solve()`` calls; acados's own
 
 Usage::
 
-    python benchmarks/fhocp_acados.py [--duration S] [--horizons 8 16 32 64] [--json FILE]
+    python benchmarks/fhocp_acados.py [--duration S] [--horizons 8 16 32 64] [--qp-solvers clarabel qocogen]
+        [--json FILE] [--acados-path DIR]
 
 acados comes from the third-party wheel ``comma-deps-acados`` (the acados, HPIPM and BLASFEO libraries,
 ``acados_template`` and the tera renderer; the solver's C code is generated and compiled with the
@@ -111,14 +112,16 @@ def _params(scenario, t: float, k: int, dt: float, obstacles: list, clearance: f
     return np.concatenate([pd, obs[0][0], [obs[0][1]], obs[1][0], [obs[1][1]]])
 
 
-def measure(duration: float, horizons: tuple[int, ...]) -> dict:
-    """Interleaved steps per horizon: the real-time SCP step and the acados SQP-RTI step (ms)."""
+def measure(duration: float, horizons: tuple[int, ...], qp_solvers: tuple[str, ...] = ("clarabel",)) -> dict:
+    """Interleaved steps per horizon: the real-time SCP step on each QP backend of ``qp_solvers`` (the first is
+    ``scp_realtime``, the others ``scp_realtime_<name>``) and the acados SQP-RTI step (ms); the order rotates from
+    state to state."""
     sys.path.insert(0, str(Path(__file__).parent))
     import dataclasses
     from fhocp import benchmark_tightening, closed_loop  # the v2 benchmark's closed loop and tightening
 
     from tubekit import paper_scenario
-    from tubekit.fhocp import FHOCP
+    from tubekit.fhocp import FHOCP, ScpOptions
 
     acados_root()
     workdir = Path(tempfile.mkdtemp(prefix="acados_build_"))
@@ -129,23 +132,25 @@ def measure(duration: float, horizons: tuple[int, ...]) -> dict:
     for n in horizons:
         sc = dataclasses.replace(base, controller=dataclasses.replace(base.controller, horizon_steps=n))
         dt = sc.controller.dt
-        ctrl = FHOCP(sc, tg, mode="realtime")
+        ctrls = {("scp_realtime" if i == 0 else f"scp_realtime_{qp}"):
+                 FHOCP(sc, tg, mode="realtime", options=ScpOptions(qp_solver=qp)) for i, qp in enumerate(qp_solvers)}
         weights = (tuple(sc.controller.Q), tuple(sc.controller.R), tuple(sc.controller.P))
         b0 = time.perf_counter()
         aca = build_acados(n, dt, np.asarray(sc.limits.vector, dtype=float),
                            (weights[0][:2], weights[1], weights[2][:2]), workdir)
         build_s = time.perf_counter() - b0
         clearance = sc.vehicle_radius + tg.obstacle_margin
-        times: dict[str, list[float]] = {"scp_realtime": [], "acados_sqp_rti": []}
-        bare: dict[str, list[float]] = {"scp_realtime": [], "acados_sqp_rti": []}
+        names = (*ctrls, "acados_sqp_rti")
+        times: dict[str, list[float]] = {k: [] for k in names}
+        bare: dict[str, list[float]] = {k: [] for k in names}
         failures = 0
         for i, (t, s, obs) in enumerate(states):
             gc.collect()
-            order = ("scp_realtime", "acados_sqp_rti") if i % 2 == 0 else ("acados_sqp_rti", "scp_realtime")
+            order = names[i % len(names):] + names[:i % len(names)]
             for name in order:
                 t0 = time.perf_counter()
-                if name == "scp_realtime":
-                    solver_s = ctrl.solve(t, s, obs).solver_time_s
+                if name != "acados_sqp_rti":
+                    solver_s = ctrls[name].solve(t, s, obs).solver_time_s
                 else:
                     aca.set(0, "lbx", s)
                     aca.set(0, "ubx", s)
@@ -162,7 +167,9 @@ def measure(duration: float, horizons: tuple[int, ...]) -> dict:
                          "solver_median_ms": float(np.median(bare[k]) * 1e3)} for k, v in times.items()}
         row["acados_failures"] = failures
         row["acados_build_s"] = build_s
-        row["scp_over_acados"] = row["scp_realtime"]["median_ms"] / row["acados_sqp_rti"]["median_ms"]
+        for name in ctrls:
+            key = "scp_over_acados" if name == "scp_realtime" else f"{name}_over_acados"
+            row[key] = row[name]["median_ms"] / row["acados_sqp_rti"]["median_ms"]
         out["by_horizon"][n] = row
     return out
 
@@ -173,6 +180,9 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--horizons", type=int, nargs="+", default=[8, 16, 32, 64], help="horizons N")
     ap.add_argument("--json", type=Path, help="write the results to this JSON file")
     ap.add_argument("--acados-path", type=Path, help="the --target directory comma-deps-acados was installed into")
+    ap.add_argument("--qp-solvers", nargs="+", default=["clarabel"],
+                    help="the real-time SCP's QP backends, each a method of its own (default clarabel; e.g. clarabel "
+                         "qocogen)")
     args = ap.parse_args(argv)
     if args.acados_path is not None:
         sys.path.append(str(args.acados_path))
@@ -183,7 +193,7 @@ def main(argv: list[str] | None = None) -> int:
         print("acados is absent: pip install --no-deps --target DIR comma-deps-acados, then --acados-path DIR "
               "(acados_template itself is not on the package index here and ships no libraries)", file=sys.stderr)
         return 1
-    res = measure(args.duration, tuple(args.horizons))
+    res = measure(args.duration, tuple(args.horizons), tuple(args.qp_solvers))
     text = json.dumps(res, indent=2)
     print(text)
     if args.json:

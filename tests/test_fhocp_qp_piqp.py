@@ -14,17 +14,12 @@ from tubekit.fhocp.qp.clarabel import ClarabelBackend
 from tubekit.fhocp.qp.piqp import DEFAULT_PIQP_SETTINGS, PIQP_STATUS, PiqpBackend
 from tubekit.fhocp.result import Status
 
+from .qp_cases import small_qp
+
 piqp = pytest.importorskip("piqp")
 
 #: every status of the installed PIQP
 RAW_STATUSES = sorted(piqp.Status.__members__)
-
-
-def _qp(center) -> ConeProgramData:
-    """min 1/2 |x - c|^2 s.t. x_0 = x_1 (zero row), x_0 <= 1 and x_1 >= -1 (nonnegative rows)."""
-    A = np.array([[1.0, -1.0], [1.0, 0.0], [0.0, -1.0]])
-    return ConeProgramData.from_matrices(np.eye(2), -np.asarray(center, dtype=float), A, [0.0, 1.0, 1.0],
-                                         ConeDims(zero=1, nonneg=2), offset=0.5 * float(np.dot(center, center)))
 
 
 @pytest.mark.parametrize("raw", RAW_STATUSES)
@@ -40,24 +35,24 @@ def test_the_table_has_no_other_entry_and_one_solved_status():
 
 def test_piqp_agrees_with_clarabel_and_updates_in_place():
     backend, reference = PiqpBackend(), ClarabelBackend({"tol_gap_abs": 1e-9, "tol_gap_rel": 1e-9})
-    data = _qp([3.0, 1.0])
+    data = small_qp([3.0, 1.0])
     for c in ([3.0, 1.0], [-0.5, 0.25], [-4.0, -2.0]):
         case = dataclasses.replace(data, q=-np.asarray(c), offset=0.5 * float(np.dot(c, c)))
         a, b = reference.solve(case), backend.solve(case)
         assert b.status is Status.OPTIMAL and b.raw_status == "PIQP_SOLVED"
         assert b.x == pytest.approx(a.x, abs=1e-6) and b.objective == pytest.approx(a.objective, abs=1e-6)
     assert (backend.setups, backend.updates) == (1, 2)
-    assert backend.solve(_qp([0.0, 0.0])).x == pytest.approx([0.0, 0.0], abs=1e-7) and backend.setups == 2
+    assert backend.solve(small_qp([0.0, 0.0])).x == pytest.approx([0.0, 0.0], abs=1e-7) and backend.setups == 2
 
 
 def test_an_infeasible_program_passes_no_solution_on():
-    data = _qp([0.0, 0.0])
+    data = small_qp([0.0, 0.0])
     sol = PiqpBackend().solve(dataclasses.replace(data, b=np.array([0.0, -2.0, -2.0])))  # x_0 <= -2, x_1 >= 2
     assert sol.status is Status.INFEASIBLE and sol.x is None and math.isnan(sol.objective)
 
 
 def test_the_iteration_cap_is_a_user_limit_without_a_solution():
-    sol = PiqpBackend({"max_iter": 1}).solve(_qp([3.0, 1.0]))
+    sol = PiqpBackend({"max_iter": 1}).solve(small_qp([3.0, 1.0]))
     assert sol.status is Status.USER_LIMIT and sol.raw_status == "PIQP_MAX_ITER_REACHED" and sol.x is None
 
 
@@ -72,4 +67,4 @@ def test_settings_default_and_unknown_ones_are_named():
     assert PiqpBackend().settings == DEFAULT_PIQP_SETTINGS
     assert PiqpBackend({"eps_abs": 1e-6}).settings == {**DEFAULT_PIQP_SETTINGS, "eps_abs": 1e-6}
     with pytest.raises(ConfigError, match=r"^piqp settings: expected names of PIQP settings"):
-        PiqpBackend({"tolerance": 1e-6}).solve(_qp([3.0, 1.0]))
+        PiqpBackend({"tolerance": 1e-6}).solve(small_qp([3.0, 1.0]))

@@ -9,29 +9,17 @@ import numpy as np
 import pytest
 
 from tubekit import ConfigError
-from tubekit.fhocp.qp.base import ConeDims, ConeProgramData
 from tubekit.fhocp.qp.clarabel import ClarabelBackend
 from tubekit.fhocp.qp.qoco import QOCO_STATUS, QocoBackend
 from tubekit.fhocp.qp.registry import make_qp_backend, qp_backends
 from tubekit.fhocp.result import Status
 
+from .qp_cases import disc, small_qp
+
 qoco = pytest.importorskip("qoco")
 
 #: every status the installed QOCO reports
 RAW_STATUSES = sorted(qoco.QOCO().solvecodes)
-
-
-def _qp(center) -> ConeProgramData:
-    """min 1/2 |x - c|^2 s.t. x_0 = x_1 (zero row), x_0 <= 1 and x_1 >= -1 (nonnegative rows)."""
-    A = np.array([[1.0, -1.0], [1.0, 0.0], [0.0, -1.0]])
-    return ConeProgramData.from_matrices(np.eye(2), -np.asarray(center, dtype=float), A, [0.0, 1.0, 1.0],
-                                         ConeDims(zero=1, nonneg=2), offset=0.5 * float(np.dot(center, center)))
-
-
-def _disc(radius: float) -> ConeProgramData:
-    """min x_0 + x_1 s.t. ||x|| <= radius (one second-order cone, no zero row): x = -radius (1, 1)/sqrt 2."""
-    A = np.array([[0.0, 0.0], [-1.0, 0.0], [0.0, -1.0]])
-    return ConeProgramData.from_matrices(np.zeros((2, 2)), np.ones(2), A, [radius, 0.0, 0.0], ConeDims(soc=(3,)))
 
 
 @pytest.mark.parametrize("raw", RAW_STATUSES)
@@ -46,7 +34,7 @@ def test_the_table_has_no_other_entry_and_one_solved_status():
 
 def test_qoco_agrees_with_clarabel_on_rows_and_updates_in_place():
     backend, reference = QocoBackend(), ClarabelBackend({"tol_gap_abs": 1e-9, "tol_gap_rel": 1e-9})
-    data = _qp([3.0, 1.0])
+    data = small_qp([3.0, 1.0])
     for c in ([3.0, 1.0], [-0.5, 0.25], [-4.0, -2.0]):
         case = dataclasses.replace(data, q=-np.asarray(c), offset=0.5 * float(np.dot(c, c)), p_changed=False)
         a, b = reference.solve(case), backend.solve(case)
@@ -56,7 +44,7 @@ def test_qoco_agrees_with_clarabel_on_rows_and_updates_in_place():
 
 
 def test_qoco_takes_the_cone_and_a_changed_right_hand_side():
-    backend, data = QocoBackend(), _disc(1.0)
+    backend, data = QocoBackend(), disc(1.0)
     for radius in (1.0, 2.0, 0.5):
         sol = backend.solve(dataclasses.replace(data, b=np.array([radius, 0.0, 0.0]), p_changed=False))
         assert sol.status is Status.OPTIMAL
@@ -67,16 +55,16 @@ def test_qoco_takes_the_cone_and_a_changed_right_hand_side():
 
 def test_an_infeasible_program_passes_no_solution_on():
     """QOCO detects no infeasibility: x_0 <= -2 and x_1 >= 2 with x_0 = x_1 ends in a failure without x."""
-    sol = QocoBackend().solve(dataclasses.replace(_qp([0.0, 0.0]), b=np.array([0.0, -2.0, -2.0])))
+    sol = QocoBackend().solve(dataclasses.replace(small_qp([0.0, 0.0]), b=np.array([0.0, -2.0, -2.0])))
     assert not sol.status.solved and sol.x is None and math.isnan(sol.objective)
 
 
 def test_the_iteration_cap_is_a_user_limit_without_a_solution():
-    sol = QocoBackend({"max_iters": 1}).solve(_disc(1.0))
+    sol = QocoBackend({"max_iters": 1}).solve(disc(1.0))
     assert sol.status is Status.USER_LIMIT and sol.raw_status == "QOCO_MAX_ITER" and sol.x is None
 
 
 def test_unknown_settings_are_named():
-    assert QocoBackend({"abstol": 1e-6}).solve(_qp([3.0, 1.0])).status is Status.OPTIMAL
+    assert QocoBackend({"abstol": 1e-6}).solve(small_qp([3.0, 1.0])).status is Status.OPTIMAL
     with pytest.raises(ConfigError, match=r"^qoco settings: expected names of QOCO settings"):
         QocoBackend({"tolerance": 1e-6})  # refused when built, before any solve

@@ -77,3 +77,13 @@ def test_ipopt_backend_solves_with_the_scenario_settings():
     t, s = STATES[1]
     res = solver.solve(t, np.array(s), SC.obstacles)
     assert not res.fallback and res.max_violation <= 1e-6
+
+
+def test_the_generated_qoco_backend_without_a_compiler_says_what_is_missing(monkeypatch):
+    """``scp-qocogen`` is refused before anything is built when no C compiler can build its solver."""
+    from tubekit.fhocp.qp import qocogen
+
+    assert "scp-qocogen" in backends()
+    monkeypatch.setattr(qocogen, "compiler", lambda: None)
+    with pytest.raises(NotAvailableError, match=r"QP backend 'qocogen' needs a C compiler"):
+        make_solver(SC, tightening(), "scp-qocogen")

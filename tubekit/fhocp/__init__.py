@@ -9,12 +9,13 @@ Modules, from the contract outwards:
 * :mod:`~tubekit.fhocp.linearisation` — the first-order models of its step and bearing error (the SCP's data);
 * :mod:`~tubekit.fhocp.convex` — the DPP cvxpy subproblem of one SCP iteration;
 * :mod:`~tubekit.fhocp.fastpath` — the compiled parameter-to-data map, solved by a QP backend;
-* :mod:`~tubekit.fhocp.qp` — the QP backends (Clarabel, PIQP through the relaxation wrapper) by name;
+* :mod:`~tubekit.fhocp.qp` — the QP backends (Clarabel, PIQP through the relaxation wrapper, QOCO, QOCO generated
+  for the pattern) by name;
 * :mod:`~tubekit.fhocp.options` — :class:`ScpOptions`, the SCP solver's validated options;
 * :mod:`~tubekit.fhocp.scp` — :class:`FHOCP`: SCP loop, trust region, fallback;
 * :mod:`~tubekit.fhocp.ipopt` — :class:`IpoptFHOCP`, the CasADi + IPOPT peer (optional);
 * :mod:`~tubekit.fhocp.registry` — the FHOCP backends by name (``"scp"``, ``"ipopt"``, ``"scp-piqp"``,
-  ``"scp-qoco"``):
+  ``"scp-qoco"``, ``"scp-qocogen"``):
   :func:`make_solver`.
 """
 

@@ -9,7 +9,10 @@ Built in:
 * ``"scp-piqp"`` — the SCP solver with ``ScpOptions(qp_solver="piqp")``: PIQP on the QP relaxation,
   checked against the cones, else Clarabel (:mod:`tubekit.fhocp.qp.relaxed`; opt-in, needs PIQP);
 * ``"scp-qoco"`` — the SCP solver with ``ScpOptions(qp_solver="qoco")``: QOCO on the whole cone program
-  (:mod:`tubekit.fhocp.qp.qoco`; opt-in, needs QOCO).
+  (:mod:`tubekit.fhocp.qp.qoco`; opt-in, needs QOCO);
+* ``"scp-qocogen"`` — the SCP solver with ``ScpOptions(qp_solver="qocogen")``: QOCO generated as C for the
+  subproblem's sparsity pattern, built once per machine (:mod:`tubekit.fhocp.qp.qocogen`; opt-in, needs qocogen
+  and a C compiler).
 
 The closed loop builds its solver with :func:`make_solver` from
 ``scenario.controller.fhocp_backend``; :func:`register_backend` adds a backend.
@@ -60,7 +63,14 @@ def _scp_qoco(scenario: Scenario, tightening: Tightening) -> FhocpSolver:
     return FHOCP(scenario, tightening, options=ScpOptions(qp_solver="qoco"))
 
 
-_BACKENDS: dict[str, SolverFactory] = {"scp": _scp, "ipopt": _ipopt, "scp-piqp": _scp_piqp, "scp-qoco": _scp_qoco}
+def _scp_qocogen(scenario: Scenario, tightening: Tightening) -> FhocpSolver:
+    """The SCP solver whose subproblems a QOCO solver generated for their pattern solves (cones taken natively)."""
+    get_qp_backend("qocogen", "backend")  # NotAvailableError with the install hint before anything is built
+    return FHOCP(scenario, tightening, options=ScpOptions(qp_solver="qocogen"))
+
+
+_BACKENDS: dict[str, SolverFactory] = {"scp": _scp, "ipopt": _ipopt, "scp-piqp": _scp_piqp, "scp-qoco": _scp_qoco,
+                                       "scp-qocogen": _scp_qocogen}
 
 
 def backends() -> tuple[str, ...]:

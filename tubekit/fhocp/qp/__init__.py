@@ -6,13 +6,16 @@
 * :mod:`~tubekit.fhocp.qp.clarabel` — Clarabel, the default (takes second-order cones);
 * :mod:`~tubekit.fhocp.qp.piqp` — PIQP (opt-in, no cones);
 * :mod:`~tubekit.fhocp.qp.qoco` — QOCO (opt-in, takes second-order cones);
+* :mod:`~tubekit.fhocp.qp.qocogen` — QOCO generated as C for the subproblem's pattern (opt-in, takes cones), built
+  and cached by :mod:`~tubekit.fhocp.qp.generated`;
 * :mod:`~tubekit.fhocp.qp.relaxed` — :class:`RelaxedQpBackend`: a backend without cones on the QP
   relaxation, its answer checked against the cones, else the cone backend;
 * :mod:`~tubekit.fhocp.qp.registry` — :func:`register_qp_backend`, :func:`qp_backends`,
   :func:`qp_backend_names`, :func:`get_qp_backend`, :func:`make_qp_backend` (what
   ``ScpOptions(qp_solver=...)`` goes through).
 
-Importing this package imports neither Clarabel, PIQP nor QOCO: a backend imports its package when it is built.
+Importing this package imports neither Clarabel, PIQP, QOCO nor qocogen: a backend imports its package when it is
+built.
 """
 
 from __future__ import annotations

@@ -1,5 +1,5 @@
-"""The QP backends by name, registered by try-import: ``"clarabel"`` (default, cones), ``"piqp"`` (no cones) and
-``"qoco"`` (cones).
+"""The QP backends by name, registered by try-import: ``"clarabel"`` (default, cones), ``"piqp"`` (no cones),
+``"qoco"`` (cones) and ``"qocogen"`` (cones; QOCO generated as C for the pattern, which also needs a C compiler).
 
 Every built-in backend is registered when this module is imported, whether its package is installed
 or not: a backend imports its package only in :meth:`QpBackend.load` (a try-import), so a missing
@@ -19,6 +19,7 @@ from tubekit.fhocp.qp.base import QpBackend
 from tubekit.fhocp.qp.clarabel import ClarabelBackend
 from tubekit.fhocp.qp.piqp import PiqpBackend
 from tubekit.fhocp.qp.qoco import QocoBackend
+from tubekit.fhocp.qp.qocogen import QocogenBackend
 from tubekit.fhocp.qp.relaxed import RelaxedQpBackend
 
 __all__ = ["DEFAULT_QP_BACKEND", "register_qp_backend", "qp_backends", "qp_backend_names", "get_qp_backend",
@@ -108,5 +109,5 @@ def make_qp_backend(backend: str | QpBackend = DEFAULT_QP_BACKEND,
     return RelaxedQpBackend(backend, get_qp_backend(DEFAULT_QP_BACKEND, field)(per.get(DEFAULT_QP_BACKEND)))
 
 
-for _builtin in (ClarabelBackend, PiqpBackend, QocoBackend):
+for _builtin in (ClarabelBackend, PiqpBackend, QocoBackend, QocogenBackend):
     register_qp_backend(_builtin)

@@ -1,0 +1,49 @@
+"""benchmarks/qp_backends.py: the QP backends on the FHOCP's recorded subproblems and in the certified tube run."""
+
+from __future__ import annotations
+
+import pytest
+
+import verify
+from tubekit.fhocp.qp.generated import compiler
+from tubekit.scenario import load_scenario
+
+from .scripts import load_script
+
+STUDY = load_script("benchmarks/qp_backends.py", "qp_backends_benchmark")
+
+pytest.importorskip("qocogen")
+if compiler() is None:
+    pytest.skip("no C compiler for the generated solver", allow_module_level=True)
+
+
+@pytest.fixture(scope="module", autouse=True)
+def cache(tmp_path_factory):
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setenv("TUBEKIT_QOCOGEN_CACHE", str(tmp_path_factory.mktemp("qocogen")))
+        yield
+
+
+@pytest.fixture(scope="module")
+def scenario():
+    return load_scenario(verify.SCENARIOS_DIR / "paper_currents.toml")
+
+
+def test_the_generated_solver_answers_the_recorded_subproblems_as_clarabel_does(scenario):
+    """Every subproblem of 1 s of the certified run (its periods' solves), solved by each backend: no failure, the
+    plan's inputs within 1e-3 of Clarabel's and the objective within 1e-5 relative (QOCO's defaults, 1e-7, against
+    the real-time Clarabel's 1e-6)."""
+    problems, inputs = STUDY.record(scenario, 1.0)
+    assert len(problems) >= 10 and inputs.size == 3 * 8
+    rows = STUDY.compare(problems, inputs, ("clarabel", "qocogen"))
+    assert rows["clarabel"]["max_input_diff"] == 0.0
+    gen = rows["qocogen"]
+    assert (gen["failed"], gen["inaccurate"]) == (0, 0)
+    assert gen["max_input_diff"] < 1e-3 and gen["max_objective_gap"] < 1e-5
+
+
+def test_the_certified_run_on_the_generated_solver_keeps_its_promises(scenario):
+    rows = STUDY.closed_loop(scenario, 2.0, ("clarabel", "qocogen"))
+    assert rows["qocogen"]["broken"] == [] == rows["clarabel"]["broken"]
+    assert rows["qocogen"]["tracking_rmse"] == pytest.approx(rows["clarabel"]["tracking_rmse"], abs=1e-3)
+    assert rows["qocogen"]["backup_s"] == 0.0

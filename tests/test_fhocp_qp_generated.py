@@ -48,11 +48,15 @@ def test_the_cache_root_is_the_named_directory_else_the_users_cache(monkeypatch,
     assert generated.cache_root() == tmp_path / "xdg" / "tubekit" / "qocogen"
 
 
-def test_a_pattern_is_built_once_and_loaded_afterwards(cache):
-    library = generated.build_solver(_program())
+def test_a_pattern_is_built_once_and_loaded_afterwards(cache, caplog):
+    with caplog.at_level("INFO", logger="tubekit.fhocp.qp.generated"):
+        library = generated.build_solver(_program())
+    assert "compiling a solver for this subproblem's pattern (2 variables, 3 rows; once per machine" in caplog.text
+    caplog.clear()
     stamp = library.stat().st_mtime_ns
-    again = generated.build_solver(_program((2.0, -3.0, 0.5, -1.0)))     # the same pattern, other values
-    assert again == library and again.stat().st_mtime_ns == stamp
+    with caplog.at_level("INFO", logger="tubekit.fhocp.qp.generated"):
+        again = generated.build_solver(_program((2.0, -3.0, 0.5, -1.0)))     # the same pattern, other values
+    assert again == library and again.stat().st_mtime_ns == stamp and caplog.text == ""
     assert [p.name for p in cache.iterdir()] == [library.parent.name]   # no scratch directory left behind
     data = _program()
     solver = generated.GeneratedSolver(library, data, dict(generated.SETTING_DEFAULTS))

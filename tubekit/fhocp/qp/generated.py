@@ -25,11 +25,13 @@ import ctypes
 import hashlib
 import importlib.metadata
 import io
+import logging
 import os
 import platform
 import shutil
 import subprocess
 import tempfile
+import time
 from functools import lru_cache
 from pathlib import Path
 
@@ -86,6 +88,8 @@ int tk_solve(void* wv, double* P, double* A, double* G, double* c, double* b, do
   return (int)w->sol.status;
 }
 """
+
+LOGGER = logging.getLogger(__name__)
 
 _SOURCES = ("qoco_custom.c", "cone.c", "utils.c", "ldl.c", "kkt.c", "tk_shim.c")
 _LIBRARY = "libtubekit_qocogen.so"
@@ -178,6 +182,9 @@ def build_solver(data: ConeProgramData) -> Path:
         return final / _LIBRARY
     final.parent.mkdir(parents=True, exist_ok=True)
     scratch = Path(tempfile.mkdtemp(prefix=".build-", dir=final.parent))
+    LOGGER.info("qocogen: generating and compiling a solver for this subproblem's pattern (%d variables, %d rows; "
+                "once per machine, seconds) into %s", data.n, data.m, final)
+    started = time.perf_counter()
     try:
         _generate(data, scratch)
         src = scratch / "solver"
@@ -194,6 +201,7 @@ def build_solver(data: ConeProgramData) -> Path:
                 raise
     finally:
         shutil.rmtree(scratch, ignore_errors=True)
+    LOGGER.info("qocogen: solver ready after %.1f s", time.perf_counter() - started)
     return final / _LIBRARY
 
 

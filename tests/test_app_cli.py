@@ -308,3 +308,26 @@ def test_processes_started_in_the_block_ignore_ctrl_c():
     with children_ignore_interrupts():
         assert _child_sigint() == "ignored"
     assert signal.getsignal(signal.SIGINT) is before and _child_sigint() == child_before
+
+
+def test_a_ctrl_c_a_library_swallows_is_raised_again_when_the_block_ends():
+    """Inside ``interrupts_remembered`` a SIGINT raises KeyboardInterrupt; caught and dropped by the code inside (as
+    a closing cluster may), it is raised again at the block's end, and the previous handler is back."""
+    import os
+    import signal
+
+    from tubekit.app.exit_codes import interrupts_remembered
+
+    before = signal.getsignal(signal.SIGINT)
+    caught = []
+    with pytest.raises(KeyboardInterrupt):
+        with interrupts_remembered():
+            try:
+                os.kill(os.getpid(), signal.SIGINT)
+                for _ in range(1000):  # the handler runs at the next bytecode boundary
+                    pass
+            except KeyboardInterrupt:
+                caught.append(True)  # swallowed, as a library might
+    assert caught == [True] and signal.getsignal(signal.SIGINT) is before
+    with interrupts_remembered():  # no Ctrl-C: nothing raised
+        pass

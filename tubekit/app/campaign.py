@@ -37,6 +37,7 @@ from tubekit.tightening import Tightening
 from tubekit.app.campaign_spec import CampaignSpec, RunPlan, spec_from_stored
 from tubekit.app.campaign_cluster import open_client, start_fork_server
 from tubekit.app.campaign_task import RunTask, row_of, simulate_all, simulate_task
+from tubekit.app.exit_codes import interrupts_remembered
 from tubekit.app.output import check_output_dir
 from tubekit.app.campaign_summary import (FIGURES, METRIC_COLUMNS, import_plotting, summarise, summary_line,
                                           write_figures)
@@ -225,6 +226,14 @@ def run_campaign(spec: CampaignSpec, out: str | Path, *, workers: int = 2, sched
             for k, p in plans.items() if k not in done]
     LOGGER.info("campaign: %d runs (%d already finished), %d distinct certificates (%d stored), %s", spec.runs,
                 spec.runs - len(todo), len(scenarios), len(certs), scheduler or f"LocalCluster of {workers} workers")
+    with interrupts_remembered():  # a Ctrl-C that dask swallows while the cluster closes still ends in exit 130
+        return _run(out, spec, plans, keys, todo, missing, certs, workers, scheduler, progress, started)
+
+
+def _run(out: Path, spec: CampaignSpec, plans: dict[int, RunPlan], keys: dict[int, str], todo: list[RunTask],
+         missing: dict[str, Scenario], certs: dict[str, Tightening], workers: int, scheduler: str | None,
+         progress: bool, started: float) -> dict[str, Any]:
+    """The cluster, the runs and the outputs of :func:`run_campaign` (its inputs validated)."""
     nworkers = 0
     if scheduler is None and (todo or missing):  # the workers' fork server warms up while the client ...
         start_fork_server(next(iter(missing.values()), todo[0].scenario if todo else None))

@@ -31,7 +31,7 @@ from tubekit.exceptions import ConfigError, NotAvailableError, ShapeError, Solve
 
 __all__ = ["EXIT_OK", "EXIT_FAILURE", "EXIT_BAD_INPUT", "EXIT_NOT_CERTIFIED", "EXIT_PROMISE_BROKEN",
            "EXIT_INTERRUPTED", "INSTALL_HINT", "ENVIRONMENT_ERRNOS", "is_environment_error", "MachineError",
-           "children_ignore_interrupts", "extra_hint", "error_table", "handle_error"]
+           "children_ignore_interrupts", "interrupts_remembered", "extra_hint", "error_table", "handle_error"]
 
 EXIT_OK = 0
 EXIT_FAILURE = 1
@@ -87,6 +87,29 @@ def children_ignore_interrupts() -> Iterator[None]:
         yield
     finally:
         signal.signal(signal.SIGINT, previous)
+
+
+@contextlib.contextmanager
+def interrupts_remembered() -> Iterator[None]:
+    """Ctrl-C inside the block raises KeyboardInterrupt as usual and is also remembered: should a library swallow
+    that KeyboardInterrupt (a cluster closing, a wait that retries), the block raises it again when it ends, so an
+    interrupted command never exits 0. Off the main thread the block changes nothing."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    seen = threading.Event()
+
+    def remember(signum: int, frame: object) -> None:
+        seen.set()
+        raise KeyboardInterrupt
+
+    previous = signal.signal(signal.SIGINT, remember)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGINT, previous)
+    if seen.is_set():
+        raise KeyboardInterrupt
 
 
 def _first_line(exc: BaseException) -> str:

@@ -143,8 +143,8 @@ def measure(name: str, scenario: Scenario, duration: float, radii: tuple[float, 
            "baseline_rmse": base["tracking_rmse"], "runs": []}
     for radius in radii:
         m = certified_run(scenario, with_radius(tight, radius), progress=False).metrics
-        out["runs"].append({"radius": radius, "certified": radius >= certified,
-                            "tracking_rmse": m["tracking_rmse"], "rmse_ratio": m["tracking_rmse"] / base["tracking_rmse"],
+        out["runs"].append({"radius": radius, "certified": radius >= certified, "tracking_rmse": m["tracking_rmse"],
+                            "rmse_ratio": m["tracking_rmse"] / base["tracking_rmse"],
                             "encirclements": m.get("encirclements"), "backup_s": m["backup_s"]})
     floor_c, floor_beta = shape_floor(omega, yaw)
     any_c, any_abeam = any_shape_floor(omega, yaw, float(scenario.limits.u_max))

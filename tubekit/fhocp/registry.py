@@ -51,26 +51,19 @@ def _ipopt(scenario: Scenario, tightening: Tightening) -> FhocpSolver:
                       terminal=scenario.controller.terminal_mode)
 
 
-def _scp_piqp(scenario: Scenario, tightening: Tightening) -> FhocpSolver:
-    """The SCP solver whose subproblems try PIQP on the QP relaxation first (same answers as ``scp``)."""
-    get_qp_backend("piqp", "backend")  # NotAvailableError with the install hint before anything is built
-    return FHOCP(scenario, tightening, options=ScpOptions(qp_solver="piqp"))
+def _scp_on(qp_solver: str) -> SolverFactory:
+    """The factory of the SCP solver whose subproblems the opt-in QP backend ``qp_solver`` solves (same answers as
+    ``scp`` to the solvers' tolerances)."""
+
+    def factory(scenario: Scenario, tightening: Tightening) -> FhocpSolver:
+        get_qp_backend(qp_solver, "backend")  # NotAvailableError with the install hint before anything is built
+        return FHOCP(scenario, tightening, options=ScpOptions(qp_solver=qp_solver))
+
+    return factory
 
 
-def _scp_qoco(scenario: Scenario, tightening: Tightening) -> FhocpSolver:
-    """The SCP solver whose subproblems QOCO solves (cones taken natively)."""
-    get_qp_backend("qoco", "backend")  # NotAvailableError with the install hint before anything is built
-    return FHOCP(scenario, tightening, options=ScpOptions(qp_solver="qoco"))
-
-
-def _scp_qocogen(scenario: Scenario, tightening: Tightening) -> FhocpSolver:
-    """The SCP solver whose subproblems a QOCO solver generated for their pattern solves (cones taken natively)."""
-    get_qp_backend("qocogen", "backend")  # NotAvailableError with the install hint before anything is built
-    return FHOCP(scenario, tightening, options=ScpOptions(qp_solver="qocogen"))
-
-
-_BACKENDS: dict[str, SolverFactory] = {"scp": _scp, "ipopt": _ipopt, "scp-piqp": _scp_piqp, "scp-qoco": _scp_qoco,
-                                       "scp-qocogen": _scp_qocogen}
+_BACKENDS: dict[str, SolverFactory] = {"scp": _scp, "ipopt": _ipopt, "scp-piqp": _scp_on("piqp"),
+                                       "scp-qoco": _scp_on("qoco"), "scp-qocogen": _scp_on("qocogen")}
 
 
 def backends() -> tuple[str, ...]:

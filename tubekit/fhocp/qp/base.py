@@ -32,7 +32,8 @@ import scipy.sparse as sp
 from tubekit.exceptions import ConfigError, NotAvailableError
 from tubekit.fhocp.result import Status
 
-__all__ = ["ConeDims", "ConeProgramData", "ConeSolution", "QpBackend", "checked_solution", "row_block"]
+__all__ = ["ConeDims", "ConeProgramData", "ConeSolution", "QpBackend", "checked_solution", "row_block",
+           "zero_and_cone_rows"]
 
 
 @dataclass(frozen=True)
@@ -184,6 +185,15 @@ def row_block(a_indices: np.ndarray, a_indptr: np.ndarray, shape: tuple[int, int
     block = pattern[lo:hi].tocsc()
     block.sort_indices()
     return block.data.astype(np.int64) - 1, block.indices.astype(np.int64), block.indptr.astype(np.int64)
+
+
+def zero_and_cone_rows(data: ConeProgramData) -> tuple[tuple[np.ndarray, np.ndarray, np.ndarray],
+                                                         tuple[np.ndarray, np.ndarray, np.ndarray]]:
+    """:func:`row_block` of A's zero rows and of the rest (nonnegative and cone rows): the split of solvers that
+    take equalities as A x = b and every other row as G x + s = h (QOCO, the generated QOCO)."""
+    shape, zero = (data.m, data.n), data.dims.zero
+    return (row_block(data.a_indices, data.a_indptr, shape, 0, zero),
+            row_block(data.a_indices, data.a_indptr, shape, zero, data.m))
 
 
 @dataclass(frozen=True)

@@ -39,9 +39,9 @@ import numpy as np
 import scipy.sparse as sp
 
 from tubekit.exceptions import NotAvailableError
-from tubekit.fhocp.qp.base import ConeProgramData, row_block
+from tubekit.fhocp.qp.base import ConeProgramData, zero_and_cone_rows
 
-__all__ = ["SHIM", "COMPILE_FLAGS", "SETTING_DEFAULTS", "compiler", "cache_root", "pattern_key", "build_solver",
+__all__ = ["SHIM", "COMPILE_FLAGS", "SETTING_DEFAULTS", "NO_COMPILER", "compiler", "cache_root", "pattern_key", "build_solver",
            "GeneratedSolver"]
 
 #: The compiler's flags: the generated solver is specialised to its pattern, and the cache to its machine. Measured
@@ -91,6 +91,10 @@ int tk_solve(void* wv, double* P, double* A, double* G, double* c, double* b, do
 """
 
 LOGGER = logging.getLogger(__name__)
+
+#: What a machine without a C compiler is told (the backend's availability and the build say the same).
+NO_COMPILER = ("the QP backend 'qocogen' needs a C compiler (cc, gcc or clang on PATH, or CC) to build its "
+               "generated solver")
 
 _SOURCES = ("qoco_custom.c", "cone.c", "utils.c", "ldl.c", "kkt.c", "tk_shim.c")
 _LIBRARY = "libtubekit_qocogen.so"
@@ -144,13 +148,11 @@ def pattern_key(data: ConeProgramData) -> str:
 
 
 def _blocks(data: ConeProgramData) -> tuple[sp.csc_matrix | None, sp.csc_matrix]:
-    """A's zero rows and its cone rows as matrices over their full patterns, every stored zero kept."""
-    zero, shape = data.dims.zero, (data.m, data.n)
-    out = []
-    for lo, hi in ((0, zero), (zero, data.m)):
-        pos, ind, ptr = row_block(data.a_indices, data.a_indptr, shape, lo, hi)
-        out.append(sp.csc_matrix((data.a_values[pos].astype(float), ind, ptr), shape=(hi - lo, data.n)))
-    return (out[0] if zero else None), out[1]
+    """A's zero rows and its other rows as matrices over their full patterns, every stored zero kept."""
+    zero = data.dims.zero
+    (pe, ie, qe), (pg, ig, qg) = zero_and_cone_rows(data)
+    eq = sp.csc_matrix((data.a_values[pe].astype(float), ie, qe), shape=(zero, data.n)) if zero else None
+    return eq, sp.csc_matrix((data.a_values[pg].astype(float), ig, qg), shape=(data.m - zero, data.n))
 
 
 def _generate(data: ConeProgramData, where: Path) -> None:
@@ -177,7 +179,7 @@ def build_solver(data: ConeProgramData) -> Path:
     """
     found = compiler()
     if found is None:
-        raise NotAvailableError("the QP backend 'qocogen' needs a C compiler (cc, gcc or clang on PATH, or CC)")
+        raise NotAvailableError(NO_COMPILER)
     final = cache_root() / pattern_key(data)
     if (final / _LIBRARY).is_file():
         return final / _LIBRARY
@@ -242,8 +244,7 @@ class GeneratedSolver:
                                     f"not {n}: remove that directory")
         values = [settings[k] for k in SETTING_DEFAULTS]
         lib.tk_settings(self._work, *(int(v) for v in values[:3]), *(float(v) for v in values[3:]))
-        self._eq = row_block(pattern.a_indices, pattern.a_indptr, (m, n), 0, zero)[0]
-        self._cone = row_block(pattern.a_indices, pattern.a_indptr, (m, n), zero, m)[0]
+        (self._eq, _, _), (self._cone, _, _) = zero_and_cone_rows(pattern)
         self._zero = zero
         self._has_p = pattern.p_values is not None
         #: the value buffers the library reads (P, A's zero rows, A's cone rows, q, b's zero and cone parts), x, info

@@ -19,7 +19,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from tubekit.exceptions import ConfigError
-from tubekit.fhocp.qp.base import ConeProgramData, ConeSolution, QpBackend, checked_solution, row_block
+from tubekit.fhocp.qp.base import ConeProgramData, ConeSolution, QpBackend, checked_solution, zero_and_cone_rows
 from tubekit.fhocp.result import Status, status_from
 
 __all__ = ["QOCO_STATUS", "QocoBackend"]
@@ -62,9 +62,7 @@ class QocoBackend(QpBackend):
     def _split(self, data: ConeProgramData) -> tuple[np.ndarray, np.ndarray]:
         """Values of (A, G) in their CSC patterns: the zero rows, then the nonnegative and cone rows."""
         if self._blocks is None or self._key is not data.a_indices:
-            zero, shape = data.dims.zero, (data.m, data.n)
-            self._blocks = (row_block(data.a_indices, data.a_indptr, shape, 0, zero),
-                            row_block(data.a_indices, data.a_indptr, shape, zero, data.m))
+            self._blocks = zero_and_cone_rows(data)
         (pe, _, _), (pg, _, _) = self._blocks
         return data.a_values[pe], data.a_values[pg]
 

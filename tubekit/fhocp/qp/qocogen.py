@@ -4,8 +4,8 @@ The SCP's subproblem keeps one sparsity pattern for a whole run (:mod:`tubekit.f
 code generator needs: on its first solve of a pattern the backend gets a solver for it from
 :mod:`tubekit.fhocp.qp.generated` (built once per machine and cached, seconds; then loaded in milliseconds) and
 afterwards copies the values into the buffers the library reads (A's zero rows and its cone rows gathered, P's upper
-triangle, q and the two halves of b), whose addresses it was given once. QOCO's form is the same as :class:`~tubekit.fhocp.qp.base.ConeProgramData`'s
-(:mod:`tubekit.fhocp.qp.qoco`). The statuses map through :data:`QOCOGEN_STATUS`; the generated QOCO detects no
+triangle, q and the two halves of b), whose addresses it was given once. QOCO's form is the same as
+:class:`~tubekit.fhocp.qp.base.ConeProgramData`'s (:mod:`tubekit.fhocp.qp.qoco`). The statuses map through :data:`QOCOGEN_STATUS`; the generated QOCO detects no
 infeasibility, so an infeasible subproblem ends at its iteration cap or in a numerical error: a failure that passes
 no solution on. Needs ``pip install qocogen`` and a C compiler.
 """
@@ -18,7 +18,7 @@ from typing import Any, Mapping
 
 from tubekit.exceptions import ConfigError, NotAvailableError
 from tubekit.fhocp.qp.base import ConeProgramData, ConeSolution, QpBackend, checked_solution
-from tubekit.fhocp.qp.generated import SETTING_DEFAULTS, GeneratedSolver, build_solver, compiler
+from tubekit.fhocp.qp.generated import NO_COMPILER, SETTING_DEFAULTS, GeneratedSolver, build_solver, compiler
 from tubekit.fhocp.result import Status, status_from
 
 __all__ = ["QOCOGEN_STATUS", "QocogenBackend"]
@@ -66,8 +66,7 @@ class QocogenBackend(QpBackend):
         """qocogen (a try-import), or :class:`NotAvailableError` naming what is missing: the package or a C compiler."""
         module = super().load()
         if compiler() is None:
-            raise NotAvailableError(f"the QP backend '{cls.name}' needs a C compiler (cc, gcc or clang on PATH, "
-                                    "or CC) to build its generated solver")
+            raise NotAvailableError(NO_COMPILER)
         return module
 
     def solve(self, data: ConeProgramData) -> ConeSolution:

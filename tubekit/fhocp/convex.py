@@ -38,6 +38,7 @@ maps straight to its QP backend's data (:mod:`tubekit.fhocp.qp`), and
 from __future__ import annotations
 
 import math
+from types import ModuleType
 from typing import Callable
 
 import cvxpy as cp
@@ -54,6 +55,14 @@ from tubekit.fhocp.result import Status, status_from
 from tubekit.fhocp.rows import backup_rows
 
 __all__ = ["ConvexSubproblem", "DEFAULT_CLARABEL_SETTINGS", "REALTIME_CLARABEL_SETTINGS", "CVXPY_STATUS"]
+
+
+def _rows() -> ModuleType:
+    """:mod:`tubekit.fhocp.compiled_rows`, imported at the first linearisation (``tubekit certify`` loads no numba)."""
+    from tubekit.fhocp import compiled_rows
+
+    return compiled_rows
+
 
 #: Clarabel settings used by default (looser than Clarabel's 1e-8: the SCP's own tolerance is 1e-5)
 DEFAULT_CLARABEL_SETTINGS: dict = {"tol_gap_abs": 1e-7, "tol_gap_rel": 1e-7, "tol_feas": 1e-7}
@@ -378,42 +387,25 @@ class ConvexSubproblem:
         """Linear and constant cost terms, p_d(N) of the terminal set, the e_o model."""
         pvec, gidx = self.param_vector, self._gidx
         r1 = ref[1:]
-        blk = -2.0 * self._wref * r1.T
+        eo_all = eo_linearisation(s, ref)
+        blk, eo = _rows().cost_rows(self._wref, r1, eo_all, psi0)
         pvec[gidx["lin"]] = blk.ravel()
         if self.nlp.terminal != "off":
             pvec[gidx["pdN"]] = ref[self.nlp.n]
-        eo_all = eo_linearisation(s, ref)
         e0 = (ref[0, 0] ** 2 + ref[0, 1] ** 2, ref[0, 2] ** 2, eo_all[4, 0] ** 2)  # k = 0 (constant)
         pvec[gidx["c0"]] = float(np.einsum("ck,kc->", self._wref, r1 * r1) + self._weights[0] @ e0)
-        eo = eo_all[:4, 1:]
-        eo[3] += eo[2] * psi0
         pvec[gidx["eo"]] = eo.ravel()
 
     def _write_state_rows(self, s: np.ndarray, r1: np.ndarray, o: np.ndarray) -> None:
         """e_d half-spaces (n'(p - p_d), n the horizontal unit error direction), e_z rows, walls."""
         nlp, N = self.nlp, self.nlp.n
-        ex = s[1:, 0] - r1[:, 0]
-        ey = s[1:, 1] - r1[:, 1]
-        ed = np.sqrt(ex * ex + ey * ey)
-        if ed.min() < 1e-9:  # on the target: use the direction behind the heading
-            tiny = ed < 1e-9
-            ex = np.where(tiny, -np.cos(s[1:, 3]), ex)
-            ey = np.where(tiny, -np.sin(s[1:, 3]), ey)
-            ed = np.sqrt(ex * ex + ey * ey)
-        st = np.empty((6, N))
-        st[0] = ex / ed
-        st[1] = ey / ed
-        npd = st[0] * r1[:, 0] + st[1] * r1[:, 1]
         nb = nlp.node_bounds()
-        st[2] = nb["e_d_lo"] + npd
-        st[3] = nb["e_d_hi"] + npd
-        st[4] = r1[:, 2] - nb["e_z"]
-        st[5] = r1[:, 2] + nb["e_z"]
-        if nlp.workspace is not None:
+        if nlp.workspace is None:
+            st = _rows().state_rows(s, r1, nb["e_d_lo"], nb["e_d_hi"], nb["e_z"], -math.inf, math.inf)
+        else:
             lo = nlp.workspace[0] + nlp.clearance - o
             hi = nlp.workspace[1] - nlp.clearance - o
-            np.maximum(st[4], lo[2], out=st[4])
-            np.minimum(st[5], hi[2], out=st[5])
+            st = _rows().state_rows(s, r1, nb["e_d_lo"], nb["e_d_hi"], nb["e_z"], lo[2], hi[2])
             # the nearer wall per axis (the origin is the measured position)
             walls = [1.0, hi[0], 1.0, hi[1]]
             for i in (0, 1):
@@ -430,20 +422,9 @@ class ConvexSubproblem:
 
     def _write_obstacles(self, s: np.ndarray, obs: np.ndarray, o: np.ndarray) -> None:
         """n'(p - c) >= r + clearance, n the unit direction from c to the plan; empty slots 0 >= -1."""
-        ob = np.zeros((self.max_obstacles, 4, self.nlp.n))
-        ob[:, 3] = -1.0  # inactive slot: 0 >= -1
         k = len(obs)
-        if k:
-            c = obs[:, :3] - o                       # (k, 3)
-            d = s[None, 1:, :3] - c[:, None, :]      # (k, N, 3)
-            dist = np.sqrt(np.einsum("jnc,jnc->jn", d, d))
-            if dist.min() < 1e-9:
-                bad = dist < 1e-9
-                d[bad] = (0.0, 0.0, 1.0)
-                dist[bad] = 1.0
-            n = d / dist[..., None]
-            ob[:k, :3] = n.transpose(0, 2, 1)
-            ob[:k, 3] = obs[:, 3:4] + self.nlp.clearance + np.einsum("jnc,jc->jn", n, c)
+        ob = _rows().obstacle_rows(s, obs[:, :3] - o, np.ascontiguousarray(obs[:, 3]), self.nlp.clearance,
+                                         self.max_obstacles)
         self.param_vector[self._gidx["obs"]] = ob.ravel()
         if self.nlp.backup_terminal is not None:  # the last node's half-space, the footprint's sphere about the anchor
             shift = ob[:, 0, -1] * self._anchor_offset[0] + ob[:, 1, -1] * self._anchor_offset[1]
@@ -461,10 +442,7 @@ class ConvexSubproblem:
 
     def _write_input_bounds(self, v: np.ndarray, radius: float) -> None:
         """The input box [v_min, v_max] intersected with the trust region |v_new - v| <= radius V-bar."""
-        vmax = self.nlp.v_max
-        bd = np.empty((6, self.nlp.n))
-        bd[0::2] = np.maximum(self.nlp.v_min, v - radius * vmax).T
-        bd[1::2] = np.minimum(vmax, v + radius * vmax).T
+        bd = _rows().input_bounds(v, radius, self.nlp.v_min, self.nlp.v_max)
         self.param_vector[self._gidx["bounds"]] = bd.ravel()
 
     # ---------------------------------------------------------------- solve

@@ -114,6 +114,7 @@ class CompiledConeProgram:
         self._a_data = -np.asarray(top[:, -1].toarray()).ravel()
         # q (with the offset d as its last entry)
         self._q_map = sp.csr_matrix(pp.q)
+        self._stacked: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None  # built at the first solve
         self._compile_quadratic(pp)
         self.dims = cone_dims(data[cp.reductions.solvers.conic_solvers.conic_solver.ConicSolver.DIMS])
         self.var_id_to_col = dict(pp.var_id_to_col)
@@ -162,18 +163,19 @@ class CompiledConeProgram:
             raise SolverError(f"parameter {parameter.name()} is not part of the compiled problem")
         return np.arange(col, col + parameter.size)
 
-    def _vectors(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, float]:
-        """(parametric A values, b, q, d) for the current parameter vector (sparse mat-vecs).
+    def _vectors(self) -> tuple[np.ndarray, np.ndarray, float]:
+        """(b, q, d) for the current parameter vector (one compiled mat-vec of the stacked maps,
+        :func:`tubekit.fhocp.compiled_rows.scatter_matvec`); also refreshes A's parametric values."""
+        from tubekit.fhocp import compiled_rows
 
-        Also refreshes the parametric entries of the full A value array.
-        """
-        pv = self.param_vector
-        a_par = -(self._a_par_map @ pv)
-        self._a_data[self._a_par] = a_par
-        b = np.zeros(self.m)
-        b[self._b_rows] = self._b_map @ pv
-        qd = self._q_map @ pv
-        return a_par, b, np.ascontiguousarray(qd[:self.n]), float(qd[self.n])
+        if self._stacked is None:
+            st = sp.vstack([self._a_par_map, self._b_map, self._q_map], format="csr")
+            self._stacked = (st.indptr.astype(np.int64), st.indices.astype(np.int64), st.data.astype(float))
+        b = np.empty(self.m)
+        q = np.empty(self.n)
+        d = compiled_rows.scatter_matvec(*self._stacked, self.param_vector, self._a_data, self._a_par, b,
+                                         self._b_rows, q)
+        return b, q, d
 
     def data(self) -> tuple[sp.csc_matrix, np.ndarray, sp.csc_matrix, np.ndarray, float]:
         """(P upper triangle, q, A, b, d) for the current parameter vector; Clarabel's Ax + s = b."""
@@ -207,7 +209,7 @@ class CompiledConeProgram:
     # ----------------------------------------------------------------- solve
     def program(self) -> ConeProgramData:
         """The cone program at the current parameter vector, as the backend gets it (views of the buffers)."""
-        _, b, q, d = self._vectors()
+        b, q, d = self._vectors()
         return ConeProgramData(self._p_data(), self._P_indices, self._P_indptr, q, self._a_data, self._A_indices,
                                self._A_indptr, b, self.dims, d, self._a_par, self._P_map is not None)
 

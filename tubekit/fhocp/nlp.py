@@ -281,6 +281,9 @@ class FhocpNlp:
         object.__setattr__(self, "_rate_w", self.rate_penalty * self.r)
         self._set_lower_corner()
         object.__setattr__(self, "_nodes", self._node_bounds())
+        object.__setattr__(self, "_violation_bounds", np.array([self.e_d_min, self.e_d_max, self.e_z_max,
+                                                                self.e_o_max, self.clearance]))
+        object.__setattr__(self, "_workspace_rows", np.zeros((0, 3)) if self.workspace is None else self.workspace)
 
     def _set_lower_corner(self) -> None:
         """Fill ``v_min`` (-v_max when None) and ``terminal_command`` (zeros when None), validated."""
@@ -381,6 +384,7 @@ class FhocpNlp:
         v_last : array (3,), optional
             The command before the plan (rate penalty; with ``first_row``, the rate row (b)).
         """
+        from tubekit.fhocp import compiled_rows
         from tubekit.model import compiled_arcs
 
         states = np.asarray(states, dtype=float)
@@ -392,25 +396,12 @@ class FhocpNlp:
         if self.rate_penalty:
             cost += rate_penalty_cost(inputs, self._rate_w, v_last)
         # per-step violations, rows: e_d_min, obstacle, e_o, box (k = 1..N)
-        viol = np.zeros((4, n))
-        e1 = e[1:]
-        np.maximum(self.e_d_min - e1[:, 0], 0.0, out=viol[0])
-        if len(obstacles):
-            diff = states[1:, None, :3] - obstacles[None, :, :3]
-            dist = np.sqrt(np.einsum("kjc,kjc->kj", diff, diff))
-            np.maximum((obstacles[:, 3] + self.clearance - dist).max(axis=1), 0.0, out=viol[1])
-        np.maximum(np.abs(e1[:, 2]) - self.e_o_max, 0.0, out=viol[2])
-        box = np.maximum(e1[:, 0] - self.e_d_max, np.abs(e1[:, 1]) - self.e_z_max)
-        if self.workspace is not None:
-            p1 = states[1:, :3]
-            wall = np.maximum(self.workspace[0] + self.clearance - p1, p1 - self.workspace[1] + self.clearance)
-            box = np.maximum(box, wall.max(axis=1))
-        np.maximum(box, 0.0, out=viol[3])
+        obstacles = np.asarray(obstacles, dtype=float).reshape(-1, 4)
+        viol, inp, dyn = compiled_rows.violation_rows(states, inputs, e, obstacles, self.dt, self._violation_bounds,
+                                                      self._workspace_rows, self.v_min, self.v_max)
         term = 0.0
         if self.terminal != "off":
             term = max(0.0, math.sqrt(float(e2[n] @ self.p)) - self.terminal_level)
-        inp = max(0.0, float(np.maximum(inputs - self.v_max, self.v_min - inputs).max()))
-        dyn = float(np.abs(states[1:] - compiled_arcs.unicycle_steps(states[:-1], inputs, self.dt)).max())
         vmax = viol.max(axis=1)
         merit = cost + self.penalty * float(viol.sum())
         if self.terminal == "soft":

@@ -14,6 +14,10 @@ same process on the same states, so what differs between the rounds is the kerne
 scatter more than the difference). Reported per round: the median whole step of the real-time and the
 converged SCP (ms), and whether both sides' plans are the very same floats.
 
+Since the compiled rows (``benchmarks/compiled_step.py``), the SCP's subproblem takes the step's Jacobian and the
+bearing error's model inside :func:`tubekit.fhocp.compiled_rows.subproblem_rows`, which calls the compiled routines
+directly: the numpy side here swaps them for the public linearisations only, no longer for the step it times.
+
 A benchmark, not a test: numbers depend on the machine and its load.
 """
 

@@ -43,8 +43,8 @@ from tubekit import paper_scenario  # noqa: E402
 from tubekit.fhocp import compiled_rows  # noqa: E402
 from tubekit.model import compiled_arcs  # noqa: E402
 
-__all__ = ["numpy_state_rows", "numpy_obstacle_rows", "numpy_input_bounds", "numpy_cost_rows", "numpy_scatter_matvec",
-           "numpy_violation_rows", "NUMPY", "numpy_rows", "measure", "compare_logs", "main"]
+__all__ = ["numpy_state_rows", "numpy_obstacle_rows", "numpy_input_bounds", "numpy_cost_rows", "numpy_subproblem_rows",
+           "numpy_scatter_matvec", "numpy_violation_rows", "NUMPY", "numpy_rows", "measure", "compare_logs", "main"]
 
 
 def numpy_state_rows(s: np.ndarray, r1: np.ndarray, e_d_lo: np.ndarray, e_d_hi: np.ndarray, e_z: np.ndarray,
@@ -109,16 +109,47 @@ def numpy_cost_rows(wref: np.ndarray, r1: np.ndarray, eo_all: np.ndarray, psi0: 
     return blk, eo
 
 
+def numpy_subproblem_rows(pv: np.ndarray, write_at: np.ndarray, s: np.ndarray, v: np.ndarray, ref: np.ndarray,
+                          psi0: float, dt: float, wref: np.ndarray, nodes: np.ndarray, z_lo: float, z_hi: float,
+                          centres: np.ndarray, radii: np.ndarray, clearance: float, slots: int, radius: float,
+                          v_min: np.ndarray, v_max: np.ndarray, floor: float) -> float:
+    """``ConvexSubproblem.linearise``'s numpy row writes before the routine (the Jacobian and the e_o model from
+    :mod:`tubekit.model.compiled_arcs`, as then)."""
+    dyn = compiled_arcs.step_linearisation(s, v, dt)
+    dyn[3] += dyn[0] * psi0
+    dyn[7] += dyn[4] * psi0
+    eo_all = compiled_arcs.eo_linearisation(s, ref, floor)
+    blk, eo = numpy_cost_rows(wref, ref[1:], eo_all.copy(), psi0)
+    blocks = [dyn.ravel(), blk.ravel(), eo.ravel(),
+              numpy_state_rows(s, ref[1:], nodes[0], nodes[1], nodes[2], z_lo, z_hi).ravel()]
+    if slots:
+        blocks.append(numpy_obstacle_rows(s, centres, radii, clearance, slots).ravel())
+    blocks.append(numpy_input_bounds(v, radius, v_min, v_max).ravel())
+    start = 0
+    for block in blocks:  # one write per parameter group, as the replaced code
+        pv[write_at[start:start + block.size]] = block
+        start += block.size
+    return float(eo_all[4, 0])
+
+
+_SPLIT: dict[tuple[int, int, int], tuple] = {}
+
+
 def numpy_scatter_matvec(indptr: np.ndarray, indices: np.ndarray, data: np.ndarray, pv: np.ndarray,
                          a_values: np.ndarray, a_par: np.ndarray, b: np.ndarray, b_rows: np.ndarray,
                          q: np.ndarray) -> float:
-    """``CompiledConeProgram._vectors``' scipy mat-vecs before the routine, on the stacked map's blocks."""
-    m = sp.csr_matrix((data, indices, indptr), shape=(len(indptr) - 1, len(pv)))
+    """``CompiledConeProgram._vectors``' three scipy mat-vecs before the routine, on the stacked map's blocks (split
+    once per map, as the replaced code held them)."""
     n_a, n_b = len(a_par), len(b_rows)
-    a_values[a_par] = -(m[:n_a] @ pv)
+    key = (id(data), n_a, n_b)
+    if key not in _SPLIT:
+        m = sp.csr_matrix((data, indices, indptr), shape=(len(indptr) - 1, len(pv)))
+        _SPLIT[key] = (m[:n_a], m[n_a:n_a + n_b], m[n_a + n_b:], data)  # data kept: its id stays its own
+    m_a, m_b, m_q, _ = _SPLIT[key]
+    a_values[a_par] = -(m_a @ pv)
     b[:] = 0.0
-    b[b_rows] = m[n_a:n_a + n_b] @ pv
-    qd = m[n_a + n_b:] @ pv
+    b[b_rows] = m_b @ pv
+    qd = m_q @ pv
     q[:] = qd[:len(q)]
     return float(qd[len(q)])
 
@@ -150,7 +181,7 @@ def numpy_violation_rows(states: np.ndarray, inputs: np.ndarray, e: np.ndarray, 
 
 #: each routine of :mod:`tubekit.fhocp.compiled_rows` and the numpy code it replaced
 NUMPY = {"state_rows": numpy_state_rows, "obstacle_rows": numpy_obstacle_rows, "input_bounds": numpy_input_bounds,
-         "cost_rows": numpy_cost_rows, "scatter_matvec": numpy_scatter_matvec,
+         "cost_rows": numpy_cost_rows, "subproblem_rows": numpy_subproblem_rows, "scatter_matvec": numpy_scatter_matvec,
          "violation_rows": numpy_violation_rows}
 
 

@@ -172,3 +172,29 @@ def test_a_nan_in_a_plan_reaches_the_violations_as_numpy_passed_it_on():
     np.testing.assert_array_equal(np.isnan(viol), np.isnan(viol_ref))
     assert inp == inp_ref == 0.0
     assert math.isnan(dyn) and math.isnan(dyn_ref)
+
+
+@given(plans(), st.integers(0, 2), st.floats(-3.0, 3.0), st.booleans(), st.data())
+def test_the_fused_rows_write_the_replaced_codes_values_where_it_wrote_them(plan, k, psi0, walls, data):
+    """Property: subproblem_rows writes the replaced code's blocks (Jacobian, cost, e_o, state, obstacle and input
+    rows; a few ulps where einsum chose the order) at the same positions of the parameter vector, touches no
+    other entry, and returns e_o at node 0."""
+    s, v, dt = plan
+    n = v.shape[0]
+    ref = s[:, :3] + data.draw(hnp.arrays(float, (n + 1, 3), elements=st.floats(-2.0, 2.0)))
+    centres = data.draw(hnp.arrays(float, (k, 3), elements=st.floats(-4.0, 4.0)))
+    radii = np.full(k, 0.4)
+    slots = k + 1 if k else 0
+    size = (8 + 3 + 4 + 6 + 6) * n + 4 * n * slots
+    write_at = np.random.default_rng(n + k).permutation(size + 5)[:size]
+    wref, nodes = np.full((3, n), 0.7), np.vstack([np.full(n, 0.4), np.full(n, 3.0), np.full(n, 0.5)])
+    z_lo, z_hi = (-1.0, 1.0) if walls else (-math.inf, math.inf)
+    args = (write_at, s, v, ref, psi0, dt, wref, nodes, z_lo, z_hi, centres, radii, 0.2, slots, 0.3,
+            np.array([-0.2, -0.3, -0.5]), np.array([0.4, 0.3, 0.5]), 1e-9)
+    pv, pv_ref = np.full(size + 5, 9.0), np.full(size + 5, 9.0)
+    eo0 = compiled_rows.subproblem_rows(pv, *args)
+    eo0_ref = BENCH.numpy_subproblem_rows(pv_ref, *args)
+    np.testing.assert_array_max_ulp(pv, pv_ref, maxulp=EINSUM_ULPS)
+    untouched = np.setdiff1d(np.arange(size + 5), write_at)
+    assert np.all(pv[untouched] == 9.0)
+    assert eo0 == eo0_ref == compiled_arcs.error_coordinates(s[:1], ref[:1], 1e-9)[0, 2]

@@ -12,6 +12,7 @@ routine                    what it computes
 :func:`obstacle_rows`      each obstacle slot's half-space normal and bound per node (M, 4, N)
 :func:`input_bounds`       the input box intersected with the trust region (6, N)
 :func:`cost_rows`          the cost's linear block (3, N) and the e_o model's rows (4, N)
+:func:`subproblem_rows`    all of the above and the step's Jacobian, written into the parameter vector at once
 :func:`scatter_matvec`     one CSR mat-vec of the stacked parameter maps, scattered into A's values, b, q, d
 :func:`violation_rows`     the per-node violations (4, N), the input box's and the dynamics' violations
 =========================  ============================================================================
@@ -26,10 +27,11 @@ import math
 
 import numpy as np
 
-from tubekit.model.compiled_arcs import unicycle_steps
+from tubekit.model.compiled_arcs import eo_linearisation, step_linearisation, unicycle_steps
 from tubekit.model.jit import routine
 
-__all__ = ["state_rows", "obstacle_rows", "input_bounds", "cost_rows", "scatter_matvec", "violation_rows"]
+__all__ = ["state_rows", "obstacle_rows", "input_bounds", "cost_rows", "subproblem_rows", "scatter_matvec",
+           "violation_rows"]
 
 #: e_d below this (m) has no direction: the rows use the direction behind the heading
 _TINY = 1e-9
@@ -157,6 +159,41 @@ def cost_rows(wref: np.ndarray, r1: np.ndarray, eo_all: np.ndarray, psi0: float)
     for k in range(n):
         eo[3, k] = eo[3, k] + eo[2, k] * psi0
     return blk, eo
+
+
+@routine
+def subproblem_rows(pv: np.ndarray, write_at: np.ndarray, s: np.ndarray, v: np.ndarray, ref: np.ndarray, psi0: float,
+                    dt: float, wref: np.ndarray, nodes: np.ndarray, z_lo: float, z_hi: float, centres: np.ndarray,
+                    radii: np.ndarray, clearance: float, slots: int, radius: float, v_min: np.ndarray,
+                    v_max: np.ndarray, floor: float) -> float:
+    """The subproblem's rows at the plan (s, v) (relative to the measured position, ``ref`` (N+1, 3) likewise),
+    written into ``pv`` at ``write_at``, in this order: the step's Jacobian (8, N) with its offsets shifted for
+    ψ − ψ_0, :func:`cost_rows`, :func:`state_rows` (``nodes`` (3, N): e_d_lo, e_d_hi, e_z), :func:`obstacle_rows`
+    (none without slots), :func:`input_bounds`, each C-ordered. Returns e_o at node 0 (the cost's constant term)."""
+    n = v.shape[0]
+    dyn = step_linearisation(s, v, dt)
+    for k in range(n):
+        dyn[3, k] = dyn[3, k] + dyn[0, k] * psi0
+        dyn[7, k] = dyn[7, k] + dyn[4, k] * psi0
+    eo_all = eo_linearisation(s, ref, floor)
+    r1 = ref[1:]
+    blk, eo = cost_rows(wref, r1, eo_all, psi0)
+    at = _write(pv, write_at, 0, dyn.ravel())
+    at = _write(pv, write_at, at, blk.ravel())
+    at = _write(pv, write_at, at, eo.ravel())
+    at = _write(pv, write_at, at, state_rows(s, r1, nodes[0], nodes[1], nodes[2], z_lo, z_hi).ravel())
+    if slots:
+        at = _write(pv, write_at, at, obstacle_rows(s, centres, radii, clearance, slots).ravel())
+    _write(pv, write_at, at, input_bounds(v, radius, v_min, v_max).ravel())
+    return eo_all[4, 0]
+
+
+@routine
+def _write(pv: np.ndarray, write_at: np.ndarray, start: int, values: np.ndarray) -> int:
+    """pv[write_at[start + i]] = values[i]; returns the next start."""
+    for i in range(values.shape[0]):
+        pv[write_at[start + i]] = values[i]
+    return start + values.shape[0]
 
 
 @routine

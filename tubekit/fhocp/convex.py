@@ -38,7 +38,6 @@ maps straight to its QP backend's data (:mod:`tubekit.fhocp.qp`), and
 from __future__ import annotations
 
 import math
-from types import ModuleType
 from typing import Callable
 
 import cvxpy as cp
@@ -47,7 +46,7 @@ import scipy.sparse as sp
 
 from tubekit.exceptions import ConfigError
 from tubekit.fhocp.fastpath import CompiledConeProgram
-from tubekit.fhocp.linearisation import eo_linearisation, step_linearisation
+from tubekit.fhocp.linearisation import ED_FLOOR, compiled
 from tubekit.fhocp.nlp import FhocpNlp, rollout
 from tubekit.fhocp.qp.base import ConeSolution, QpBackend
 from tubekit.fhocp.qp.registry import DEFAULT_QP_BACKEND, make_qp_backend
@@ -55,13 +54,6 @@ from tubekit.fhocp.result import Status, status_from
 from tubekit.fhocp.rows import backup_rows
 
 __all__ = ["ConvexSubproblem", "DEFAULT_CLARABEL_SETTINGS", "REALTIME_CLARABEL_SETTINGS", "CVXPY_STATUS"]
-
-
-def _rows() -> ModuleType:
-    """:mod:`tubekit.fhocp.compiled_rows`, imported at the first linearisation (``tubekit certify`` loads no numba)."""
-    from tubekit.fhocp import compiled_rows
-
-    return compiled_rows
 
 
 #: Clarabel settings used by default (looser than Clarabel's 1e-8: the SCP's own tolerance is 1e-5)
@@ -333,6 +325,9 @@ class ConvexSubproblem:
                   "anchorT": ["aT"] if nlp.backup_terminal is not None else []}
         self._gidx = {g: np.concatenate([self._cols[n] for n in names]) if names else np.zeros(0, dtype=int)
                       for g, names in groups.items()}
+        self._write_at = np.concatenate([self._gidx[g] for g in ("dyn", "lin", "eo", "step", "obs", "bounds")])
+        nodes = nlp.node_bounds()
+        self._node_rows = np.stack([nodes["e_d_lo"], nodes["e_d_hi"], nodes["e_z"]])
 
     def push_parameters(self) -> None:
         """Copy :attr:`param_vector` into the cvxpy Parameters' values (for ``problem.solve``)."""
@@ -362,74 +357,61 @@ class ConvexSubproblem:
         """
         o = s0[:3]
         psi0 = s0[3]
-        bt = self.nlp.backup_terminal
+        nlp = self.nlp
+        bt = nlp.backup_terminal
         self._anchor_offset = (np.zeros(3) if bt is None
-                               else bt.best_offset(o, np.asarray(s[-1, :3], dtype=float), obs, self.nlp.workspace))
+                               else bt.best_offset(o, np.asarray(s[-1, :3], dtype=float), obs, nlp.workspace))
         if bt is not None:
             self.param_vector[self._gidx["anchorT"]] = self._anchor_offset[:2]
         s = s.copy()
         s[:, :3] -= o
         ref = ref - o
-        self._write_dynamics(s, v, psi0)
-        self._write_cost_and_eo(s, ref, psi0)
-        self._write_state_rows(s, ref[1:], o)
-        if self.max_obstacles:
-            self._write_obstacles(s, obs, o)
-        self._write_input_bounds(v, radius)
+        z_lo, z_hi = -math.inf, math.inf
+        if nlp.workspace is not None:
+            z_lo, z_hi = self._write_walls(o)
+        eo0 = compiled()[1].subproblem_rows(self.param_vector, self._write_at, s, v, ref, psi0, nlp.dt, self._wref,
+                                            self._node_rows, z_lo, z_hi, obs[:, :3] - o,
+                                            np.ascontiguousarray(obs[:, 3]), nlp.clearance, self.max_obstacles,
+                                            radius, nlp.v_min, nlp.v_max, ED_FLOOR)
+        self._write_cost_constants(ref, eo0)
+        if bt is not None and self.max_obstacles:
+            self._write_backup_obstacles(len(obs))
 
-    def _write_dynamics(self, s: np.ndarray, v: np.ndarray, psi0: float) -> None:
-        dyn = step_linearisation(s, v, self.nlp.dt)
-        dyn[3] += dyn[0] * psi0          # offsets for the heading variable psi - psi_0
-        dyn[7] += dyn[4] * psi0
-        self.param_vector[self._gidx["dyn"]] = dyn.ravel()
-
-    def _write_cost_and_eo(self, s: np.ndarray, ref: np.ndarray, psi0: float) -> None:
-        """Linear and constant cost terms, p_d(N) of the terminal set, the e_o model."""
+    def _write_cost_constants(self, ref: np.ndarray, eo0: float) -> None:
+        """p_d(N) of the terminal set and the cost's constant term (node 0 and the reference's squares)."""
         pvec, gidx = self.param_vector, self._gidx
         r1 = ref[1:]
-        eo_all = eo_linearisation(s, ref)
-        blk, eo = _rows().cost_rows(self._wref, r1, eo_all, psi0)
-        pvec[gidx["lin"]] = blk.ravel()
         if self.nlp.terminal != "off":
             pvec[gidx["pdN"]] = ref[self.nlp.n]
-        e0 = (ref[0, 0] ** 2 + ref[0, 1] ** 2, ref[0, 2] ** 2, eo_all[4, 0] ** 2)  # k = 0 (constant)
+        e0 = (ref[0, 0] ** 2 + ref[0, 1] ** 2, ref[0, 2] ** 2, eo0 ** 2)  # k = 0 (constant)
         pvec[gidx["c0"]] = float(np.einsum("ck,kc->", self._wref, r1 * r1) + self._weights[0] @ e0)
-        pvec[gidx["eo"]] = eo.ravel()
 
-    def _write_state_rows(self, s: np.ndarray, r1: np.ndarray, o: np.ndarray) -> None:
-        """e_d half-spaces (n'(p - p_d), n the horizontal unit error direction), e_z rows, walls."""
+    def _write_walls(self, o: np.ndarray) -> tuple[float, float]:
+        """The nearer wall per horizontal axis and the backup's footprint inside the box; returns the depth
+        bounds (m) relative to the measured position ``o``."""
         nlp, N = self.nlp, self.nlp.n
-        nb = nlp.node_bounds()
-        if nlp.workspace is None:
-            st = _rows().state_rows(s, r1, nb["e_d_lo"], nb["e_d_hi"], nb["e_z"], -math.inf, math.inf)
-        else:
-            lo = nlp.workspace[0] + nlp.clearance - o
-            hi = nlp.workspace[1] - nlp.clearance - o
-            st = _rows().state_rows(s, r1, nb["e_d_lo"], nb["e_d_hi"], nb["e_z"], lo[2], hi[2])
-            # the nearer wall per axis (the origin is the measured position)
-            walls = [1.0, hi[0], 1.0, hi[1]]
-            for i in (0, 1):
-                if -lo[i] < hi[i]:
-                    walls[2 * i], walls[2 * i + 1] = -1.0, -lo[i]
-            self.param_vector[self._gidx["walls"]] = np.repeat(walls, N)
-            if nlp.backup_terminal is not None:
-                r_f, h_f = nlp.backup_terminal.footprint
-                pad = np.array([r_f, r_f, h_f])
-                shift = o + self._anchor_offset  # the rows hold the anchor p_N + offset inside the box
-                self.param_vector[self._gidx["wallT"]] = np.concatenate([nlp.workspace[0] + pad - shift,
-                                                                         nlp.workspace[1] - pad - shift])
-        self.param_vector[self._gidx["step"]] = st.ravel()
+        lo = nlp.workspace[0] + nlp.clearance - o
+        hi = nlp.workspace[1] - nlp.clearance - o
+        walls = [1.0, hi[0], 1.0, hi[1]]  # the nearer wall per axis (the origin is the measured position)
+        for i in (0, 1):
+            if -lo[i] < hi[i]:
+                walls[2 * i], walls[2 * i + 1] = -1.0, -lo[i]
+        self.param_vector[self._gidx["walls"]] = np.repeat(walls, N)
+        if nlp.backup_terminal is not None:
+            r_f, h_f = nlp.backup_terminal.footprint
+            pad = np.array([r_f, r_f, h_f])
+            shift = o + self._anchor_offset  # the rows hold the anchor p_N + offset inside the box
+            self.param_vector[self._gidx["wallT"]] = np.concatenate([nlp.workspace[0] + pad - shift,
+                                                                     nlp.workspace[1] - pad - shift])
+        return float(lo[2]), float(hi[2])
 
-    def _write_obstacles(self, s: np.ndarray, obs: np.ndarray, o: np.ndarray) -> None:
-        """n'(p - c) >= r + clearance, n the unit direction from c to the plan; empty slots 0 >= -1."""
-        k = len(obs)
-        ob = _rows().obstacle_rows(s, obs[:, :3] - o, np.ascontiguousarray(obs[:, 3]), self.nlp.clearance,
-                                         self.max_obstacles)
-        self.param_vector[self._gidx["obs"]] = ob.ravel()
-        if self.nlp.backup_terminal is not None:  # the last node's half-space, the footprint's sphere about the anchor
-            shift = ob[:, 0, -1] * self._anchor_offset[0] + ob[:, 1, -1] * self._anchor_offset[1]
-            self.param_vector[self._gidx["obsT"]] = ob[:, 3, -1] + np.where(
-                np.arange(self.max_obstacles) < k, self.nlp.backup_terminal.sphere - self.nlp.clearance - shift, 0.0)
+    def _write_backup_obstacles(self, k: int) -> None:
+        """The last node's obstacle half-spaces moved to the footprint's sphere about the anchor (``k`` obstacles
+        in the problem; the other slots stay inactive)."""
+        ob = self.param_vector[self._gidx["obs"]].reshape(self.max_obstacles, 4, self.nlp.n)
+        shift = ob[:, 0, -1] * self._anchor_offset[0] + ob[:, 1, -1] * self._anchor_offset[1]
+        self.param_vector[self._gidx["obsT"]] = ob[:, 3, -1] + np.where(
+            np.arange(self.max_obstacles) < k, self.nlp.backup_terminal.sphere - self.nlp.clearance - shift, 0.0)
 
     def write_last_command(self, v_last: np.ndarray, first_row: bool) -> None:
         """Write ``vlast`` (the rate rows' and the rate penalty's v_last, (3,)) and the bound ``jb`` of
@@ -439,11 +421,6 @@ class ConvexSubproblem:
             self.param_vector[gidx["vlast"]] = v_last
         if gidx["jb"].size:
             self.param_vector[gidx["jb"]] = nlp.rate_jump if first_row else 2.0 * nlp.v_max
-
-    def _write_input_bounds(self, v: np.ndarray, radius: float) -> None:
-        """The input box [v_min, v_max] intersected with the trust region |v_new - v| <= radius V-bar."""
-        bd = _rows().input_bounds(v, radius, self.nlp.v_min, self.nlp.v_max)
-        self.param_vector[self._gidx["bounds"]] = bd.ravel()
 
     # ---------------------------------------------------------------- solve
     def solve(self) -> tuple[Status, np.ndarray | None, float, float]:

@@ -29,6 +29,7 @@ import scipy.sparse as sp
 from cvxpy.lin_ops.lin_op import CONSTANT_ID
 
 from tubekit.exceptions import ConfigError, SolverError
+from tubekit.fhocp.linearisation import compiled
 from tubekit.fhocp.qp.base import ConeDims, ConeProgramData, ConeSolution, QpBackend
 from tubekit.fhocp.qp.registry import make_qp_backend
 
@@ -166,14 +167,12 @@ class CompiledConeProgram:
     def _vectors(self) -> tuple[np.ndarray, np.ndarray, float]:
         """(b, q, d) for the current parameter vector (one compiled mat-vec of the stacked maps,
         :func:`tubekit.fhocp.compiled_rows.scatter_matvec`); also refreshes A's parametric values."""
-        from tubekit.fhocp import compiled_rows
-
         if self._stacked is None:
             st = sp.vstack([self._a_par_map, self._b_map, self._q_map], format="csr")
             self._stacked = (st.indptr.astype(np.int64), st.indices.astype(np.int64), st.data.astype(float))
         b = np.empty(self.m)
         q = np.empty(self.n)
-        d = compiled_rows.scatter_matvec(*self._stacked, self.param_vector, self._a_data, self._a_par, b,
+        d = compiled()[1].scatter_matvec(*self._stacked, self.param_vector, self._a_data, self._a_par, b,
                                          self._b_rows, q)
         return b, q, d
 

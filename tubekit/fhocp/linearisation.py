@@ -9,9 +9,11 @@ compiled routines of :mod:`tubekit.model.compiled_arcs` (numba, imported at the 
 
 from __future__ import annotations
 
+from types import ModuleType
+
 import numpy as np
 
-__all__ = ["STEP_LINEARISATION_ROWS", "step_linearisation", "eo_linearisation", "ED_FLOOR"]
+__all__ = ["STEP_LINEARISATION_ROWS", "step_linearisation", "eo_linearisation", "ED_FLOOR", "compiled"]
 
 #: Guards e_o = (...)/e_d against e_d = 0 (m) (the NLP's own floor, :mod:`tubekit.fhocp.nlp`).
 ED_FLOOR = 1e-9
@@ -19,6 +21,20 @@ ED_FLOOR = 1e-9
 
 #: row order of :func:`step_linearisation`
 STEP_LINEARISATION_ROWS: tuple[str, ...] = ("ax", "bxu", "bxr", "cx", "ay", "byu", "byr", "cy")
+
+_COMPILED: tuple[ModuleType, ModuleType] | None = None
+
+
+def compiled() -> tuple[ModuleType, ModuleType]:
+    """(:mod:`tubekit.model.compiled_arcs`, :mod:`tubekit.fhocp.compiled_rows`), imported at the first call and
+    kept (numba is loaded by the first step, never by ``tubekit certify``; a kept module costs no import per call)."""
+    global _COMPILED
+    if _COMPILED is None:
+        from tubekit.fhocp import compiled_rows
+        from tubekit.model import compiled_arcs
+
+        _COMPILED = (compiled_arcs, compiled_rows)
+    return _COMPILED
 
 
 def step_linearisation(states: np.ndarray, inputs: np.ndarray, dt: float) -> np.ndarray:
@@ -46,9 +62,7 @@ def step_linearisation(states: np.ndarray, inputs: np.ndarray, dt: float) -> np.
     array (8, N)
         Rows ``ax, bxu, bxr, cx, ay, byu, byr, cy`` (:data:`STEP_LINEARISATION_ROWS`).
     """
-    from tubekit.model import compiled_arcs
-
-    return compiled_arcs.step_linearisation(np.asarray(states, dtype=float), np.asarray(inputs, dtype=float), float(dt))
+    return compiled()[0].step_linearisation(np.asarray(states, dtype=float), np.asarray(inputs, dtype=float), float(dt))
 
 
 def eo_linearisation(states: np.ndarray, ref: np.ndarray) -> np.ndarray:
@@ -62,6 +76,4 @@ def eo_linearisation(states: np.ndarray, ref: np.ndarray) -> np.ndarray:
     array (5, K)
         Rows ``gx, gy, gpsi, h, e_o``.
     """
-    from tubekit.model import compiled_arcs
-
-    return compiled_arcs.eo_linearisation(np.asarray(states, dtype=float), np.asarray(ref, dtype=float), ED_FLOOR)
+    return compiled()[0].eo_linearisation(np.asarray(states, dtype=float), np.asarray(ref, dtype=float), ED_FLOOR)

@@ -72,7 +72,7 @@ import numpy as np
 
 from tubekit.exceptions import ConfigError, ShapeError
 from tubekit.fhocp.rows import RATE_MARGIN, BackupTerminal, rate_penalty_cost, rate_violation
-from tubekit.fhocp.linearisation import ED_FLOOR
+from tubekit.fhocp.linearisation import ED_FLOOR, compiled
 from tubekit.model.kinematics import unicycle_step
 from tubekit.scenario import Obstacle, Scenario, TerminalMode
 from tubekit.tightening import Tightening
@@ -91,9 +91,7 @@ discrete_step = unicycle_step
 def rollout(s0: np.ndarray, inputs: np.ndarray, dt: float) -> np.ndarray:
     """States (N+1, 4) obtained by applying ``inputs`` (N, 3) from ``s0`` (4,) with :func:`discrete_step`
     (compiled: :func:`tubekit.model.compiled_arcs.rollout`, the same floats as chaining the step)."""
-    from tubekit.model import compiled_arcs
-
-    return compiled_arcs.rollout(np.asarray(s0, dtype=float), np.asarray(inputs, dtype=float), float(dt))
+    return compiled()[0].rollout(np.asarray(s0, dtype=float), np.asarray(inputs, dtype=float), float(dt))
 
 
 def obstacle_array(obstacles: Sequence[Obstacle] | np.ndarray) -> np.ndarray:
@@ -359,9 +357,7 @@ class FhocpNlp:
 
     def errors(self, states: np.ndarray, ref: np.ndarray) -> np.ndarray:
         """[e_d, e_z, e_o] (K, 3) of ``states`` (K, 4) w.r.t. ``ref`` (K, 3), e_d floored at 1e-9."""
-        from tubekit.model import compiled_arcs
-
-        return compiled_arcs.error_coordinates(np.asarray(states, dtype=float), np.asarray(ref, dtype=float), ED_FLOOR)
+        return compiled()[0].error_coordinates(np.asarray(states, dtype=float), np.asarray(ref, dtype=float), ED_FLOOR)
 
     def cost(self, states: np.ndarray, inputs: np.ndarray, ref: np.ndarray, v_last: np.ndarray | None = None) -> float:
         """Stage + terminal cost + the rate penalty (no exact penalties)."""
@@ -384,9 +380,7 @@ class FhocpNlp:
         v_last : array (3,), optional
             The command before the plan (rate penalty; with ``first_row``, the rate row (b)).
         """
-        from tubekit.fhocp import compiled_rows
-        from tubekit.model import compiled_arcs
-
+        compiled_arcs, compiled_rows = compiled()
         states = np.asarray(states, dtype=float)
         inputs = np.asarray(inputs, dtype=float)
         n = self.n

@@ -105,7 +105,7 @@ def rate_penalty_cost(inputs: np.ndarray, weight: np.ndarray, v_last: np.ndarray
     ``weight`` (3,) is lambda R (the rate penalty times the input weights).
     """
     v = np.asarray(inputs, dtype=float)
-    d = np.diff(v, axis=0)
+    d = v[1:] - v[:-1]
     total = float(np.einsum("kc,kc,c->", d, d, weight))
     if v_last is not None:
         d0 = v[0] - np.asarray(v_last, dtype=float)
@@ -208,7 +208,7 @@ def backup_rows(bt: BackupTerminal, end: tuple[cp.Expression, cp.Expression, cp.
                 par: Callable[[str, int], cp.Parameter], walls: bool) -> tuple[list, cp.Variable]:
     """The backup's terminal rows at the last node p_N = ``end`` (x, y, z relative to the measured position) and
     their shared slack sig_B: per obstacle slot j the half-space ``normals[j]`` · p_N + sig_B >= rt_j (rt_j
-    carries the sphere about the anchor, :meth:`ConvexSubproblem._write_obstacles`), the walls' box wT about the
+    carries the sphere about the anchor, :meth:`ConvexSubproblem._write_backup_obstacles`), the walls' box wT about the
     anchor (``walls``), and the sensed region hypot(‖p_N,xy + aT‖ + c, |z_N| + Z) <= R_bar − r_bar + sig_B with
     aT the anchor's offset (:meth:`BackupTerminal.best_offset`). ``par(name, size)`` makes a Parameter."""
     x, y, z = end

@@ -82,8 +82,12 @@ class Circle(Trajectory):
 
     def position(self, t):
         a = self.rate * np.asarray(t, dtype=float) + self.phase
-        c = np.asarray(self.center)
-        return np.stack([c[0] + self.radius * np.sin(a), c[1] + self.radius * np.cos(a), c[2] + 0.0 * a], axis=-1)
+        c = self.center
+        out = np.empty(a.shape + (3,))
+        out[..., 0] = c[0] + self.radius * np.sin(a)
+        out[..., 1] = c[1] + self.radius * np.cos(a)
+        out[..., 2] = c[2] + 0.0 * a
+        return out
 
     def velocity(self, t):
         a = self.rate * np.asarray(t, dtype=float) + self.phase

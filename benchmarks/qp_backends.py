@@ -4,6 +4,7 @@ Usage::
 
     python benchmarks/qp_backends.py [--duration S] [--only NAME ...] [--backends clarabel qocogen ...] [--json FILE]
     python benchmarks/qp_backends.py --closed-loop [--duration S] [--only NAME ...] [--backends ...]
+    python benchmarks/qp_backends.py --qocogen-tolerances 1e-6 1e-5 [--duration S] [--only NAME ...]
 
 Every shipped scenario (those of ``benchmarks/clarabel_settings.py``: Section VI, ``paper_currents``,
 ``certifiable``, ``examples/paper_law.toml`` with their faster and steady currents, the transit, the examples
@@ -26,6 +27,11 @@ does the opposite). Per method: the median of its rounds' median step (ms) and i
 ``--closed-loop`` instead runs each scenario's certified tube run once per backend (``ScpOptions(qp_solver=...)``)
 and prints its tracking RMSE, the seconds the backup ran, the periods the candidate replaced a plan, the smallest
 clearance and the promises broken: what the backend does to the loop rather than to one subproblem.
+
+``--qocogen-tolerances TOL ...`` instead solves every recorded subproblem with the generated solver at its default
+tolerance (1e-7) and at each TOL (absolute and relative), the order rotated: per setting the failures, inaccurate
+solves, the largest input difference from the default's plan, the mean iterations and the median call (ms). It
+chose :data:`tubekit.fhocp.qp.qocogen.REALTIME_QOCOGEN_SETTINGS`.
 """
 
 from __future__ import annotations
@@ -38,7 +44,7 @@ from pathlib import Path
 
 import numpy as np
 
-__all__ = ["BACKENDS", "record", "compare", "closed_loop", "steps", "main"]
+__all__ = ["BACKENDS", "record", "compare", "qocogen_tolerances", "closed_loop", "steps", "main"]
 
 #: The backends compared by default: the shipped one first, then the opt-in ones that take cones.
 BACKENDS = ("clarabel", "qoco", "qocogen")
@@ -128,6 +134,35 @@ def compare(problems: list, inputs: np.ndarray, names: tuple[str, ...] = BACKEND
                 "p99_ms": float(np.percentile(s["times"], 99) * 1e3)} for n, s in stats.items()}
 
 
+def qocogen_tolerances(problems: list, inputs: np.ndarray, tolerances: tuple[float, ...]) -> dict:
+    """The generated solver at QOCO's default tolerance (1e-7) and at each of ``tolerances`` (absolute = relative),
+    the order rotated per problem: per setting its failures, inaccurate solves, the largest input difference from
+    the default's plan, the mean iterations and the whole call's median (ms, every problem but the first)."""
+    from tubekit.fhocp.qp.registry import make_qp_backend
+
+    settings = {"1e-07 (default)": {}, **{f"{tol:g}": {"abstol": tol, "reltol": tol} for tol in tolerances}}
+    backends = {k: make_qp_backend("qocogen", {"qocogen": v}) for k, v in settings.items()}
+    keys = tuple(settings)
+    stats = {k: {"failed": 0, "inaccurate": 0, "dv": 0.0, "iterations": [], "times": []} for k in keys}
+    for i, data in enumerate(problems):
+        sols = {}
+        for key in keys[i % len(keys):] + keys[:i % len(keys)]:
+            t0 = time.perf_counter()
+            sol = backends[key].solve(data)
+            if i:
+                stats[key]["times"].append(time.perf_counter() - t0)
+            stats[key]["iterations"].append(sol.iterations)
+            stats[key]["inaccurate" if sol.status.value == "optimal_inaccurate" else "failed"] += (
+                sol.status.value != "optimal")
+            sols[key] = sol
+        base = sols[keys[0]]
+        for key in keys:
+            if base.x is not None and sols[key].x is not None:
+                stats[key]["dv"] = max(stats[key]["dv"], float(np.max(np.abs(sols[key].x[inputs] - base.x[inputs]))))
+    return {k: {"failed": s["failed"], "inaccurate": s["inaccurate"], "max_input_diff": s["dv"],
+                "iterations": s["iterations"], "times": s["times"]} for k, s in stats.items()}
+
+
 def closed_loop(scenario, duration: float, names: tuple[str, ...] = BACKENDS) -> dict:
     """Per backend: the certified tube run's figures (module doc)."""
     import verify
@@ -194,6 +229,8 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--closed-loop", action="store_true", help="compare whole tube runs instead (module doc)")
     ap.add_argument("--steps", action="store_true", help="time the real-time step alone per backend (module doc)")
     ap.add_argument("--rounds", type=int, default=2, help="rounds per method with --steps (default 2)")
+    ap.add_argument("--qocogen-tolerances", type=float, nargs="+", metavar="TOL",
+                    help="compare the generated solver at these tolerances with its default instead")
     args = ap.parse_args(argv)
     names = tuple(args.backends)
     if args.steps:
@@ -202,6 +239,9 @@ def main(argv: list[str] | None = None) -> int:
     if "clarabel" not in names:
         ap.error("--backends must include clarabel (the reference)")
     scenarios = {k: v for k, v in _study("clarabel_settings")._scenarios().items() if not args.only or k in args.only}
+    if args.qocogen_tolerances:
+        print(json.dumps(_tolerance_study(scenarios, args.duration, tuple(args.qocogen_tolerances)), indent=1))
+        return 0
     if args.closed_loop:
         for name, sc in scenarios.items():
             print(json.dumps({"scenario": name, "backends": closed_loop(sc, args.duration, names)}), flush=True)
@@ -224,6 +264,27 @@ def main(argv: list[str] | None = None) -> int:
 
         write_text(args.json, json.dumps({"rows": rows, "problems": total, "summary": summary}, indent=1) + "\n")
     return 0
+
+
+def _tolerance_study(scenarios: dict, duration: float, tolerances: tuple[float, ...]) -> dict:
+    """:func:`qocogen_tolerances` over every scenario's recorded subproblems, pooled."""
+    pooled: dict = {}
+    total = 0
+    for sc in scenarios.values():
+        problems, inputs = record(sc, duration)
+        total += len(problems)
+        for key, row in qocogen_tolerances(problems, inputs, tolerances).items():
+            acc = pooled.setdefault(key, {"failed": 0, "inaccurate": 0, "max_input_diff": 0.0, "iterations": [],
+                                          "times": []})
+            for name in ("failed", "inaccurate"):
+                acc[name] += row[name]
+            acc["max_input_diff"] = max(acc["max_input_diff"], row["max_input_diff"])
+            acc["iterations"] += row["iterations"]
+            acc["times"] += row["times"]
+    return {"problems": total, **{k: {"failed": v["failed"], "inaccurate": v["inaccurate"],
+                                      "max_input_diff": v["max_input_diff"],
+                                      "mean_iterations": float(np.mean(v["iterations"])),
+                                      "median_ms": float(np.median(v["times"]) * 1e3)} for k, v in pooled.items()}}
 
 
 if __name__ == "__main__":

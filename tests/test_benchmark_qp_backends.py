@@ -47,3 +47,16 @@ def test_the_certified_run_on_the_generated_solver_keeps_its_promises(scenario):
     assert rows["qocogen"]["broken"] == [] == rows["clarabel"]["broken"]
     assert rows["qocogen"]["tracking_rmse"] == pytest.approx(rows["clarabel"]["tracking_rmse"], abs=1e-3)
     assert rows["qocogen"]["backup_s"] == 0.0
+
+
+def test_the_tolerance_study_compares_each_setting_with_the_default_on_the_same_problems(scenario):
+    """1 s of recorded subproblems at the default and two looser tolerances: the default is its own reference (no
+    difference), every setting solves every problem, and the loosest needs no more iterations than the default."""
+    problems, inputs = STUDY.record(scenario, 1.0)
+    rows = STUDY.qocogen_tolerances(problems, inputs, (1e-6, 1e-4))
+    assert list(rows) == ["1e-07 (default)", "1e-06", "0.0001"]
+    assert rows["1e-07 (default)"]["max_input_diff"] == 0.0
+    for row in rows.values():
+        assert row["failed"] == 0 and len(row["iterations"]) == len(problems)
+    assert sum(rows["0.0001"]["iterations"]) <= sum(rows["1e-07 (default)"]["iterations"])
+    assert 0.0 < rows["0.0001"]["max_input_diff"] < 0.1

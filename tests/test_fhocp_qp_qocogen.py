@@ -126,3 +126,21 @@ def test_a_degenerate_program_qoco_solves_is_a_numerical_error_of_the_generated_
     assert sol.raw_status == "QOCO_CUSTOM_NUMERICAL_ERROR" and sol.x is None
     qoco = pytest.importorskip("tubekit.fhocp.qp.qoco")
     assert qoco.QocoBackend().solve(data).status is Status.OPTIMAL
+
+
+def test_the_real_time_fhocp_runs_the_generated_solver_at_its_real_time_tolerance():
+    """The real-time mode hands the generated solver REALTIME_QOCOGEN_SETTINGS (as it hands Clarabel its own); the
+    converged mode keeps the defaults."""
+    from tubekit import paper_scenario
+    from tubekit.fhocp.options import ScpOptions
+    from tubekit.fhocp.qp.qocogen import REALTIME_QOCOGEN_SETTINGS
+    from tubekit.fhocp.scp import FHOCP
+    from tubekit.tightening import Tightening
+
+    sc = paper_scenario()
+    tg = Tightening.untightened(sc)
+    options = ScpOptions(qp_solver="qocogen")
+    realtime = FHOCP(sc, tg, mode="realtime", options=options).subproblem.compiled.backend
+    converged = FHOCP(sc, tg, mode="converged", options=options).subproblem.compiled.backend
+    assert dict(realtime.settings) == REALTIME_QOCOGEN_SETTINGS == {"abstol": 1e-6, "reltol": 1e-6}
+    assert dict(converged.settings) == {}

@@ -115,6 +115,9 @@ class ConvexSubproblem:
         The fast path's backend (:mod:`tubekit.fhocp.qp`): a registered name (default ``"clarabel"``;
         ``"piqp"`` is wrapped in the relaxation wrapper since it takes no cones) or an instance, through
         :func:`tubekit.fhocp.qp.registry.make_qp_backend`. Only ``"clarabel"`` without the fast path.
+    backend_settings : dict, optional
+        Per backend name, its setting overrides for a named ``qp_backend`` other than Clarabel (whose are
+        ``clarabel_settings``), e.g. ``{"qocogen": {"abstol": 1e-6}}``.
 
     Attributes
     ----------
@@ -128,7 +131,8 @@ class ConvexSubproblem:
 
     def __init__(self, nlp: FhocpNlp, max_obstacles: int, neutral_state: np.ndarray,
                  neutral_reference: np.ndarray, trust_radius: float, *, fast_path: bool = True,
-                 clarabel_settings: dict | None = None, qp_backend: str | QpBackend = DEFAULT_QP_BACKEND) -> None:
+                 clarabel_settings: dict | None = None, qp_backend: str | QpBackend = DEFAULT_QP_BACKEND,
+                 backend_settings: dict[str, dict] | None = None) -> None:
         if not fast_path and qp_backend != DEFAULT_QP_BACKEND:
             raise ConfigError("qp_backend", f"{DEFAULT_QP_BACKEND!r} when fast_path=False (the QP backends read "
                               "the compiled data)", qp_backend)
@@ -143,7 +147,7 @@ class ConvexSubproblem:
         self.clarabel_settings = {**DEFAULT_CLARABEL_SETTINGS, **(clarabel_settings or {})}
         self.compiled: CompiledConeProgram | None = None
         if fast_path:
-            backend = make_qp_backend(qp_backend, {"clarabel": self.clarabel_settings})
+            backend = make_qp_backend(qp_backend, {**(backend_settings or {}), "clarabel": self.clarabel_settings})
             self.compiled = CompiledConeProgram(self.problem, backend=backend)
         self._layout()
         self.linearise(neutral_state, rollout(neutral_state, np.zeros((N, 3)), nlp.dt), np.zeros((N, 3)),

@@ -45,6 +45,7 @@ from tubekit.fhocp.convex import REALTIME_CLARABEL_SETTINGS, ConvexSubproblem
 from tubekit.fhocp.fastpath import CompiledConeProgram
 from tubekit.fhocp.nlp import FhocpNlp, NlpEvaluation, rollout, select_obstacles
 from tubekit.fhocp.options import ScpOptions
+from tubekit.fhocp.qp.qocogen import REALTIME_QOCOGEN_SETTINGS
 from tubekit.fhocp.result import FallbackWarning, FhocpResult, Status, shift_steps, shifted_plan
 from tubekit.fhocp.rows import rate_project
 
@@ -202,7 +203,7 @@ class FHOCP:
         self.subproblem = ConvexSubproblem(self.nlp, self.max_obstacles, s0,
                                            self.nlp.reference(scenario.trajectory, 0.0), self.trust_radius,
                                            fast_path=self.fast_path, clarabel_settings=self._clarabel_settings(opts),
-                                           qp_backend=opts.qp_solver)
+                                           qp_backend=opts.qp_solver, backend_settings=self._backend_settings())
         self.build_time_s = time.perf_counter() - t0
 
     def _clarabel_settings(self, opts: ScpOptions) -> dict | None:
@@ -211,6 +212,13 @@ class FHOCP:
         if self.mode is not FhocpMode.REALTIME:
             return opts.clarabel_overrides()
         return {**REALTIME_CLARABEL_SETTINGS, **(opts.clarabel_overrides() or {})}
+
+    def _backend_settings(self) -> dict[str, dict] | None:
+        """The other backends' real-time settings (the generated QOCO's
+        :data:`~tubekit.fhocp.qp.qocogen.REALTIME_QOCOGEN_SETTINGS`); None in the converged mode."""
+        if self.mode is not FhocpMode.REALTIME:
+            return None
+        return {"qocogen": dict(REALTIME_QOCOGEN_SETTINGS)}
 
     def _check_workspace(self) -> None:
         """The subproblem keeps one wall row per axis: the workspace must be wide enough for that."""

@@ -29,6 +29,7 @@ import gc
 import json
 import sys
 from pathlib import Path
+from types import ModuleType
 from typing import Iterator
 
 import numpy as np
@@ -42,8 +43,8 @@ from tubekit.model import compiled_arcs  # noqa: E402
 from tubekit.model.errors import error_coordinates  # noqa: E402
 from tubekit.model.kinematics import dsinc, sinc, unicycle_step  # noqa: E402
 
-__all__ = ["numpy_rollout", "numpy_step_linearisation", "numpy_eo_linearisation", "numpy_kernels", "measure",
-           "main"]
+__all__ = ["numpy_rollout", "numpy_step_linearisation", "numpy_eo_linearisation", "swapped", "numpy_kernels",
+           "measure", "main"]
 
 
 def numpy_rollout(s0: np.ndarray, inputs: np.ndarray, dt: float) -> np.ndarray:
@@ -100,16 +101,21 @@ NUMPY = {"rollout": numpy_rollout, "step_linearisation": numpy_step_linearisatio
 
 
 @contextlib.contextmanager
-def numpy_kernels() -> Iterator[None]:
-    """The numpy functions in the compiled routines' place (every caller looks them up at the call)."""
-    compiled = {name: getattr(compiled_arcs, name) for name in NUMPY}
-    for name, fn in NUMPY.items():
-        setattr(compiled_arcs, name, fn)
+def swapped(module: ModuleType, replacements: dict) -> Iterator[None]:
+    """``module``'s attributes named in ``replacements`` replaced by their values, and put back at the end."""
+    kept = {name: getattr(module, name) for name in replacements}
+    for name, fn in replacements.items():
+        setattr(module, name, fn)
     try:
         yield
     finally:
-        for name, fn in compiled.items():
-            setattr(compiled_arcs, name, fn)
+        for name, fn in kept.items():
+            setattr(module, name, fn)
+
+
+def numpy_kernels() -> contextlib.AbstractContextManager:
+    """The numpy functions in the compiled routines' place (every caller looks them up at the call)."""
+    return swapped(compiled_arcs, NUMPY)
 
 
 def measure(duration: float = 100.0, rounds: int = 4) -> dict:

@@ -28,9 +28,7 @@ import gc
 import json
 import math
 import sys
-import time
 from pathlib import Path
-from typing import Iterator
 
 import numpy as np
 import scipy.sparse as sp
@@ -38,6 +36,7 @@ import scipy.sparse as sp
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 import fhocp as v2  # noqa: E402  (the sibling benchmark: its closed loop, methods and replay)
+from compiled_period import swapped  # noqa: E402  (the sibling benchmark's attribute swap)
 
 from tubekit import paper_scenario  # noqa: E402
 from tubekit.fhocp import compiled_rows  # noqa: E402
@@ -185,29 +184,9 @@ NUMPY = {"state_rows": numpy_state_rows, "obstacle_rows": numpy_obstacle_rows, "
          "violation_rows": numpy_violation_rows}
 
 
-@contextlib.contextmanager
-def numpy_rows() -> Iterator[None]:
+def numpy_rows() -> contextlib.AbstractContextManager:
     """The numpy functions in the compiled routines' place (every caller looks them up at the call)."""
-    compiled = {name: getattr(compiled_rows, name) for name in NUMPY}
-    for name, fn in NUMPY.items():
-        setattr(compiled_rows, name, fn)
-    try:
-        yield
-    finally:
-        for name, fn in compiled.items():
-            setattr(compiled_rows, name, fn)
-
-
-def _alone(ctrl, states: list) -> float:
-    """Median real-time step (ms) of ``ctrl`` along ``states``, nothing else between its steps."""
-    ctrl.solve(*states[0])
-    gc.collect()
-    times = []
-    for t, s, obs in states[1:]:
-        t0 = time.perf_counter()
-        ctrl.solve(t, s, obs)
-        times.append(time.perf_counter() - t0)
-    return float(1e3 * np.median(times))
+    return swapped(compiled_rows, NUMPY)
 
 
 def measure(duration: float = 100.0, rounds: int = 3, backends: tuple[str, ...] = ("clarabel", "qocogen")) -> dict:
@@ -225,7 +204,7 @@ def measure(duration: float = 100.0, rounds: int = 3, backends: tuple[str, ...] 
         with numpy_rows() if side == "numpy" else contextlib.nullcontext():
             for b in backends:
                 ctrl = v2.make_methods(sc, tg, with_casadi=False, opt_in=opt_in)[keys[b]][0]
-                row[f"{b}_alone_ms"] = _alone(ctrl, states)
+                row[f"{b}_alone_ms"] = v2.median_step_alone(ctrl, states)
                 last.setdefault(side, {})[b] = ctrl.plan_inputs
             methods = {name: m for name, m in v2.make_methods(sc, tg, with_casadi=False, opt_in=opt_in).items()
                        if name in keys.values()}

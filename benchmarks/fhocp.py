@@ -206,6 +206,19 @@ def replay(methods: dict, run_states: list, profile: cProfile.Profile | None = N
     return rec
 
 
+def median_step_alone(ctrl, run_states: list) -> float:
+    """Median step (ms) of ``ctrl`` along ``run_states`` with nothing else between its steps (its caches warm);
+    the first state's solve, a cold start (a generated solver's build or load), is not timed."""
+    ctrl.solve(*run_states[0])
+    gc.collect()
+    times = []
+    for t, s, obs in run_states[1:]:
+        t0 = time.perf_counter()
+        ctrl.solve(t, s, obs)
+        times.append(time.perf_counter() - t0)
+    return float(np.median(times) * 1e3)
+
+
 def gaps(rec: dict, methods: dict) -> dict[str, np.ndarray]:
     """Relative merit gap of each method to the best converged, non-failed merit, per state (NaN if failed)."""
     merits = {n: np.where(rec[n]["failed"], np.nan, rec[n]["merit"]) for n in rec}

@@ -187,7 +187,6 @@ def closed_loop(scenario, duration: float, names: tuple[str, ...] = BACKENDS) ->
 def steps(names: tuple[str, ...], rounds: int, duration: float = 100.0) -> dict:
     """Per method (each backend's real-time SCP, then IPOPT if CasADi is there), built by ``benchmarks/fhocp.py``'s
     ``make_methods`` (the same obstacle slots and rate penalty): its rounds' median steps (ms) and their median."""
-    import gc
     import importlib.util
 
     fhocp = _study("fhocp")
@@ -205,14 +204,7 @@ def steps(names: tuple[str, ...], rounds: int, duration: float = 100.0) -> dict:
     for _ in range(rounds):
         for method in picks:
             ctrl = fhocp.make_methods(sc, tg, with_casadi=method == "ipopt", opt_in=opt_in)[method][0]
-            ctrl.solve(*states[0])  # the cold start (a generated solver's build or load) is not timed
-            gc.collect()
-            times = []
-            for t, s, obs in states[1:]:
-                t0 = time.perf_counter()
-                ctrl.solve(t, s, obs)
-                times.append(time.perf_counter() - t0)
-            medians[method].append(float(np.median(times) * 1e3))
+            medians[method].append(fhocp.median_step_alone(ctrl, states))
     out = {k: {"median_ms": float(np.median(v)), "rounds_ms": v} for k, v in medians.items()}
     if "ipopt" in out:
         for k in out:

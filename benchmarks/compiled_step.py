@@ -178,9 +178,9 @@ def numpy_violation_rows(states: np.ndarray, inputs: np.ndarray, e: np.ndarray, 
     return viol, inp, dyn
 
 
-#: each routine of :mod:`tubekit.fhocp.compiled_rows` and the numpy code it replaced
-NUMPY = {"state_rows": numpy_state_rows, "obstacle_rows": numpy_obstacle_rows, "input_bounds": numpy_input_bounds,
-         "cost_rows": numpy_cost_rows, "subproblem_rows": numpy_subproblem_rows, "scatter_matvec": numpy_scatter_matvec,
+#: the routines of :mod:`tubekit.fhocp.compiled_rows` the step calls and the numpy code each replaced (the row
+#: routines inside ``subproblem_rows`` are swapped with it: its reference is made of theirs)
+NUMPY = {"subproblem_rows": numpy_subproblem_rows, "scatter_matvec": numpy_scatter_matvec,
          "violation_rows": numpy_violation_rows}
 
 

@@ -103,47 +103,12 @@ def _backend(name: str):
     return make_qp_backend(name, {"clarabel": shipped})
 
 
-def compare(problems: list, inputs: np.ndarray, names: tuple[str, ...] = BACKENDS) -> dict:
-    """Per backend: failures, inaccurate solves, the largest input and objective differences from Clarabel's,
-    the whole ``solve`` call's median and p99 (ms) over every problem but the first."""
-    backends = {name: _backend(name) for name in names}
-    stats = {n: {"failed": 0, "inaccurate": 0, "times": [], "dv": 0.0, "dobj": 0.0} for n in names}
-    for i, data in enumerate(problems):
-        shift = i % len(names)
-        order = names[shift:] + names[:shift]
-        sols = {}
-        for name in order:
-            t0 = time.perf_counter()
-            sol = backends[name].solve(data)
-            if i:
-                stats[name]["times"].append(time.perf_counter() - t0)
-            if sol.status.value == "optimal_inaccurate":
-                stats[name]["inaccurate"] += 1
-            elif sol.status.value != "optimal":
-                stats[name]["failed"] += 1
-            sols[name] = sol if sol.x is not None else None
-        base = sols.get("clarabel")
-        for name in names:
-            if base is not None and sols[name] is not None:
-                x = sols[name].x
-                stats[name]["dv"] = max(stats[name]["dv"], float(np.max(np.abs(x[inputs] - base.x[inputs]))))
-                gap = abs(sols[name].objective - base.objective) / max(1.0, abs(base.objective))
-                stats[name]["dobj"] = max(stats[name]["dobj"], gap)
-    return {n: {"failed": s["failed"], "inaccurate": s["inaccurate"], "max_input_diff": s["dv"],
-                "max_objective_gap": s["dobj"], "median_ms": float(np.median(s["times"]) * 1e3),
-                "p99_ms": float(np.percentile(s["times"], 99) * 1e3)} for n, s in stats.items()}
-
-
-def qocogen_tolerances(problems: list, inputs: np.ndarray, tolerances: tuple[float, ...]) -> dict:
-    """The generated solver at QOCO's default tolerance (1e-7) and at each of ``tolerances`` (absolute = relative),
-    the order rotated per problem: per setting its failures, inaccurate solves, the largest input difference from
-    the default's plan, the mean iterations and the whole call's median (ms, every problem but the first)."""
-    from tubekit.fhocp.qp.registry import make_qp_backend
-
-    settings = {"1e-07 (default)": {}, **{f"{tol:g}": {"abstol": tol, "reltol": tol} for tol in tolerances}}
-    backends = {k: make_qp_backend("qocogen", {"qocogen": v}) for k, v in settings.items()}
-    keys = tuple(settings)
-    stats = {k: {"failed": 0, "inaccurate": 0, "dv": 0.0, "iterations": [], "times": []} for k in keys}
+def _solve_rotated(problems: list, inputs: np.ndarray, backends: dict, reference: str) -> dict:
+    """Every problem solved by each backend, the order rotated per problem: per backend its failures, inaccurate
+    solves, iterations, call times (every problem but the first) and the largest differences of the plan's inputs
+    and of the objective (relative) from ``reference``'s."""
+    keys = tuple(backends)
+    stats = {k: {"failed": 0, "inaccurate": 0, "iterations": [], "times": [], "dv": 0.0, "dobj": 0.0} for k in keys}
     for i, data in enumerate(problems):
         sols = {}
         for key in keys[i % len(keys):] + keys[:i % len(keys)]:
@@ -152,13 +117,39 @@ def qocogen_tolerances(problems: list, inputs: np.ndarray, tolerances: tuple[flo
             if i:
                 stats[key]["times"].append(time.perf_counter() - t0)
             stats[key]["iterations"].append(sol.iterations)
-            stats[key]["inaccurate" if sol.status.value == "optimal_inaccurate" else "failed"] += (
-                sol.status.value != "optimal")
+            if sol.status.value == "optimal_inaccurate":
+                stats[key]["inaccurate"] += 1
+            elif sol.status.value != "optimal":
+                stats[key]["failed"] += 1
             sols[key] = sol
-        base = sols[keys[0]]
+        base = sols[reference]
         for key in keys:
             if base.x is not None and sols[key].x is not None:
-                stats[key]["dv"] = max(stats[key]["dv"], float(np.max(np.abs(sols[key].x[inputs] - base.x[inputs]))))
+                x = sols[key].x
+                stats[key]["dv"] = max(stats[key]["dv"], float(np.max(np.abs(x[inputs] - base.x[inputs]))))
+                gap = abs(sols[key].objective - base.objective) / max(1.0, abs(base.objective))
+                stats[key]["dobj"] = max(stats[key]["dobj"], gap)
+    return stats
+
+
+def compare(problems: list, inputs: np.ndarray, names: tuple[str, ...] = BACKENDS) -> dict:
+    """Per backend: failures, inaccurate solves, the largest input and objective differences from Clarabel's,
+    the whole ``solve`` call's median and p99 (ms) over every problem but the first."""
+    stats = _solve_rotated(problems, inputs, {name: _backend(name) for name in names}, "clarabel")
+    return {n: {"failed": s["failed"], "inaccurate": s["inaccurate"], "max_input_diff": s["dv"],
+                "max_objective_gap": s["dobj"], "median_ms": float(np.median(s["times"]) * 1e3),
+                "p99_ms": float(np.percentile(s["times"], 99) * 1e3)} for n, s in stats.items()}
+
+
+def qocogen_tolerances(problems: list, inputs: np.ndarray, tolerances: tuple[float, ...]) -> dict:
+    """The generated solver at QOCO's default tolerance (1e-7) and at each of ``tolerances`` (absolute = relative),
+    the order rotated per problem: per setting its failures, inaccurate solves, the largest input difference from
+    the default's plan, its iterations and call times (s, every problem but the first)."""
+    from tubekit.fhocp.qp.registry import make_qp_backend
+
+    settings = {"1e-07 (default)": {}, **{f"{tol:g}": {"abstol": tol, "reltol": tol} for tol in tolerances}}
+    backends = {k: make_qp_backend("qocogen", {"qocogen": v}) for k, v in settings.items()}
+    stats = _solve_rotated(problems, inputs, backends, "1e-07 (default)")
     return {k: {"failed": s["failed"], "inaccurate": s["inaccurate"], "max_input_diff": s["dv"],
                 "iterations": s["iterations"], "times": s["times"]} for k, s in stats.items()}
 

@@ -107,15 +107,13 @@ class CompiledConeProgram:
         self._A_indices = np.asarray(indices[:nnz_a], dtype=np.int64)
         self._A_indptr = np.asarray(indptr[:self.n + 1], dtype=np.int64)
         self._b_rows = np.asarray(indices[nnz_a:], dtype=np.int64)
-        self._b_map = a_map[nnz_a:]
         # entries of A that depend on a parameter; the others are constant
         top = a_map[:nnz_a]
         self._a_par = np.flatnonzero(top[:, :-1].getnnz(axis=1)).astype(np.int64)
-        self._a_par_map = top[self._a_par]
         self._a_data = -np.asarray(top[:, -1].toarray()).ravel()
-        # q (with the offset d as its last entry)
-        self._q_map = sp.csr_matrix(pp.q)
-        self._stacked: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None  # built at the first solve
+        # one CSR map of A's parametric entries, b's and q's (with the offset d as its last row)
+        stacked = sp.vstack([top[self._a_par], a_map[nnz_a:], sp.csr_matrix(pp.q)], format="csr")
+        self._stacked = (stacked.indptr.astype(np.int64), stacked.indices.astype(np.int64), stacked.data.astype(float))
         self._compile_quadratic(pp)
         self.dims = cone_dims(data[cp.reductions.solvers.conic_solvers.conic_solver.ConicSolver.DIMS])
         self.var_id_to_col = dict(pp.var_id_to_col)
@@ -167,9 +165,6 @@ class CompiledConeProgram:
     def _vectors(self) -> tuple[np.ndarray, np.ndarray, float]:
         """(b, q, d) for the current parameter vector (one compiled mat-vec of the stacked maps,
         :func:`tubekit.fhocp.compiled_rows.scatter_matvec`); also refreshes A's parametric values."""
-        if self._stacked is None:
-            st = sp.vstack([self._a_par_map, self._b_map, self._q_map], format="csr")
-            self._stacked = (st.indptr.astype(np.int64), st.indices.astype(np.int64), st.data.astype(float))
         b = np.empty(self.m)
         q = np.empty(self.n)
         d = compiled()[1].scatter_matvec(*self._stacked, self.param_vector, self._a_data, self._a_par, b,

@@ -9,6 +9,7 @@ compiled routines of :mod:`tubekit.model.compiled_arcs` (numba, imported at the 
 
 from __future__ import annotations
 
+import functools
 from types import ModuleType
 
 import numpy as np
@@ -22,19 +23,15 @@ ED_FLOOR = 1e-9
 #: row order of :func:`step_linearisation`
 STEP_LINEARISATION_ROWS: tuple[str, ...] = ("ax", "bxu", "bxr", "cx", "ay", "byu", "byr", "cy")
 
-_COMPILED: tuple[ModuleType, ModuleType] | None = None
 
-
+@functools.cache
 def compiled() -> tuple[ModuleType, ModuleType]:
     """(:mod:`tubekit.model.compiled_arcs`, :mod:`tubekit.fhocp.compiled_rows`), imported at the first call and
     kept (numba is loaded by the first step, never by ``tubekit certify``; a kept module costs no import per call)."""
-    global _COMPILED
-    if _COMPILED is None:
-        from tubekit.fhocp import compiled_rows
-        from tubekit.model import compiled_arcs
+    from tubekit.fhocp import compiled_rows
+    from tubekit.model import compiled_arcs
 
-        _COMPILED = (compiled_arcs, compiled_rows)
-    return _COMPILED
+    return compiled_arcs, compiled_rows
 
 
 def step_linearisation(states: np.ndarray, inputs: np.ndarray, dt: float) -> np.ndarray:

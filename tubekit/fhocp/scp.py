@@ -45,7 +45,7 @@ from tubekit.fhocp.convex import REALTIME_CLARABEL_SETTINGS, ConvexSubproblem
 from tubekit.fhocp.fastpath import CompiledConeProgram
 from tubekit.fhocp.nlp import FhocpNlp, NlpEvaluation, rollout, select_obstacles
 from tubekit.fhocp.options import ScpOptions
-from tubekit.fhocp.qp.qocogen import REALTIME_QOCOGEN_SETTINGS
+from tubekit.fhocp.qp.registry import DEFAULT_QP_BACKEND, get_qp_backend
 from tubekit.fhocp.result import FallbackWarning, FhocpResult, Status, shift_steps, shifted_plan
 from tubekit.fhocp.rows import rate_project
 
@@ -203,7 +203,7 @@ class FHOCP:
         self.subproblem = ConvexSubproblem(self.nlp, self.max_obstacles, s0,
                                            self.nlp.reference(scenario.trajectory, 0.0), self.trust_radius,
                                            fast_path=self.fast_path, clarabel_settings=self._clarabel_settings(opts),
-                                           qp_backend=opts.qp_solver, backend_settings=self._backend_settings())
+                                           qp_backend=opts.qp_solver, backend_settings=self._backend_settings(opts))
         self.build_time_s = time.perf_counter() - t0
 
     def _clarabel_settings(self, opts: ScpOptions) -> dict | None:
@@ -213,12 +213,13 @@ class FHOCP:
             return opts.clarabel_overrides()
         return {**REALTIME_CLARABEL_SETTINGS, **(opts.clarabel_overrides() or {})}
 
-    def _backend_settings(self) -> dict[str, dict] | None:
-        """The other backends' real-time settings (the generated QOCO's
-        :data:`~tubekit.fhocp.qp.qocogen.REALTIME_QOCOGEN_SETTINGS`); None in the converged mode."""
-        if self.mode is not FhocpMode.REALTIME:
+    def _backend_settings(self, opts: ScpOptions) -> dict[str, dict] | None:
+        """The chosen QP backend's ``realtime_settings`` in the real-time mode (Clarabel's go through
+        :meth:`_clarabel_settings`); None in the converged mode or when it has none."""
+        if self.mode is not FhocpMode.REALTIME or opts.qp_solver == DEFAULT_QP_BACKEND:
             return None
-        return {"qocogen": dict(REALTIME_QOCOGEN_SETTINGS)}
+        settings = get_qp_backend(opts.qp_solver).realtime_settings
+        return {opts.qp_solver: dict(settings)} if settings else None
 
     def _check_workspace(self) -> None:
         """The subproblem keeps one wall row per axis: the workspace must be wide enough for that."""

@@ -23,7 +23,7 @@ import math
 from abc import ABC, abstractmethod
 from dataclasses import dataclass
 from functools import cached_property
-from types import ModuleType
+from types import MappingProxyType, ModuleType
 from typing import Any, Mapping
 
 import numpy as np
@@ -260,6 +260,10 @@ class QpBackend(ABC):
         The Python package the backend imports (None: none).
     pip_name : str
         What ``pip install`` needs for it (the install hint).
+    realtime_settings : mapping
+        The setting overrides the FHOCP's real-time mode gives the backend when it is the chosen one (empty: its
+        defaults). Clarabel's real-time setting goes with the user's ``ScpOptions.clarabel_settings`` instead
+        (:data:`tubekit.fhocp.convex.REALTIME_CLARABEL_SETTINGS`), since Clarabel is also the cone fallback.
     setups, updates : int
         Solver set-ups and in-place data updates so far.
     """
@@ -268,6 +272,7 @@ class QpBackend(ABC):
     takes_cones: bool = False
     package: str | None = None
     pip_name: str = ""
+    realtime_settings: Mapping[str, Any] = MappingProxyType({})
 
     def __init__(self, settings: Mapping[str, Any] | None = None) -> None:
         if settings is not None and (not isinstance(settings, Mapping) or not all(isinstance(k, str)

@@ -13,7 +13,7 @@ no solution on. Needs ``pip install qocogen`` and a C compiler.
 from __future__ import annotations
 
 import time
-from types import ModuleType
+from types import MappingProxyType, ModuleType
 from typing import Any, Mapping
 
 from tubekit.exceptions import ConfigError, NotAvailableError
@@ -33,12 +33,12 @@ QOCOGEN_STATUS: dict[str, Status] = {
 }
 _RAW = tuple(QOCOGEN_STATUS)
 
-#: What the FHOCP's real-time mode sets (:class:`tubekit.fhocp.scp.FHOCP`, before the user's overrides), as it sets
-#: Clarabel's: absolute and relative tolerance 1e-6. Chosen on the 15,025 recorded real-time subproblems of every
+#: What the FHOCP's real-time mode sets (:class:`tubekit.fhocp.scp.FHOCP`, through ``realtime_settings``), as it
+#: sets Clarabel's: absolute and relative tolerance 1e-6. Chosen on the 15,025 recorded real-time subproblems of every
 #: shipped scenario (``python benchmarks/qp_backends.py --qocogen-tolerances 1e-6 1e-5``): 0 failures, none
 #: inaccurate, plans within 0.017 of the 1e-7 default's (Clarabel's real-time setting moved them by up to 0.031),
 #: 13.1 iterations on average against 13.8; the exact plan check decides every plan. 1e-5 moved them by 0.075.
-REALTIME_QOCOGEN_SETTINGS: dict[str, float] = {"abstol": 1e-6, "reltol": 1e-6}
+REALTIME_QOCOGEN_SETTINGS: Mapping[str, float] = MappingProxyType({"abstol": 1e-6, "reltol": 1e-6})
 
 
 class QocogenBackend(QpBackend):
@@ -55,6 +55,7 @@ class QocogenBackend(QpBackend):
     takes_cones = True
     package = "qocogen"
     pip_name = "qocogen"
+    realtime_settings = REALTIME_QOCOGEN_SETTINGS
 
     def __init__(self, settings: Mapping[str, Any] | None = None) -> None:
         super().__init__(settings)

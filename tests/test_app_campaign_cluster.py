@@ -98,3 +98,14 @@ def test_the_warm_up_copy_is_short_and_never_certifies_a_dynamic_design():
     warm = warm_scenario(dynamic)
     assert warm.plant.kind == "kinematic" and dynamic.plant.kind == "dynamic"
     assert warm.duration == 1.0 and warm.trajectory == dynamic.trajectory and warm.limits == dynamic.limits
+
+
+def test_the_warm_up_copy_of_a_lateral_backup_campaign_is_a_valid_kinematic_scenario():
+    """A campaign whose backup commands sway (the hold law, which only a dynamic plant with lateral thrust takes):
+    the kinematic warm-up copy falls back to station keeping instead of being refused."""
+    from tubekit.app.campaign_cluster import warm_scenario
+    from tubekit.scenario import load_scenario
+    pier = load_scenario(Path(__file__).resolve().parents[1] / "examples" / "bluerov2_pier.toml")
+    warm = warm_scenario(pier)
+    assert pier.controller.backup == "hold" and warm.controller.backup == "station_keeping"
+    assert warm.plant.kind == "kinematic" and warm.duration == 1.0

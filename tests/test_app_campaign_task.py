@@ -44,6 +44,22 @@ def test_the_disturbance_sequences_are_drawn_from_the_seed_within_the_bounds(tas
         assert math.hypot(wx, wy) <= bound.omega_xy * (1 + 1e-12) and abs(wz) <= bound.omega_z * (1 + 1e-12)
 
 
+def test_on_the_dynamic_plant_the_sequences_replace_the_current_within_its_own_bound():
+    """The dynamic plant's override replaces the water current only (the sway and the loop error are the plant's), so
+    the sequences stay within the current's bound, the premise the certificate assumes (0.1 m/s per axis here), not
+    within ω̄ (which adds the sway and the loop error the certificate derives)."""
+    from pathlib import Path
+
+    from tubekit.scenario import load_scenario
+    scenario = load_scenario(Path(__file__).resolve().parents[1] / "examples" / "bluerov2_pier.toml").with_changes(
+        duration=2.0)
+    tight = certify_design(scenario).tightening
+    seq = campaign_task._disturbances(RunTask(3, 5, scenario, tight, 1))[1]
+    assert tight.disturbance.omega_xy > 0.15 > 0.1
+    biggest = max(math.hypot(wx, wy) for wx, wy, _ in seq.table)
+    assert 0.05 < biggest <= 0.1 * (1 + 1e-12) and max(abs(wz) for _, _, wz in seq.table) <= 0.1 * (1 + 1e-12)
+
+
 def test_a_run_that_cannot_be_simulated_is_recorded_not_raised(task, monkeypatch):
     def fail(_task):
         raise TubekitError("the plan cannot start here\nsecond line")

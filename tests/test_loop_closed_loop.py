@@ -601,3 +601,40 @@ def test_a_loiter_backup_keeps_its_surge_and_the_vehicle_clear_in_the_loop():
     assert run.saturated_ticks == 0 and run.metrics["min_clearance"] > 0.0
     safety = {p.name: p.ok for p in check_promises(run)}
     assert safety["clearance"] and safety["inputs"] and safety["workspace"]
+
+
+def test_a_hold_backup_keeps_its_disc_and_hands_back_to_a_plan_in_the_loop():
+    """examples/bluerov2_pier.toml with the FHOCP failing for 15 s (periods 100..249, the candidate off): the hold law
+    takes over from the moving vehicle without a jump (its sway command starts at 0), commands sway to hold the
+    vehicle inside its certified disc and depth band, and a plan takes over again only once its sway command is
+    within the law's release; every promise of the certificate's tier holds (the recursive-feasibility premise
+    fails by construction)."""
+    from pathlib import Path
+
+    import verify
+    from tubekit.loop.promises import check_promises
+    from tubekit.model.hold import Hold
+    from tubekit.scenario import load_scenario
+
+    from .failing_solver import failing_between
+
+    _Failing = failing_between(100, 250)
+
+    sc = load_scenario(Path(__file__).resolve().parents[1] / "examples" / "bluerov2_pier.toml")
+    cert = verify.certify(sc)
+    law, disc = cert.backup.law, cert.backup.safe_set
+    assert cert.tiers.safe and isinstance(law, Hold)
+    sc = sc.with_changes(duration=40.0, **{"controller.candidate": False})
+    res = run_closed_loop(sc, tightening=cert.tightening, solver_factory=_Failing, progress=False)
+    on = np.flatnonzero(res.backup_active[:-1])
+    assert res.metrics["backup_engagements"] == 1 and on.size * 0.01 > 10.0 and not res.backup_active[-2]
+    first, last = on[0], on[-1]
+    np.testing.assert_array_equal(res.inputs[first], res.inputs[first - 1])      # the blend: no jump
+    assert res.sway_command[first] == 0.0 and np.linalg.norm(res.inputs[first - 1]) > 0.05
+    anchor = res.backup_anchor[on]
+    assert np.hypot(*(res.states[on, :2] - anchor[:, :2]).T).max() <= disc.level
+    assert np.abs(res.states[on, 2] - anchor[:, 2]).max() <= disc.depth
+    assert 0.0 < np.abs(res.sway_command[on]).max() <= law.speed
+    assert abs(res.sway_command[last]) <= law.release and np.all(res.sway_command[last + 1:] == 0.0)
+    broken = [p.name for p in check_promises(res) if p.given and not p.ok and p.name != "recursive_feasibility"]
+    assert broken == []

@@ -17,7 +17,7 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 from tubekit.tiers import Tiers
-from tubekit.loop.plan_check import RATE_TOLERANCE, PlanCheck, check_plan, check_rates, plan_arcs
+from tubekit.loop.plan_check import RATE_TOLERANCE, PlanCheck, check_plan, check_rates, check_sway, plan_arcs
 from tubekit.model.backup import BackupPlan, SafeSet, StationKeeping
 from tubekit.scenario import Obstacle
 from tubekit.tightening import Tightening
@@ -278,3 +278,16 @@ def test_the_terminal_rest_is_about_the_loiters_surge(stationary):
     cruise = _with_u([0.05, 0.1, 0.15, 0.2, 0.25, 0.3, 0.3, 0.3])   # ends 0.05 above u_l
     assert check_rates(sc, tight, cruise).ok
     assert check_rates(sc, _tight(backup=BACKUP), cruise).where == "rate: terminal rest"   # station keeping: at rest
+
+
+@pytest.mark.parametrize("sway, release, ok", [
+    (0.0, math.inf, True), (0.3, math.inf, True),          # a law without sway: never holds a plan back
+    (4e-4, 5e-4, True), (-5e-4, 5e-4, True),              # within the release: the jump to 0 is charged
+    (6e-4, 5e-4, False), (-0.1, 5e-4, False),
+])
+def test_a_plan_takes_over_only_once_the_sway_command_is_within_the_release(sway, release, ok):
+    gate = check_sway(sway, release)
+    assert (gate is None) is ok
+    if not ok:
+        assert not gate.ok and not gate.safe and gate.where.startswith("sway")
+        assert gate.slack == pytest.approx(release - abs(sway))

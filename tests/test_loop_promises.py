@@ -52,7 +52,7 @@ def _run(stationary, **changes) -> SimulationResult:
         solve_ms=np.zeros(rows), step_ms=np.zeros(rows), wall=np.zeros(rows), rejected=np.zeros(STEPS, dtype=bool),
         plan_age=np.zeros(STEPS, dtype=int), plan_slack=np.zeros(STEPS),
             backup_active=np.zeros(rows, dtype=bool),
-            backup_anchor=np.full((rows, 3), np.nan), recovery=np.zeros(rows, dtype=bool))
+            backup_anchor=np.full((rows, 3), np.nan), recovery=np.zeros(rows, dtype=bool), sway_command=np.zeros(rows))
     fields.update(changes)
     return SimulationResult(**fields)
 

@@ -55,7 +55,7 @@ def _run(stationary, **changes) -> SimulationResult:
         max_violation=np.array([0.0, 1e-3, 2e-3]), rejected=np.zeros(STEPS, dtype=bool),
         plan_age=np.zeros(STEPS, dtype=int), plan_slack=np.zeros(STEPS),
         backup_active=np.zeros(ROWS, dtype=bool),
-        backup_anchor=np.full((ROWS, 3), np.nan), recovery=np.zeros(ROWS, dtype=bool))
+        backup_anchor=np.full((ROWS, 3), np.nan), recovery=np.zeros(ROWS, dtype=bool), sway_command=np.zeros(ROWS))
     fields.update(changes)
     return SimulationResult(**fields)
 
@@ -66,7 +66,8 @@ def test_the_result_and_the_loop_buffer_take_their_arrays_from_log_fields():
     from tubekit.loop.closed_loop import _Log
 
     names = [f.name for f in LOG_FIELDS]
-    assert len(names) == len(set(names)) == 21 and {"backup_active", "backup_anchor", "candidate", "recovery"} <= set(names)
+    assert len(names) == len(set(names)) == 22 and {"backup_active", "backup_anchor", "candidate", "recovery",
+                                                    "sway_command"} <= set(names)
     assert issubclass(SimulationResult, LogArrays) and issubclass(_Log, LogArrays)
     assert {f.name for f in dataclasses.fields(LogArrays)} == set(names)
     assert set(names) <= {f.name for f in dataclasses.fields(_Log)}

@@ -89,3 +89,52 @@ def test_the_compiled_current_and_omega_series_are_their_formulas_tick_by_tick()
             expected[i] = (c1 + du * cp - vb * sp, c2 + du * sp + vb * cp, c3 + body[i, 2] - inputs[i, 1])
     np.testing.assert_array_equal(plant.omega_series(times, states, inputs), expected)
     assert len(body) == 13 and np.isnan(expected[12:]).all()
+
+
+@given(st.integers(0, 2 ** 32 - 1), st.floats(0.0, 300.0),
+       st.lists(st.tuples(SPEED, st.floats(-0.3, 0.3), st.floats(-0.5, 0.5), st.floats(-0.3, 0.3)),
+                min_size=1, max_size=6),
+       st.sampled_from([0.005, 0.01, 0.02]), st.integers(1, 3))
+def test_the_compiled_sway_command_is_the_generic_rk4_bit_for_bit(seed, t, commands, h, n):
+    """Property: with lateral thrust and a commanded sway velocity v_c (command[3]), step_tuple (compiled) gives
+    the very pose, state and peaks of rk4_tuple on DynamicPlant._rhs under (u_c, w_c, r_c, v_c)."""
+    scenario = SCENARIOS["bluerov2_spread"]
+    point = scenario.plant.params.sample(np.random.default_rng(seed))
+    compiled, generic = DynamicPlant(scenario, params=point), DynamicPlant(scenario, params=point)
+    assert compiled.lateral
+    pose = (0.0, 0.0, 0.0, 0.3)
+    for u, w, r, vc in commands:
+        got = compiled.step_tuple(t, pose, (u, w, r), h, n, sway=vc)
+        if generic.state is None:
+            generic.state = generic._start((u, w, r))
+        y = rk4_tuple(generic._rhs, t, (*pose, *generic.state), (u, w, r, vc), h, n)
+        generic.state = y[4:]
+        assert got == y[:4]
+        assert compiled.state == generic.state
+        pose, t = got, t + h * n
+    assert compiled._peak == generic._peak
+
+
+def test_the_compiled_omega_series_subtracts_the_commanded_sway():
+    """omega_series(sway=v_c) is δ + R(ψ)(u_b − u_c, v_b − v_c), δ_z + w_b − w_c tick by tick (None: v_c = 0)."""
+    import math
+
+    plant = DynamicPlant(SCENARIOS["bluerov2_spread"])
+    rng = np.random.default_rng(5)
+    t, pose, states, inputs, sway = 0.0, (0.0, 0.0, 0.0, 0.3), [], [], rng.uniform(-0.1, 0.1, 9)
+    for i in range(8):
+        v = tuple(rng.uniform(-0.2, 0.2, 3).tolist())
+        states.append(pose)
+        inputs.append(v)
+        pose, t = plant.step_tuple(t, pose, v, 0.005, 2, sway=float(sway[i])), t + 0.01
+    times, states, inputs = 0.01 * np.arange(9), np.array(states + [pose]), np.array(inputs + [(math.nan,) * 3])
+    body, _ = plant.history()
+    expected = np.full((9, 3), np.nan)
+    for i in range(8):
+        c1, c2, c3 = plant.current_at(float(times[i]))
+        du, dv = body[i, 0] - inputs[i, 0], body[i, 1] - sway[i]
+        cp, sp = math.cos(states[i, 3]), math.sin(states[i, 3])
+        expected[i] = (c1 + du * cp - dv * sp, c2 + du * sp + dv * cp, c3 + body[i, 2] - inputs[i, 1])
+    np.testing.assert_array_equal(plant.omega_series(times, states, inputs, sway=sway), expected)
+    np.testing.assert_array_equal(plant.omega_series(times, states, inputs, sway=np.zeros(9)),
+                                  plant.omega_series(times, states, inputs))

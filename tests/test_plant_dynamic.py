@@ -11,7 +11,7 @@ import pytest
 from tubekit import paper_scenario
 from tubekit.plant.factory import make_plant
 from tubekit.plant.dynamic import DynamicPlant, body_acceleration, body_forces, kinetic_energy
-from tubekit.exceptions import ConfigError
+from tubekit.exceptions import ConfigError, ShapeError
 from tubekit.model.kinematics import SwayModel
 from tubekit.plant.kinematic import Plant
 from tubekit.scenario import Disturbance
@@ -244,3 +244,92 @@ def test_the_water_current_is_logged_apart_from_omega_at_the_ticks_and_every_sta
     amplitude = sc.disturbance.amplitude
     assert sc.disturbance.constant == (0.0, 0.0, 0.0)
     assert peak_xy <= max(amplitude[0], amplitude[1]) + 1e-12 and peak_z <= amplitude[2] + 1e-12
+
+
+# ---- the commanded sway velocity v_c ---------------------------------------------------------------------------
+def _sway_commands(n: int) -> list[tuple[float, float, float]]:
+    return [(0.2 + 0.1 * math.sin(0.7 * 0.01 * i), 0.08 * math.cos(0.5 * 0.01 * i), 0.2 * math.sin(0.9 * 0.01 * i))
+            for i in range(n)]
+
+
+# captured from the code before the sway command existed (the sway loop regulated v to 0): 300 ticks of
+# _sway_commands on examples/bluerov2_current.toml, h = 0.005 s, 2 substeps, from (-1, 3, 0.2, 0)
+_BEFORE_POSE = (-0.04374737013050533, 3.386952229222297, 0.5265649671090286, 0.42795093599202255)
+_BEFORE_STATE = (0.28880201583651494, 7.09650985748559e-05, 0.0060317139632765525, 0.09060750569823511,
+                 15.009892108336151, -1.0896593104230285, -0.08632764635561205, -0.0009327061274314589,
+                 -0.001634355224929835, -0.005254029313867374, 0.5175349184966562, -7.515926055446984e-05)
+_BEFORE_PEAK = [0.10251651179563187, 0.09535226895273749, 0.10000000000000003, 0.09510565162951536]
+_BEFORE_OMEGA_150 = (0.060152811857910896, 0.08120055816903907, 0.0596282605498967)
+
+
+@pytest.mark.parametrize("path", ["compiled", "python"])
+def test_zero_sway_command_gives_the_very_floats_of_the_sway_loop_regulating_to_zero(path):
+    """v_c = 0 (the default, and passed explicitly) is bit for bit the former sway loop on e_v = −v, on both paths."""
+    from tubekit import load_scenario
+
+    sc = load_scenario("examples/bluerov2_current.toml")
+    override = Plant(sc.disturbance).current_at if path == "python" else None
+    plant = DynamicPlant(sc, override=override)
+    assert plant.lateral
+    commands = _sway_commands(300)
+    x, states = (-1.0, 3.0, 0.2, 0.0), [(-1.0, 3.0, 0.2, 0.0)]
+    for i, v in enumerate(commands):
+        x = plant.step_tuple(0.01 * i, x, v, 0.005, 2, sway=0.0) if i % 2 else plant.step_tuple(0.01 * i, x, v,
+                                                                                                   0.005, 2)
+        states.append(x)
+    assert x == _BEFORE_POSE
+    assert tuple(plant.state) == _BEFORE_STATE
+    assert plant._peak == _BEFORE_PEAK
+    t, inputs = 0.01 * np.arange(301), np.vstack([commands, [np.nan] * 3])
+    omega = plant.omega_series(t, np.array(states), inputs)
+    assert tuple(omega[150].tolist()) == _BEFORE_OMEGA_150
+    np.testing.assert_array_equal(plant.omega_series(t, np.array(states), inputs, sway=np.zeros(301)), omega)
+
+
+def _hold_sway(plant: DynamicPlant, sway: float, ticks: int) -> np.ndarray:
+    """From rest at the origin, command (0, 0, 0) and the sway velocity ``sway`` (m/s) for ``ticks`` of 0.01 s."""
+    x, states = (0.0, 0.0, 0.0, 0.0), [(0.0, 0.0, 0.0, 0.0)]
+    for i in range(ticks):
+        x = plant.step_tuple(0.01 * i, x, (0.0, 0.0, 0.0), 0.005, 2, sway=sway)
+        states.append(x)
+    return np.array(states)
+
+
+def test_the_sway_loop_tracks_a_commanded_sway_velocity_on_both_paths():
+    """Property: BlueROV2 Heavy (lateral thrust), at rest in calm water, commanded v_c = 0.1 m/s for 20 s: the body
+    sway converges to v_c within 1e-3 m/s, the other velocities stay at their (zero) commands, the Python path
+    (a current override) equals the compiled one to 1e-12, and ω counts the sway against v_c."""
+    sc = _scenario("bluerov2_heavy")
+    compiled, python = DynamicPlant(sc), DynamicPlant(sc, override=lambda t: (0.0, 0.0, 0.0))
+    assert compiled.lateral
+    states = _hold_sway(compiled, 0.1, 2000)
+    np.testing.assert_allclose(_hold_sway(python, 0.1, 2000), states, rtol=0.0, atol=1e-12)
+    np.testing.assert_allclose(python.state, compiled.state, rtol=0.0, atol=1e-12)
+    np.testing.assert_allclose(python._peak, compiled._peak, rtol=0.0, atol=1e-12)
+    body, thrust = compiled.history()
+    assert abs(body[-1, 1] - 0.1) < 1e-3 and np.all(np.abs(body[-100:, 1] - 0.1) < 1e-3)
+    np.testing.assert_allclose(body[-1, [0, 2, 3]], 0.0, atol=1e-3)
+    assert abs(compiled.state[10]) <= compiled.params.Y_max  # the lateral thrust Y
+    np.testing.assert_allclose(states[-1, 1], 0.1 * 20.0, rtol=0.1)  # ψ ≈ 0: the body sway is the world's y
+    t, inputs = 0.01 * np.arange(2001), np.vstack([np.zeros((2000, 3)), [np.nan] * 3])
+    vc = np.full(2001, 0.1)
+    for plant in (compiled, python):
+        tracked, free = plant.omega_series(t, states, inputs, sway=vc), plant.omega_series(t, states, inputs)
+        assert np.max(np.hypot(tracked[-100:-1, 0], tracked[-100:-1, 1])) < 1e-3  # v_b − v_c ≈ 0
+        assert np.hypot(free[-2, 0], free[-2, 1]) == pytest.approx(0.1, abs=1e-3)  # v_b against 0
+        assert np.all(np.isnan(tracked[-1]))
+    np.testing.assert_allclose(python.omega_series(t, states, inputs, sway=vc),
+                               compiled.omega_series(t, states, inputs, sway=vc), rtol=0.0, atol=1e-12)
+    with pytest.raises(ShapeError, match="sway"):
+        compiled.omega_series(t, states, inputs, sway=vc[:-1])
+
+
+def test_a_sway_command_needs_lateral_thrust():
+    plant = DynamicPlant(_scenario("remus100"))
+    assert not plant.lateral
+    with pytest.raises(ConfigError, match="sway"):
+        plant.step_tuple(0.0, (0.0, 0.0, 0.0, 0.0), (0.3, 0.0, 0.0), 0.005, 2, sway=0.1)
+    with pytest.raises(ConfigError, match="sway"):
+        plant.step(0.0, np.zeros(4), np.array([0.3, 0.0, 0.0]), 0.005, 2, sway=-0.05)
+    assert plant.state is None  # refused before the first step
+    plant.step(0.0, np.zeros(4), np.array([0.3, 0.0, 0.0]), 0.005, 2, sway=0.0)

@@ -308,3 +308,17 @@ def test_a_surge_floor_is_off_by_default_in_the_dict_only_when_set_and_round_tri
 def test_surge_floor_errors_name_the_field(table, match):
     with pytest.raises(ConfigError, match=match):
         scenario_from_dict({"limits": table})
+
+
+@pytest.mark.parametrize("plant, ok", [
+    ({}, False),                                                                    # the kinematic plant
+    ({"kind": "dynamic", "vehicle": "remus100"}, False),                           # no lateral thrust
+    ({"kind": "dynamic", "vehicle": "bluerov2_heavy"}, True),                      # Y_max > 0
+])
+def test_a_backup_that_commands_sway_needs_a_vehicle_with_lateral_thrust(plant, ok):
+    data = {**paper_scenario().to_dict(), "controller": {"backup": "hold"}, "plant": plant}
+    if ok:
+        assert scenario_from_dict(data).controller.backup == "hold"
+    else:
+        with pytest.raises(ConfigError, match=r"controller\.backup"):
+            scenario_from_dict(data)

@@ -108,6 +108,10 @@ class SpyProof:
         self.calls.append("tick_change")
         return STATION_KEEPING_PROOF.tick_change(law, safe, **kw)
 
+    def sway_change(self, law, safe, **kw) -> float:
+        self.calls.append("sway_change")
+        return STATION_KEEPING_PROOF.sway_change(law, safe, **kw)
+
     def summary_lines(self, cert: BackupCertificate) -> list[str]:
         return [f"backup (hover): {'certified' if cert.certified else 'NOT certified'}"]
 

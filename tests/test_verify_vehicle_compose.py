@@ -145,19 +145,10 @@ def test_a_forced_backup_from_a_moving_state_keeps_every_promise_and_tracking_re
     of the tier it gives holds (the recursive-feasibility premise fails by construction, which voids nothing of the
     safe tier)."""
     import tubekit
-    from tubekit.exceptions import SolverError
-    from tubekit.fhocp import FHOCP
+    from .failing_solver import failing_between
     from tubekit.loop.closed_loop import run_closed_loop
 
-    class _Failing:
-        def __init__(self, scenario, tightening):
-            self.inner, self.k = FHOCP(scenario, tightening), 0
-
-        def solve(self, t, state, obstacles, v_last=None):
-            self.k += 1
-            if 100 <= self.k - 1 < 250:
-                raise SolverError("injected")
-            return self.inner.solve(t, state, obstacles, v_last=v_last)
+    _Failing = failing_between(100, 250)
 
     sc = load_scenario(SLOW).with_changes(duration=40.0, **{"controller.candidate": False})  # the backup, not the candidate
     res = run_closed_loop(sc, tightening=slow_cert.tightening, solver_factory=_Failing, progress=False)

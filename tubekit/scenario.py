@@ -134,6 +134,17 @@ class Scenario:
                 raise ConfigError("workspace", "lower < upper on every axis", self.workspace)
             object.__setattr__(self, "workspace", (tuple(float(x) for x in lo), tuple(float(x) for x in hi)))
         period_count("duration", self.duration, self.controller.dt)
+        self._check_lateral_backup()
+
+    def _check_lateral_backup(self) -> None:
+        """A backup law that commands sway (``controller.backup = "hold"``) needs a dynamic plant whose vehicle has
+        lateral thrust (``Y_max`` > 0): the kinematic plant and a free-swaying hull take no sway command."""
+        from tubekit.model.backup import BACKUP_LAWS  # the registry (tubekit.model registers every law)
+        if not BACKUP_LAWS[self.controller.backup].lateral:
+            return
+        if not (self.plant.dynamic and self.plant.params.lateral):
+            raise ConfigError("controller.backup", "a law without a sway command (station_keeping, loiter) unless "
+                              "[plant] is dynamic with lateral thrust (Y_max > 0)", self.controller.backup)
 
     @property
     def steps(self) -> int:

@@ -44,11 +44,12 @@ WARM_DURATION_S = 1.0
 def warm_scenario(scenario: Scenario) -> Scenario:
     """The fork server's warm-up copy of ``scenario``: :data:`WARM_DURATION_S` s long and, on the dynamic plant,
     on the kinematic one. The warm-up's certificate is discarded (the workers certify every design again), and a
-    dynamic certificate's fixed point and backup design can take seconds, paid twice; the kinematic copy
-    imports and runs the same ``verify``, cvxpy and loop code."""
+    dynamic certificate's fixed point and backup design can take seconds, paid twice; the kinematic copy (with
+    station keeping, which the kinematic plant takes) imports and runs the same ``verify``, cvxpy and loop code."""
     warm = scenario.with_changes(duration=WARM_DURATION_S)
-    if warm.plant.dynamic:
-        warm = warm.with_changes(plant=dataclasses.replace(warm.plant, kind="kinematic"))
+    if warm.plant.dynamic:  # a backup law that commands sway needs the dynamic plant: the default law's copy
+        warm = warm.with_changes(plant=dataclasses.replace(warm.plant, kind="kinematic"),
+                                 **{"controller.backup": "station_keeping"})
     return warm
 
 

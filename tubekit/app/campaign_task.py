@@ -18,6 +18,7 @@ from typing import TYPE_CHECKING, Any, Callable
 import numpy as np
 
 from tubekit.exceptions import TubekitError
+from tubekit.loop.promises import current_bound
 from tubekit.scenario import Scenario
 from tubekit.tightening import Tightening
 
@@ -40,13 +41,18 @@ class RunTask:
 
 
 def _disturbances(task: RunTask) -> list[Callable | None]:
-    """None (the scenario's current), then ``sequences`` piecewise-constant ω within the certificate's bounds."""
+    """None (the scenario's current), then ``sequences`` piecewise-constant ω within the certificate's bounds: on the
+    kinematic plant the whole ω̄ (current and sway, both assumed); on the dynamic plant, where the override replaces
+    the water current only and the hull's sway and the loop error are the plant's own, the current's bound
+    (:func:`tubekit.loop.promises.current_bound`, the premise the certificate assumes)."""
     if task.sequences == 0:
         return [None]
     from verify.falsify.closed_loop import piecewise_disturbance
 
     bound = task.tightening.disturbance
     omega_xy, omega_z = bound.omega_xy, bound.omega_z
+    if task.scenario.plant.dynamic:
+        omega_xy, omega_z = current_bound(task.scenario)
     rng = np.random.default_rng([task.seed, 1])
     dt = task.scenario.controller.dt
     return [None] + [piecewise_disturbance(omega_xy, omega_z, dt, rng.random((task.scenario.steps, 3)))

@@ -66,7 +66,7 @@ from tubekit.model.ancillary import AncillaryLaw
 from tubekit.exceptions import ConfigError, SolverError
 from tubekit.loop.candidate import candidate_plan
 from tubekit.loop.memory import ZERO_INPUT, PlanMemory
-from tubekit.loop.plan_check import PlanCheck, check_plan, check_rates
+from tubekit.loop.plan_check import PlanCheck, check_plan, check_rates, check_sway
 from tubekit.loop.setup import (Clock, build_solver, progress_bar, saturate, silence_fallback_warnings, status_text,
                                 takes_v_last, validate_inputs)
 from tubekit.plant.base import OmegaOverride, PlantModel
@@ -154,6 +154,8 @@ class _ClosedLoop:
         self.v_last = None if scenario.limits.rate is None else np.clip(np.zeros(3), self.v_low, self.v_bar)
         self.passes_v_last = takes_v_last(solver)
         self.t_h, self.v_h = 0.0, (0.0, 0.0, 0.0)  # the last hand-over to the backup: time (s), applied command
+        self.sway_last = 0.0  # the last tick's sway command (m/s): a lateral backup's, else 0
+        self.release = math.inf if tightening.backup is None else tightening.backup.law.sway_release
 
     def sense(self, xk: np.ndarray) -> tuple[Obstacle, ...]:
         """Obstacles known after sensing at the position of ``xk``."""
@@ -230,7 +232,8 @@ class _ClosedLoop:
                               self.scenario.limits.jump(self.scenario.controller.dt), goal, law=law, v_min=self.v_low)
         if plan is None:
             return None
-        check = check_plan(self.scenario, tight, tk, xk, plan, known, self.sign, v_last=self.v_last)
+        check = check_sway(self.sway_last, self.release) or \
+            check_plan(self.scenario, tight, tk, xk, plan, known, self.sign, v_last=self.v_last)
         if not (check.ok or (recovery and check.safe)):
             return None
         self.log.candidate[k] = True
@@ -281,7 +284,10 @@ class _ClosedLoop:
 
         The check's ``end`` is the accepted plan's nominal end: the backup's anchor.
         """
-        if self.tightening.horizon_arcs == 0:
+        gate = check_sway(self.sway_last, self.release)
+        if gate is not None:
+            check = gate
+        elif self.tightening.horizon_arcs == 0:
             if self.scenario.limits.rate is None:
                 return PlanCheck(True, math.inf, "no margins")
             check = check_rates(self.scenario, self.tightening, plan, self.v_last)
@@ -318,8 +324,15 @@ class _ClosedLoop:
             i = i0 + j
             xs = np.asarray(x)
             log.states[i] = xs
+            sway = 0.0
             if period.anchor is not None:
-                v = backup.command(x, period.anchor, float(clock.t[i] - self.t_h), self.v_h)
+                if backup.lateral:
+                    u_c, w_c, r_c, sway = backup.lateral_command(x, period.anchor, float(clock.t[i] - self.t_h),
+                                                                 self.v_h)
+                    v = (u_c, w_c, r_c)
+                    log.sway_command[i] = sway
+                else:
+                    v = backup.command(x, period.anchor, float(clock.t[i] - self.t_h), self.v_h)
                 log.kappa[i] = 0.0
                 log.v_hat[i] = v
             elif self.sigma > 0.0:
@@ -333,7 +346,9 @@ class _ClosedLoop:
                 v = vh
             v, log.saturated[i] = saturate(v, self.limits, self.lower)
             log.inputs[i] = v
-            x = self.plant.step_tuple(float(clock.t[i]), x, v, h, clock.substeps)
+            x = self.plant.step_tuple(float(clock.t[i]), x, v, h, clock.substeps, sway) if sway else \
+                self.plant.step_tuple(float(clock.t[i]), x, v, h, clock.substeps)
+        self.sway_last = sway
         return x, law_s
 
     def log_period(self, k: int, xk: np.ndarray, period: _Period, nominal_before: np.ndarray) -> None:
@@ -377,7 +392,7 @@ class _ClosedLoop:
 
     def omega_log(self) -> np.ndarray:
         """ω = ẋ − f(x) v (m/s) at the start of every tick (NaN where the input is NaN)."""
-        return self.plant.omega_series(self.clock.t, self.log.states, self.log.inputs)
+        return self.plant.omega_series(self.clock.t, self.log.states, self.log.inputs, self.log.sway_command)
 
 
 def run_closed_loop(scenario: Scenario, tightening: Tightening | None = None, *, tube: bool = True,
@@ -443,6 +458,7 @@ def run_closed_loop(scenario: Scenario, tightening: Tightening | None = None, *,
     loop.log.backup_active[-1] = loop.log.backup_active[-2]  # the final state is reached under the last period's law
     loop.log.recovery[-1] = loop.log.recovery[-2]
     loop.log.backup_anchor[-1] = loop.log.backup_anchor[-2]
+    loop.log.sway_command[-1] = loop.log.sway_command[-2]
     return _result(loop, tube, wall0, disturbance is not None)
 
 
@@ -464,5 +480,6 @@ def _result(loop: _ClosedLoop, tube: bool, wall0: float, overridden: bool) -> Si
         kappa_failures=log.kappa_failures, wall_s=wall_s, rejected=log.rejected, plan_age=log.plan_age,
         candidate=log.candidate, recovery=log.recovery,
         plan_slack=log.plan_slack, backup_active=log.backup_active, backup_anchor=log.backup_anchor,
+        sway_command=log.sway_command,
         omega_overridden=overridden, body=body, current=loop.plant.current_series(clock.t),
         thrust=thrust, omega_peak=loop.plant.omega_peak(), current_peak=loop.plant.current_peak())

@@ -52,7 +52,7 @@ from tubekit.loop.terminal import terminal_condition
 from tubekit.tightening import Tightening
 
 __all__ = ["PlanCheck", "check_plan", "check_rates", "rate_slacks", "box_excess", "plan_arcs", "tracking_checked",
-           "RATE_TOLERANCE"]
+           "RATE_TOLERANCE", "check_sway"]
 
 #: Points per arc of the check (plus the arc's end).
 SAMPLES_PER_ARC = ARC_SAMPLES
@@ -135,6 +135,17 @@ def check_rates(scenario: Scenario, tight: Tightening, inputs: np.ndarray,
     slacks = rate_slacks(v, jump, v_last, tight.terminal_rest, target=tight.terminal_command)
     where, worst = min(slacks.items(), key=lambda kv: kv[1])
     return PlanCheck(worst >= -RATE_TOLERANCE, worst, where)
+
+
+def check_sway(sway_last: float, release: float) -> PlanCheck | None:
+    """None when a plan may take over from the last sway command ``sway_last`` (m/s), else the refusal: a plan never
+    commands sway, so the sway command jumps to 0 when one is accepted, and the velocity loop's bound charges that
+    jump at most the backup law's ``release`` (m/s; :mod:`tubekit.model.hold` turns the nose until its sway command
+    is that small; ∞ for a law without sway)."""
+    if abs(float(sway_last)) <= release:
+        return None
+    return PlanCheck(False, release - abs(float(sway_last)),
+                     f"sway: the last sway command {sway_last:.4g} m/s is more than {release:.4g} m/s from 0")
 
 
 def box_excess(inputs: np.ndarray, tight: Tightening) -> float:

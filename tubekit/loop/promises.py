@@ -97,6 +97,7 @@ class RunLog(Protocol):
     body: np.ndarray | None
     current: np.ndarray | None
     current_peak: tuple[float, float] | None
+    sway_command: np.ndarray
 
     @property
     def errors(self) -> np.ndarray: ...
@@ -232,14 +233,15 @@ def _peaks(ticks: np.ndarray, stages: tuple[float, float] | None) -> tuple[float
 
 
 def _sway(run: RunLog) -> Promise:
-    """The sway the plant applied against γ̄: the hull's |v_b| (dynamic plant) or the sway model's |v_s|."""
+    """The sway the plant applied against γ̄: the hull's |v_b − v_c| (dynamic plant; v_c the sway command, 0 but
+    under a backup law with lateral thrust) or the sway model's |v_s|."""
     gamma = run.tightening.disturbance.sway
     if run.body is not None:
-        vb = np.abs(run.body[:, 1])
-        bound = ("the sway loop's error bound: lateral thrust regulates the sway to 0"
+        vb = np.abs(run.body[:, 1] - np.asarray(run.sway_command, dtype=float)[:len(run.body)])
+        bound = ("the sway loop's error bound: lateral thrust regulates the sway to its command"
                  if run.scenario.plant.params.lateral else "ISS bound of the hull's free sway")
         return _at_most("sway", float(np.nanmax(vb)) if len(vb) else 0.0, gamma + _TOL,
-                        f"max |v_b| of the 4-DOF hull (m/s) vs gamma_bar ({bound})")
+                        f"max |v_b - v_c| of the 4-DOF hull (m/s) vs gamma_bar ({bound})")
     if run.omega_overridden:
         return Promise("sway", math.nan, gamma, True, "not applicable: the disturbance is overridden, "
                                                       "so the sway cannot be separated from it")

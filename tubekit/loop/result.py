@@ -70,6 +70,8 @@ LOG_FIELDS: tuple[LogField, ...] = (
              "a recovery plan is followed (accepted for safety alone, its error left R: tracking not in force)"),
     LogField("backup_anchor", "tick", 3, float, np.nan, ("anchor_x", "anchor_y", "anchor_z"),
              "the backup's anchor p* (m) while it runs, NaN otherwise"),
+    LogField("sway_command", "tick", 0, float, 0.0, (),
+             "the sway command v_c (m/s): a backup law with lateral thrust (tubekit.model.hold) only, else 0"),
     LogField("n_detected", "tick", 0, int, 0, ("n_detected",), "obstacles known to the map"),
     LogField("solve_ms", "tick", 0, float, np.nan, ("solve_ms",), "FHOCP solve time (ms), first tick of a period"),
     LogField("step_ms", "tick", 0, float, np.nan, ("step_ms",), "controller time per period (ms), first tick"),

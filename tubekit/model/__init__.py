@@ -9,6 +9,7 @@ from __future__ import annotations
 from tubekit.model.ancillary import LAWS, AncillaryLaw, get_law, jacobian_at, register_law
 from tubekit.model.errors import bearing, error_coordinates, heading_cosine, numeric
 from tubekit.model.loiter import Loiter  # registers the loiter backup law (kind "loiter")
+from tubekit.model.hold import Hold  # registers the hold backup law (kind "hold", lateral thrust)
 from tubekit.model.kinematics import (InputLimits, SwayModel, dsinc, kinematics, nominal_kinematics, sinc,
                                       unicycle_step)
 from tubekit.model.thrusters import ThrusterGeometry
@@ -20,5 +21,5 @@ __all__ = [
     "error_coordinates", "bearing", "heading_cosine", "numeric",
     "AncillaryLaw", "LAWS", "get_law", "register_law", "jacobian_at",
     "Trajectory", "Circle", "Helix", "Line", "Waypoints", "trajectory_from_dict",
-    "VehicleParams", "VEHICLES", "PlantSettings", "vehicle_params", "Loiter", "ThrusterGeometry",
+    "VehicleParams", "VEHICLES", "PlantSettings", "vehicle_params", "Loiter", "Hold", "ThrusterGeometry",
 ]

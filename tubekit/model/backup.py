@@ -63,8 +63,8 @@ import numpy as np
 from tubekit.exceptions import ConfigError
 from tubekit.validation import nonnegative, positive
 
-__all__ = ["BackupLaw", "BACKUP_LAWS", "register_backup_law", "backup_law_from_dict", "StationKeeping", "SafeSet",
-           "BackupPlan", "line_of_sight_angle", "axis_angle", "station_keeping_input", "yaw_shape", "axis_shape",
+__all__ = ["BackupLaw", "BACKUP_LAWS", "register_backup_law", "backup_law_from_dict", "StationKeeping", "NoSway",
+           "SafeSet", "BackupPlan", "line_of_sight_angle", "axis_angle", "station_keeping_input", "yaw_shape", "axis_shape",
            "YAW_LAWS", "SHAPE_PLATEAU", "ANCHOR_RING", "ANCHOR_DIRECTIONS", "anchor_offsets"]
 
 
@@ -73,6 +73,8 @@ class BackupLaw(Protocol):
     """What the loop, the terminal condition and the velocity loop's bound read of a backup law (module doc)."""
 
     kind: ClassVar[str]
+    #: True when the law commands sway (a vehicle with lateral thrust: :mod:`tubekit.model.hold`).
+    lateral: ClassVar[bool]
 
     @property
     def blends(self) -> bool:
@@ -102,6 +104,21 @@ class BackupLaw(Protocol):
     def command(self, state: tuple[float, float, float, float], anchor: tuple[float, float, float],
                 elapsed: float, start: tuple[float, float, float]) -> tuple[float, float, float]:
         """(u, w, r) at ``state`` about ``anchor``, ``elapsed`` s after the hand-over, ``start`` the command then."""
+        ...
+
+    @property
+    def sway_bound(self) -> float:
+        """The largest |v| the law commands (m/s; 0 when it never commands sway)."""
+        ...
+
+    @property
+    def sway_release(self) -> float:
+        """A plan may take over only once the law's sway command is within this of 0 (m/s; ∞ without sway)."""
+        ...
+
+    def lateral_command(self, state: tuple[float, float, float, float], anchor: tuple[float, float, float],
+                        elapsed: float, start: tuple[float, float, float]) -> tuple[float, float, float, float]:
+        """(u, w, r, v): :meth:`command` and the sway command v (m/s; 0 for a law that never commands sway)."""
         ...
 
     def to_dict(self) -> dict[str, Any]:
@@ -137,8 +154,32 @@ def axis_angle(phi: float) -> float:
     return phi
 
 
+class NoSway:
+    """The backup-law protocol's sway members for a law that never commands sway (station keeping, the loiter)."""
+
+    #: The law never commands sway.
+    lateral: ClassVar[bool] = False
+
+    @property
+    def sway_bound(self) -> float:
+        """0 (m/s): no sway command."""
+        return 0.0
+
+    @property
+    def sway_release(self) -> float:
+        """∞: the law never commands sway, so it never holds a plan back."""
+        return math.inf
+
+    def lateral_command(self, state: tuple[float, float, float, float], anchor: tuple[float, float, float],
+                        elapsed: float = math.inf, start: tuple[float, float, float] = (0.0, 0.0, 0.0)
+                        ) -> tuple[float, float, float, float]:
+        """(``command``, 0): no sway command."""
+        u, w, r = self.command(state, anchor, elapsed, start)  # the law's own (the subclass's)
+        return u, w, r, 0.0
+
+
 @dataclass(frozen=True)
-class StationKeeping:
+class StationKeeping(NoSway):
     """Gains of the station-keeping law.
 
     Attributes
@@ -228,6 +269,7 @@ class StationKeeping:
                 ) -> tuple[float, float, float]:
         """:func:`station_keeping_input` of this law (float tuples: the loop's inner loop)."""
         return station_keeping_input(self, state, anchor, elapsed, start)
+
 
     def to_dict(self) -> dict[str, Any]:
         """The gains with ``kind``; the fades, the ramp and the yaw law only when set (0 / "ridge": off)."""

@@ -27,7 +27,7 @@ from typing import Any, ClassVar
 import numpy as np
 
 from tubekit.exceptions import ConfigError
-from tubekit.model.backup import line_of_sight_angle, register_backup_law
+from tubekit.model.backup import NoSway, line_of_sight_angle, register_backup_law
 from tubekit.validation import positive
 
 __all__ = ["Loiter", "loiter_input", "loiter_shape", "loiter_shape_slope"]
@@ -39,7 +39,7 @@ def _sat(x: float) -> float:
 
 @register_backup_law
 @dataclass(frozen=True)
-class Loiter:
+class Loiter(NoSway):
     """Gains of the loiter law (module doc).
 
     Attributes
@@ -105,6 +105,7 @@ class Loiter:
                 ) -> tuple[float, float, float]:
         """:func:`loiter_input` of this law (``elapsed`` and ``start`` are not read: the law does not blend)."""
         return loiter_input(self, state, anchor)
+
 
     def to_dict(self) -> dict[str, Any]:
         """The gains with ``kind``."""

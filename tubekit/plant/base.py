@@ -50,11 +50,12 @@ class PlantModel(Protocol):
     """The simulated vehicle as the closed loop drives it (state [x, y, z, ψ] in m and rad)."""
 
     def step_tuple(self, t: float, x: Sequence[float], v: Sequence[float], h: float,
-                   n: int) -> tuple[float, float, float, float]:
-        """``n`` RK4 steps of ``h`` (s) from ``x`` at ``t`` (s) with the command ``v`` (m/s, m/s, rad/s) held."""
+                   n: int, sway: float = 0.0) -> tuple[float, float, float, float]:
+        """``n`` RK4 steps of ``h`` (s) from ``x`` at ``t`` (s) with the command ``v`` (m/s, m/s, rad/s) and the sway
+        command ``sway`` (m/s; only a vehicle with lateral thrust takes one other than 0) held."""
         ...
 
-    def step(self, t: float, x: np.ndarray, v: np.ndarray, h: float, n: int) -> np.ndarray:
+    def step(self, t: float, x: np.ndarray, v: np.ndarray, h: float, n: int, sway: float = 0.0) -> np.ndarray:
         """:meth:`step_tuple` on arrays."""
         ...
 
@@ -62,8 +63,9 @@ class PlantModel(Protocol):
         """The current (m/s) at time ``t`` (s)."""
         ...
 
-    def omega_series(self, t: np.ndarray, states: np.ndarray, inputs: np.ndarray) -> np.ndarray:
-        """ω = ẋ − f(x) v (K + 1, 3), m/s, at the logged ticks."""
+    def omega_series(self, t: np.ndarray, states: np.ndarray, inputs: np.ndarray,
+                     sway: np.ndarray | None = None) -> np.ndarray:
+        """ω = ẋ − f(x) v (K + 1, 3), m/s, at the logged ticks (``sway``: the sway commands per tick, m/s; None: 0)."""
         ...
 
     def omega_peak(self) -> tuple[float, float]:

@@ -69,8 +69,10 @@ def _saturate(c: float, lim: float) -> float:
 @routine
 def _rhs(t: float, y: np.ndarray, command: np.ndarray, truth: np.ndarray, model: np.ndarray, control: np.ndarray,
          limits: np.ndarray, current: np.ndarray, lateral: bool, out: np.ndarray, peak: np.ndarray) -> None:
-    """d/dt of ``y`` into ``out`` (``DynamicPlant._rhs``); ``control`` = (k_p, k_i, 1/T_thr)."""
+    """d/dt of ``y`` into ``out`` (``DynamicPlant._rhs``); ``control`` = (k_p, k_i, 1/T_thr), ``command`` =
+    (u_c, w_c, r_c[, v_c]) (v_c = 0 when absent)."""
     kp, ki, tau_inv = control[0], control[1], control[2]
+    vc = command[3] if command.shape[0] > 3 else 0.0
     c1, c2, c3 = current_at(current, t)
     psi, u, v, w, r = y[3], y[4], y[5], y[6], y[7]
     cp, sp = math.cos(psi), math.sin(psi)
@@ -93,7 +95,8 @@ def _rhs(t: float, y: np.ndarray, command: np.ndarray, truth: np.ndarray, model:
     else:
         lim1, lim2 = limits[1], limits[2]
     s0, s1, s2 = _saturate(raw0, limits[0]), _saturate(raw1, lim1), _saturate(raw2, lim2)
-    o1, o2, o3 = c1 - e0 * cp - v * sp, c2 - e0 * sp + v * cp, c3 - e1
+    dv = v - vc  # the sway's error as ω sees it: exactly v at v_c = 0
+    o1, o2, o3 = c1 - e0 * cp - dv * sp, c2 - e0 * sp + dv * cp, c3 - e1
     _record(peak, o1, o2, o3, c1, c2, c3)
     out[0], out[1], out[2], out[3] = u * cp - v * sp + c1, u * sp + v * cp + c2, w + c3, r
     out[8], out[9], out[10] = (s0 - y[8]) * tau_inv, (s1 - y[9]) * tau_inv, (s2 - y[10]) * tau_inv
@@ -102,10 +105,12 @@ def _rhs(t: float, y: np.ndarray, command: np.ndarray, truth: np.ndarray, model:
     out[12] = 0.0 if s1 != raw1 and s1 * e1 > 0.0 else e1
     out[13] = 0.0 if s2 != raw2 and s2 * e2 > 0.0 else e2
     if lateral:
-        raw = f2 + model[_M22] * (-kp * v + ki * y[15])
+        # Y_cmd = n̂_2 + m̂_22 (k_p e_v + k_i ∫e_v), e_v = v_c − v = −dv (exactly −v at v_c = 0)
+        raw = f2 + model[_M22] * (-kp * dv + ki * y[15])
         sat = _saturate(raw, limits[7])
         out[14] = (sat - y[14]) * tau_inv
-        out[15] = 0.0 if sat != raw and sat * v < 0.0 else -v
+        ev = -dv
+        out[15] = 0.0 if sat != raw and sat * ev > 0.0 else ev
 
 
 @routine
@@ -127,10 +132,13 @@ def rk4_dynamic(t: float, y0: np.ndarray, command: np.ndarray, h: float, n: int,
                 model: np.ndarray, control: np.ndarray, limits: np.ndarray, current: np.ndarray, lateral: bool,
                 peak: np.ndarray) -> np.ndarray:
     """``n`` RK4 steps of ``h`` (s) from ``y0`` (14,) or, with ``lateral``, (16,) at ``t`` (s), ``command``
-    (u_c, w_c, r_c) held; ``peak`` (4,) is updated in place.
+    (u_c, w_c, r_c[, v_c]) held; ``peak`` (4,) is updated in place.
 
     Parameters
     ----------
+    command : array (3,) or (4,)
+        (u_c (m/s), w_c (m/s), r_c (rad/s)[, v_c (m/s)]): the kinematic command and the commanded body sway
+        velocity, tracked by the sway loop with ``lateral`` (0 when absent; without ``lateral`` it must be 0).
     truth, model : array (21,)
         :func:`coefficients` of the vehicle as simulated and of the controller's model.
     control : array (3,)
@@ -169,17 +177,40 @@ def current_at_ticks(t: np.ndarray, current: np.ndarray) -> np.ndarray:
     return out
 
 
-@routine
 def omega_at_ticks(t: np.ndarray, states: np.ndarray, inputs: np.ndarray, body: np.ndarray,
-                   current: np.ndarray) -> np.ndarray:
-    """ω = δ + R(ψ)(u_b − u_c, v_b), δ_z + w_b − w_c (m/s) at every tick (len(t), 3) from the logged body velocities
-    ``body`` (K, 4); NaN where u_c or r_c is NaN or past the log."""
+                   current: np.ndarray, sway: np.ndarray | None = None) -> np.ndarray:
+    """ω = δ + R(ψ)(u_b − u_c, v_b − v_c), δ_z + w_b − w_c (m/s) at every tick (len(t), 3); NaN where u_c or r_c is
+    NaN or past the log.
+
+    Parameters
+    ----------
+    t : array (K + 1,)
+        Tick times (s).
+    states : array (K + 1, 4)
+        Poses at the ticks (m, m, m, rad).
+    inputs : array (K + 1, 3)
+        Commands (u_c, w_c, r_c) at the ticks (m/s, m/s, rad/s).
+    body : array (K, 4)
+        Logged body velocities (u_b, v_b, w_b, r_b) (m/s, m/s, m/s, rad/s).
+    current : array (7,)
+        The current's parameters (:func:`tubekit.plant.compiled_kinematic.current_at`).
+    sway : array (K + 1,), optional
+        Commanded sway velocities v_c at the ticks (m/s); None: zeros.
+    """
+    vc = np.zeros(t.shape[0]) if sway is None else np.ascontiguousarray(sway, dtype=float)
+    return _omega_at_ticks(t, states, inputs, body, current, vc)
+
+
+@routine
+def _omega_at_ticks(t: np.ndarray, states: np.ndarray, inputs: np.ndarray, body: np.ndarray,
+                    current: np.ndarray, sway: np.ndarray) -> np.ndarray:
+    """:func:`omega_at_ticks` compiled, ``sway`` (K + 1,) given."""
     out = np.full((t.shape[0], 3), np.nan)
     for i in range(min(t.shape[0], body.shape[0])):
         if not (math.isfinite(inputs[i, 0]) and math.isfinite(inputs[i, 2])):
             continue
         c1, c2, c3 = current_at(current, t[i])
-        du, vb = body[i, 0] - inputs[i, 0], body[i, 1]
+        du, vb = body[i, 0] - inputs[i, 0], body[i, 1] - sway[i]
         cp, sp = math.cos(states[i, 3]), math.sin(states[i, 3])
         out[i, 0] = c1 + du * cp - vb * sp
         out[i, 1] = c2 + du * sp + vb * cp

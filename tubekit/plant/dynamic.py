@@ -23,9 +23,10 @@ n̂(ν) = Ĉ(ν)ν + D̂(ν)ν of the NOMINAL vehicle (the midpoints of the coef
 feedback linearisation, the sway row eliminated from the yaw row) plus PI on
 e = (u_c − u, w_c − w, r_c − r) with k_p = ω_b, k_i = ω_b²/4 and conditional
 integration while saturated. A vehicle with lateral thrust (``Y_max`` > 0,
-:attr:`~tubekit.model.vehicle_params.VehicleParams.lateral`; M diagonal in sway and yaw) regulates its sway
-to 0 by a fourth loop of the same form: Y_cmd = n̂_2(ν) + m̂_22 (k_p e_v + k_i ∫e_v), e_v = 0 − v, its
-thrust lagging like the others; without it Y = 0 and the hull's sway is free. The vehicle itself moves
+:attr:`~tubekit.model.vehicle_params.VehicleParams.lateral`; M diagonal in sway and yaw) tracks a commanded sway
+velocity v_c (``step_tuple(..., sway=v_c)``, 0 by default) by a fourth loop of the same form:
+Y_cmd = n̂_2(ν) + m̂_22 (k_p e_v + k_i ∫e_v), e_v = v_c − v, its thrust lagging like the others; without it
+Y = 0, v_c must be 0 and the hull's sway is free. The vehicle itself moves
 with the TRUTH (a point of the box, ``[plant.truth]``). Positions, ν, τ and the integrators are integrated together by
 classical RK4 at the closed loop's fixed step; without a current override as one compiled routine
 (:mod:`tubekit.plant.compiled_dynamic`, the very floats of :func:`~tubekit.plant.kinematic.rk4_tuple` on ``_rhs``).
@@ -38,6 +39,7 @@ from typing import Sequence
 
 import numpy as np
 
+from tubekit.exceptions import ConfigError, ShapeError
 from tubekit.plant.base import OmegaOverride
 from tubekit.plant.kinematic import Plant, rk4_tuple
 from tubekit.scenario import Scenario
@@ -152,17 +154,33 @@ class DynamicPlant:
         sat = tuple(min(max(c, -lim), lim) for c, lim in zip(raw, self._limits or self.params.thrust_limits_at(nu[0])))
         return sat, tuple(s != c for s, c in zip(sat, raw))
 
-    def sway_command(self, nu: Sequence[float], integral: float, forces: Floats4 | None = None) -> tuple[float, bool]:
-        """Y_cmd = n̂_2(ν) + m̂_22 (k_p (0 − v) + k_i ∫(0 − v)) saturated at ±Y_max (N), and whether it saturates
-        (``forces``: n̂(ν) already evaluated)."""
+    def sway_command(self, nu: Sequence[float], integral: float, forces: Floats4 | None = None,
+                     sway: float = 0.0) -> tuple[float, bool]:
+        """Y_cmd = n̂_2(ν) + m̂_22 (k_p (v_c − v) + k_i ∫(v_c − v)) saturated at ±Y_max (N), and whether it
+        saturates.
+
+        Parameters
+        ----------
+        nu : sequence of 4 floats
+            Body velocities (u, v, w, r) (m/s, m/s, m/s, rad/s).
+        integral : float
+            The sway integrator ∫(v_c − v) (m).
+        forces : tuple of 4 floats, optional
+            n̂(ν) already evaluated (N, N, N, N m).
+        sway : float
+            The commanded body sway velocity v_c (m/s).
+        """
         n2 = (forces if forces is not None else body_forces(self.model, nu))[1]
-        raw = n2 + self._mass[1] * (-self._kp * nu[1] + self._ki * integral)
+        # −k_p (v − v_c): at v_c = 0 the very floats of −k_p v (signed zeros too)
+        raw = n2 + self._mass[1] * (-self._kp * (nu[1] - sway) + self._ki * integral)
         sat = min(max(raw, -self._sway_limit), self._sway_limit)
         return sat, sat != raw
 
     def _rhs(self, t: float, y: Sequence[float], command: Sequence[float]) -> tuple[float, ...]:
-        """d/dt of (x, y, z, ψ, u, v, w, r, X, Z, N, I_u, I_w, I_r[, Y, I_v])."""
+        """d/dt of (x, y, z, ψ, u, v, w, r, X, Z, N, I_u, I_w, I_r[, Y, I_v]) under ``command`` = (u_c, w_c, r_c[, v_c])
+        (m/s, m/s, rad/s[, m/s]; v_c = 0 when absent)."""
         psi, nu, tau, integral = y[3], y[4:8], y[8:11], y[11:14]
+        vc = command[3] if len(command) > 3 else 0.0
         c1, c2, c3 = self.current_at(t)
         cp, sp = math.cos(psi), math.sin(psi)
         u, v, w, r = nu
@@ -172,13 +190,15 @@ class DynamicPlant:
         err = (command[0] - u, command[1] - w, command[2] - r)
         # conditional integration: hold the integral while its channel saturates in the error's direction
         integ = tuple(0.0 if s and c * e > 0.0 else e for s, c, e in zip(saturated, cmd, err))
-        self._record(c1 - err[0] * cp - v * sp, c2 - err[0] * sp + v * cp, c3 - err[1], c1, c2, c3)
+        dv = v - vc  # the sway's error as ω sees it: exactly v at v_c = 0
+        self._record(c1 - err[0] * cp - dv * sp, c2 - err[0] * sp + dv * cp, c3 - err[1], c1, c2, c3)
         out = (u * cp - v * sp + c1, u * sp + v * cp + c2, w + c3, r, *acc,
                *((ci - ti) * self._tau_inv for ci, ti in zip(cmd, tau)), *integ)
         if not self.lateral:
             return out
-        y_cmd, y_sat = self.sway_command(nu, y[15], model_forces)
-        return (*out, (y_cmd - y[14]) * self._tau_inv, 0.0 if y_sat and y_cmd * v < 0.0 else -v)
+        y_cmd, y_sat = self.sway_command(nu, y[15], model_forces, vc)
+        ev = -dv  # e_v = v_c − v, exactly −v at v_c = 0; held while Y saturates in the error's direction
+        return (*out, (y_cmd - y[14]) * self._tau_inv, 0.0 if y_sat and y_cmd * ev > 0.0 else ev)
 
     def _record(self, o1: float, o2: float, o3: float, c1: float, c2: float, c3: float) -> None:
         """Keep the largest ‖ω_xy‖, |ω_z| of ω = ẋ − f(x) v and ‖δ_xy‖, |δ_z| of the current δ (m/s) seen by
@@ -211,27 +231,57 @@ class DynamicPlant:
         return (*nu, *tau, 0.0, 0.0, 0.0)
 
     # ---- the closed loop's interface ----------------------------------------------------
-    def step_tuple(self, t: float, x: Sequence[float], v: Sequence[float], h: float, n: int) -> Floats4:
-        """Pose after ``n`` RK4 steps of ``h`` (s) from pose ``x`` at ``t`` (s), command ``v`` held."""
+    def step_tuple(self, t: float, x: Sequence[float], v: Sequence[float], h: float, n: int,
+                   sway: float = 0.0) -> Floats4:
+        """Pose after ``n`` RK4 steps of ``h`` (s) from pose ``x`` at ``t`` (s), command ``v`` held.
+
+        Parameters
+        ----------
+        t : float
+            Time at the step's start (s).
+        x : sequence of 4 floats
+            Pose (x, y, z, ψ) (m, m, m, rad).
+        v : sequence of 3 floats
+            Kinematic command (u_c, w_c, r_c) (m/s, m/s, rad/s), held over the step.
+        h : float
+            RK4 step (s).
+        n : int
+            Number of RK4 steps.
+        sway : float
+            Commanded body sway velocity v_c (m/s), held over the step; nonzero only with lateral thrust.
+
+        Returns
+        -------
+        tuple of 4 floats
+            The pose after ``n`` steps (m, m, m, rad).
+
+        Raises
+        ------
+        ConfigError
+            ``sway`` is nonzero on a vehicle without lateral thrust.
+        """
+        if sway != 0.0 and not self.lateral:
+            raise ConfigError("sway", "0 on a vehicle without lateral thrust (Y_max = 0)", sway)
         if self.state is None:
             self.state = self._start(v)
         self._log.append(self.state[:7])
+        command = (v[0], v[1], v[2], float(sway))
         if self.override is not None:
-            y = rk4_tuple(self._rhs, t, (*x, *self.state), v, h, n)
+            y = rk4_tuple(self._rhs, t, (*x, *self.state), command, h, n)
             self.state = y[4:]
             return y[0], y[1], y[2], y[3]
-        return self._compiled_step(t, x, v, h, n)
+        return self._compiled_step(t, x, command, h, n)
 
-    def _compiled_step(self, t: float, x: Sequence[float], v: Sequence[float], h: float, n: int) -> Floats4:
+    def _compiled_step(self, t: float, x: Sequence[float], command: Sequence[float], h: float, n: int) -> Floats4:
         """:func:`rk4_tuple` of :meth:`_rhs` (no override) in one compiled routine,
-        :func:`tubekit.plant.compiled_dynamic.rk4_dynamic` (the same floats)."""
+        :func:`tubekit.plant.compiled_dynamic.rk4_dynamic` (the same floats); ``command`` = (u_c, w_c, r_c, v_c)."""
         from tubekit.plant import compiled_dynamic
 
         truth, model, control, limits, current = self._packed()
         peak = np.array(self._peak)
         y = compiled_dynamic.rk4_dynamic(float(t), np.array((*x, *self.state), dtype=float),
-                                         np.array(v, dtype=float), float(h), int(n), truth, model, control, limits,
-                                         current, self.lateral, peak)
+                                         np.array(command, dtype=float), float(h), int(n), truth, model, control,
+                                         limits, current, self.lateral, peak)
         self._peak[:] = peak.tolist()
         values = y.tolist()
         self.state = tuple(values[4:])
@@ -249,9 +299,10 @@ class DynamicPlant:
                               np.array(self._current_model.current_parameters))
         return self._compiled
 
-    def step(self, t: float, x: np.ndarray, v: np.ndarray, h: float, n: int) -> np.ndarray:
-        """:meth:`step_tuple` on arrays."""
-        return np.array(self.step_tuple(float(t), tuple(map(float, x)), tuple(map(float, v)), float(h), n))
+    def step(self, t: float, x: np.ndarray, v: np.ndarray, h: float, n: int, sway: float = 0.0) -> np.ndarray:
+        """:meth:`step_tuple` on arrays (pose (4,), command (3,)); ``sway`` the commanded sway velocity v_c (m/s)."""
+        return np.array(self.step_tuple(float(t), tuple(map(float, x)), tuple(map(float, v)), float(h), n,
+                                        sway=float(sway)))
 
     def history(self) -> tuple[np.ndarray, np.ndarray]:
         """Body velocities (K + 1, 4) and thrusts (K + 1, 3) at the start of every tick, plus the final state."""
@@ -268,19 +319,35 @@ class DynamicPlant:
             return current_at_ticks(np.asarray(t, dtype=float).reshape(-1), self._packed()[4])
         return np.array([self.current_at(float(ti)) for ti in np.asarray(t, dtype=float)], dtype=float).reshape(-1, 3)
 
-    def omega_series(self, t: np.ndarray, states: np.ndarray, inputs: np.ndarray) -> np.ndarray:
-        """ω = ẋ − f(x) v at every tick (K + 1, 3), m/s: δ + R(ψ)(u_b − u_c, v_b), δ_z + w_b − w_c."""
+    def omega_series(self, t: np.ndarray, states: np.ndarray, inputs: np.ndarray,
+                     sway: np.ndarray | None = None) -> np.ndarray:
+        """ω = ẋ − f(x) v at every tick (K + 1, 3), m/s: δ + R(ψ)(u_b − u_c, v_b − v_c), δ_z + w_b − w_c.
+
+        Parameters
+        ----------
+        t : array (K + 1,)
+            Tick times (s).
+        states : array (K + 1, 4)
+            Poses at the ticks (m, m, m, rad).
+        inputs : array (K + 1, 3)
+            Commands (u_c, w_c, r_c) at the ticks (m/s, m/s, rad/s); NaN rows give NaN.
+        sway : array (K + 1,), optional
+            Commanded sway velocities v_c at the ticks (m/s); None: zeros.
+        """
         body, _ = self.history()
+        vc = np.zeros(len(t)) if sway is None else np.asarray(sway, dtype=float).reshape(-1)
+        if vc.shape != (len(t),):
+            raise ShapeError("sway", f"({len(t)},)", vc.shape)
         if self.override is None:
             from tubekit.plant.compiled_dynamic import omega_at_ticks
 
             return omega_at_ticks(np.asarray(t, dtype=float), np.asarray(states, dtype=float),
-                                  np.asarray(inputs, dtype=float), body, self._packed()[4])
+                                  np.asarray(inputs, dtype=float), body, self._packed()[4], vc)
         out = np.full((len(t), 3), np.nan)
         for i, ti in enumerate(t):
             if i < len(body) and np.isfinite(inputs[i, 0]) and np.isfinite(inputs[i, 2]):
                 c1, c2, c3 = self.current_at(float(ti))
-                du, vb = body[i, 0] - inputs[i, 0], body[i, 1]
+                du, vb = body[i, 0] - inputs[i, 0], body[i, 1] - vc[i]
                 cp, sp = math.cos(states[i, 3]), math.sin(states[i, 3])
                 out[i] = (c1 + du * cp - vb * sp, c2 + du * sp + vb * cp, c3 + body[i, 2] - inputs[i, 1])
         return out

@@ -26,6 +26,7 @@ from typing import Callable, Sequence
 
 import numpy as np
 
+from tubekit.exceptions import ConfigError
 from tubekit.plant.base import OmegaOverride, PiecewiseOmega
 from tubekit.scenario import Disturbance, Scenario
 
@@ -128,10 +129,12 @@ class Plant:
         """δ(t) (m/s) as three floats; ``t`` in s."""
         return self._current(t)
 
-    def omega_series(self, t: np.ndarray, states: np.ndarray, inputs: np.ndarray) -> np.ndarray:
+    def omega_series(self, t: np.ndarray, states: np.ndarray, inputs: np.ndarray,
+                     sway: np.ndarray | None = None) -> np.ndarray:
         """ω (m/s) at every logged tick (len(t), 3); NaN where the input is NaN (without an override or under a
         :class:`~tubekit.plant.base.PiecewiseOmega`, compiled: :func:`tubekit.plant.compiled_kinematic.omega_at_ticks`,
-        the same floats as :meth:`omega` tick by tick)."""
+        the same floats as :meth:`omega` tick by tick). ``sway`` is not read: the kinematic plant takes no sway
+        command."""
         if self.override is None or isinstance(self.override, PiecewiseOmega):
             from tubekit.plant.compiled_kinematic import omega_at_ticks
 
@@ -169,16 +172,20 @@ class Plant:
         """ẋ = f(x) v + [ω, 0] (4,) at time ``t`` (s)."""
         return np.array(self._rhs(float(t), tuple(map(float, x)), tuple(map(float, v))))
 
-    def step(self, t: float, x: np.ndarray, v: np.ndarray, h: float, n: int) -> np.ndarray:
+    def step(self, t: float, x: np.ndarray, v: np.ndarray, h: float, n: int, sway: float = 0.0) -> np.ndarray:
         """State (4,) after ``n`` classical RK4 steps of ``h`` (s) from ``x`` at ``t``, ``v`` held."""
-        return np.array(self.step_tuple(float(t), tuple(map(float, x)), tuple(map(float, v)), float(h), n))
+        return np.array(self.step_tuple(float(t), tuple(map(float, x)), tuple(map(float, v)), float(h), n, sway))
 
-    def step_tuple(self, t: float, x: Sequence[float], v: Sequence[float], h: float, n: int) -> Floats4:
-        """:meth:`step` on float tuples, without arrays (the closed loop's inner loop).
+    def step_tuple(self, t: float, x: Sequence[float], v: Sequence[float], h: float, n: int,
+                   sway: float = 0.0) -> Floats4:
+        """:meth:`step` on float tuples, without arrays (the closed loop's inner loop). The kinematic model (eq. 11)
+        takes no sway command: ``sway`` other than 0 is a ConfigError.
 
         Without an override this is :meth:`_compiled_step`: :func:`rk4_tuple` of :meth:`_rhs` as one compiled
         routine, the same floating-point operations in the same order (bit-identical results).
         """
+        if sway != 0.0:
+            raise ConfigError("sway", "0 on the kinematic plant (eq. 11 has no sway command)", sway)
         if self.override is None or isinstance(self.override, PiecewiseOmega):
             return self._compiled_step(t, tuple(x), v, h, n)
         return rk4_tuple(self._rhs, t, tuple(x), v, h, n)

@@ -11,6 +11,7 @@ A backup law (:class:`tubekit.model.backup.BackupLaw`: ``kind``, ``command``, ``
 * :meth:`BackupProof.command_rate` and :meth:`BackupProof.tick_change` — the bounds on the command's rate and
   on its change from one tick to the next along the plant (step 13a), which the velocity loop is charged on the
   dynamic plant (:mod:`verify.vehicle.compose`);
+* :meth:`BackupProof.sway_change` — the same for the sway command of a law that commands sway (0 otherwise);
 * :meth:`BackupProof.summary_lines` — the law's lines of a certificate's text.
 
 The safe set's footprint for the terminal condition (step 11) is the :class:`tubekit.model.backup.SafeSet`
@@ -204,6 +205,13 @@ class BackupProof(Protocol):
         the backup, the hand-over included: the per-tick jumps the velocity loop's bound is charged."""
         ...
 
+    def sway_change(self, law: BackupLaw, safe: SafeSet, *, omega_xy: float, omega_z: float,
+                    limits: tuple[float, float, float], loop_error: tuple[float, float, float],
+                    tick: float) -> float:
+        """Bound (m/s) on the change of the held sway command from one tick to the next during the backup (0 for a
+        law that never commands sway): the sway loop's per-tick jump."""
+        ...
+
     def summary_lines(self, cert: BackupCertificate) -> list[str]:
         """The certificate's text lines for a backup of this kind."""
         ...
@@ -218,8 +226,8 @@ def register_backup_proof(proof: BackupProof) -> BackupProof:
     :class:`BackupProof`, its kind is not a registered backup law (:data:`tubekit.model.backup.BACKUP_LAWS`), or
     another proof holds the kind."""
     if not isinstance(proof, BackupProof):
-        raise ConfigError("backup.proof", "an object with kind, design, certify, command_rate, tick_change and "
-                          "summary_lines", type(proof).__name__)
+        raise ConfigError("backup.proof", "an object with kind, design, certify, command_rate, tick_change, "
+                          "sway_change and summary_lines", type(proof).__name__)
     kind = proof.kind
     if not isinstance(kind, str) or kind not in BACKUP_LAWS:
         raise ConfigError("backup.kind", f"the kind of a registered backup law ({sorted(BACKUP_LAWS)})", kind)

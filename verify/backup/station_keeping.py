@@ -58,6 +58,12 @@ class StationKeepingProof:
         return backup_tick_change(law, safe, omega_xy=omega_xy, omega_z=omega_z, limits=limits,
                                   loop_error=loop_error, tick=tick)
 
+    def sway_change(self, law: BackupLaw, safe: SafeSet, *, omega_xy: float, omega_z: float,
+                    limits: tuple[float, float, float], loop_error: tuple[float, float, float],
+                    tick: float) -> float:
+        """0 (m/s): the law never commands sway."""
+        return 0.0
+
     def summary_lines(self, cert: BackupCertificate) -> list[str]:
         """The station-keeping backup's lines: verdict, safe set, gains, level-set rate, fades and ramp."""
         s, law = cert.safe_set, _station_keeping(cert.law)

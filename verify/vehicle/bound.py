@@ -106,14 +106,16 @@ class Inputs:
 class _Loop:
     """The vehicle's fixed data for the fixed point: balls, gains, slopes λ_c, the response sums per channel."""
 
-    def __init__(self, params: VehicleParams, v_max: Sequence[float], tick: float, ticks: int) -> None:
+    def __init__(self, params: VehicleParams, v_max: Sequence[float], tick: float, ticks: int,
+                 sway_max: float = 0.0) -> None:
         self.params, self.v_max, self.tick = params, tuple(v_max), tick
-        # with lateral thrust a fourth channel, sway (index 1), regulated to 0: its command box is {0}
+        # with lateral thrust a fourth channel, sway (index 1), regulated to its command: the command box is
+        # |v_c| <= sway_max (0 but under a backup law that commands sway, verify.backup.hold)
         self.lateral = bool(getattr(params, "lateral", False))
         self.names = LATERAL_CHANNELS if self.lateral else CHANNELS
         self.own = (0, 1, 2, 3) if self.lateral else (0, 2, 3)
         self.forces = "XYZN" if self.lateral else "XZN"
-        self.v_int = with_sway(self.v_max, 0.0, self.lateral)
+        self.v_int = with_sway(self.v_max, float(sway_max), self.lateral)
         self.nominal, self.hull = nominal_balls(params), hull_balls(params)
         nom = nominal_params(params)
         self.k_p, self.k_i = float(nom.loop_bandwidth), 0.25 * float(nom.loop_bandwidth) ** 2
@@ -154,19 +156,20 @@ class _Loop:
 
 
 @functools.lru_cache(maxsize=8)
-def _cached_loop(params: VehicleParams, v_max: tuple, tick: float, ticks: int, prec: int) -> _Loop:
+def _cached_loop(params: VehicleParams, v_max: tuple, tick: float, ticks: int, prec: int,
+                 sway_max: float = 0.0) -> _Loop:
     """:class:`_Loop` memoised on its inputs and the working precision ``prec`` (bits) it is built at."""
-    return _Loop(params, v_max, tick, ticks)
+    return _Loop(params, v_max, tick, ticks, sway_max)
 
 
-def _loop_of(params: VehicleParams, v_max: tuple, tick: float, ticks: int) -> _Loop:
+def _loop_of(params: VehicleParams, v_max: tuple, tick: float, ticks: int, sway_max: float = 0.0) -> _Loop:
     """The :class:`_Loop` (its impulse-response sums) of a vehicle, V and h, built once per (hashable) vehicle: it
     does not depend on the jump bounds, which the fixed point of :mod:`verify.vehicle.compose` changes each round."""
     try:
         hash(params)
     except TypeError:
-        return _Loop(params, v_max, tick, ticks)
-    return _cached_loop(params, v_max, tick, ticks, ctx.prec)
+        return _Loop(params, v_max, tick, ticks, sway_max)
+    return _cached_loop(params, v_max, tick, ticks, ctx.prec, sway_max)
 
 
 def _rates(loop: _Loop, nu: Sequence[arb], accel: Sequence[float]) -> tuple[arb, arb, arb, arb]:
@@ -269,7 +272,8 @@ def _validate(params: VehicleParams, v_max: Any, tick: Any, period: Any, jump_ti
 def velocity_loop_bound(params: VehicleParams, *, v_max: Sequence[float], tick: float, period: float,
                         jump_tick: Sequence[float], jump_period: Sequence[float],
                         rate: Sequence[float] | None = None, first_command: Sequence[float] | None = None,
-                        surge_floor: float = 0.0, max_iterations: int = LOOP_MAX_ITERATIONS) -> LoopBound:
+                        surge_floor: float = 0.0, max_iterations: int = LOOP_MAX_ITERATIONS,
+                        sway: tuple[float, float, float] = (0.0, 0.0, 0.0)) -> LoopBound:
     """The velocity loop's error bound over the command box ``v_max`` (m/s, m/s, rad/s) and Θ.
 
     Parameters
@@ -293,16 +297,21 @@ def velocity_loop_bound(params: VehicleParams, *, v_max: Sequence[float], tick: 
         water) instead of down to u = 0.
     max_iterations : int
         Bound on the fixed-point iterations.
+    sway : (3,) floats
+        With lateral thrust, the sway command's bound |v_c| <= V_v (m/s), its change per tick and at a period
+        boundary (m/s): (0, 0, 0) while only plans run (the sway loop regulates to 0); a backup law that commands
+        sway (``verify.backup.hold``) gives its own. Refused other than 0 without lateral thrust.
     """
     v, h, d, ticks, jt, jp, rho = _validate(params, v_max, tick, period, jump_tick, jump_period, rate,
                                             max_iterations)
     first = v if first_command is None else tuple(min(f, x) for f, x in zip(triple("first_command",
                                                                                       first_command), v))
-    loop = _loop_of(params, v, h, ticks)
+    sway_max, sway_tick, sway_period = _sway_command(params, sway)
+    loop = _loop_of(params, v, h, ticks, sway_max)
     start = start_bounds(loop, first)
     floor_u = nonnegative("surge_floor", surge_floor)
-    # the sway channel's command is 0 at all times: it never jumps
-    jt_int, jp_int = with_sway(jt, 0.0, loop.lateral), with_sway(jp, 0.0, loop.lateral)
+    # the sway channel's command: 0 under plans, a lateral backup's own jumps
+    jt_int, jp_int = with_sway(jt, sway_tick, loop.lateral), with_sway(jp, sway_period, loop.lateral)
     n = len(loop.names)
     base = computed_bounds(loop, jt_int, jp_int)
     assumed = [[x * (1 + LOOP_INFLATION) + 1e-12 for x in row] for row in base]
@@ -325,9 +334,21 @@ def velocity_loop_bound(params: VehicleParams, *, v_max: Sequence[float], tick: 
     if loop.lateral and not found:  # no sway bound to take the authority over
         authority = (-math.inf,) * 3
     else:  # over |v| <= E_v with a sway loop, else the free hull's γ̄
-        authority = actuator_authority(params, v, floor_u, computed[1][0] if loop.lateral else None)
+        authority = actuator_authority(params, v, floor_u, upper(arb(sway_max) + arb(computed[1][0]))
+                                       if loop.lateral else None)
     return _result(loop, params, (v, h, d, jt, jp, first, floor_u), assumed, computed, inputs, authority,
                    (k, max_iterations), found, rho, _why_open(loop, found, stop, growth))
+
+
+def _sway_command(params: VehicleParams, sway: Sequence[float]) -> tuple[float, float, float]:
+    """(V_v, per-tick jump, per-period jump) of the sway command, checked: each >= 0, the period's jump the larger,
+    all 0 without lateral thrust (ConfigError naming ``sway``)."""
+    values = triple("sway", sway)
+    if any(x < 0.0 for x in values):
+        raise ConfigError("sway", "three numbers >= 0 (m/s): V_v, per-tick and per-period jumps", sway)
+    if any(values) and not getattr(params, "lateral", False):
+        raise ConfigError("sway", "(0, 0, 0) on a vehicle without lateral thrust (Y_max = 0)", sway)
+    return values[0], values[1], max(values[1], values[2])
 
 
 #: What the fixed point bounds, per channel, in the order of :func:`computed_bounds`' rows.

@@ -202,14 +202,21 @@ class _LoopInputs:
         """The loop bound for the jump bounds that ``assumed`` implies (plans: J; backup: its proof's
         :meth:`~verify.backup.BackupProof.tick_change`, the command's rate × h; a law that does not blend: its
         hand-over jump, :func:`handover_jump`)."""
-        per_tick = proof_for(law).tick_change(law, safe, omega_xy=dist.omega_xy, omega_z=dist.omega_z,
-                                              limits=self.v_max, loop_error=assumed, tick=self.tick)
+        proof = proof_for(law)
+        per_tick = proof.tick_change(law, safe, omega_xy=dist.omega_xy, omega_z=dist.omega_z,
+                                     limits=self.v_max, loop_error=assumed, tick=self.tick)
         per_period = tuple(max(j, t) for j, t in zip(self.plans, per_tick))
         if not law.blends:
             per_period = tuple(max(p, h) for p, h in zip(per_period, handover_jump(law, self.plans)))
+        sway = (0.0, 0.0, 0.0)
+        if law.lateral:  # the sway command: the law's per-tick change; a plan takes over within its release of 0
+            sway_tick = proof.sway_change(law, safe, omega_xy=dist.omega_xy, omega_z=dist.omega_z,
+                                          limits=self.v_max, loop_error=assumed, tick=self.tick)
+            sway = (law.sway_bound, sway_tick, max(sway_tick, law.sway_release))
         return velocity_loop_bound(self.params, v_max=self.v_max, tick=self.tick, period=self.period,
                                    jump_tick=per_tick, jump_period=per_period,
-                                   first_command=self.start if law.blends else None, surge_floor=self.surge_floor)
+                                   first_command=self.start if law.blends else None, surge_floor=self.surge_floor,
+                                   sway=sway)
 
 
 def surge_floor_of(scenario: Scenario) -> float:

@@ -114,7 +114,7 @@ def test_the_tick_change_bounds_the_simulated_command(designed):
                                       loop_error=(0.0, 0.0, E_R), tick=TICK)
     sway = HOLD_PROOF.sway_change(law, designed.safe_set, omega_xy=WXY, omega_z=WZ, limits=LIMITS,
                                   loop_error=(0.0, 0.0, E_R), tick=TICK)
-    rates = hold_command_rate(law, omega_xy=WXY, omega_z=WZ, limits=LIMITS, loop_error=(0.0, 0.0, E_R))
+    rates = hold_command_rate(law, omega_xy=WXY, omega_z=WZ, limits=LIMITS, loop_error=(0.0, 0.0, E_R), tick=TICK)
     assert per_tick == pytest.approx(tuple(r * TICK for r in rates[:3])) and sway == pytest.approx(rates[3] * TICK)
     x, y, z, psi, prev, worst = HAND[0], 0.0, HAND[1], 0.0, None, np.zeros(4)
     for j in range(int(round((law.ramp + 10.0) / TICK))):

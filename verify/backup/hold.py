@@ -205,21 +205,25 @@ def certify_hold(law: BackupLaw, safe: SafeSet, *, omega_xy: float, omega_z: flo
 
 
 def hold_command_rate(law: BackupLaw, *, omega_xy: float, omega_z: float, limits: tuple[float, float, float],
-                      loop_error: tuple[float, float, float]) -> tuple[float, float, float, float]:
-    """Upper bounds on |u̇|, |ẇ|, |ṙ|, |v̇| of the held command per unit time (m/s², m/s², rad/s², m/s²), the
-    ramp's blend included (module doc): the change over one tick h is at most h times these.
+                      loop_error: tuple[float, float, float], tick: float | None = None
+                      ) -> tuple[float, float, float, float]:
+    """Upper bounds on |u̇|, |ẇ|, |ṙ|, |v̇| of the command along the plant (m/s², m/s², rad/s², m/s²), the ramp's
+    blend included (module doc): the change of the held command from one tick h (s, ``tick``) to the next is at
+    most h times these.
 
-    With σ the blend's weight, the command is (1 − σ) v_h + σ b, b = R(ψ)ᵀ q; |ṗ| <= (1 − σ) ū + σ s + ω̄_xy and
-    |ψ̇| <= (1 − σ) r̄ + σ r_t + E_r, so σ |ḃ| <= σ (k |ṗ| + |ψ̇| s) <= k (ū/4 + s + ω̄_xy) + s (r̄/4 + r_t + E_r)
-    (σ (1 − σ) <= 1/4), and the blend adds |b − v_h| / t_r. The yaw law r_t sat(v / v_t) is Lipschitz r_t / v_t in
-    the sway command. The heave: σ (w_b / z_0)((1 − σ) w̄ + σ w_b + ω̄_z)."""
+    With σ the blend's weight (σ_j held over a tick, σ(t) <= σ_j + h/t_r along it), the command is
+    (1 − σ) v_h + σ b, b = R(ψ)ᵀ q; |ṗ| <= (1 − σ_j) ū + σ_j s + ω̄_xy and |ψ̇| <= (1 − σ_j) r̄ + σ_j r_t + E_r, so
+    σ(t) |ḃ| <= k (c ū + s + ω̄_xy) + s (c r̄ + r_t + E_r) with c = 1/4 + h/t_r (σ (1 − σ) <= 1/4; without ``tick``
+    c = 1/2, which holds for h <= t_r/4), and the blend adds |b − v_h| / t_r. The yaw law r_t sat(v / v_t) is
+    Lipschitz r_t / v_t in the sway command. The heave: σ (w_b / z_0)(c w̄ + w_b + ω̄_z)."""
     hold = _law_of(law)
     lim = tuple(arb(x) for x in limits)
     s, k, blend, turn = arb(hold.speed), arb(hold.gain), 1 / arb(hold.ramp), arb(hold.turn)
-    body = k * (lim[0] / 4 + s + arb(omega_xy)) + s * (lim[2] / 4 + turn + arb(loop_error[2]))
+    c = arb(0.5) if tick is None else arb(1) / 4 + arb(positive("tick", tick)) * blend
+    body = k * (c * lim[0] + s + arb(omega_xy)) + s * (c * lim[2] + turn + arb(loop_error[2]))
     slope = turn / arb(hold.turn_band)
     heave_b, band = arb(hold.heave), arb(hold.heave_band)
-    heave = blend * (heave_b + lim[1]) + heave_b / band * (lim[1] / 4 + heave_b + arb(omega_z))
+    heave = blend * (heave_b + lim[1]) + heave_b / band * (c * lim[1] + heave_b + arb(omega_z))
     return (upper(blend * (s + lim[0]) + body), upper(heave), upper(blend * (turn + lim[2]) + slope * body),
             upper(blend * s + body))
 
@@ -227,7 +231,8 @@ def hold_command_rate(law: BackupLaw, *, omega_xy: float, omega_z: float, limits
 def _tick_changes(law: BackupLaw, *, omega_xy: float, omega_z: float, limits: tuple[float, float, float],
                   loop_error: tuple[float, float, float], tick: float) -> tuple[float, float, float, float]:
     """:func:`hold_command_rate` × h (m/s, m/s, rad/s, m/s per tick), rounded up."""
-    rates = hold_command_rate(law, omega_xy=omega_xy, omega_z=omega_z, limits=limits, loop_error=loop_error)
+    rates = hold_command_rate(law, omega_xy=omega_xy, omega_z=omega_z, limits=limits, loop_error=loop_error,
+                              tick=tick)
     return tuple(upper(arb(r) * arb(tick)) for r in rates)
 
 

@@ -140,3 +140,20 @@ def test_the_proof_refuses_another_kind_and_a_shaped_set(designed):
                      limits=LIMITS, tick=TICK)
     assert proof_for("station_keeping").sway_change(other, designed.safe_set, omega_xy=WXY, omega_z=WZ,
                                                     limits=LIMITS, loop_error=(0, 0, 0), tick=TICK) == 0.0
+
+
+def test_with_the_bundled_thrust_shares_the_hold_is_refused_by_the_lateral_thrust_and_says_which_knob():
+    """The bundled BlueROV2 Heavy keeps 10 % of its horizontal thrust for sway (Y_max 11.37 N): enough to regulate the
+    sway to 0, not to push sideways against 0.1 m/s of current. The hold is then refused by ``loop_saturation[Y]``
+    (not by a diverging fixed point: when no law's loop bound closes the design falls back to its gentlest law), and
+    the detail names the thrust shares."""
+    from pathlib import Path
+
+    import verify
+    from tubekit.scenario import load_scenario
+    brisk = load_scenario(Path(__file__).resolve().parents[1] / "examples" / "bluerov2_brisk_current.toml")
+    cert = verify.certify(brisk.with_changes(**{"controller.backup": "hold"}))
+    failed = {c.condition: c for c in cert.plant_conditions if not c.ok}
+    assert not cert.tiers.safe and "loop_saturation[Y]" in failed and "loop_fixed_point" not in failed
+    y = failed["loop_saturation[Y]"]
+    assert y.lhs > y.rhs == pytest.approx(11.37) and "thrusters] shares" in y.detail

@@ -317,12 +317,14 @@ def design_hold(*, omega_xy: float, omega_z: float, limits: tuple[float, float, 
 
 
 def _gentlest(candidates: list[tuple[float, float, Hold]], fits: Fits | None) -> tuple[float, float, Hold]:
-    """The first disc (in the candidates' order) with a law of ratio < 1, its smallest-ratio law; else the
-    smallest ratio overall (the first candidate without ``fits``). At most :data:`MAX_FITS` ratios are evaluated
-    (the command's rate does not depend on the disc: a law's ratio is evaluated at its own disc)."""
+    """The first disc (in the candidates' order) with a law of ratio < 1, its smallest-ratio law; else the smallest
+    disc whose loop bound closes, else the gentlest law (the first candidate without ``fits``). At most
+    :data:`MAX_FITS` ratios are evaluated (a law's command rate does not depend on its disc)."""
     if fits is None:
         return candidates[0]
-    best, best_ratio = candidates[0], math.inf
+    # when no law's loop bound closes, the gentlest (the slowest command): the failure it names is the real limit
+    best = min(candidates, key=lambda c: (-c[2].ramp, c[2].gain, c[2].speed, -c[2].heave_band))
+    best_ratio = math.inf
     for _, group in itertools.groupby(candidates[:MAX_FITS], key=lambda c: c[0]):
         rated = [(fits(law, SafeSet(level=level, shape=0.0, depth=depth)), i, (level, depth, law))
                  for i, (level, depth, law) in enumerate(group)]

@@ -132,6 +132,9 @@ def saturation_conditions(loop: _Loop, params: VehicleParams, v: Sequence[float]
                f"{_ACTUATOR[ch]} is 0 at u = 0, inside the velocity box |u| <= {u_bar:.4g} m/s: a fin's lift grows "
                "with u², so this vehicle cannot produce it at rest (a minimum surge, limits.u_min, above the loop's "
                "E_u keeps the vehicle off u = 0)")
+        if ch == "Y" and loop.v_int[1] > 0.0:  # a backup that commands sway (the hold) pushes sideways
+            why += (f"; the backup commands sway up to {loop.v_int[1]:.4g} m/s: a larger sway share of the "
+                    "thrusters ([plant.vehicle.thrusters] shares) raises Y_max")
         peak = peaks[c]
         if not closed:  # the assumed bounds of a fixed point that did not close mean nothing: no number
             peak, why = None, "not evaluated: the loop bound did not close (root cause: loop_fixed_point)" + (

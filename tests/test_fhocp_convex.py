@@ -110,3 +110,39 @@ def test_terminal_modes_build_and_solve(terminal):
     assert not res.fallback
     if terminal == "off":
         assert res.violations["terminal"] == 0.0
+
+
+def test_the_lookahead_moves_only_the_known_obstacles_rows_by_its_margins():
+    """With controller.lookahead the nodes' obstacle rows of the obstacles in the problem move by the margins of
+    FhocpNlp.lookahead_margins, the inactive slots and the terminal rows stay as without it."""
+    import dataclasses
+
+    from .fhocp_cases import backup_plan
+    tight = dataclasses.replace(tightening(), backup=backup_plan())
+    plain = FHOCP(SC, tight, mode="realtime")
+    ahead = FHOCP(SC.with_changes(**{"controller.lookahead": 1.5}), tight, mode="realtime")
+    t, s = STATES[2]
+    for solver in (plain, ahead):
+        solver.reset()
+        solver.solve(t, np.array(s), OBSTACLES)
+    sub_p, sub_a = plain.subproblem, ahead.subproblem
+    # the same linearisation point for both: write the rows once more from the plain solver's last point
+    obs = np.array([[*o.center, o.radius] for o in OBSTACLES[:plain.max_obstacles]], dtype=float)
+    state = np.array(s, dtype=float)
+    from tubekit.fhocp.nlp import rollout
+    v = np.zeros((plain.nlp.n, 3))
+    for sub in (sub_p, sub_a):
+        sub.linearise(state, rollout(state, v, plain.nlp.dt), v, np.zeros((plain.nlp.n + 1, 3)), obs, 0.1)
+    m, n = plain.max_obstacles, plain.nlp.n
+    rows_p = sub_p.param_vector[sub_p._gidx["obs"]].reshape(m, 4, n).copy()
+    rows_a = sub_a.param_vector[sub_a._gidx["obs"]].reshape(m, 4, n).copy()
+    k = len(obs)
+    assert k >= 1 and ahead.nlp.lookahead_margins()[-1] > 1.0
+    np.testing.assert_allclose(rows_a[:k, 3, :] - rows_p[:k, 3, :],
+                               np.broadcast_to(ahead.nlp.lookahead_margins(), (k, n)), atol=1e-12)
+    np.testing.assert_array_equal(rows_a[:, :3, :], rows_p[:, :3, :])
+    np.testing.assert_array_equal(sub_a.param_vector[sub_a._gidx["obsT"]], sub_p.param_vector[sub_p._gidx["obsT"]])
+    # no obstacle known: no row moves
+    for sub in (sub_p, sub_a):
+        sub.linearise(state, rollout(state, v, plain.nlp.dt), v, np.zeros((n + 1, 3)), obs[:0], 0.1)
+    np.testing.assert_array_equal(sub_a.param_vector[sub_a._gidx["obs"]], sub_p.param_vector[sub_p._gidx["obs"]])

@@ -180,3 +180,18 @@ def test_the_last_node_is_narrowed_to_the_terminal_set_only_with_the_tracking_th
     assert nb["e_o"][-1] == pytest.approx(math.sin(0.1)) and nb["e_d_lo"][0] == 0.3 and nb["e_o"][0] == 0.8
     unproven = dataclasses.replace(proving, tiers=Tiers(True, False))
     assert FhocpNlp.from_scenario(SC, unproven, terminal="off").tracking_terminal is None
+
+
+def test_the_lookahead_margins_grow_along_the_horizon_to_a_share_of_the_footprint():
+    """lambda_f (k/N) of the footprint's extent beyond the clearance at node k = 1..N; zeros when off or without a
+    backup; a negative lookahead is refused by name."""
+    with_backup = dataclasses.replace(tightening(), backup=backup_plan())
+    nlp = FhocpNlp.from_scenario(SC.with_changes(**{"controller.lookahead": 1.5}), with_backup)
+    extent = nlp.backup_terminal.sphere - nlp.clearance
+    n = nlp.horizon_steps
+    np.testing.assert_allclose(nlp.lookahead_margins(), [1.5 * extent * k / n for k in range(1, n + 1)])
+    assert not FhocpNlp.from_scenario(SC, with_backup).lookahead_margins().any()
+    assert not FhocpNlp.from_scenario(SC.with_changes(**{"controller.lookahead": 1.5}),
+                                      tightening()).lookahead_margins().any()
+    with pytest.raises(ConfigError, match="lookahead"):
+        dataclasses.replace(nlp, lookahead=-0.1)

@@ -322,3 +322,18 @@ def test_a_backup_that_commands_sway_needs_a_vehicle_with_lateral_thrust(plant, 
     else:
         with pytest.raises(ConfigError, match=r"controller\.backup"):
             scenario_from_dict(data)
+
+
+@pytest.mark.parametrize("value", [-0.5, math.nan, math.inf])
+def test_a_negative_or_non_finite_lookahead_is_refused_by_name(value):
+    with pytest.raises(ConfigError, match=r"controller\.lookahead"):
+        scenario_from_dict({**paper_scenario().to_dict(), "controller": {"lookahead": value}})
+
+
+def test_the_lookahead_is_written_only_when_on_and_is_not_a_certificate_input():
+    from tubekit.design_inputs import DesignInputs
+    base = paper_scenario()
+    on = base.with_changes(**{"controller.lookahead": 1.5})
+    assert "lookahead" not in base.to_dict()["controller"] and on.to_dict()["controller"]["lookahead"] == 1.5
+    assert scenario_from_dict(on.to_dict()) == on
+    assert DesignInputs.of(on).key() == DesignInputs.of(base).key()

@@ -186,7 +186,8 @@ class Scenario:
                            for k, v in asdict(self.controller).items()
                            if v is not None and not (k == "fhocp_backend" and v == "scp")
                            and not (k == "backup" and v == "station_keeping")
-                           and not (k in ("candidate", "recovery") and v is True)},
+                           and not (k in ("candidate", "recovery") and v is True)
+                           and not (k == "lookahead" and v == 0.0)},
             "region": {k: (str(v) if isinstance(v, str) else v) for k, v in asdict(self.region).items()},
         }
         if self.limits.rate is not None:  # only when set: a scenario without it keeps its dict

@@ -15,7 +15,8 @@ import numpy as np
 
 from tubekit.exceptions import ConfigError
 from tubekit.model.kinematics import SwayModel
-from tubekit.validation import StrChoice, as_vector, choice, gain, positive, speed_bound, ticks_per_period
+from tubekit.validation import (StrChoice, as_vector, choice, gain, nonnegative, positive, speed_bound,
+                                ticks_per_period)
 
 __all__ = ["FhocpMode", "TerminalMode", "Heading", "LAW_NAMES", "HEADINGS", "HEMISPHERE_SIGN", "Obstacle",
            "Disturbance", "ControllerSettings", "RegionSettings"]
@@ -155,6 +156,12 @@ class ControllerSettings:
         station, surging ahead or astern; the default) or ``"loiter"`` (circle about the anchor at a constant
         surge: :mod:`tubekit.model.loiter`). The certificate designs and proves a law of this kind. Left out of
         :meth:`Scenario.to_dict` when ``"station_keeping"``.
+    lookahead : float
+        lambda_f >= 0: the FHOCP asks node k of a plan to keep lambda_f k/N of the backup's footprint from every
+        known obstacle too, not only the plan's end (``tubekit.fhocp.nlp.FhocpNlp.lookahead_margins``), so a plan
+        turns away before its end is trapped against an obstacle. A planning preference, not a certificate input:
+        plans are still accepted by the exact check alone. 0 (default): off; left out of :meth:`Scenario.to_dict`
+        when 0.
     """
 
     dt: float = 0.1
@@ -172,9 +179,11 @@ class ControllerSettings:
     candidate: bool = True
     recovery: bool = True
     backup: str = "station_keeping"
+    lookahead: float = 0.0
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "dt", positive("controller.dt", self.dt))
+        object.__setattr__(self, "lookahead", nonnegative("controller.lookahead", self.lookahead))
         for name in ("candidate", "recovery"):
             if not isinstance(getattr(self, name), bool):
                 raise ConfigError(f"controller.{name}", "true or false", getattr(self, name))

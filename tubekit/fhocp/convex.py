@@ -143,6 +143,7 @@ class ConvexSubproblem:
         self._weights = np.vstack([np.tile(nlp.dt * nlp.q, (N, 1)), nlp.p])   # (N+1, 3) for k = 0..N
         self._wref = self._weights[1:, (0, 0, 1)].T  # (3, N) weights of x, y, z at k = 1..N
         self._anchor_offset = np.zeros(3)  # the backup anchor's offset from p_N in this linearisation (m)
+        self._lookahead = nlp.lookahead_margins()  # (N,) m added to the nodes' obstacle rows (controller.lookahead)
         self._build()
         self.clarabel_settings = {**DEFAULT_CLARABEL_SETTINGS, **(clarabel_settings or {})}
         self.compiled: CompiledConeProgram | None = None
@@ -416,6 +417,9 @@ class ConvexSubproblem:
         shift = ob[:, 0, -1] * self._anchor_offset[0] + ob[:, 1, -1] * self._anchor_offset[1]
         self.param_vector[self._gidx["obsT"]] = ob[:, 3, -1] + np.where(
             np.arange(self.max_obstacles) < k, self.nlp.backup_terminal.sphere - self.nlp.clearance - shift, 0.0)
+        if self.nlp.lookahead > 0.0 and k:  # the nodes' rows keep a growing share of the footprint too
+            ob[:k, 3, :] += self._lookahead
+            self.param_vector[self._gidx["obs"]] = ob.reshape(-1)
 
     def write_last_command(self, v_last: np.ndarray, first_row: bool) -> None:
         """Write ``vlast`` (the rate rows' and the rate penalty's v_last, (3,)) and the bound ``jb`` of

@@ -225,6 +225,7 @@ class IpoptFHOCP:
     def _path_constraints(self, ca: Any, sym: dict, states: list, rows: _Rows) -> None:
         """The slackened state constraints at k = 1..N (e_d, e_o, e_z, obstacles, workspace walls)."""
         nlp, sig, obs = self.nlp, sym["sig"], sym["obs"]
+        ahead = nlp.lookahead_margins()  # controller.lookahead: the nodes keep a growing share of the footprint
         for k in range(1, nlp.n + 1):
             s = states[k]
             ed, ez, eo = _errors(ca, sym["ref"], s, k)
@@ -234,7 +235,7 @@ class IpoptFHOCP:
             for j in range(self.max_obstacles):
                 d = s[:3] - obs[:3, j]
                 dist = ca.sqrt(ca.dot(d, d) + _TINY)
-                rows.nonpositive([obs[4, j] * (obs[3, j] + nlp.clearance - dist) - so])
+                rows.nonpositive([obs[4, j] * (obs[3, j] + nlp.clearance + float(ahead[k - 1]) - dist) - so])
             if nlp.workspace is not None:
                 lo = nlp.workspace[0] + nlp.clearance
                 hi = nlp.workspace[1] - nlp.clearance

@@ -215,6 +215,10 @@ class FhocpNlp:
         The command c of the terminal rest |v_{N-1} - c| <= J (m/s, m/s, rad/s): ``Tightening.terminal_command``
         (0 for station keeping, (u_l, 0, 0) for the loiter). None (default): zeros; always an array after
         construction.
+    lookahead : float
+        lambda_f >= 0 (``controller.lookahead``): node k's obstacle rows also keep lambda_f k/N of the backup's
+        footprint (:meth:`lookahead_margins`), so a plan turns away from an obstacle before its end has to; a
+        planning preference, not a certificate input (plans are accepted by the exact check alone). 0: off.
     """
 
     dt: float
@@ -240,6 +244,7 @@ class FhocpNlp:
     tracking_terminal: tuple[float, float, float, float] | None = None
     v_min: np.ndarray | None = None
     terminal_command: np.ndarray | None = None
+    lookahead: float = 0.0
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "dt", positive("dt", self.dt))
@@ -276,6 +281,8 @@ class FhocpNlp:
             object.__setattr__(self, "rate_jump", jump)
         if self.rate_penalty < 0 or not math.isfinite(self.rate_penalty):
             raise ConfigError("rate_penalty", "a finite number >= 0", self.rate_penalty)
+        if self.lookahead < 0 or not math.isfinite(self.lookahead):
+            raise ConfigError("lookahead", "a finite number >= 0", self.lookahead)
         object.__setattr__(self, "_rate_w", self.rate_penalty * self.r)
         self._set_lower_corner()
         object.__setattr__(self, "_nodes", self._node_bounds())
@@ -325,7 +332,16 @@ class FhocpNlp:
                    backup_terminal=backup, rate_jump=None if jump is None else jump * (1.0 - RATE_MARGIN),
                    terminal_rest=jump is not None and tightening.terminal_rest, rate_penalty=rate_penalty,
                    tracking_terminal=_tracking_terminal(tightening), v_min=tightening.v_low,
-                   terminal_command=tightening.terminal_command)
+                   terminal_command=tightening.terminal_command, lookahead=c.lookahead)
+
+    def lookahead_margins(self) -> np.ndarray:
+        """(N,) distances (m) added to the clearance of node k = 1..N's obstacle rows: lambda_f (k/N) of the backup
+        footprint's extent beyond the clearance (``backup_terminal.sphere`` - ``clearance``); zeros without a backup
+        or with lookahead 0."""
+        bt, n = self.backup_terminal, self.horizon_steps
+        if bt is None or self.lookahead == 0.0:
+            return np.zeros(n)
+        return self.lookahead * max(0.0, bt.sphere - self.clearance) * np.arange(1, n + 1) / n
 
     def node_bounds(self) -> dict[str, np.ndarray]:
         """Per-node bounds (N,) ``e_d_lo``, ``e_d_hi``, ``e_z``, ``e_o``: the tightened sets, the last node

@@ -224,7 +224,7 @@ def compare_previous(repeat: int = 4, duration: float | None = None) -> dict:
     compiled = {name: getattr(compiled_arcs, name) for name in uncompiled}
     new_step = kinematic.Plant.step_tuple
 
-    def old_step(self, t, x, v, h, n):
+    def old_step(self, t, x, v, h, n, sway=0.0):  # the plant protocol's signature (the kinematic plant: sway 0)
         return kinematic.rk4_tuple(self._rhs, t, tuple(x), v, h, n)
 
     @contextlib.contextmanager

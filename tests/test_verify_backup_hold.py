@@ -82,7 +82,7 @@ def test_a_disc_inside_the_equilibrium_is_refuted_and_left_by_the_adversary(desi
 
 def test_a_disc_smaller_than_the_ramps_reach_is_refuted_by_the_ramp(designed):
     law = designed.law
-    reach, _ = hold_reach(HAND[0], gain=law.gain, cap=law.speed, contraction_slack=0.99, push=WXY, rest=LIMITS[0],
+    reach = hold_reach(HAND[0], gain=law.gain, cap=law.speed, contraction_slack=0.99, push=WXY, rest=LIMITS[0],
                           ramp=law.ramp, tick=TICK)
     assert reach >= HAND[0] + 0.5 * LIMITS[0] * law.ramp * 0.5  # the hand-over's surge alone carries it that far
     small = SafeSet(level=0.5 * designed.safe_set.level, shape=0.0, depth=designed.safe_set.depth)

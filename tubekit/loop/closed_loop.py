@@ -325,14 +325,10 @@ class _ClosedLoop:
             xs = np.asarray(x)
             log.states[i] = xs
             sway = 0.0
-            if period.anchor is not None:
-                if backup.lateral:
-                    u_c, w_c, r_c, sway = backup.lateral_command(x, period.anchor, float(clock.t[i] - self.t_h),
-                                                                 self.v_h)
-                    v = (u_c, w_c, r_c)
-                    log.sway_command[i] = sway
-                else:
-                    v = backup.command(x, period.anchor, float(clock.t[i] - self.t_h), self.v_h)
+            if period.anchor is not None:  # the backup law; its sway command is 0 but for a lateral law
+                u_c, w_c, r_c, sway = backup.lateral_command(x, period.anchor, float(clock.t[i] - self.t_h), self.v_h)
+                v = (u_c, w_c, r_c)
+                log.sway_command[i] = sway
                 log.kappa[i] = 0.0
                 log.v_hat[i] = v
             elif self.sigma > 0.0:
@@ -346,8 +342,7 @@ class _ClosedLoop:
                 v = vh
             v, log.saturated[i] = saturate(v, self.limits, self.lower)
             log.inputs[i] = v
-            x = self.plant.step_tuple(float(clock.t[i]), x, v, h, clock.substeps, sway) if sway else \
-                self.plant.step_tuple(float(clock.t[i]), x, v, h, clock.substeps)
+            x = self.plant.step_tuple(float(clock.t[i]), x, v, h, clock.substeps, sway)
         self.sway_last = sway
         return x, law_s
 

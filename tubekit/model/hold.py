@@ -117,7 +117,7 @@ class Hold:
 
     def within(self, u_max: float, w_max: float, r_max: float) -> bool:
         """True when every input of the law lies in V = {|u| <= u_max, |w| <= w_max, |r| <= r_max}."""
-        return self.speed <= u_max and self.heave <= w_max and self.turn <= r_max
+        return all(b <= m for b, m in zip(self.bounds, (u_max, w_max, r_max)))
 
     def command(self, state: tuple[float, float, float, float], anchor: tuple[float, float, float],
                 elapsed: float = math.inf, start: tuple[float, float, float] = (0.0, 0.0, 0.0)

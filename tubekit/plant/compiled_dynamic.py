@@ -177,34 +177,11 @@ def current_at_ticks(t: np.ndarray, current: np.ndarray) -> np.ndarray:
     return out
 
 
-def omega_at_ticks(t: np.ndarray, states: np.ndarray, inputs: np.ndarray, body: np.ndarray,
-                   current: np.ndarray, sway: np.ndarray | None = None) -> np.ndarray:
-    """ω = δ + R(ψ)(u_b − u_c, v_b − v_c), δ_z + w_b − w_c (m/s) at every tick (len(t), 3); NaN where u_c or r_c is
-    NaN or past the log.
-
-    Parameters
-    ----------
-    t : array (K + 1,)
-        Tick times (s).
-    states : array (K + 1, 4)
-        Poses at the ticks (m, m, m, rad).
-    inputs : array (K + 1, 3)
-        Commands (u_c, w_c, r_c) at the ticks (m/s, m/s, rad/s).
-    body : array (K, 4)
-        Logged body velocities (u_b, v_b, w_b, r_b) (m/s, m/s, m/s, rad/s).
-    current : array (7,)
-        The current's parameters (:func:`tubekit.plant.compiled_kinematic.current_at`).
-    sway : array (K + 1,), optional
-        Commanded sway velocities v_c at the ticks (m/s); None: zeros.
-    """
-    vc = np.zeros(t.shape[0]) if sway is None else np.ascontiguousarray(sway, dtype=float)
-    return _omega_at_ticks(t, states, inputs, body, current, vc)
-
-
 @routine
-def _omega_at_ticks(t: np.ndarray, states: np.ndarray, inputs: np.ndarray, body: np.ndarray,
-                    current: np.ndarray, sway: np.ndarray) -> np.ndarray:
-    """:func:`omega_at_ticks` compiled, ``sway`` (K + 1,) given."""
+def omega_at_ticks(t: np.ndarray, states: np.ndarray, inputs: np.ndarray, body: np.ndarray,
+                   current: np.ndarray, sway: np.ndarray) -> np.ndarray:
+    """ω = δ + R(ψ)(u_b − u_c, v_b − v_c), δ_z + w_b − w_c (m/s) at every tick (len(t), 3) from the logged body
+    velocities ``body`` (K, 4) and sway commands ``sway`` (K + 1,); NaN where u_c or r_c is NaN or past the log."""
     out = np.full((t.shape[0], 3), np.nan)
     for i in range(min(t.shape[0], body.shape[0])):
         if not (math.isfinite(inputs[i, 0]) and math.isfinite(inputs[i, 2])):

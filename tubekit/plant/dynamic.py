@@ -342,7 +342,7 @@ class DynamicPlant:
             from tubekit.plant.compiled_dynamic import omega_at_ticks
 
             return omega_at_ticks(np.asarray(t, dtype=float), np.asarray(states, dtype=float),
-                                  np.asarray(inputs, dtype=float), body, self._packed()[4], vc)
+                                  np.asarray(inputs, dtype=float), body, self._packed()[4], np.ascontiguousarray(vc))
         out = np.full((len(t), 3), np.nan)
         for i, ti in enumerate(t):
             if i < len(body) and np.isfinite(inputs[i, 0]) and np.isfinite(inputs[i, 2]):

@@ -86,8 +86,8 @@ def _ramp_ticks(law: Hold, tick: float) -> int:
 
 
 def hold_reach(start: float, *, gain: float, cap: float, contraction_slack: float, push: float, rest: float,
-               ramp: float, tick: float) -> tuple[float, float]:
-    """(largest ρ over the ramp, ρ at its end) (m) of the comparison sequence ρ_{j+1} = G_{σ_j}(ρ_j, h) (module doc)
+               ramp: float, tick: float) -> float:
+    """The largest ρ (m) over the ramp (its end included) of the comparison sequence ρ_{j+1} = G_{σ_j}(ρ_j, h) (module doc)
     from ``start``, in Arb: m(ρ) = min(``gain`` ρ, ``cap``), the rotation's factor (1 − Y h / 2) =
     ``contraction_slack``, the disturbance ``push`` (ω̄), the hand-over command's part ``rest`` (ū or w̄) weighted by
     1 − σ_j, σ_j = (j h − :data:`TIME_SLACK`) / t_r rounded down (at least 0). The same routine bounds the depth
@@ -107,7 +107,7 @@ def hold_reach(start: float, *, gain: float, cap: float, contraction_slack: floa
         step = h * sigma * fac
         rho = _max_ball(rho * (1 - step * k), rho - step * s) + h * ((1 - sigma) * u + w)
         top = _max_ball(top, rho)
-    return upper(top), upper(rho)
+    return upper(top)
 
 
 def _min_ball(a: arb, b: arb) -> arb:
@@ -132,20 +132,20 @@ def _turn_rates(law: Hold, limits: tuple[float, float, float], yaw_err: float) -
     """(Y during the ramp, Y after it) (rad/s): bounds of |ψ̇| while a command is held, max(r̄, r_t) + E_r and
     r_t + E_r."""
     turn = arb(law.turn)
-    ramp = (arb(limits[2]) if arb(limits[2]) >= turn else turn) + arb(yaw_err)
+    ramp = _max_ball(arb(limits[2]), turn) + arb(yaw_err)
     return ramp, turn + arb(yaw_err)
 
 
 def _reaches(law: Hold, dist: tuple[float, float], limits: tuple[float, float, float], tick: float,
-             handover: tuple[float, float], yaw_err: float) -> tuple[float, float, float, float]:
-    """(horizontal largest, horizontal end, depth largest, depth end) of the ramp's comparison sequences (m)."""
+             handover: tuple[float, float], yaw_err: float) -> tuple[float, float]:
+    """(horizontal, depth) largest values (m) of the ramp's comparison sequences."""
     y_ramp, _ = _turn_rates(law, limits, yaw_err)
     fac = 1 - y_ramp * arb(tick) / 2
     xy = hold_reach(handover[0], gain=law.gain, cap=law.speed, contraction_slack=max(0.0, float(fac.lower())),
                     push=dist[0], rest=limits[0], ramp=law.ramp, tick=tick)
     z = hold_reach(handover[1], gain=law.heave / law.heave_band, cap=law.heave, contraction_slack=1.0, push=dist[1],
                    rest=limits[1], ramp=law.ramp, tick=tick)
-    return (*xy, *z)
+    return xy, z
 
 
 def _level_margin(law: Hold, level: float, omega_xy: float, limits: tuple[float, float, float], tick: float,
@@ -165,7 +165,7 @@ def _depth_margin(law: Hold, depth: float, omega_z: float) -> float:
 def _conditions(law: Hold, safe: SafeSet, dist: tuple[float, float], limits: tuple[float, float, float],
                 tick: float, handover: tuple[float, float], yaw_err: float) -> tuple[Condition, ...]:
     """Every inequality of the theorem (module doc), with both numbers."""
-    top_xy, _, top_z, _ = _reaches(law, dist, limits, tick, handover, yaw_err)
+    top_xy, top_z = _reaches(law, dist, limits, tick, handover, yaw_err)
     y_ramp, _ = _turn_rates(law, limits, yaw_err)
     stiff = max(upper(arb(law.gain) * arb(tick)), upper(arb(law.heave) * arb(tick) / arb(law.heave_band)),
                 upper(y_ramp * arb(tick) / 2))
@@ -198,7 +198,7 @@ def certify_hold(law: BackupLaw, safe: SafeSet, *, omega_xy: float, omega_z: flo
     wxy, wz, h, e_r, hand = checked_bounds(omega_xy, omega_z, tick, yaw_rate_error, handover)
     lim = tuple(positive(f"limits[{i}]", x) for i, x in enumerate(limits))
     conditions = _conditions(hold, safe, (wxy, wz), lim, h, hand, e_r)
-    margin = _level_margin(hold, safe.level, wxy, lim, h, e_r)
+    margin = next(c.lhs for c in conditions if c.condition == "backup_level_set")
     return BackupCertificate(law=hold, safe_set=safe, omega_xy=wxy, omega_z=wz, tick=h, rate_bound=-margin,
                              rate_sampled=-margin, boxes=_ramp_ticks(hold, h), conditions=conditions,
                              handover=hand, yaw_rate_error=e_r)

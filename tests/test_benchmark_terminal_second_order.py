@@ -1,0 +1,54 @@
+"""benchmarks/terminal_second_order.py: sizing a rate-limited completion by the minimal robust invariant set."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from .scripts import load_script
+
+STUDY = load_script("benchmarks/terminal_second_order.py", "bench_terminal_second_order")
+DT = 0.1
+
+
+@pytest.mark.parametrize("w, m", [(0.01, 0.0), (0.0, 0.002), (0.0118, 0.0021)])
+def test_the_deadbeat_gains_give_the_hand_solved_set(w, m):
+    """k1 = 1/delta, k2 = 1 make A nilpotent: x' = -delta m and s' = -(x + w)/delta - m, so by hand
+    sup|x| = delta M, sup|s| = W/delta + 2M and sup|Delta| = 2W/delta + 3M."""
+    x, s, change = STUDY.support_sums(np.array(1 / DT), np.array(1.0), DT, w, m)
+    assert math.isclose(float(x), DT * m, abs_tol=1e-15)
+    assert math.isclose(float(s), w / DT + 2 * m, rel_tol=1e-12)
+    assert math.isclose(float(change), 2 * w / DT + 3 * m, rel_tol=1e-12)
+
+
+def test_an_unstable_pair_of_gains_has_no_invariant_set():
+    """k2 = 2.5 puts an eigenvalue of A below -1: every sum is infinite."""
+    assert all(math.isinf(float(v)) for v in STUDY.support_sums(np.array(0.1), np.array(2.5), DT, 0.01, 0.0))
+
+
+def test_the_narrowest_band_keeps_its_command_change_within_j_and_none_without_room():
+    """The band found changes the command by at most J; a J below the deviation's own share k1 W of every searched
+    gain leaves none."""
+    band = STUDY.smallest_band(DT, 0.0065, 0.0, 0.003)
+    assert band is not None and band.change <= 0.003 and 0 < band.x < 1.0
+    assert STUDY.smallest_band(DT, 0.0065, 0.0, 1e-6) is None
+
+
+def test_a_narrower_rate_limit_never_narrows_the_band():
+    """Property: the set that fits J fits any larger J, so the narrowest band is monotone in J."""
+    widths = [STUDY.smallest_band(DT, 0.0065, 0.0005, j).x for j in (0.003, 0.006, 0.012)]
+    assert widths[0] >= widths[1] >= widths[2]
+
+
+def test_on_the_slow_scenario_the_radial_channel_is_what_does_not_fit():
+    """On examples/bluerov2_slow.toml as shipped the depth channel's band fits its room while the radial one gets
+    no gains keeping its change within J: the closing speed's own change per period (the heading's band through
+    cos alpha, the line of sight's turn) is about J_u (docs/verify.md, step 17)."""
+    res = STUDY.study()
+    ch = res["channels"]
+    assert res["failed"] == ""
+    assert ch["depth"]["fits"] and ch["depth"]["band"]["change"] <= ch["depth"]["J"]
+    assert not ch["radial"]["fits"] and not ch["heading"]["fits"]
+    assert math.isclose(ch["radial"]["J"], 0.03 * DT)

@@ -102,3 +102,18 @@ def test_a_rejected_plan_is_replaced_by_the_candidate_and_tracking_is_kept(pc_ce
     off = sc.with_changes(**{"controller.candidate": False})
     replayed = certified_run(off, pc_cert.tightening, solver_factory=_spinning_in(forced)).run
     assert not replayed.candidate.any() and replayed.plan_age[33] >= 4
+
+
+def test_under_a_surge_floor_the_bearing_faced_law_keeps_a_plan_and_the_surge_above_u_min():
+    """examples/keep_moving_tracked.toml (u_min 0.2 m/s, a line target at 0.4 m/s): both tiers certified with the
+    bearing face (docs/verify.md step 17b). Flown for 20 s every period has an accepted plan (the candidate where
+    the solver's plan is rejected), no command falls below u_min and both tiers' promises are kept."""
+    from pathlib import Path
+    sc = load_scenario(Path(__file__).resolve().parents[1] / "examples" / "keep_moving_tracked.toml").with_changes(
+        duration=20.0)
+    cert = verify.certify(sc)
+    assert cert.tiers.tracking and cert.tightening.terminal_law.has_bearing
+    done = certified_run(sc, cert.tightening)
+    assert done.broken == () and done.metrics["outcome"] == {"safe": "certified, kept", "tracking": "certified, kept"}
+    assert {p.name: p for p in done.promises}["plan_available"].ok
+    assert not done.run.backup_active.any() and float(np.nanmin(done.run.inputs[:-1, 0])) >= sc.limits.u_min

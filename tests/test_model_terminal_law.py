@@ -11,7 +11,7 @@ from hypothesis import strategies as st
 
 from tubekit.exceptions import ConfigError
 from tubekit.model.kinematics import unicycle_step
-from tubekit.model.terminal_law import TerminalLaw, line_of_sight
+from tubekit.model.terminal_law import NO_BEARING, TerminalLaw, bearing, line_of_sight
 
 GOOD = dict(d_lo=0.6, d_hi=0.9, d_star=0.75, alpha_max=0.06, z_max=0.8, gain_d=1.5, gain_z=0.3, turn=0.6)
 
@@ -24,6 +24,8 @@ GOOD = dict(d_lo=0.6, d_hi=0.9, d_star=0.75, alpha_max=0.06, z_max=0.8, gain_d=1
     ({"turn": 1.5}, "terminal.turn"),
     ({"gain_d": -1.0}, "terminal.gain_d"),
     ({"z_max": float("nan")}, "terminal.z_max"),
+    ({"bearing_max": 0.0}, "terminal.bearing_max"),
+    ({"bearing_max": 3.5}, "terminal.bearing_max"),
 ])
 def test_a_bad_set_is_refused_naming_the_field(change, match):
     with pytest.raises(ConfigError, match=match):
@@ -35,6 +37,32 @@ def test_the_dict_round_trip_is_exact_and_a_missing_key_is_named():
     assert TerminalLaw.from_dict(law.to_dict()) == law
     with pytest.raises(ConfigError, match="certificate.terminal"):
         TerminalLaw.from_dict({k: v for k, v in GOOD.items() if k != "turn"}, "certificate.terminal")
+
+
+def test_a_bearing_face_survives_the_round_trip_and_is_the_ninth_key():
+    law = TerminalLaw(**GOOD, bearing_max=0.4)
+    assert law.has_bearing and not TerminalLaw(**GOOD).has_bearing and TerminalLaw(**GOOD).bearing_max == NO_BEARING
+    assert len(law.to_dict()) == 9 and TerminalLaw.from_dict(law.to_dict()) == law
+
+
+@pytest.mark.parametrize("state, target, velocity, expected", [
+    ([-1.0, 0.0, 0.0, 0.0], [0.0, 0.0, 0.0], [0.4, 0.0, 0.0], 0.0),              # trailing: the velocity along the LOS
+    ([-1.0, 0.0, 0.0, 0.0], [0.0, 0.0, 0.0], [0.0, 0.3, 0.0], math.pi / 2),      # the target crosses to the left
+    ([1.0, 0.0, 0.0, math.pi], [0.0, 0.0, 0.0], [0.4, 0.0, 0.0], math.pi),       # the target comes at the vehicle
+    ([-1.0, -1.0, 0.0, 0.0], [0.0, 0.0, 0.0], [0.0, 0.2, 0.0], math.pi / 4),     # LOS at 45 deg, velocity at 90
+])
+def test_the_bearing_by_hand(state, target, velocity, expected):
+    assert abs(bearing(np.array(state), np.array(target), np.array(velocity))) == pytest.approx(expected)
+
+
+def test_the_bearing_face_needs_the_targets_velocity_and_a_standing_target_is_outside():
+    law = TerminalLaw(**GOOD, bearing_max=0.4)
+    x, p = np.array([-0.7, 0.0, 0.1, 0.0]), np.zeros(3)
+    with pytest.raises(ValueError, match="pd_dot"):
+        law.slacks(x, p)
+    assert law.slacks(x, p, np.array([0.4, 0.1, 0.0]))["terminal set: |bearing|"] == pytest.approx(0.4 - math.atan(0.25))
+    assert law.slacks(x, p, np.zeros(3))["terminal set: |bearing|"] == -math.inf
+    assert "terminal set: |bearing|" not in TerminalLaw(**GOOD).slacks(x, p)
 
 
 def test_line_of_sight_by_hand():

@@ -120,3 +120,22 @@ def test_the_acceleration_bound_holds_on_second_differences(make):
     assert np.max(np.abs(acc[:, 2])) <= a_z * (1 + 1e-4) + 1e-9
     if isinstance(tr, (Circle, Line)):
         assert np.max(np.hypot(acc[:, 0], acc[:, 1])) == pytest.approx(a_xy, rel=1e-4, abs=1e-9)
+
+
+@pytest.mark.parametrize("trajectory", [
+    Line(direction_velocity=(0.3, -0.4, 0.1)),
+    Circle(radius=3.0, rate=-0.2),
+    Helix(radius=2.0, rate=0.1, climb=0.05),
+    Waypoints(points=((0.0, 0.0, 0.0), (4.0, 0.0, 0.0), (4.0, 3.0, 0.0)), speed=0.3),
+])
+def test_the_horizontal_speed_floor_is_below_every_sampled_speed_and_zero_where_the_path_stops(trajectory):
+    """Property: the floor lower-bounds the horizontal speed at every sampled time; a line and a circle keep their
+    speed (floor = bound), waypoints rest at their corners (floor 0)."""
+    t = np.linspace(0.0, 60.0, 6001)
+    speed = np.hypot(*np.asarray(trajectory.velocity(t))[:, :2].T)
+    floor = trajectory.horizontal_speed_floor()
+    assert np.all(speed >= floor - 1e-12)
+    if isinstance(trajectory, Waypoints):
+        assert floor == 0.0 and speed.min() < 1e-9
+    else:
+        assert floor == pytest.approx(trajectory.horizontal_speed_bound()) and floor > 0

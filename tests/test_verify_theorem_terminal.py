@@ -96,12 +96,14 @@ def test_one_completion_from_the_deviated_set_lands_in_the_set(pc_cert, t, u, a,
     assert law.contains(end, p_end), (line_of_sight(end, p_end), law)
 
 
-def test_a_surge_floor_leaves_the_tracking_tier_refused_by_name_and_the_safe_tier_given(keep_moving_cert):
-    """The terminal law's surge is not proved above u_min (a target approaching along the line of sight makes it
-    negative): the tracking tier is refused by ``terminal_surge_floor``, which the safe tier does not read."""
+def test_a_surge_floor_with_an_obstacle_near_the_path_leaves_tracking_refused_by_the_path_and_safe_given(
+        keep_moving_cert):
+    """Under the surge floor the bearing face makes the terminal law's own conditions hold (step 17b); on
+    keep_moving what refuses tracking is the loiter's footprint about the completion's end against the obstacle 3 m
+    off the path, which the safe tier does not read."""
     c = keep_moving_cert
     assert c.tiers.safe and not c.tiers.tracking
     failed = [x for x in c.conditions if x.ok is not True]
-    assert [x.condition for x in failed] == ["terminal_surge_floor"]
-    assert "u_min = 0.2" in failed[0].detail
-    assert "terminal_surge_floor" not in {x.condition for x in c.tier_conditions["safe"]}
+    assert [x.condition for x in failed] == ["path_clearance[0]"]
+    assert "binding: the backup's footprint" in failed[0].detail
+    assert "path_clearance[0]" not in {x.condition for x in c.tier_conditions["safe"]}

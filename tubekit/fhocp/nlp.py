@@ -78,10 +78,13 @@ from tubekit.scenario import Obstacle, Scenario, TerminalMode
 from tubekit.tightening import Tightening
 from tubekit.validation import as_vector, choice, positive
 
-__all__ = ["TERMINAL_MODES", "discrete_step", "rollout", "obstacle_array", "select_obstacles", "FhocpNlp",
-           "NlpEvaluation", "BackupTerminal"]
+__all__ = ["TERMINAL_MODES", "TERMINAL_PAD", "discrete_step", "rollout", "obstacle_array", "select_obstacles",
+           "FhocpNlp", "NlpEvaluation", "BackupTerminal"]
 
 TERMINAL_MODES: tuple[str, ...] = TerminalMode.values()
+#: The share of X_f's widths (e_d band, heading room, depth band) by which the FHOCP's last node keeps inside the
+#: tracking theorem's terminal set: a plan the solver ends on a face (to its tolerance) then passes the exact check.
+TERMINAL_PAD = 0.01
 
 
 #: Exact zero-order-hold step F(s, v, dt) of the nominal kinematics (the model's own exact arc).
@@ -352,10 +355,13 @@ class FhocpNlp:
         n = self.horizon_steps
         out = {k: np.full(n, float(v)) for k, v in (("e_d_lo", self.e_d_min), ("e_d_hi", self.e_d_max),
                                                      ("e_z", self.e_z_max), ("e_o", self.e_o_max))}
-        if self.tracking_terminal is not None:
-            d_lo, d_hi, e_o, z_f = self.tracking_terminal
-            out["e_d_lo"][-1], out["e_d_hi"][-1] = max(out["e_d_lo"][-1], d_lo), min(out["e_d_hi"][-1], d_hi)
-            out["e_o"][-1], out["e_z"][-1] = min(out["e_o"][-1], e_o), min(out["e_z"][-1], z_f)
+        if self.tracking_terminal is not None:  # X_f shrunk by TERMINAL_PAD of its widths: plans that end on a
+            d_lo, d_hi, e_o, z_f = self.tracking_terminal  # face pass the exact check despite the solver's tolerance
+            pad = TERMINAL_PAD * (d_hi - d_lo)
+            out["e_d_lo"][-1] = max(out["e_d_lo"][-1], d_lo + pad)
+            out["e_d_hi"][-1] = min(out["e_d_hi"][-1], d_hi - pad)
+            out["e_o"][-1] = min(out["e_o"][-1], (1 - TERMINAL_PAD) * e_o)
+            out["e_z"][-1] = min(out["e_z"][-1], (1 - TERMINAL_PAD) * z_f)
         return out
 
     def clip(self, inputs: np.ndarray) -> np.ndarray:

@@ -225,8 +225,11 @@ def check_plan(scenario: Scenario, tight: Tightening, t0: float, x0: np.ndarray,
     safe_name, safe_worst = _worst(safety)
     slacks = _error_slacks(tight, e, cos_rel, m, pad, sign) if tracking_checked(tight) else {}
     if tight.terminal_law is not None and tracking_checked(tight):
-        end_target = np.asarray(scenario.trajectory.position(t0 + dt * n), dtype=float).reshape(3)
-        slacks.update({k: np.array([v]) for k, v in tight.terminal_law.slacks(arcs[-1, -1], end_target).items()})
+        end_time = t0 + dt * n
+        end_target = np.asarray(scenario.trajectory.position(end_time), dtype=float).reshape(3)
+        end_velocity = np.asarray(scenario.trajectory.velocity(end_time), dtype=float).reshape(3)
+        slacks.update({k: np.array([v]) for k, v in
+                       tight.terminal_law.slacks(arcs[-1, -1], end_target, end_velocity).items()})
     worst_name, worst = _worst(slacks)
     if safe_worst < worst or math.isnan(safe_worst):
         worst_name, worst = safe_name, safe_worst

@@ -5,9 +5,12 @@ period and completed at its end by a terminal law that keeps the error in a term
 set is, with d the horizontal distance to the target, α = ψ − λ_los the heading's angle to the line of
 sight λ_los = atan2(y_d − y, x_d − x) (α = 0: pointing at the target; e_o = −sin α) and e_z = z − z_d,
 
-    X_f = {d_lo <= d <= d_hi, |α| <= α_f, |e_z| <= z_f},
+    X_f = {d_lo <= d <= d_hi, |α| <= α_f, |e_z| <= z_f, |φ| <= φ_f},
 
-and the law, held over one period δ (a plan's row) from the state at time t, is
+φ the bearing: the angle between the target's horizontal velocity and the line of sight (φ = 0: the vehicle
+trails the target). The bearing face is used only under a minimum surge (φ_f = π otherwise: no face); there it
+keeps the target's speed along the line of sight, hence the law's surge, above the floor (``docs/verify.md``,
+step 17b). The law, held over one period δ (a plan's row) from the state at time t, is
 
 * r = −g α / δ (turn the fraction g of the way onto the line of sight);
 * u = (V_r + λ (d − d*)) / (S(g α / 2) cos(α (1 − g / 2))), V_r = ṗ_d(t) · (p_d − p) / d the target's
@@ -33,7 +36,10 @@ from tubekit.exceptions import ConfigError
 from tubekit.model.kinematics import sinc
 from tubekit.validation import finite, positive
 
-__all__ = ["TerminalLaw", "line_of_sight"]
+__all__ = ["TerminalLaw", "line_of_sight", "bearing", "NO_BEARING"]
+
+#: ``bearing_max`` of a terminal set without the bearing face (rad).
+NO_BEARING = math.pi
 
 
 def line_of_sight(state: np.ndarray, p_d: np.ndarray) -> tuple[float, float, float]:
@@ -42,6 +48,16 @@ def line_of_sight(state: np.ndarray, p_d: np.ndarray) -> tuple[float, float, flo
     los = math.atan2(dy, dx)
     alpha = math.atan2(math.sin(state[3] - los), math.cos(state[3] - los))
     return math.hypot(dx, dy), alpha, float(state[2] - p_d[2])
+
+
+def bearing(state: np.ndarray, p_d: np.ndarray, pd_dot: np.ndarray) -> float:
+    """φ (rad, in [−π, π]): the angle from the line of sight (``state`` [x, y, z, ψ] to ``p_d`` (3,)) to the
+    target's horizontal velocity ``pd_dot`` (3,); nan when the target does not move horizontally."""
+    if math.hypot(float(pd_dot[0]), float(pd_dot[1])) == 0.0:
+        return math.nan
+    los = math.atan2(float(p_d[1] - state[1]), float(p_d[0] - state[0]))
+    phi = math.atan2(float(pd_dot[1]), float(pd_dot[0])) - los
+    return math.atan2(math.sin(phi), math.cos(phi))
 
 
 @dataclass(frozen=True)
@@ -56,6 +72,7 @@ class TerminalLaw:
     gain_d: float
     gain_z: float
     turn: float
+    bearing_max: float = NO_BEARING
 
     def __post_init__(self) -> None:
         for f in fields(self):
@@ -71,16 +88,31 @@ class TerminalLaw:
         for name in ("gain_d", "gain_z"):
             if getattr(self, name) < 0.0:
                 raise ConfigError(f"terminal.{name}", ">= 0 (1/s)", getattr(self, name))
+        if not 0.0 < self.bearing_max <= NO_BEARING:
+            raise ConfigError("terminal.bearing_max", "in (0, pi] rad (pi: no bearing face)", self.bearing_max)
 
-    def slacks(self, state: np.ndarray, p_d: np.ndarray) -> dict[str, float]:
-        """Slack (>= 0: inside) of each face of X_f at ``state`` (4,) against ``p_d`` (3,)."""
-        d, alpha, e_z = line_of_sight(np.asarray(state, dtype=float), np.asarray(p_d, dtype=float))
-        return {"terminal set: d >= d_lo": d - self.d_lo, "terminal set: d <= d_hi": self.d_hi - d,
-                "terminal set: |alpha|": self.alpha_max - abs(alpha), "terminal set: |e_z|": self.z_max - abs(e_z)}
+    @property
+    def has_bearing(self) -> bool:
+        """True when X_f has the bearing face |φ| <= φ_f."""
+        return self.bearing_max < NO_BEARING
 
-    def contains(self, state: np.ndarray, p_d: np.ndarray) -> bool:
-        """True when ``state`` lies in X_f."""
-        return min(self.slacks(state, p_d).values()) >= 0.0
+    def slacks(self, state: np.ndarray, p_d: np.ndarray, pd_dot: np.ndarray | None = None) -> dict[str, float]:
+        """Slack (>= 0: inside) of each face of X_f at ``state`` (4,) against ``p_d`` (3,) and, for the bearing
+        face, the target's velocity ``pd_dot`` (3,) at the same time (needed when :attr:`has_bearing`)."""
+        x = np.asarray(state, dtype=float)
+        d, alpha, e_z = line_of_sight(x, np.asarray(p_d, dtype=float))
+        out = {"terminal set: d >= d_lo": d - self.d_lo, "terminal set: d <= d_hi": self.d_hi - d,
+               "terminal set: |alpha|": self.alpha_max - abs(alpha), "terminal set: |e_z|": self.z_max - abs(e_z)}
+        if self.has_bearing:
+            if pd_dot is None:
+                raise ValueError("TerminalLaw.slacks: a bearing face needs the target's velocity pd_dot")
+            phi = bearing(x, np.asarray(p_d, dtype=float), np.asarray(pd_dot, dtype=float))
+            out["terminal set: |bearing|"] = self.bearing_max - abs(phi) if math.isfinite(phi) else -math.inf
+        return out
+
+    def contains(self, state: np.ndarray, p_d: np.ndarray, pd_dot: np.ndarray | None = None) -> bool:
+        """True when ``state`` lies in X_f (``pd_dot``: see :meth:`slacks`)."""
+        return min(self.slacks(state, p_d, pd_dot).values()) >= 0.0
 
     def command(self, state: np.ndarray, p_d: np.ndarray, pd_dot: np.ndarray, dt: float) -> np.ndarray:
         """The law's row v = [u, w, r] (m/s, m/s, rad/s) at the nominal ``state`` (4,), the target's position
@@ -95,7 +127,7 @@ class TerminalLaw:
         return np.array([u, v[2] - self.gain_z * e_z, -g * alpha / dt])
 
     def to_dict(self) -> dict[str, float]:
-        """The eight numbers by name."""
+        """The nine numbers by name."""
         return {k: float(v) for k, v in asdict(self).items()}
 
     @classmethod

@@ -41,6 +41,10 @@ class Trajectory(ABC):
         """Bound on sqrt(xdot_d^2 + ydot_d^2) (m/s)."""
         return float(np.hypot(*self.velocity_bound()[:2]))
 
+    def horizontal_speed_floor(self) -> float:
+        """A lower bound on sqrt(xdot_d^2 + ydot_d^2) over all time (m/s); 0 when not known (a path that stops)."""
+        return 0.0
+
     def acceleration_bound(self) -> tuple[float, float]:
         """(horizontal, vertical) bounds on ‖p̈_d,xy‖ and |z̈_d| (m/s²); (inf, inf) when not known."""
         return (math.inf, math.inf)
@@ -99,6 +103,9 @@ class Circle(Trajectory):
         return np.array([k, k, 0.0])
 
     def horizontal_speed_bound(self):
+        return abs(self.radius * self.rate)
+
+    def horizontal_speed_floor(self):
         return abs(self.radius * self.rate)
 
     def acceleration_bound(self):
@@ -174,6 +181,9 @@ class Line(Trajectory):
         return np.abs(np.asarray(self.direction_velocity))
 
     def horizontal_speed_bound(self):
+        return float(np.hypot(*self.direction_velocity[:2]))
+
+    def horizontal_speed_floor(self):
         return float(np.hypot(*self.direction_velocity[:2]))
 
     def acceleration_bound(self):

@@ -32,8 +32,11 @@ from verify.theorem.design import Condition, Design
 __all__ = ["law_plan", "initial_plan_condition"]
 
 
-def law_plan(scenario: Scenario, law: TerminalLaw, v_bar: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """(rows (N, 3), arcs (N, ARC_SAMPLES + 1, 4), times (N, ARC_SAMPLES + 1)) of the law's plan from the start."""
+def law_plan(scenario: Scenario, law: TerminalLaw, v_bar: np.ndarray, v_low: np.ndarray | None = None
+             ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(rows (N, 3), arcs (N, ARC_SAMPLES + 1, 4), times (N, ARC_SAMPLES + 1)) of the law's plan from the start,
+    each row clipped to [``v_low``, ``v_bar``] (``v_low`` None: −``v_bar``)."""
+    low = -np.asarray(v_bar, dtype=float) if v_low is None else np.asarray(v_low, dtype=float)
     ctrl = scenario.controller
     dt, n = float(ctrl.dt), int(ctrl.horizon_steps)
     tau = np.linspace(0.0, dt, ARC_SAMPLES + 1)
@@ -43,12 +46,22 @@ def law_plan(scenario: Scenario, law: TerminalLaw, v_bar: np.ndarray) -> tuple[n
         t = j * dt
         p = np.asarray(scenario.trajectory.position(t), dtype=float).reshape(3)
         v = np.asarray(scenario.trajectory.velocity(t), dtype=float).reshape(3)
-        rows[j] = np.clip(law.command(x, p, v, dt), -v_bar, v_bar)
+        rows[j] = np.clip(law.command(x, p, v, dt), low, v_bar)
         arcs[j] = unicycle_step(np.broadcast_to(x, (ARC_SAMPLES + 1, 4)), np.broadcast_to(rows[j], (ARC_SAMPLES + 1, 3)),
                                 tau)
         x = arcs[j, -1]
     times = dt * (np.arange(n)[:, None] + np.linspace(0.0, 1.0, ARC_SAMPLES + 1)[None, :])
     return rows, arcs, times
+
+
+def _lower_corner(scenario: Scenario, v_bar: np.ndarray) -> np.ndarray | None:
+    """The plans' lower corner as the loop clips to it (``Tightening.v_low``): under a minimum surge
+    u_min + (u_max − ū̄), −w̄, −r̄ (``verify.certificate.handoff``); None for the symmetric box."""
+    limits = scenario.limits
+    if limits.u_min is None:
+        return None
+    corner = np.asarray(limits.lower, dtype=float) + (np.array([limits.u_max, limits.w_max, limits.r_max]) - v_bar)
+    return np.minimum(corner, v_bar)
 
 
 def _footprint_slacks(scenario: Scenario, end: np.ndarray, safe: SafeSet) -> dict[str, float]:
@@ -98,12 +111,14 @@ def _arc_slacks(scenario: Scenario, design: Design, region: Region, arcs: np.nda
 def initial_plan_condition(scenario: Scenario, design: Design, region: Region, law: TerminalLaw,
                            safe: SafeSet) -> Condition:
     """``initial_terminal``: the law's clipped plan from the start passes the exact check (module doc)."""
-    rows, arcs, times = law_plan(scenario, law, np.asarray(design.v_bar, dtype=float))
+    v_bar = np.asarray(design.v_bar, dtype=float)
+    rows, arcs, times = law_plan(scenario, law, v_bar, _lower_corner(scenario, v_bar))
     end = arcs[-1, -1]
     end_target = np.asarray(scenario.trajectory.position(times[-1, -1]), dtype=float).reshape(3)
+    end_velocity = np.asarray(scenario.trajectory.velocity(times[-1, -1]), dtype=float).reshape(3)
     slacks = _arc_slacks(scenario, design, region, arcs, times)
     slacks.update(_footprint_slacks(scenario, end, safe))
-    slacks.update(law.slacks(end, end_target))
+    slacks.update(law.slacks(end, end_target, end_velocity))
     where, worst = min(slacks.items(), key=lambda kv: kv[1])
     start = np.asarray(scenario.initial_state, dtype=float)
     p0 = np.asarray(scenario.trajectory.position(0.0), dtype=float).reshape(3)

@@ -26,7 +26,9 @@ unicycle arc (``tubekit.model.terminal_law`` for the law), in the line-of-sight 
 * at t = 0, the law's own plan from the start passes the exact check (``initial_terminal``,
   :mod:`verify.theorem.initial_plan`): it is the candidate when the solver's plan is rejected.
 
-Plans with a rate limit are not covered (``terminal_rate``: the completion's row would have to be within J of
+Under a minimum surge the completion's surge must stay above u_min + κ̄_u: X_f gets a bearing face, a cone behind a
+target whose speed has a positive floor (:mod:`verify.theorem.terminal_bearing`, step 17b); a target that may stop
+is refused (``terminal_surge_floor``). Plans with a rate limit are not covered (``terminal_rate``: the completion's row would have to be within J of
 the plan's last row, which is not proved). Every inequality is evaluated in Arb and must hold with the slack
 :data:`FLOAT_SLACK`, so that the run's float check of the same set agrees. :func:`design_terminal` searches a
 small grid of sets, largest first, and keeps the first that meets every condition.
@@ -50,6 +52,8 @@ from verify.kernel.region import Region
 from verify.theorem.design import Condition, Design
 from verify.theorem.initial_plan import initial_plan_condition
 from verify.theorem.path_clearance import PathFootprint, horizon_end, path_clearance, path_samples, path_workspace
+from verify.theorem.completion_bounds import TerminalBounds
+from verify.theorem.terminal_bearing import bearing_conditions, bearing_sets
 
 __all__ = ["TerminalBounds", "terminal_bounds", "law_conditions", "footprint_of", "sensing_condition",
            "design_terminal", "with_terminal", "FLOAT_SLACK", "TERMINAL_PREFIXES"]
@@ -67,26 +71,6 @@ LOWER_ENDS = (0.0, 0.1, 0.2, 0.35, 0.5)
 ANGLES = (1.0, 0.6, 0.3)
 
 
-@dataclass(frozen=True)
-class TerminalBounds:
-    """What the completion's proof reads (floats; m, s, rad): V̄, the target's speed and acceleration bounds,
-    the replay's deviation at the shifted end, and R shrunk by the last arc's margins and the check's pad."""
-
-    dt: float
-    steps: int
-    v_bar: tuple[float, float, float]
-    speed_xy: float
-    speed_z: float
-    accel_xy: float
-    accel_z: float
-    dev_xy: float
-    dev_z: float
-    dev_psi: float
-    room_d: tuple[float, float]
-    room_o: float
-    room_z: float
-
-
 def terminal_bounds(scenario: Scenario, design: Design, region: Region) -> TerminalBounds:
     """The :class:`TerminalBounds` of ``design`` (a design with margins and V̄)."""
     p, tube, m = design.problem, design.tube, design.margins
@@ -100,7 +84,10 @@ def terminal_bounds(scenario: Scenario, design: Design, region: Region) -> Termi
         accel_xy=float(ax), accel_z=float(az), dev_xy=dev_xy, dev_z=tube.p_z, dev_psi=tube.psi,
         room_d=(upper(arb(region.e_d[0]) + arb(md) + arb(pad[0])), lower(arb(region.e_d[1]) - arb(md) - arb(pad[0]))),
         room_o=lower(arb(min(-region.e_o[0], region.e_o[1])) - arb(mo) - arb(pad[2])),
-        room_z=lower(arb(min(-region.e_z[0], region.e_z[1])) - arb(mz) - arb(pad[1])))
+        room_z=lower(arb(min(-region.e_z[0], region.e_z[1])) - arb(mz) - arb(pad[1])),
+        speed_floor_xy=float(scenario.trajectory.horizontal_speed_floor()),
+        surge_floor=None if scenario.limits.u_min is None else upper(arb(scenario.limits.u_min)
+                                                                    + arb(design.tube.kappa[0])))
 
 
 def _cond(name: str, text: str, lhs: arb, rhs: arb, detail: str = "") -> Condition:
@@ -195,7 +182,9 @@ def law_conditions(b: TerminalBounds, law: TerminalLaw) -> tuple[Condition, ...]
     if arc is None:
         return (Condition("terminal_invariant[geometry]", "D_xy < d_lo and beta < pi/2", None, None, False,
                           f"the replay's deviation {b.dev_xy:.4g} m or the heading room does not fit this set"),)
-    return tuple(_input_conditions(b, law, arc) + _invariance_conditions(b, law, arc) + _region_conditions(b, law, arc))
+    bearing = bearing_conditions(b, law, arc.x_min, arc.x_max, FLOAT_SLACK) if b.surge_floor is not None else []
+    return tuple(_input_conditions(b, law, arc) + _invariance_conditions(b, law, arc) + _region_conditions(b, law, arc)
+                 + bearing)
 
 
 def footprint_of(scenario: Scenario, design: Design, b: TerminalBounds, law: TerminalLaw,
@@ -222,7 +211,14 @@ def sensing_condition(scenario: Scenario, b: TerminalBounds, safe: SafeSet) -> C
 
 
 def _sets(b: TerminalBounds) -> list[TerminalLaw]:
-    """The grid of terminal sets and their gains, largest first (module doc)."""
+    """The grid of terminal sets and their gains, largest first (module doc); under a surge floor each with its
+    bearing face (:func:`verify.theorem.terminal_bearing.bearing_sets`)."""
+    laws = _grid(b)
+    return bearing_sets(b, laws) if b.surge_floor is not None else laws
+
+
+def _grid(b: TerminalBounds) -> list[TerminalLaw]:
+    """The grid of terminal sets without the bearing face."""
     dt, (ub, wb, rb) = b.dt, b.v_bar
     half_run = (ub + b.speed_xy) * dt / 2
     lo_min = b.room_d[0] + b.dev_xy + half_run + 1e-6
@@ -262,12 +258,13 @@ def _no_set(b: TerminalBounds) -> Condition:
 
 def _not_covered(scenario: Scenario, region: Region) -> tuple[Condition, ...]:
     """The designs the theorem does not cover yet, named (whatever the backup): rate-limited plans, a minimum
-    surge, a region whose heading is not ``toward``."""
-    if scenario.limits.u_min is not None:
-        return (Condition("terminal_surge_floor", "plans without a minimum surge (the terminal law's surge, "
-                          "V_r + lambda (d - d*) over S cos, is not proved above u_min + kappa_u: a target "
-                          "approaching along the line of sight makes it negative)", None, None, False,
-                          f"limits.u_min = {scenario.limits.u_min:g} m/s; the safe tier does not need it"),)
+    surge after a target that may stop, a region whose heading is not ``toward``."""
+    if scenario.limits.u_min is not None and not scenario.trajectory.horizontal_speed_floor() > 0.0:
+        return (Condition("terminal_surge_floor", "under a minimum surge, a target whose horizontal speed has a "
+                          "positive floor (the terminal law's surge follows the target's speed along the line of "
+                          "sight; a target that stops or turns toward the vehicle makes it negative)", None, None,
+                          False, f"limits.u_min = {scenario.limits.u_min:g} m/s, trajectory "
+                          f"{scenario.trajectory.kind!r} has no speed floor; the safe tier does not need it"),)
     if scenario.limits.rate is not None:
         return (Condition("terminal_rate", "plans without a rate limit (the completion's row is not proved "
                           "within J of the plan's last)", None, None, False,

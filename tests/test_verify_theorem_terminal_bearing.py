@@ -1,0 +1,122 @@
+"""verify.theorem.terminal_bearing: the bearing face of X_f under a minimum surge (docs/verify.md, step 17b)."""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+import verify
+from tubekit import load_scenario
+from tubekit.model.kinematics import unicycle_step
+from tubekit.model.terminal_law import bearing, line_of_sight
+from tubekit.model.trajectory import Circle, Waypoints
+from verify.theorem.terminal import law_conditions, terminal_bounds
+from verify.theorem.terminal_bearing import BEARING_STEP, smallest_bearing
+
+TRACKED = load_scenario(Path(__file__).resolve().parents[1] / "examples" / "keep_moving_tracked.toml")
+#: The same vehicle after a target on a 10 m circle at 0.4 m/s (curvature: the velocity turns 0.004 rad a period).
+CIRCLING = TRACKED.with_changes(trajectory=Circle(radius=10.0, rate=0.04, center=(0.0, -10.0, 0.0), phase=0.0),
+                                obstacles=())
+SCENARIOS = {"line": TRACKED, "circle": CIRCLING}
+
+
+@pytest.fixture(scope="module")
+def certs():
+    return {name: verify.certify(sc) for name, sc in SCENARIOS.items()}
+
+
+def test_a_line_or_a_circle_under_a_surge_floor_gets_both_tiers_with_a_bearing_face(certs):
+    for name, cert in certs.items():
+        law = cert.design.terminal
+        assert cert.tiers.safe and cert.tiers.tracking, name
+        assert law is not None and law.has_bearing and 0 < law.bearing_max < math.pi / 2
+        names = {c.condition for c in cert.design.conditions}
+        assert {"terminal_invariant[bearing]", "terminal_invariant[bearing_cross]", "terminal_surge_floor"} <= names
+        assert cert.tightening.terminal_law == law and cert.tightening.plan_always_available
+
+
+def test_a_target_that_may_stop_leaves_tracking_refused_by_the_surge_floor_by_name():
+    """Waypoints rest at their corners: no speed floor, so the law's surge cannot be kept above u_min."""
+    sc = TRACKED.with_changes(trajectory=Waypoints(points=((0.0, 0.0, 0.0), (10.0, 0.0, 0.0), (20.0, 5.0, 0.0)),
+                                                   speed=0.4), obstacles=())
+    cert = verify.certify(sc)
+    assert cert.tiers.safe and not cert.tiers.tracking
+    failed = {c.condition: c for c in cert.failures}
+    assert list(failed) == ["terminal_surge_floor"] and "no speed floor" in failed["terminal_surge_floor"].detail
+
+
+def _state(law, b, p: np.ndarray, v: np.ndarray, d: float, phi: float, a: float, z: float,
+           shift: tuple[float, float], dpsi: float) -> np.ndarray:
+    """A state of X_f (distance d, bearing phi, heading error a, depth error z against the target at p moving at
+    v), moved by the replay's deviation: ``shift`` (a direction, scaled to D_xy) and ``dpsi`` (in units of D_psi)."""
+    los = math.atan2(v[1], v[0]) - phi                      # phi: from the line of sight to the velocity
+    where = p[:2] - d * np.array([math.cos(los), math.sin(los)])
+    x = np.array([where[0], where[1], p[2] + z, los + a])
+    s = np.asarray(shift, dtype=float)
+    s = s / max(1.0, float(np.hypot(*s))) * b.dev_xy
+    return x + np.array([s[0], s[1], math.copysign(b.dev_z, z), dpsi * b.dev_psi])
+
+
+@settings(max_examples=120, deadline=None, derandomize=True)
+@given(which=st.sampled_from(sorted(SCENARIOS)), t=st.floats(0.0, 60.0), u=st.floats(0.0, 1.0),
+       f=st.floats(-1.0, 1.0), a=st.floats(-1.0, 1.0), z=st.floats(-1.0, 1.0),
+       dx=st.floats(-1.0, 1.0), dy=st.floats(-1.0, 1.0), dpsi=st.floats(-1.0, 1.0))
+def test_one_completion_keeps_the_cone_and_the_surge_above_its_floor(certs, which, t, u, f, a, z, dx, dy, dpsi):
+    """Property (step 17b): from any state of X_f (the bearing face included) moved by the replay's deviation, one
+    row of the certified law held over delta along the exact arc commands a surge of at least u_min + kappa_u and
+    ends in X_f again, its bearing measured against the target's velocity one period later."""
+    sc, cert = SCENARIOS[which], certs[which]
+    law, dt = cert.design.terminal, sc.controller.dt
+    b = terminal_bounds(sc, cert.design, cert.region)
+    tr = sc.trajectory
+    p, v = np.asarray(tr.position(t), float).reshape(3), np.asarray(tr.velocity(t), float).reshape(3)
+    x = _state(law, b, p, v, law.d_lo + u * (law.d_hi - law.d_lo), f * law.bearing_max, a * law.alpha_max,
+               z * law.z_max, (dx, dy), dpsi)
+    row = law.command(x, p, v, dt)
+    assert row[0] >= b.surge_floor - 1e-12 and np.all(np.abs(row) <= np.asarray(cert.design.v_bar) + 1e-12)
+    end = unicycle_step(x, row, dt)
+    p1, v1 = (np.asarray(g(t + dt), float).reshape(3) for g in (tr.position, tr.velocity))
+    assert law.contains(end, p1, v1), (line_of_sight(end, p1), bearing(end, p1, v1), law)
+
+
+def test_a_cone_narrower_than_the_proof_allows_is_refuted_and_left_by_a_completion(certs):
+    """Counterexample: half the smallest admissible phi_f. The condition fails, and a start on the cone's edge
+    pushed outward by the deviation (the vehicle moved sideways, its heading turned outward) ends outside it."""
+    sc, cert = TRACKED, certs["line"]
+    b = terminal_bounds(sc, cert.design, cert.region)
+    narrow = dataclasses.replace(cert.design.terminal, bearing_max=0.5 * smallest_bearing(b, cert.design.terminal))
+    failed = {c.condition for c in law_conditions(b, narrow) if not c.ok}
+    assert "terminal_invariant[bearing]" in failed
+    dt, tr = sc.controller.dt, sc.trajectory
+    p, v = np.asarray(tr.position(10.0), float).reshape(3), np.asarray(tr.velocity(10.0), float).reshape(3)
+    phi = narrow.bearing_max
+    los = math.atan2(v[1], v[0]) - phi
+    outward = (-math.sin(los), math.cos(los))     # the vehicle moved to the line of sight's left: the bearing grows
+    x = _state(narrow, b, p, v, narrow.d_hi, phi, narrow.alpha_max, 0.0, outward, 0.0)  # heading left of it too
+    assert bearing(x, p, v) > phi                           # the deviation alone already left the cone
+    end = unicycle_step(x, narrow.command(x, p, v, dt), dt)
+    p1, v1 = (np.asarray(g(10.0 + dt), float).reshape(3) for g in (tr.position, tr.velocity))
+    assert abs(bearing(end, p1, v1)) > narrow.bearing_max
+
+
+def test_the_smallest_bearing_is_the_first_grid_point_the_condition_admits(certs):
+    """The grid point below the one returned fails the float inequality, the one returned passes it in Arb."""
+    cert = certs["line"]
+    b = terminal_bounds(TRACKED, cert.design, cert.region)
+    law = cert.design.terminal
+    phi = smallest_bearing(b, law)
+    assert phi is not None and phi == pytest.approx(law.bearing_max)
+    below = dataclasses.replace(law, bearing_max=phi - BEARING_STEP)
+    assert not {c.condition: c.ok for c in law_conditions(b, below)}["terminal_invariant[bearing]"]
+
+
+def test_without_a_speed_floor_no_bearing_is_admitted(certs):
+    cert = certs["line"]
+    b = dataclasses.replace(terminal_bounds(TRACKED, cert.design, cert.region), speed_floor_xy=0.0)
+    assert smallest_bearing(b, cert.design.terminal) is None

@@ -1,0 +1,141 @@
+"""The tracking theorem under a minimum surge: the bearing face of X_f keeps the terminal law's surge above u_min.
+
+The terminal law's surge u = (V_r + λ (d − d*)) / (S(gα/2) cos β̂) follows the target's speed along the line of
+sight, V_r = P cos φ, where φ is the *bearing*, the angle from the line of sight to the target's horizontal
+velocity (``tubekit.model.terminal_law.bearing``). A target that comes toward the vehicle makes V_r, hence u,
+negative, so without more the law cannot respect u >= u_min (``terminal_surge_floor`` refused every design). With
+a target whose horizontal speed never drops below P_min > 0 (``Trajectory.horizontal_speed_floor``: a line or a
+circle), X_f gets a fourth face |φ| <= φ_f, a cone behind the target, and two things are proved
+(:func:`bearing_conditions`, Arb, with :data:`verify.theorem.terminal.FLOAT_SLACK`):
+
+* **the cone is invariant** (``terminal_invariant[bearing]``). The completion starts within the replay's deviation
+  D_xy of X_f: its bearing |φ̃| <= Φ_0 = φ_f + asin(D_xy / d_lo). In the line-of-sight frame of that start the
+  relative position becomes q' = (q'_x, q'_y) with q'_x in [x_min, x_max] (the radial closing of
+  ``verify.theorem.terminal``) and, for φ̃ >= 0, q'_y >= δ P_min sin φ̃ − L_c − A δ²/2: the target's lateral run,
+  less the vehicle's lateral chord L_c = δ (P + λ Δ) tan β (the law's surge times tan of the chord's angle) and
+  the target's curvature. The line of sight turns toward the target's velocity by θ = atan2(q'_y, q'_x), and the
+  velocity itself turns by at most η = A δ / P_min. φ' = φ̃ + η − θ is increasing in φ̃ (δ P <= x_min), so its
+  largest value is at Φ_0: Φ_0 + η − atan(y_lo / x_max) <= φ_f with y_lo = δ P_min sin Φ_0 − L_c − A δ²/2 > 0;
+  by symmetry the same bounds −φ' from above; the cone is not crossed to the other side
+  (``terminal_invariant[bearing_cross]``): η + atan((L_c + A δ²/2) / x_min) <= φ_f.
+* **the surge stays above the floor** (``terminal_surge_floor``): over the start set, V_r >= P_min cos Φ_0 and
+  d − d* >= −(d* − d_lo + D_xy), and S cos <= 1 divides a positive numerator, so
+  u >= P_min cos Φ_0 − λ (d* − d_lo + D_xy) >= u_min + κ̄_u (the plans' surge floor, ``v_bar[surge_floor]``).
+
+:func:`bearing_sets` gives each set of the grid the smallest φ_f that the float version of the first inequality
+admits, with narrower heading rooms and smaller radial gains tried too (the lateral chord grows with both).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from typing import Iterable
+
+from flint import arb
+
+from tubekit.model.terminal_law import TerminalLaw
+
+from verify.theorem.completion_bounds import TerminalBounds
+from verify.theorem.design import Condition
+
+__all__ = ["bearing_conditions", "bearing_sets", "smallest_bearing", "ALPHA_FRACTIONS", "GAIN_FRACTIONS",
+           "BEARING_STEP"]
+
+#: Fractions of each grid set's heading room α_f tried under a surge floor (largest first).
+ALPHA_FRACTIONS = (1.0, 0.3, 0.1, 0.05)
+#: Fractions of each grid set's radial gain λ tried under a surge floor (largest first).
+GAIN_FRACTIONS = (1.0, 0.5, 0.2, 0.1, 0.05)
+#: The grid on which the smallest admissible φ_f is searched (rad).
+BEARING_STEP = 0.005
+
+
+def _geometry(b: TerminalBounds, law: TerminalLaw) -> dict[str, float]:
+    """The completion's floats the bearing inequalities read (module doc)."""
+    dt, dxy = b.dt, b.dev_xy
+    lam = law.gain_d * dt
+    a0 = law.alpha_max + b.dev_psi + math.asin(min(1.0, dxy / law.d_lo))
+    beta = a0 * (1 - law.turn / 2)
+    spread = max(law.d_hi + dxy - law.d_star, law.d_star - law.d_lo + dxy)
+    curve = b.accel_xy * dt * dt / 2
+    return {"dev": math.asin(min(1.0, dxy / law.d_lo)), "chord": dt * (b.speed_xy + law.gain_d * spread) * math.tan(beta),
+            "curve": curve, "turn": b.accel_xy * dt / b.speed_floor_xy if b.speed_floor_xy > 0 else math.inf,
+            "x_min": (law.d_lo - dxy) * (1 - lam) + lam * law.d_star - curve,
+            "x_max": (law.d_hi + dxy) * (1 - lam) + lam * law.d_star + curve}
+
+
+def smallest_bearing(b: TerminalBounds, law: TerminalLaw) -> float | None:
+    """The smallest φ_f on the :data:`BEARING_STEP` grid below π/2 for which the float version of
+    ``terminal_invariant[bearing]`` holds for ``law`` (its other faces as given); None when none does."""
+    if b.speed_floor_xy <= 0.0:
+        return None
+    g = _geometry(b, law)
+    for i in range(1, int(math.pi / 2 / BEARING_STEP)):
+        phi = i * BEARING_STEP
+        start = phi + g["dev"]
+        if start >= math.pi / 2:
+            return None
+        lateral = b.dt * b.speed_floor_xy * math.sin(start) - g["chord"] - g["curve"]
+        if lateral > 0 and start + g["turn"] - math.atan(lateral / g["x_max"]) <= phi - 1e-6:
+            return phi
+    return None
+
+
+def bearing_sets(b: TerminalBounds, laws: Iterable[TerminalLaw]) -> list[TerminalLaw]:
+    """Each set of ``laws`` with narrower heading rooms and smaller radial gains (:data:`ALPHA_FRACTIONS`,
+    :data:`GAIN_FRACTIONS`; the turn fraction g recomputed from r̄̄) and its smallest bearing face; sets without
+    one are dropped."""
+    out = []
+    rb, dt = b.v_bar[2], b.dt
+    for law in laws:
+        for fa in ALPHA_FRACTIONS:
+            alpha = law.alpha_max * fa
+            a0 = alpha + b.dev_psi + math.asin(min(1.0, b.dev_xy / law.d_lo))
+            turn = min(1.0, rb * dt / a0 * (1 - 1e-6))
+            for fg in GAIN_FRACTIONS:
+                cand = dataclasses.replace(law, alpha_max=alpha, turn=turn, gain_d=law.gain_d * fg)
+                phi = smallest_bearing(b, cand)
+                if phi is not None:
+                    out.append(dataclasses.replace(cand, bearing_max=phi))
+    return out
+
+
+def _cond(name: str, text: str, lhs: arb, rhs: arb, slack: float, detail: str = "") -> Condition:
+    """lhs + ``slack`` <= rhs in Arb (lhs's upper end, rhs's lower end reported)."""
+    ok = bool((lhs + arb(slack)) <= rhs) and lhs.is_finite() and rhs.is_finite()
+    return Condition(name, text, float(lhs.upper()) if lhs.is_finite() else math.inf,
+                     float(rhs.lower()) if rhs.is_finite() else math.inf, ok, detail)
+
+
+def bearing_conditions(b: TerminalBounds, law: TerminalLaw, x_min: arb, x_max: arb, slack: float) -> list[Condition]:
+    """``terminal_invariant[bearing]``, ``terminal_invariant[bearing_cross]`` and ``terminal_surge_floor`` of
+    ``law`` (module doc), in Arb; ``x_min``, ``x_max`` the completion's radial bounds
+    (``verify.theorem.terminal._arc``). Under a surge floor a set without the bearing face fails by name."""
+    if not law.has_bearing:
+        return [Condition("terminal_surge_floor", "a bearing face |phi| <= phi_f (the target's speed along the line "
+                          "of sight keeps the law's surge above u_min + kappa_u)", None, None, False,
+                          "this set has none")]
+    dt, dxy = arb(b.dt), arb(b.dev_xy)
+    p_min, p_max = arb(b.speed_floor_xy), arb(b.speed_xy)
+    lam, d_lo, d_star = arb(law.gain_d), arb(law.d_lo), arb(law.d_star)
+    dev = (dxy / d_lo).asin()
+    a0 = arb(law.alpha_max) + arb(b.dev_psi) + dev
+    beta = a0 * (1 - arb(law.turn) / 2)
+    spread = max(arb(law.d_hi) + dxy - d_star, d_star - d_lo + dxy)
+    chord = dt * (p_max + lam * spread) * beta.tan()
+    curve = arb(b.accel_xy) * dt * dt / 2
+    turn = arb(b.accel_xy) * dt / p_min
+    phi_f = arb(law.bearing_max)
+    start = phi_f + dev
+    lateral = dt * p_min * start.sin() - chord - curve
+    valid = bool(start < arb.pi() / 2) and bool(lateral > 0) and bool(dt * p_max <= x_min)
+    nxt = start + turn - (lateral / x_max).atan() if valid else arb("inf")
+    floor = p_min * start.cos() - lam * (d_star - d_lo + dxy)
+    return [_cond("terminal_invariant[bearing]", "Phi_0 + eta - atan((delta P_min sin Phi_0 - L_c - A delta^2/2) "
+                  "/ x_max) <= phi_f (the cone behind the target is invariant)", nxt, phi_f, slack,
+                  f"phi_f {law.bearing_max:.4g} rad, P_min {b.speed_floor_xy:.4g} m/s, chord {float(chord.upper()):.4g} m"),
+            _cond("terminal_invariant[bearing_cross]", "eta + atan((L_c + A delta^2/2) / x_min) <= phi_f",
+                  turn + ((chord + curve) / x_min).atan(), phi_f, slack),
+            _cond("terminal_surge_floor", "P_min cos Phi_0 - lambda (d* - d_lo + D_xy) >= u_min + kappa_u (the law's "
+                  "surge never below the plans' floor)", arb(b.surge_floor), floor, slack,
+                  f"floor u_min + kappa_u = {b.surge_floor:.4g} m/s")]

@@ -123,11 +123,12 @@ def test_a_bad_truth_entry_names_its_field(entry, scenario, match):
         _truth_spec(entry, scenario)
 
 
-def test_the_keep_moving_campaign_samples_currents_within_what_its_scenario_certifies():
-    """examples/keep_moving_campaign.toml: the sampled amplitudes stay at or below the scenario's own (the bound its
-    certificate holds over), and the scenario keeps its surge floor and its loiter."""
+@pytest.mark.parametrize("name", ["keep_moving_campaign.toml", "keep_moving_tracked_campaign.toml"])
+def test_the_keep_moving_campaigns_sample_currents_within_what_their_scenario_certifies(name):
+    """examples/keep_moving_campaign.toml and its tracked twin: the sampled amplitudes stay at or below the
+    scenario's own (the bound its certificate holds over), and the scenario keeps its surge floor and its loiter."""
     from tubekit.app.campaign_spec import load_spec
-    spec = load_spec(ROOT / "examples" / "keep_moving_campaign.toml")
+    spec = load_spec(ROOT / "examples" / name)
     assert spec.runs == 200 and spec.falsify_sequences == 1
     assert spec.base["limits"]["u_min"] == 0.2 and spec.base["controller"]["backup"] == "loiter"
     high = dict(spec.sample)["disturbance.amplitude"].to_dict()["uniform"][1]

@@ -1,0 +1,88 @@
+"""Where a vehicle that must keep moving certifies at survey speed, the velocity loop aside: the kinematic frontier.
+
+The survey target of the torpedo issue is a line at >= 1 m/s in >= 0.3 m/s of current, with a minimum surge, the
+loiter backup, ε <= 3 m and an obstacle within 5 m of the path. REMUS 100's velocity loop does not close there
+(``benchmarks/remus_frontier.py``); this study asks what the rest of the theorem gives on the kinematic plant (the
+paper's model, no velocity loop): the minimum-surge tube, the loiter's certified safe set, and the tracking tier
+through the terminal set's bearing face (``docs/verify.md`` steps 13e, 17b). For each target speed P and current
+amplitude c (per horizontal axis; 0.05 m/s in depth) ``examples/keep_moving_tracked.toml`` is re-set to a survey:
+a line at P along x, u_min ``--u-min``, u_max ``--u-max``, r_max ``--r-max``, ε ``--epsilon``, e_d <= ε + 5 m, the start
+2 m behind the target's ε, and one obstacle (radius 0.5 m) whose centre is ``--offset`` m off the path, 40 m ahead.
+Each cell prints the tiers (``both``, ``safe``, or the first failed conditions) and the loiter's certified radius.
+Nothing is timed.
+
+Usage: ``python benchmarks/survey_frontier.py [--speed 0.6 1.0 1.5] [--current 0.1 0.2 0.3] [--offset 5 30]``
+(about a second per cell).
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+
+SCENARIO = Path(__file__).resolve().parent.parent / "examples" / "keep_moving_tracked.toml"
+SPEEDS = (0.6, 1.0, 1.5)
+CURRENTS = (0.1, 0.2, 0.3)
+OFFSETS = (5.0, 30.0)
+
+__all__ = ["survey", "cell", "main"]
+
+
+def survey(speed: float, current: float, offset: float, *, u_min: float = 0.5, u_max: float = 2.0,
+           r_max: float = 0.2, epsilon: float = 3.0):
+    """The survey scenario of the module doc (a :class:`tubekit.scenario.Scenario`)."""
+    from tubekit import load_scenario
+    from tubekit.model.trajectory import Line
+    from tubekit.scenario import Obstacle
+
+    return load_scenario(SCENARIO).with_changes(
+        name="survey", trajectory=Line(start=(0.0, 0.0, 0.0), direction_velocity=(speed, 0.0, 0.0)),
+        obstacles=(Obstacle((40.0, offset, 0.0), 0.5),), epsilon=epsilon, duration=60.0, sensing_range=80.0,
+        workspace=((-100.0, -100.0, -10.0), (300.0, 100.0, 10.0)), initial_state=(-(epsilon + 2.0), 0.0, 0.0, 0.0),
+        **{"limits.u_max": u_max, "limits.u_min": u_min, "limits.r_max": r_max,
+           "disturbance.amplitude": (current, current, 0.05), "region.e_d_max": epsilon + 5.0})
+
+
+def cell(speed: float, current: float, offset: float, **limits: float) -> dict:
+    """The verdict of one cell: ``tiers`` (both / safe / none), the failed conditions and the loiter's radius (m)."""
+    import verify
+
+    cert = verify.certify(survey(speed, current, offset, **limits))
+    tiers = "both" if cert.tiers.tracking else "safe" if cert.tiers.safe else "none"
+    radius = cert.backup.safe_set.radius if cert.backup is not None and cert.backup.safe_set is not None else None
+    return {"tiers": tiers, "failed": [c.condition for c in cert.failures], "loiter_radius": radius}
+
+
+def _text(res: dict) -> str:
+    radius = "" if res["loiter_radius"] is None else f" (loiter {res['loiter_radius']:.3g} m)"
+    if res["tiers"] == "both":
+        return "both" + radius
+    head = "safe; tracking: " if res["tiers"] == "safe" else ""
+    return head + ", ".join(res["failed"][:3]) + radius
+
+
+def main(argv: list[str] | None = None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--speed", type=float, nargs="+", default=list(SPEEDS), help="target speeds (m/s)")
+    ap.add_argument("--current", type=float, nargs="+", default=list(CURRENTS), help="current per axis (m/s)")
+    ap.add_argument("--offset", type=float, nargs="+", default=list(OFFSETS), help="obstacle off the path (m)")
+    ap.add_argument("--u-min", type=float, default=0.5)
+    ap.add_argument("--u-max", type=float, default=2.0)
+    ap.add_argument("--r-max", type=float, default=0.2)
+    ap.add_argument("--epsilon", type=float, default=3.0)
+    args = ap.parse_args(argv)
+    limits = {"u_min": args.u_min, "u_max": args.u_max, "r_max": args.r_max, "epsilon": args.epsilon}
+    for offset in args.offset:
+        print(f"obstacle {offset:g} m off the path; u_min {args.u_min:g}, u_max {args.u_max:g} m/s, "
+              f"r_max {args.r_max:g} rad/s, epsilon {args.epsilon:g} m")
+        print("| target (m/s) \\ current (m/s) | " + " | ".join(f"{c:g}" for c in args.current) + " |")
+        print("|---" * (len(args.current) + 1) + "|")
+        for speed in args.speed:
+            row = [_text(cell(speed, c, offset, **limits)) for c in args.current]
+            print(f"| {speed:g} | " + " | ".join(row) + " |")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

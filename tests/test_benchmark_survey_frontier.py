@@ -1,0 +1,25 @@
+"""benchmarks/survey_frontier.py: a vehicle that must keep moving at survey speed, on the kinematic plant."""
+
+from __future__ import annotations
+
+from .scripts import load_script
+
+STUDY = load_script("benchmarks/survey_frontier.py", "bench_survey_frontier")
+
+
+def test_at_one_metre_per_second_in_the_survey_current_both_tiers_hold_with_room_and_the_loiter_refuses_a_near_rock():
+    """1 m/s along a line in 0.3 m/s of current per axis, u_min 0.5 m/s, r_max 0.3 rad/s, epsilon 3 m: with the
+    obstacle 30 m off the path both tiers are certified (the bearing face keeps the terminal law's surge above the
+    floor); 5 m off it, tracking is refused by the path's clearance alone, the loiter's certified safe set (about
+    20 m) being what the candidate's completion must keep clear."""
+    far = STUDY.cell(1.0, 0.3, 30.0, r_max=0.3)
+    near = STUDY.cell(1.0, 0.3, 5.0, r_max=0.3)
+    assert far["tiers"] == "both" and far["failed"] == []
+    assert near["tiers"] == "safe" and near["failed"] == ["path_clearance[0]"]
+    assert near["loiter_radius"] == far["loiter_radius"] > 5.0
+
+
+def test_a_target_barely_faster_than_the_surge_floor_cannot_keep_the_law_above_it():
+    """0.6 m/s against u_min 0.5 m/s: P_min cos(Phi_0) less the radial correction falls below the floor."""
+    res = STUDY.cell(0.6, 0.1, 30.0, r_max=0.3)
+    assert res["tiers"] == "safe" and "terminal_surge_floor" in res["failed"]

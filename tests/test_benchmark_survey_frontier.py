@@ -11,7 +11,7 @@ def test_at_one_metre_per_second_in_the_survey_current_both_tiers_hold_with_room
     """1 m/s along a line in 0.3 m/s of current per axis, u_min 0.5 m/s, r_max 0.3 rad/s, epsilon 3 m: with the
     obstacle 30 m off the path both tiers are certified (the bearing face keeps the terminal law's surge above the
     floor); 5 m off it, tracking is refused by the path's clearance alone, the loiter's certified safe set (about
-    20 m) being what the candidate's completion must keep clear."""
+    13 m) being what the candidate's completion must keep clear."""
     far = STUDY.cell(1.0, 0.3, 30.0, r_max=0.3)
     near = STUDY.cell(1.0, 0.3, 5.0, r_max=0.3)
     assert far["tiers"] == "both" and far["failed"] == []

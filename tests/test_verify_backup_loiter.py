@@ -16,7 +16,7 @@ from tubekit.model.backup import SafeSet, StationKeeping
 from tubekit.model.loiter import Loiter
 from tubekit.scenario import paper_scenario
 from verify.backup import proof_for
-from verify.backup.loiter import (LOITER_PROOF, certify_loiter, design_loiter, loiter_rate_sampled,
+from verify.backup.loiter import (LOITER_PROOF, certify_loiter, design_loiter, loiter_rate_sampled, loiter_surges,
                                   loiter_tick_change, shape_floor)
 
 # The paper's vehicle and current: V = (0.4, 0.3, 0.5), ω̄ = (0.12, 0.1) m/s, tick 10 ms, hand-over 0.125 m.
@@ -145,3 +145,23 @@ def test_the_same_current_pushes_a_refuted_shape_out_of_its_set(designed):
     beta = 0.5 * shape_floor(law, WXY)
     safe = SafeSet(level=beta + 1.5, shape=beta, depth=designed.safe_set.depth)
     assert _largest_value(law, safe, 0.3, math.pi, 1.0, 100) > safe.level
+
+
+@pytest.mark.parametrize("u_max, floor, expected", [
+    (1.0, 0.2, (0.2, 0.3, 0.4, 0.5, 0.625, 0.75, 0.875, 1.0)),    # the floor is a grid point: once
+    (2.0, 0.5, (0.5, 0.6, 0.8, 1.0, 1.25, 1.5, 1.75, 2.0)),       # the floor first, then 0.3 u_max and up
+    (0.4, None, (0.08, 0.12, 0.16, 0.2, 0.25, 0.3, 0.35, 0.4)),   # no floor: the fractions of u_max
+])
+def test_the_loiters_surges_start_at_the_plans_floor_and_never_go_below_it(u_max, floor, expected):
+    assert loiter_surges(u_max, floor) == pytest.approx(expected)
+
+
+def test_a_surge_floor_gives_the_slowest_loiter_it_allows_and_its_smaller_set():
+    """examples/keep_moving.toml's loiter (u 1 m/s, r 0.5 rad/s, the current 0.1 m/s): at the floor u_min = 0.2 m/s
+    the loiter turns on a 0.4 m radius instead of 1 m at u_max / 2, and its certified set is smaller."""
+    limits, hand = (1.0, 0.3, 0.5), (1.0, 0.04)
+    slow = design_loiter(omega_xy=0.1, omega_z=0.05, limits=limits, tick=TICK, handover=hand, surge_floor=0.2)
+    half = design_loiter(omega_xy=0.1, omega_z=0.05, limits=limits, tick=TICK, handover=hand, surge_floor=0.5)
+    assert slow.certified and half.certified
+    assert slow.law.surge == pytest.approx(0.2) and half.law.surge >= 0.5
+    assert slow.safe_set.radius < half.safe_set.radius

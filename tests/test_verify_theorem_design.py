@@ -204,7 +204,9 @@ def test_limits_enter_v_bar(pc):
 
 def test_a_surge_floor_is_reserved_kappa_bar_above_u_min_and_fails_when_the_band_closes(keep_moving_cert):
     """``v_bar[surge_floor]``: the nominal surge lives in [u_min + kappa_u, u_max - kappa_u]; at sigma = 25 1/s the
-    feedback's kappa_u closes the band once u_min reaches u_max - 2 kappa_u."""
+    feedback's kappa_u closes the band once u_min reaches u_max - 2 kappa_u, and the tracking tier is refused. The
+    safe tier stands on its own sigma = 0 design, where kappa = 0 leaves the band [u_min, u_max] open, with a
+    loiter at the floor itself (its grid starts at u_min)."""
     import verify
     sc = keep_moving_cert.inputs.scenario.with_changes(**{"controller.sigma": 25.0})
     cert = verify.certify(sc)
@@ -214,6 +216,9 @@ def test_a_surge_floor_is_reserved_kappa_bar_above_u_min_and_fails_when_the_band
     assert floor.lhs == pytest.approx(0.2 + kappa, rel=1e-9) and floor.rhs == pytest.approx(1.0 - kappa, rel=1e-9)
     closed = verify.certify(sc.with_changes(**{"limits.u_min": 1.0 - 1.5 * kappa}))
     held = {x.condition: x for x in closed.design.conditions}
-    assert held["v_bar[surge_floor]"].ok is False and not closed.tiers.safe
+    assert held["v_bar[surge_floor]"].ok is False and not closed.tiers.tracking
+    safe = {x.condition: x for x in closed.tier_conditions["safe"]}
+    assert closed.tiers.safe and safe["safe_only.v_bar[surge_floor]"].ok and safe["backup_min_surge"].ok
+    assert closed.backup.law.surge == pytest.approx(1.0 - 1.5 * kappa)
     sym = {x.condition for x in verify.certify(sc.with_changes(**{"limits.u_min": None})).design.conditions}
     assert "v_bar[surge_floor]" not in sym                                        # the symmetric box: no such row

@@ -343,8 +343,9 @@ class HoldProof:
 
     def design(self, *, omega_xy: float, omega_z: float, limits: tuple[float, float, float], tick: float,
                handover: tuple[float, float], yaw_rate_error: float = 0.0, smooth: bool = False,
-               fits: Fits | None = None) -> BackupCertificate:
-        """:func:`design_hold` (the law is rate-bounded by construction: ``smooth`` is not read)."""
+               fits: Fits | None = None, surge_floor: float | None = None) -> BackupCertificate:
+        """:func:`design_hold` (the law is rate-bounded by construction: ``smooth`` is not read; nor is
+        ``surge_floor``: the law stops)."""
         return design_hold(omega_xy=omega_xy, omega_z=omega_z, limits=limits, tick=tick, handover=handover,
                            yaw_rate_error=yaw_rate_error, fits=fits)
 

@@ -49,13 +49,15 @@ from verify.backup.search import depth_band
 from verify.kernel.intervals import bisect_sup, enclose, lower, upper
 from verify.theorem.design import Condition
 
-__all__ = ["LoiterProof", "LOITER_PROOF", "certify_loiter", "design_loiter", "loiter_rate_bound", "shape_floor",
+__all__ = ["LoiterProof", "LOITER_PROOF", "certify_loiter", "design_loiter", "loiter_surges", "loiter_rate_bound",
+           "shape_floor",
            "loiter_rate_sampled", "loiter_command_rate", "loiter_tick_change", "LOITER_MAX_BOXES"]
 
 #: Bisection budget of :func:`loiter_rate_bound` (intervals of φ examined, both pieces): a work unit, not seconds.
 LOITER_MAX_BOXES = 4096
-#: The design grid (:func:`design_loiter`): surge fractions of ū, the yaw band χ_0 (rad), level and shape steps (m).
-SURGE_FRACTIONS = (0.5, 0.625, 0.75, 0.875, 1.0)
+#: The design grid (:func:`design_loiter`): surge fractions of ū (besides the surge floor u_min itself), the yaw band
+#: χ_0 (rad), level and shape steps (m). The slowest loiter turns tightest (radius u_l / k), so its set is smallest.
+SURGE_FRACTIONS = (0.2, 0.3, 0.4, 0.5, 0.625, 0.75, 0.875, 1.0)
 YAW_BAND = 0.1
 LEVEL_STEP = 0.25
 MAX_LEVEL = 40.0
@@ -182,22 +184,29 @@ def _best_shape(law: Loiter, level: float, omega_xy: float, handover: float, yaw
     return float(shapes[i]) if rates[i] < 0.0 else None
 
 
+def loiter_surges(u_max: float, surge_floor: float | None = None) -> tuple[float, ...]:
+    """The surges :func:`design_loiter` tries, slowest first (m/s): the floor u_min when given, then f ū for f of
+    :data:`SURGE_FRACTIONS` above it (a loiter never commands less than the plans' floor: ``backup_min_surge``)."""
+    floor = 0.0 if surge_floor is None else float(surge_floor)
+    grid = [f * u_max for f in SURGE_FRACTIONS if f * u_max > floor]
+    return tuple(([floor] if surge_floor is not None and 0.0 < floor < u_max else []) + grid)
+
+
 def design_loiter(*, omega_xy: float, omega_z: float, limits: tuple[float, float, float], tick: float,
                   handover: tuple[float, float] = (0.0, 0.0), yaw_rate_error: float = 0.0,
-                  max_boxes: int = LOITER_MAX_BOXES) -> BackupCertificate:
-    """The certified loiter with the smallest safe radius on a fixed grid (deterministic): for each surge
-    u_l = f ū (f of :data:`SURGE_FRACTIONS`, u_l > ω̄_xy) with k = r̄ and χ_0 = :data:`YAW_BAND`, the levels c
-    of a :data:`LEVEL_STEP` grid up to :data:`MAX_LEVEL` in order, each with the shape of the most negative
-    sampled rate, until one certifies; the smallest certified level over the surges. Returns the last refuted
-    candidate when none certifies."""
+                  max_boxes: int = LOITER_MAX_BOXES, surge_floor: float | None = None) -> BackupCertificate:
+    """The certified loiter with the smallest safe radius on a fixed grid (deterministic): for each surge u_l of
+    :func:`loiter_surges` (``surge_floor``: the plans' u_min, m/s) with k = r̄ and χ_0 = :data:`YAW_BAND`, the
+    levels c of a :data:`LEVEL_STEP` grid up to :data:`MAX_LEVEL` in order, each with the shape of the most
+    negative sampled rate, until one certifies; the smallest certified level over the surges. Returns the last
+    refuted candidate when none certifies."""
     wxy, wz, h = nonnegative("omega_xy", omega_xy), nonnegative("omega_z", omega_z), positive("tick", tick)
     lim = tuple(float(x) for x in limits)
     z0, depth = depth_band(handover, lim, wz, h)
     best: BackupCertificate | None = None
     last: BackupCertificate | None = None
     levels = np.round(np.arange(LEVEL_STEP, MAX_LEVEL + 1e-9, LEVEL_STEP), 6)
-    for fraction in SURGE_FRACTIONS:
-        surge = fraction * lim[0]
+    for surge in loiter_surges(lim[0], surge_floor):
         law = Loiter(surge=surge, yaw_rate=lim[2], yaw_band=YAW_BAND, heave=lim[1], heave_band=z0)
         start = shape_floor(law, wxy, yaw_rate_error) + handover[0]
         for level in levels[(levels > start) & (levels < (best.safe_set.level if best else math.inf))]:
@@ -248,11 +257,11 @@ class LoiterProof:
 
     def design(self, *, omega_xy: float, omega_z: float, limits: tuple[float, float, float], tick: float,
                handover: tuple[float, float], yaw_rate_error: float = 0.0, smooth: bool = False,
-               fits: Fits | None = None) -> BackupCertificate:
-        """:func:`design_loiter`. The law's yaw command is not rate-bounded (``smooth`` and ``fits`` are not read:
-        the velocity loop is charged its tick change, 2 k)."""
+               fits: Fits | None = None, surge_floor: float | None = None) -> BackupCertificate:
+        """:func:`design_loiter`, no slower than ``surge_floor``. The law's yaw command is not rate-bounded
+        (``smooth`` and ``fits`` are not read: the velocity loop is charged its tick change, 2 k)."""
         return design_loiter(omega_xy=omega_xy, omega_z=omega_z, limits=limits, tick=tick, handover=handover,
-                             yaw_rate_error=yaw_rate_error)
+                             yaw_rate_error=yaw_rate_error, surge_floor=surge_floor)
 
     def certify(self, law: BackupLaw, safe: SafeSet, *, omega_xy: float, omega_z: float,
                 limits: tuple[float, float, float], tick: float, handover: tuple[float, float] = (0.0, 0.0),

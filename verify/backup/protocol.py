@@ -177,11 +177,13 @@ class BackupProof(Protocol):
 
     def design(self, *, omega_xy: float, omega_z: float, limits: tuple[float, float, float], tick: float,
                handover: tuple[float, float], yaw_rate_error: float = 0.0, smooth: bool = False,
-               fits: Fits | None = None) -> BackupCertificate:
+               fits: Fits | None = None, surge_floor: float | None = None) -> BackupCertificate:
         """A law of this kind and its safe set, proved for ω̄_xy, ω̄_z (m/s), V = ``limits`` (m/s, m/s, rad/s),
         the tick h (s), the hand-over (m, m) and E_r (rad/s); ``smooth``: the command's rate must be bounded
-        (the dynamic plant); ``fits``: keep only candidates whose command the velocity loop can follow. A design
-        that does not certify is returned with its failed conditions."""
+        (the dynamic plant); ``fits``: keep only candidates whose command the velocity loop can follow;
+        ``surge_floor``: the plans' minimum surge u_min (m/s), below which a law that keeps moving must not go (a law
+        that stops ignores it and fails ``backup_min_surge``). A design that does not certify is returned with its
+        failed conditions."""
         ...
 
     def certify(self, law: BackupLaw, safe: SafeSet, *, omega_xy: float, omega_z: float,

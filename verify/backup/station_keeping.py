@@ -31,9 +31,9 @@ class StationKeepingProof:
 
     def design(self, *, omega_xy: float, omega_z: float, limits: tuple[float, float, float], tick: float,
                handover: tuple[float, float], yaw_rate_error: float = 0.0, smooth: bool = False,
-               fits: Fits | None = None) -> BackupCertificate:
+               fits: Fits | None = None, surge_floor: float | None = None) -> BackupCertificate:
         """:func:`verify.backup.search.design_backup` (the smallest certified safe set on its grid; with ``fits``
-        the smallest whose command the velocity loop can follow)."""
+        the smallest whose command the velocity loop can follow). ``surge_floor`` is not read: the law stops."""
         return design_backup(omega_xy=omega_xy, omega_z=omega_z, limits=limits, tick=tick, handover=handover,
                              yaw_rate_error=yaw_rate_error, smooth=smooth, fits=fits)
 

@@ -166,7 +166,8 @@ def backup_of(scenario: Scenario, dist: DisturbanceBounds, margins: HorizonMargi
     hand = _handover(margins)
     bc = proof.design(omega_xy=dist.omega_xy, omega_z=dist.omega_z, limits=limits, tick=tick,
                       handover=hand if math.isfinite(hand[0]) else (0.0, 0.0),
-                      yaw_rate_error=dist.yaw_rate_error, smooth=scenario.plant.dynamic, fits=fits)
+                      yaw_rate_error=dist.yaw_rate_error, smooth=scenario.plant.dynamic, fits=fits,
+                      surge_floor=scenario.limits.u_min)
     if not math.isfinite(hand[0]):
         bc = proof.certify(bc.law, bc.safe_set, omega_xy=dist.omega_xy, omega_z=dist.omega_z, limits=limits,
                            tick=tick, handover=(np.finfo(float).max, np.finfo(float).max),

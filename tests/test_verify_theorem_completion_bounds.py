@@ -30,3 +30,15 @@ def test_without_a_surge_floor_the_bounds_carry_none(pc_cert):
     sc = load_scenario(verify.SCENARIOS_DIR / "paper_currents.toml")
     b = terminal_bounds(sc, pc_cert.design, pc_cert.region)
     assert b.surge_floor is None and b.speed_floor_xy == pytest.approx(3 * math.pi / 50)
+
+
+@pytest.mark.parametrize("lhs, rhs, ok", [
+    ("1.0", "1.0000000011", True),        # beyond the 1e-9 slack
+    ("1.0", "1.0000000009", False),       # within it: refused, so the float check cannot disagree
+    ("inf", "2.0", False),                # an unbounded side never holds
+])
+def test_a_completion_condition_holds_only_with_the_float_slack(lhs, rhs, ok):
+    from flint import arb
+    from verify.theorem.completion_bounds import FLOAT_SLACK, slack_condition
+    c = slack_condition("x", "lhs <= rhs", arb(lhs), arb(rhs))
+    assert FLOAT_SLACK == 1e-9 and c.ok is ok and c.condition == "x"

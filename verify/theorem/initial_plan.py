@@ -8,7 +8,7 @@ not import the loop): every arc at ``ARC_SAMPLES`` + 1 points, e inside R shrunk
 the pad rate · (δ / ARC_SAMPLES) / 2, the heading toward the target, the vehicle ball (r̄ + M_pos,j + pad)
 clear of every obstacle of the scenario and inside the workspace, the end in X_f, the backup's footprint
 about the end clear and inside the workspace, its safe set within the region sensed from the start. The
-smallest slack must exceed :data:`verify.theorem.terminal.FLOAT_SLACK` (the same floats, computed by two
+smallest slack must exceed :data:`verify.theorem.completion_bounds.FLOAT_SLACK` (the same floats, computed by two
 codes). Condition ``initial_terminal``: then a plan exists at t = 0, and by the completion's invariance at
 every period after it.
 """

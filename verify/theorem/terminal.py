@@ -28,17 +28,17 @@ unicycle arc (``tubekit.model.terminal_law`` for the law), in the line-of-sight 
 
 Under a minimum surge the completion's surge must stay above u_min + κ̄_u: X_f gets a bearing face, a cone behind a
 target whose speed has a positive floor (:mod:`verify.theorem.terminal_bearing`, step 17b); a target that may stop
-is refused (``terminal_surge_floor``). Plans with a rate limit are not covered (``terminal_rate``: the completion's row would have to be within J of
-the plan's last row, which is not proved). Every inequality is evaluated in Arb and must hold with the slack
-:data:`FLOAT_SLACK`, so that the run's float check of the same set agrees. :func:`design_terminal` searches a
-small grid of sets, largest first, and keeps the first that meets every condition.
+is refused (``terminal_surge_floor``). Plans with a rate limit are not covered (``terminal_rate``: the completion's
+row would have to be within J of the plan's last row, which is not proved). Every inequality is evaluated in Arb
+and must hold with the slack :data:`FLOAT_SLACK`, so that the run's float check of the same set agrees.
+:func:`design_terminal` searches a small grid of sets, largest first, and keeps the first that meets every
+condition.
 """
 
 from __future__ import annotations
 
 import dataclasses
 import math
-from dataclasses import dataclass
 
 from flint import arb
 
@@ -52,14 +52,13 @@ from verify.kernel.region import Region
 from verify.theorem.design import Condition, Design
 from verify.theorem.initial_plan import initial_plan_condition
 from verify.theorem.path_clearance import PathFootprint, horizon_end, path_clearance, path_samples, path_workspace
-from verify.theorem.completion_bounds import TerminalBounds
+from verify.theorem.completion_bounds import FLOAT_SLACK, CompletionArc, TerminalBounds
+from verify.theorem.completion_bounds import slack_condition as _cond  # lhs + FLOAT_SLACK <= rhs, in Arb
 from verify.theorem.terminal_bearing import bearing_conditions, bearing_sets
 
 __all__ = ["TerminalBounds", "terminal_bounds", "law_conditions", "footprint_of", "sensing_condition",
            "design_terminal", "with_terminal", "FLOAT_SLACK", "TERMINAL_PREFIXES"]
 
-#: Every inequality of the completion holds with this slack (m or rad), so the run's float check agrees.
-FLOAT_SLACK = 1e-9
 #: Name prefixes of the terminal ingredients' conditions (tracking tier).
 TERMINAL_PREFIXES = ("terminal_", "path_", "initial_terminal")
 #: Fractions of the free e_d band X_f's width is tried at, largest first.
@@ -90,27 +89,7 @@ def terminal_bounds(scenario: Scenario, design: Design, region: Region) -> Termi
                                                                     + arb(design.tube.kappa[0])))
 
 
-def _cond(name: str, text: str, lhs: arb, rhs: arb, detail: str = "") -> Condition:
-    """lhs + FLOAT_SLACK <= rhs, in Arb (lhs's upper end, rhs's lower end reported)."""
-    ok = bool((lhs + arb(FLOAT_SLACK)) <= rhs) and lhs.is_finite() and rhs.is_finite()
-    return Condition(name, text, upper(lhs) if lhs.is_finite() else math.inf,
-                     lower(rhs) if rhs.is_finite() else math.inf, ok, detail)
-
-
-@dataclass(frozen=True)
-class _Arc:
-    """Derived quantities of one completion (Arb)."""
-
-    a0: arb
-    beta: arb
-    spread: arb
-    x_min: arb
-    x_max: arb
-    lateral: arb
-    start_min: arb
-
-
-def _arc(b: TerminalBounds, law: TerminalLaw) -> _Arc | None:
+def _arc(b: TerminalBounds, law: TerminalLaw) -> CompletionArc | None:
     """The completion's derived bounds (module doc), None when a premise of the formulas fails."""
     dt, dxy = arb(b.dt), arb(b.dev_xy)
     d_lo, d_hi, d_star = arb(law.d_lo), arb(law.d_hi), arb(law.d_star)
@@ -127,10 +106,10 @@ def _arc(b: TerminalBounds, law: TerminalLaw) -> _Arc | None:
     lateral = dt * arb(b.speed_xy) / beta.cos() + beta.tan() * lam * spread + curve
     x_min = start_min * (1 - lam) + lam * d_star - curve
     x_max = (d_hi + dxy) * (1 - lam) + lam * d_star + curve
-    return _Arc(a0=a0, beta=beta, spread=spread, x_min=x_min, x_max=x_max, lateral=lateral, start_min=start_min)
+    return CompletionArc(a0=a0, beta=beta, spread=spread, x_min=x_min, x_max=x_max, lateral=lateral, start_min=start_min)
 
 
-def _input_conditions(b: TerminalBounds, law: TerminalLaw, arc: _Arc) -> list[Condition]:
+def _input_conditions(b: TerminalBounds, law: TerminalLaw, arc: CompletionArc) -> list[Condition]:
     dt, g = arb(b.dt), arb(law.turn)
     ub, wb, rb = (arb(v) for v in b.v_bar)
     u_peak = (arb(b.speed_xy) + arb(law.gain_d) * arc.spread) / ((g * arc.a0 / 2).sinc() * arc.beta.cos())
@@ -142,7 +121,7 @@ def _input_conditions(b: TerminalBounds, law: TerminalLaw, arc: _Arc) -> list[Co
                   max(arb(law.gain_d), arb(law.gain_z)) * dt, arb(1))]
 
 
-def _invariance_conditions(b: TerminalBounds, law: TerminalLaw, arc: _Arc) -> list[Condition]:
+def _invariance_conditions(b: TerminalBounds, law: TerminalLaw, arc: CompletionArc) -> list[Condition]:
     dt, g = arb(b.dt), arb(law.turn)
     d_hi, alpha_f, z_f = arb(law.d_hi), arb(law.alpha_max), arb(law.z_max)
     alpha_next = (1 - g) * arc.a0 + (arc.lateral / arc.x_min).atan() if arc.x_min > 0 else arb("inf")
@@ -156,7 +135,7 @@ def _invariance_conditions(b: TerminalBounds, law: TerminalLaw, arc: _Arc) -> li
             _cond("terminal_invariant[e_z]", "(1 - lambda_z delta)(z_f + D_z) + A_z delta^2 / 2 <= z_f", z_next, z_f)]
 
 
-def _region_conditions(b: TerminalBounds, law: TerminalLaw, arc: _Arc) -> list[Condition]:
+def _region_conditions(b: TerminalBounds, law: TerminalLaw, arc: CompletionArc) -> list[Condition]:
     dt, dxy = arb(b.dt), arb(b.dev_xy)
     ub, wb = arb(b.v_bar[0]), arb(b.v_bar[1])
     run = (ub + arb(b.speed_xy)) * dt
@@ -182,7 +161,7 @@ def law_conditions(b: TerminalBounds, law: TerminalLaw) -> tuple[Condition, ...]
     if arc is None:
         return (Condition("terminal_invariant[geometry]", "D_xy < d_lo and beta < pi/2", None, None, False,
                           f"the replay's deviation {b.dev_xy:.4g} m or the heading room does not fit this set"),)
-    bearing = bearing_conditions(b, law, arc.x_min, arc.x_max, FLOAT_SLACK) if b.surge_floor is not None else []
+    bearing = bearing_conditions(b, law, arc) if b.surge_floor is not None else []
     return tuple(_input_conditions(b, law, arc) + _invariance_conditions(b, law, arc) + _region_conditions(b, law, arc)
                  + bearing)
 

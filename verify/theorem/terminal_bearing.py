@@ -6,7 +6,7 @@ velocity (``tubekit.model.terminal_law.bearing``). A target that comes toward th
 negative, so without more the law cannot respect u >= u_min (``terminal_surge_floor`` refused every design). With
 a target whose horizontal speed never drops below P_min > 0 (``Trajectory.horizontal_speed_floor``: a line or a
 circle), X_f gets a fourth face |φ| <= φ_f, a cone behind the target, and two things are proved
-(:func:`bearing_conditions`, Arb, with :data:`verify.theorem.terminal.FLOAT_SLACK`):
+(:func:`bearing_conditions`, Arb, with :data:`verify.theorem.completion_bounds.FLOAT_SLACK`):
 
 * **the cone is invariant** (``terminal_invariant[bearing]``). The completion starts within the replay's deviation
   D_xy of X_f: its bearing |φ̃| <= Φ_0 = φ_f + asin(D_xy / d_lo). In the line-of-sight frame of that start the
@@ -36,7 +36,7 @@ from flint import arb
 
 from tubekit.model.terminal_law import TerminalLaw
 
-from verify.theorem.completion_bounds import TerminalBounds
+from verify.theorem.completion_bounds import CompletionArc, TerminalBounds, slack_condition
 from verify.theorem.design import Condition
 
 __all__ = ["bearing_conditions", "bearing_sets", "smallest_bearing", "ALPHA_FRACTIONS", "GAIN_FRACTIONS",
@@ -100,17 +100,10 @@ def bearing_sets(b: TerminalBounds, laws: Iterable[TerminalLaw]) -> list[Termina
     return out
 
 
-def _cond(name: str, text: str, lhs: arb, rhs: arb, slack: float, detail: str = "") -> Condition:
-    """lhs + ``slack`` <= rhs in Arb (lhs's upper end, rhs's lower end reported)."""
-    ok = bool((lhs + arb(slack)) <= rhs) and lhs.is_finite() and rhs.is_finite()
-    return Condition(name, text, float(lhs.upper()) if lhs.is_finite() else math.inf,
-                     float(rhs.lower()) if rhs.is_finite() else math.inf, ok, detail)
-
-
-def bearing_conditions(b: TerminalBounds, law: TerminalLaw, x_min: arb, x_max: arb, slack: float) -> list[Condition]:
+def bearing_conditions(b: TerminalBounds, law: TerminalLaw, arc: CompletionArc) -> list[Condition]:
     """``terminal_invariant[bearing]``, ``terminal_invariant[bearing_cross]`` and ``terminal_surge_floor`` of
-    ``law`` (module doc), in Arb; ``x_min``, ``x_max`` the completion's radial bounds
-    (``verify.theorem.terminal._arc``). Under a surge floor a set without the bearing face fails by name."""
+    ``law`` (module doc), in Arb, from its completion's bounds ``arc`` (A_0, β, Δ, x_min, x_max). Under a surge
+    floor a set without the bearing face fails by name."""
     if not law.has_bearing:
         return [Condition("terminal_surge_floor", "a bearing face |phi| <= phi_f (the target's speed along the line "
                           "of sight keeps the law's surge above u_min + kappa_u)", None, None, False,
@@ -118,24 +111,22 @@ def bearing_conditions(b: TerminalBounds, law: TerminalLaw, x_min: arb, x_max: a
     dt, dxy = arb(b.dt), arb(b.dev_xy)
     p_min, p_max = arb(b.speed_floor_xy), arb(b.speed_xy)
     lam, d_lo, d_star = arb(law.gain_d), arb(law.d_lo), arb(law.d_star)
-    dev = (dxy / d_lo).asin()
-    a0 = arb(law.alpha_max) + arb(b.dev_psi) + dev
-    beta = a0 * (1 - arb(law.turn) / 2)
-    spread = max(arb(law.d_hi) + dxy - d_star, d_star - d_lo + dxy)
-    chord = dt * (p_max + lam * spread) * beta.tan()
+    chord = dt * (p_max + lam * arc.spread) * arc.beta.tan()
     curve = arb(b.accel_xy) * dt * dt / 2
     turn = arb(b.accel_xy) * dt / p_min
     phi_f = arb(law.bearing_max)
-    start = phi_f + dev
+    start = phi_f + (dxy / d_lo).asin()
     lateral = dt * p_min * start.sin() - chord - curve
-    valid = bool(start < arb.pi() / 2) and bool(lateral > 0) and bool(dt * p_max <= x_min)
-    nxt = start + turn - (lateral / x_max).atan() if valid else arb("inf")
+    valid = bool(start < arb.pi() / 2) and bool(lateral > 0) and bool(dt * p_max <= arc.x_min)
+    nxt = start + turn - (lateral / arc.x_max).atan() if valid else arb("inf")
     floor = p_min * start.cos() - lam * (d_star - d_lo + dxy)
-    return [_cond("terminal_invariant[bearing]", "Phi_0 + eta - atan((delta P_min sin Phi_0 - L_c - A delta^2/2) "
-                  "/ x_max) <= phi_f (the cone behind the target is invariant)", nxt, phi_f, slack,
-                  f"phi_f {law.bearing_max:.4g} rad, P_min {b.speed_floor_xy:.4g} m/s, chord {float(chord.upper()):.4g} m"),
-            _cond("terminal_invariant[bearing_cross]", "eta + atan((L_c + A delta^2/2) / x_min) <= phi_f",
-                  turn + ((chord + curve) / x_min).atan(), phi_f, slack),
-            _cond("terminal_surge_floor", "P_min cos Phi_0 - lambda (d* - d_lo + D_xy) >= u_min + kappa_u (the law's "
-                  "surge never below the plans' floor)", arb(b.surge_floor), floor, slack,
-                  f"floor u_min + kappa_u = {b.surge_floor:.4g} m/s")]
+    invariant = slack_condition(
+        "terminal_invariant[bearing]", "Phi_0 + eta - atan((delta P_min sin Phi_0 - L_c - A delta^2/2) / x_max) <= "
+        "phi_f (the cone behind the target is invariant)", nxt, phi_f,
+        f"phi_f {law.bearing_max:.4g} rad, P_min {b.speed_floor_xy:.4g} m/s, chord {float(chord.upper()):.4g} m")
+    crossing = slack_condition("terminal_invariant[bearing_cross]", "eta + atan((L_c + A delta^2/2) / x_min) <= phi_f",
+                               turn + ((chord + curve) / arc.x_min).atan(), phi_f)
+    surge = slack_condition("terminal_surge_floor", "P_min cos Phi_0 - lambda (d* - d_lo + D_xy) >= u_min + kappa_u "
+                            "(the law's surge never below the plans' floor)", arb(b.surge_floor), floor,
+                            f"floor u_min + kappa_u = {b.surge_floor:.4g} m/s")
+    return [invariant, crossing, surge]

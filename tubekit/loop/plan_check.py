@@ -227,7 +227,8 @@ def check_plan(scenario: Scenario, tight: Tightening, t0: float, x0: np.ndarray,
     if tight.terminal_law is not None and tracking_checked(tight):
         end_time = t0 + dt * n
         end_target = np.asarray(scenario.trajectory.position(end_time), dtype=float).reshape(3)
-        end_velocity = np.asarray(scenario.trajectory.velocity(end_time), dtype=float).reshape(3)
+        end_velocity = (np.asarray(scenario.trajectory.velocity(end_time), dtype=float).reshape(3)
+                        if tight.terminal_law.has_bearing else None)  # only the bearing face reads it
         slacks.update({k: np.array([v]) for k, v in
                        tight.terminal_law.slacks(arcs[-1, -1], end_target, end_velocity).items()})
     worst_name, worst = _worst(slacks)

@@ -24,11 +24,12 @@ narrowest x whose Δ stays within J, so that the law is linear on the set (no sa
 
 **What it reads from a certificate** (:func:`channels`, floats, from ``verify.theorem.terminal.terminal_bounds``): W
 per channel is the deviation the tracking theorem already uses (D_ψ + asin(D_xy / d) for the heading, D_xy radially,
-D_z in depth); M is an estimate, stated in :func:`channels`: the target's acceleration over a period, the line of
-sight's turn and, radially, the heading band's effect on the closing speed (the surge divided by cos α). The
-channels are sized one after the other (heading first: its band enters the radial M). Not a proof: a sizing, so
-that the theorem a later step would prove (invariant sets in Arb, the completion's geometry) is known to fit the room
-R leaves, or known not to.
+D_z in depth); M is an estimate, stated in :func:`channels`: the target's acceleration over a period and the line of
+sight's turn. The heading is sized first; its band then enters the radial channel in one of two ways
+(:func:`radial_with_heading`): with today's terminal surge, divided by cos α, the command moves with the heading
+(``radial``: M grows); with a surge that is not divided by it, the closing speed falls short by u (1 − cos α)
+(``radial_plain``: W grows). Not a proof: a sizing, so that the theorem a later step would prove (invariant sets in
+Arb, the completion's geometry) is known to fit the room R leaves, or known not to.
 
 Usage: ``python benchmarks/terminal_second_order.py [--scenario FILE] [--rate-scale 1 2 ...]``; nothing is timed.
 """
@@ -104,22 +105,34 @@ def smallest_band(dt: float, w: float, m: float, jump: float) -> Band | None:
 
 
 def channels(b, speed_cap: float) -> dict[str, tuple[float, float, float]]:
-    """(W, M, J) per channel from a certificate's terminal bounds ``b`` (``TerminalBounds``), the heading's band
-    left open (see :func:`study`). ``speed_cap``: the surge the terminal set needs, the target's speed plus the
-    radial band's correction (m/s). Estimates (module doc), at the middle of the free e_d band d_m:
+    """(W, M, J) per channel from a certificate's terminal bounds ``b`` (``TerminalBounds``), before the heading
+    band's share of the radial channel (see :func:`study`). ``speed_cap``: the surge the terminal set needs, the
+    target's speed plus the radial band's correction (m/s). Estimates (module doc), at the middle of the free e_d
+    band d_m, with Δθ = asin(D_xy / d_m) + δ (P + u) / d_m the line of sight's turn in a period (the deviation's and
+    the relative motion's; the heading's own deviation does not turn it):
 
-    * heading: W = D_ψ + asin(D_xy / d_m); M = (A_xy δ + J_u + (P + u) Δβ) / d_m, the change per period of the line
-      of sight's rate, Δβ = W + δ (P + u) / d_m the change of the relative direction;
-    * radial: W = D_xy; M = A_xy δ + P Δβ (the target's speed along a turning line of sight); the heading band's
-      share is added by :func:`study`;
+    * heading: W = D_ψ + asin(D_xy / d_m); M = (A_xy δ + J_u + (P + u) Δθ) / d_m, the change per period of the line
+      of sight's rate;
+    * radial: W = D_xy; M = A_xy δ + P Δθ (the target's speed along a turning line of sight);
     * depth: W = D_z; M = A_z δ."""
     dt, j = b.dt, [b.dt * r for r in b.rates]
     d_mid = 0.5 * (b.room_d[0] + b.room_d[1])
+    turn = math.asin(min(1.0, b.dev_xy / d_mid)) + dt * (b.speed_xy + speed_cap) / d_mid
     w_psi = b.dev_psi + math.asin(min(1.0, b.dev_xy / d_mid))
-    turn = w_psi + dt * (b.speed_xy + speed_cap) / d_mid
     return {"heading": (w_psi, (b.accel_xy * dt + j[0] + (b.speed_xy + speed_cap) * turn) / d_mid, j[2]),
             "radial": (b.dev_xy, b.accel_xy * dt + b.speed_xy * turn, j[0]),
             "depth": (b.dev_z, b.accel_z * dt, j[1])}
+
+
+def radial_with_heading(w: float, m: float, speed: float, alpha: float, heading_step: float, dt: float,
+                        divided: bool) -> tuple[float, float]:
+    """The radial channel's (W, M) with the heading band |α| <= ``alpha`` (rad) whose angle moves by at most
+    ``heading_step`` (rad) a period. ``divided``: the surge is divided by cos α (today's terminal law), so the
+    command moves by u tan α × the heading's step (M grows); else the surge is not, and the closing speed falls
+    short by u (1 − cos α) (a deviation of δ u (1 − cos α) a period: W grows)."""
+    if divided:
+        return w, m + speed * math.tan(alpha) * heading_step
+    return w + dt * speed * (1.0 - math.cos(alpha)), m
 
 
 @dataclass(frozen=True)
@@ -171,14 +184,19 @@ def study(path: Path = SCENARIO, rate_scale: float = 1.0) -> dict:
     w_m_j = channels(b, speed)
     heading = smallest_band(b.dt, *w_m_j["heading"])
     w, m, j = w_m_j["radial"]
-    if heading is not None:  # the surge divided by cos α: its change per period over the heading band
+    radial_wm = {}
+    if heading is not None:
         alpha = min(heading.x + w_m_j["heading"][0], 1.5)
-        m += speed * math.tan(alpha) * (w_m_j["heading"][0] + b.dt * heading.s)
-    radial = smallest_band(b.dt, w, m, j)
+        step = w_m_j["heading"][0] + b.dt * heading.s
+        radial_wm = {law: radial_with_heading(w, m, speed, alpha, step, b.dt, law == "radial")
+                     for law in ("radial", "radial_plain")}
     depth = smallest_band(b.dt, *w_m_j["depth"])
     out["channels"] = {}
-    for key, band, (w_c, m_c, j_c) in (("heading", heading, w_m_j["heading"]), ("radial", radial, (w, m, j)),
-                                       ("depth", depth, w_m_j["depth"])):
+    rows = [("heading", heading, w_m_j["heading"])]
+    rows += [(key, smallest_band(b.dt, *wm, j), (*wm, j)) for key, wm in radial_wm.items()]
+    rows.append(("depth", depth, w_m_j["depth"]))
+    room["radial_plain"] = room["radial"]
+    for key, band, (w_c, m_c, j_c) in rows:
         need = None if band is None else band.x + w_c  # the replayed end lies within W of the set
         out["channels"][key] = {"W": w_c, "M": m_c, "J": j_c, "band": None if band is None else band.__dict__,
                                 "needed": need, "room": room[key],

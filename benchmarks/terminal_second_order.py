@@ -104,8 +104,9 @@ def smallest_band(dt: float, w: float, m: float, jump: float) -> Band | None:
     return Band(x=float(x[i]), s=float(s[i]), change=float(change[i]), k1=float(k1[i]), k2=float(k2[i]))
 
 
-def channels(b, speed_cap: float) -> dict[str, tuple[float, float, float]]:
-    """(W, M, J) per channel from a certificate's terminal bounds ``b`` (``TerminalBounds``), before the heading
+def channels(b, jumps: tuple[float, float, float], speed_cap: float) -> dict[str, tuple[float, float, float]]:
+    """(W, M, J) per channel from a certificate's terminal bounds ``b`` (``TerminalBounds``) and the plans' jumps
+    J = ``jumps`` (m/s, m/s, rad/s per period), before the heading
     band's share of the radial channel (see :func:`study`). ``speed_cap``: the surge the terminal set needs, the
     target's speed plus the radial band's correction (m/s). Estimates (module doc), at the middle of the free e_d
     band d_m, with Δθ = asin(D_xy / d_m) + δ (P + u) / d_m the line of sight's turn in a period (the deviation's and
@@ -115,7 +116,7 @@ def channels(b, speed_cap: float) -> dict[str, tuple[float, float, float]]:
       of sight's rate;
     * radial: W = D_xy; M = A_xy δ + P Δθ (the target's speed along a turning line of sight);
     * depth: W = D_z; M = A_z δ."""
-    dt, j = b.dt, [b.dt * r for r in b.rates]
+    dt, j = b.dt, jumps
     d_mid = 0.5 * (b.room_d[0] + b.room_d[1])
     turn = math.asin(min(1.0, b.dev_xy / d_mid)) + dt * (b.speed_xy + speed_cap) / d_mid
     w_psi = b.dev_psi + math.asin(min(1.0, b.dev_xy / d_mid))
@@ -135,24 +136,9 @@ def radial_with_heading(w: float, m: float, speed: float, alpha: float, heading_
     return w + dt * speed * (1.0 - math.cos(alpha)), m
 
 
-@dataclass(frozen=True)
-class _Bounds:
-    dt: float
-    rates: tuple[float, float, float]
-    dev_xy: float
-    dev_psi: float
-    dev_z: float
-    speed_xy: float
-    accel_xy: float
-    accel_z: float
-    room_d: tuple[float, float]
-    room_o: float
-    room_z: float
-
-
-def _bounds(path: Path, rate_scale: float) -> tuple[str, _Bounds | None, str]:
-    """The scenario's certified terminal bounds with its plans' rates scaled; None and the tiers' failure when the
-    safe or the tracking design does not certify up to ``terminal_rate``."""
+def _bounds(path: Path, rate_scale: float):
+    """(name, the certificate's ``TerminalBounds`` or None, the plans' jumps J per channel, the failed conditions
+    besides ``terminal_rate``) for the scenario with its plans' rates × ``rate_scale``."""
     import verify
     from tubekit.scenario import load_scenario
     from verify.theorem.terminal import terminal_bounds
@@ -160,28 +146,25 @@ def _bounds(path: Path, rate_scale: float) -> tuple[str, _Bounds | None, str]:
     sc = load_scenario(path)
     if sc.limits.rate is None:
         raise SystemExit(f"{path}: no limits.rate, nothing to ask")
-    rates = tuple(rate_scale * float(r) for r in sc.limits.rate)
-    sc = sc.with_changes(**{"limits.rate": list(rates)})
+    sc = sc.with_changes(**{"limits.rate": [rate_scale * float(r) for r in sc.limits.rate]})
+    jumps = tuple(float(j) for j in sc.limits.jump(sc.controller.dt))
     cert = verify.certify(sc)
     failed = sorted({c.condition for c in cert.failures} - {"terminal_rate"})
     if failed:
-        return sc.name, None, ", ".join(failed[:4])
-    t = terminal_bounds(sc, cert.design, cert.region)
-    return sc.name, _Bounds(dt=t.dt, rates=rates, dev_xy=t.dev_xy, dev_psi=t.dev_psi, dev_z=t.dev_z,
-                            speed_xy=t.speed_xy, accel_xy=t.accel_xy, accel_z=t.accel_z, room_d=t.room_d,
-                            room_o=t.room_o, room_z=t.room_z), ""
+        return sc.name, None, jumps, ", ".join(failed[:4])
+    return sc.name, terminal_bounds(sc, cert.design, cert.region), jumps, ""
 
 
 def study(path: Path = SCENARIO, rate_scale: float = 1.0) -> dict:
     """Bands per channel against the room R leaves (module doc), for the scenario with its rates × ``rate_scale``."""
-    name, b, failed = _bounds(path, rate_scale)
+    name, b, jumps, failed = _bounds(path, rate_scale)
     out: dict = {"scenario": name, "rate_scale": rate_scale, "failed": failed}
     if b is None:
         return out
     room = {"heading": math.asin(min(b.room_o, 1.0)), "radial": 0.5 * (b.room_d[1] - b.room_d[0]),
             "depth": b.room_z}
     speed = b.speed_xy + 0.1 * room["radial"]  # the set's own surge: the target's speed and a radial correction
-    w_m_j = channels(b, speed)
+    w_m_j = channels(b, jumps, speed)
     heading = smallest_band(b.dt, *w_m_j["heading"])
     w, m, j = w_m_j["radial"]
     radial_wm = {}

@@ -9,10 +9,12 @@ from dataclasses import dataclass
 
 from flint import arb
 
+from tubekit.model.terminal_law import TerminalLaw
+
 from verify.kernel.intervals import lower, upper
 from verify.theorem.design import Condition
 
-__all__ = ["TerminalBounds", "CompletionArc", "slack_condition", "FLOAT_SLACK"]
+__all__ = ["TerminalBounds", "CompletionArc", "completion_arc", "slack_condition", "FLOAT_SLACK"]
 
 #: Every inequality of the completion holds with this slack (m or rad), so the run's float check agrees.
 FLOAT_SLACK = 1e-9
@@ -49,7 +51,7 @@ class TerminalBounds:
 
 @dataclass(frozen=True)
 class CompletionArc:
-    """Derived quantities of one completion, in Arb (``verify.theorem.terminal._arc``): A_0 (the start's heading
+    """Derived quantities of one completion, in Arb (:func:`completion_arc`): A_0 (the start's heading
     bound), β (the chord's), the radial spread Δ, the radial end's bounds x_min, x_max, the lateral bound Y and the
     start's least distance d_lo − D_xy."""
 
@@ -60,3 +62,25 @@ class CompletionArc:
     x_max: arb
     lateral: arb
     start_min: arb
+
+
+def completion_arc(b: TerminalBounds, law: TerminalLaw) -> CompletionArc | None:
+    """The bounds of one completion of ``law`` from the start set about X_f (``docs/verify.md`` step 17), in Arb;
+    None when a premise of the formulas fails (D_xy >= d_lo, β >= π/2)."""
+    dt, dxy = arb(b.dt), arb(b.dev_xy)
+    d_lo, d_hi, d_star = arb(law.d_lo), arb(law.d_hi), arb(law.d_star)
+    start_min = d_lo - dxy
+    if not start_min > 0:
+        return None
+    a0 = arb(law.alpha_max) + arb(b.dev_psi) + (dxy / d_lo).asin()
+    beta = a0 * (1 - arb(law.turn) / 2)
+    if not (beta < arb.pi() / 2 and a0 < arb.pi()):
+        return None
+    spread = max(d_hi + dxy - d_star, d_star - d_lo + dxy)
+    lam = arb(law.gain_d) * dt
+    curve = arb(b.accel_xy) * dt * dt / 2
+    lateral = dt * arb(b.speed_xy) / beta.cos() + beta.tan() * lam * spread + curve
+    x_min = start_min * (1 - lam) + lam * d_star - curve
+    x_max = (d_hi + dxy) * (1 - lam) + lam * d_star + curve
+    return CompletionArc(a0=a0, beta=beta, spread=spread, x_min=x_min, x_max=x_max, lateral=lateral,
+                         start_min=start_min)

@@ -52,7 +52,7 @@ from verify.kernel.region import Region
 from verify.theorem.design import Condition, Design
 from verify.theorem.initial_plan import initial_plan_condition
 from verify.theorem.path_clearance import PathFootprint, horizon_end, path_clearance, path_samples, path_workspace
-from verify.theorem.completion_bounds import FLOAT_SLACK, CompletionArc, TerminalBounds
+from verify.theorem.completion_bounds import FLOAT_SLACK, CompletionArc, TerminalBounds, completion_arc
 from verify.theorem.completion_bounds import slack_condition as _cond  # lhs + FLOAT_SLACK <= rhs, in Arb
 from verify.theorem.terminal_bearing import bearing_conditions, bearing_sets
 
@@ -87,26 +87,6 @@ def terminal_bounds(scenario: Scenario, design: Design, region: Region) -> Termi
         speed_floor_xy=float(scenario.trajectory.horizontal_speed_floor()),
         surge_floor=None if scenario.limits.u_min is None else upper(arb(scenario.limits.u_min)
                                                                     + arb(design.tube.kappa[0])))
-
-
-def _arc(b: TerminalBounds, law: TerminalLaw) -> CompletionArc | None:
-    """The completion's derived bounds (module doc), None when a premise of the formulas fails."""
-    dt, dxy = arb(b.dt), arb(b.dev_xy)
-    d_lo, d_hi, d_star = arb(law.d_lo), arb(law.d_hi), arb(law.d_star)
-    start_min = d_lo - dxy
-    if not start_min > 0:
-        return None
-    a0 = arb(law.alpha_max) + arb(b.dev_psi) + (dxy / d_lo).asin()
-    beta = a0 * (1 - arb(law.turn) / 2)
-    if not (beta < arb.pi() / 2 and a0 < arb.pi()):
-        return None
-    spread = max(d_hi + dxy - d_star, d_star - d_lo + dxy)
-    lam = arb(law.gain_d) * dt
-    curve = arb(b.accel_xy) * dt * dt / 2
-    lateral = dt * arb(b.speed_xy) / beta.cos() + beta.tan() * lam * spread + curve
-    x_min = start_min * (1 - lam) + lam * d_star - curve
-    x_max = (d_hi + dxy) * (1 - lam) + lam * d_star + curve
-    return CompletionArc(a0=a0, beta=beta, spread=spread, x_min=x_min, x_max=x_max, lateral=lateral, start_min=start_min)
 
 
 def _input_conditions(b: TerminalBounds, law: TerminalLaw, arc: CompletionArc) -> list[Condition]:
@@ -157,7 +137,7 @@ def _region_conditions(b: TerminalBounds, law: TerminalLaw, arc: CompletionArc) 
 
 def law_conditions(b: TerminalBounds, law: TerminalLaw) -> tuple[Condition, ...]:
     """The completion's conditions for ``law`` (module doc): inputs, invariance and the region along the arc."""
-    arc = _arc(b, law)
+    arc = completion_arc(b, law)
     if arc is None:
         return (Condition("terminal_invariant[geometry]", "D_xy < d_lo and beta < pi/2", None, None, False,
                           f"the replay's deviation {b.dev_xy:.4g} m or the heading room does not fit this set"),)

@@ -36,11 +36,12 @@ from flint import arb
 
 from tubekit.model.terminal_law import TerminalLaw
 
-from verify.theorem.completion_bounds import CompletionArc, TerminalBounds, slack_condition
+from verify.kernel.intervals import upper
+from verify.theorem.completion_bounds import CompletionArc, TerminalBounds, completion_arc, slack_condition
 from verify.theorem.design import Condition
 
-__all__ = ["bearing_conditions", "bearing_sets", "smallest_bearing", "ALPHA_FRACTIONS", "GAIN_FRACTIONS",
-           "BEARING_STEP"]
+__all__ = ["bearing_conditions", "bearing_sets", "smallest_bearing", "lateral_chord", "ALPHA_FRACTIONS",
+           "GAIN_FRACTIONS", "BEARING_STEP"]
 
 #: Fractions of each grid set's heading room α_f tried under a surge floor (largest first).
 ALPHA_FRACTIONS = (1.0, 0.3, 0.1, 0.05)
@@ -50,33 +51,29 @@ GAIN_FRACTIONS = (1.0, 0.5, 0.2, 0.1, 0.05)
 BEARING_STEP = 0.005
 
 
-def _geometry(b: TerminalBounds, law: TerminalLaw) -> dict[str, float]:
-    """The completion's floats the bearing inequalities read (module doc)."""
-    dt, dxy = b.dt, b.dev_xy
-    lam = law.gain_d * dt
-    a0 = law.alpha_max + b.dev_psi + math.asin(min(1.0, dxy / law.d_lo))
-    beta = a0 * (1 - law.turn / 2)
-    spread = max(law.d_hi + dxy - law.d_star, law.d_star - law.d_lo + dxy)
-    curve = b.accel_xy * dt * dt / 2
-    return {"dev": math.asin(min(1.0, dxy / law.d_lo)), "chord": dt * (b.speed_xy + law.gain_d * spread) * math.tan(beta),
-            "curve": curve, "turn": b.accel_xy * dt / b.speed_floor_xy if b.speed_floor_xy > 0 else math.inf,
-            "x_min": (law.d_lo - dxy) * (1 - lam) + lam * law.d_star - curve,
-            "x_max": (law.d_hi + dxy) * (1 - lam) + lam * law.d_star + curve}
+def lateral_chord(b: TerminalBounds, law: TerminalLaw, arc: CompletionArc) -> arb:
+    """L_c = δ (P + λ Δ) tan β (m): the most the completion's chord moves the vehicle across its line of sight."""
+    return arb(b.dt) * (arb(b.speed_xy) + arb(law.gain_d) * arc.spread) * arc.beta.tan()
 
 
 def smallest_bearing(b: TerminalBounds, law: TerminalLaw) -> float | None:
     """The smallest φ_f on the :data:`BEARING_STEP` grid below π/2 for which the float version of
-    ``terminal_invariant[bearing]`` holds for ``law`` (its other faces as given); None when none does."""
-    if b.speed_floor_xy <= 0.0:
+    ``terminal_invariant[bearing]`` holds for ``law`` (its other faces as given, the arc's bounds at their
+    unfavourable ends); None when none does. The Arb condition decides; this only proposes."""
+    arc = completion_arc(b, law) if b.speed_floor_xy > 0.0 else None
+    if arc is None:
         return None
-    g = _geometry(b, law)
+    dt = b.dt
+    dev = math.asin(min(1.0, b.dev_xy / law.d_lo))
+    loss = upper(lateral_chord(b, law, arc)) + b.accel_xy * dt * dt / 2
+    turn, x_max = b.accel_xy * dt / b.speed_floor_xy, upper(arc.x_max)
     for i in range(1, int(math.pi / 2 / BEARING_STEP)):
         phi = i * BEARING_STEP
-        start = phi + g["dev"]
+        start = phi + dev
         if start >= math.pi / 2:
             return None
-        lateral = b.dt * b.speed_floor_xy * math.sin(start) - g["chord"] - g["curve"]
-        if lateral > 0 and start + g["turn"] - math.atan(lateral / g["x_max"]) <= phi - 1e-6:
+        lateral = dt * b.speed_floor_xy * math.sin(start) - loss
+        if lateral > 0 and start + turn - math.atan(lateral / x_max) <= phi - 1e-6:
             return phi
     return None
 
@@ -111,7 +108,7 @@ def bearing_conditions(b: TerminalBounds, law: TerminalLaw, arc: CompletionArc) 
     dt, dxy = arb(b.dt), arb(b.dev_xy)
     p_min, p_max = arb(b.speed_floor_xy), arb(b.speed_xy)
     lam, d_lo, d_star = arb(law.gain_d), arb(law.d_lo), arb(law.d_star)
-    chord = dt * (p_max + lam * arc.spread) * arc.beta.tan()
+    chord = lateral_chord(b, law, arc)
     curve = arb(b.accel_xy) * dt * dt / 2
     turn = arb(b.accel_xy) * dt / p_min
     phi_f = arb(law.bearing_max)

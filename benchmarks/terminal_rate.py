@@ -1,30 +1,21 @@
-"""Why rate-limited plans get no tracking tier: the terminal law's rows move more per period than J allows.
+"""How far rate-limited plans are from a tracking tier: the row faces' rate conditions against J, measured.
 
-The tracking theorem (``verify.theorem.terminal``) completes the shifted candidate with one row of a memoryless
-terminal law κ_f(x) and refuses plans with a rate limit (``terminal_rate``): the completion's row would have to be
-within J = ρ δ of the plan's last. This what-if asks whether that could be proved for the law family as it is.
+Under rate-limited plans X_f has row faces |v_{N−1} − κ_f(x_N)| <= S, and the completion's row is within the plans'
+jump J = ρ δ of the plan's last when S + K(deviation) <= J per channel (``terminal_rate[u|w|r]``,
+:mod:`verify.theorem.terminal_rows`, ``docs/verify.md`` step 17c). This study asks, for a scenario with its plans'
+rates scaled, how near the law family comes: the tracking design is certified as usual, the row-faced sets are
+searched on a finer grid (X_f's lower end at every twentieth of the free e_d band, narrower widths, every gain factor
+of the shipped search), and among the sets whose every other law condition holds (inputs, invariance, region, the
+faces' own invariance) it reports the smallest largest ratio (S + K(deviation)) / J over the three channels, and
+that set's ratio per channel: below 1 the rate rows are proved. Nothing is timed.
 
-For a scenario (default ``examples/bluerov2_slow.toml``) the tracking design is certified as usual and the law
-family of :func:`verify.theorem.terminal.design_terminal` is searched on a finer grid (X_f's lower end anywhere in
-the free e_d band, narrower widths; everything else as shipped). For every set whose own conditions all hold
-(inputs, invariance, region: ``law_conditions``), two lower bounds of how far one period's replay deviation alone
-(D_xy, D_ψ of the certified one-period tube) moves the law's row, at a state of X_f with d = d_lo:
-
-* yaw: r = −g α / δ, and the deviation turns α by D_ψ + atan(D_xy / d_lo):
-  |Δr| >= g (D_ψ + atan(D_xy / d_lo)) / δ;
-* surge: u = (V_r + λ (d − d*)) / (S cos) with S cos <= 1, and the deviation moves d by D_xy: |Δu| >= λ D_xy.
-
-Where both exceed J for every invariant set, no plan check can make the memoryless law's completion meet the rate
-rows: the candidate would need a law that keeps the last command as a state. Nothing is timed.
-
-Usage: ``python benchmarks/terminal_rate.py [--scenario FILE]``
+Usage: ``python benchmarks/terminal_rate.py [--scenario FILE] [--rate-scale 1 2 ...]``
 """
 
 from __future__ import annotations
 
 import argparse
 import contextlib
-import math
 import sys
 from pathlib import Path
 from typing import Iterator
@@ -33,6 +24,9 @@ SCENARIO = Path(__file__).resolve().parent.parent / "examples" / "bluerov2_slow.
 #: The finer grid: X_f's lower end at every twentieth of the free band, and narrower widths.
 LOWER_ENDS = tuple(i / 20 for i in range(20))
 WIDTHS = (1.0, 0.6, 0.35, 0.2, 0.1, 0.05)
+CHANNELS = ("u", "w", "r")
+
+__all__ = ["finer_grid", "study", "main", "SCENARIO", "LOWER_ENDS", "WIDTHS"]
 
 
 @contextlib.contextmanager
@@ -47,43 +41,60 @@ def finer_grid() -> Iterator[None]:
         terminal.LOWER_ENDS, terminal.WIDTHS = saved
 
 
-def study(path: Path = SCENARIO) -> dict:
-    """The sets tried, the invariant ones and the smallest deviation-only row changes against J (module doc)."""
+def _ratios(conds) -> dict[str, float] | None:
+    """(S + K(deviation)) / J per channel from a set's conditions, None when another law condition fails."""
+    if any(not c.ok for c in conds if not c.condition.startswith("terminal_rate[")):
+        return None
+    return {c.condition[len("terminal_rate["):-1]: c.lhs / c.rhs for c in conds
+            if c.condition.startswith("terminal_rate[")}
+
+
+def study(path: Path = SCENARIO, rate_scale: float = 1.0) -> dict:
+    """The sets tried, those whose other law conditions hold, and the nearest one's ratios (module doc)."""
     import verify
     from tubekit.scenario import load_scenario
-    from verify.theorem.terminal import _sets, law_conditions, terminal_bounds
+    from verify.theorem.terminal import TERMINAL_PREFIXES, _sets, law_conditions, terminal_bounds
 
     sc = load_scenario(path)
     if sc.limits.rate is None:
         raise SystemExit(f"{path}: no limits.rate, nothing to ask")
+    sc = sc.with_changes(**{"limits.rate": [rate_scale * float(r) for r in sc.limits.rate]})
     cert = verify.certify(sc)
+    out: dict = {"scenario": sc.name, "rate_scale": rate_scale, "tiers": [cert.tiers.safe, cert.tiers.tracking],
+                 "failed": sorted(c.condition for c in cert.failures if not c.condition.startswith(TERMINAL_PREFIXES))}
+    if out["failed"]:
+        return out
     b = terminal_bounds(sc, cert.design, cert.region)
     with finer_grid():
         laws = _sets(b)
-    invariant = [law for law in laws if all(c.ok for c in law_conditions(b, law))]
-    jump = [float(r) * b.dt for r in sc.limits.rate]
-    yaw = [law.turn * (b.dev_psi + math.atan(b.dev_xy / law.d_lo)) / b.dt for law in invariant]
-    surge = [law.gain_d * b.dev_xy for law in invariant]
-    return {"scenario": sc.name, "sets": len(laws), "invariant": len(invariant), "jump": jump,
-            "deviation": {"xy": b.dev_xy, "psi": b.dev_psi},
-            "d_lo_range": [min((law.d_lo for law in invariant), default=math.nan),
-                           max((law.d_lo for law in invariant), default=math.nan)],
-            "least_yaw_change": min(yaw, default=math.nan), "least_surge_change": min(surge, default=math.nan)}
+    ratios = [(r, law) for law in laws if (r := _ratios(law_conditions(b, law))) is not None]
+    out.update(sets=len(laws), candidates=len(ratios), jump=list(b.jumps))
+    if ratios:
+        best, law = min(ratios, key=lambda rl: max(rl[0].values()))
+        out.update(best={c: best[c] for c in CHANNELS}, worst=max(best.values()),
+                   law={k: round(v, 6) for k, v in law.to_dict().items()})
+    return out
 
 
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--scenario", type=Path, default=SCENARIO, help="a scenario with limits.rate")
+    ap.add_argument("--rate-scale", type=float, nargs="+", default=[1.0],
+                    help="factors on the plans' limits.rate (each re-certified)")
     args = ap.parse_args(argv)
-    res = study(args.scenario)
-    j = res["jump"]
-    print(f"{res['scenario']}: {res['sets']} sets of the finer grid, {res['invariant']} meet every law condition "
-          f"(d_lo {res['d_lo_range'][0]:.3f}-{res['d_lo_range'][1]:.3f} m); one period's replay deviation "
-          f"D_xy = {res['deviation']['xy']:.4g} m, D_psi = {res['deviation']['psi']:.4g} rad")
-    print(f"  least yaw-row change from the deviation alone: {res['least_yaw_change']:.4g} rad/s "
-          f"against J_r = {j[2]:.4g} ({res['least_yaw_change'] / j[2]:.2f}x)")
-    print(f"  least surge-row change from the deviation alone: {res['least_surge_change']:.4g} m/s "
-          f"against J_u = {j[0]:.4g} ({res['least_surge_change'] / j[0]:.2f}x)")
+    for scale in args.rate_scale:
+        res = study(args.scenario, scale)
+        head = f"{res['scenario']}, plans' rates x{scale:g}"
+        if res["failed"]:
+            print(f"{head}: not certified beyond the terminal ingredients ({', '.join(res['failed'][:4])})")
+            continue
+        if "best" not in res:
+            print(f"{head}: {res['sets']} row-faced sets, none meets the other law conditions")
+            continue
+        per = ", ".join(f"{c} {res['best'][c]:.3g}x" for c in CHANNELS)
+        verdict = "the rate rows are proved" if res["worst"] <= 1.0 else f"short by {res['worst']:.3g}x"
+        print(f"{head}: {res['sets']} row-faced sets, {res['candidates']} meet the other law conditions; the nearest "
+              f"needs (S + K(deviation)) / J = {per} ({verdict}); J = {', '.join(f'{j:.4g}' for j in res['jump'])}")
     return 0
 
 

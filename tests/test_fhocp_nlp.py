@@ -185,6 +185,26 @@ def test_the_last_node_is_narrowed_to_the_terminal_set_only_with_the_tracking_th
     assert FhocpNlp.from_scenario(SC, unproven, terminal="off").tracking_terminal is None
 
 
+def test_the_last_row_box_is_the_law_s_row_within_the_faces_less_their_pad():
+    """With a tracking theorem whose X_f has row faces, the NLP carries the law (``terminal_rows``) and its last
+    row's box is the law's row at the end state ± (1 − ROW_FACE_PAD) S; without the faces, no box."""
+    from tubekit.fhocp.nlp import ROW_FACE_PAD
+    from tubekit.model.terminal_law import TerminalLaw
+    from tubekit.tiers import Tiers
+    law = TerminalLaw(d_lo=0.6, d_hi=0.9, d_star=0.75, alpha_max=0.1, z_max=0.5, gain_d=1.0, gain_z=0.2, turn=0.5,
+                      row_u=0.01, row_w=0.002, row_r=0.03)
+    proving = dataclasses.replace(TIGHT, terminal_law=law, tiers=Tiers(True, True), margins=np.zeros((8, 4)))
+    nlp = FhocpNlp.from_scenario(SC, proving, terminal="off")
+    end, p_end, v_end = np.array([-1.0, 0.0, 0.1, 0.0]), np.zeros(3), np.array([0.2, 0.0, 0.0])
+    lo, hi = nlp.last_row_box(end, p_end, v_end)
+    row = law.command(end, p_end, v_end, SC.controller.dt)
+    np.testing.assert_allclose(0.5 * (lo + hi), row, atol=1e-15)
+    np.testing.assert_allclose(0.5 * (hi - lo), (1 - ROW_FACE_PAD) * np.array([0.01, 0.002, 0.03]), atol=1e-15)
+    assert NLP.terminal_rows is None
+    with pytest.raises(ValueError, match="no row faces"):
+        NLP.last_row_box(end, p_end, v_end)
+
+
 def test_the_lookahead_margins_grow_along_the_horizon_to_a_share_of_the_footprint():
     """lambda_f (k/N) of the footprint's extent beyond the clearance at node k = 1..N; zeros when off or without a
     backup; a negative lookahead is refused by name."""

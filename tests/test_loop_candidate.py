@@ -10,7 +10,7 @@ import pytest
 
 import verify
 from tubekit import load_scenario, paper_scenario
-from tubekit.loop.candidate import candidate_plan, pursuit_input
+from tubekit.loop.candidate import SETTLE_MARGIN, candidate_plan, pursuit_input, settle_last_row
 from tubekit.fhocp.registry import make_solver
 from tubekit.loop.pipeline import certified_run
 from tubekit.model.errors import error_coordinates
@@ -117,3 +117,62 @@ def test_under_a_surge_floor_the_bearing_faced_law_keeps_a_plan_and_the_surge_ab
     assert done.broken == () and done.metrics["outcome"] == {"safe": "certified, kept", "tracking": "certified, kept"}
     assert {p.name: p for p in done.promises}["plan_available"].ok
     assert not done.run.backup_active.any() and float(np.nanmin(done.run.inputs[:-1, 0])) >= sc.limits.u_min
+
+
+SMOOTH_LINE = "smooth_line.toml"
+
+
+@pytest.fixture(scope="module")
+def smooth():
+    from pathlib import Path
+    sc = load_scenario(Path(__file__).resolve().parents[1] / "examples" / SMOOTH_LINE)
+    return sc, verify.certify(sc)
+
+
+def test_under_rate_limited_plans_the_row_faced_law_keeps_a_solver_plan_and_the_rate_rows(smooth):
+    """examples/smooth_line.toml (plans limited to 0.5 m/s², 0.5 m/s², 1 rad/s²): both tiers certified with the
+    row faces (docs/verify.md step 17c). Flown for 20 s every period has an accepted plan, the solver's own at all
+    but a few periods (the FHOCP's last row is kept inside the faces, and its last row settled onto them), every
+    command within J of the one before it, and both tiers' promises kept."""
+    sc, cert = smooth
+    sc = sc.with_changes(duration=20.0)
+    assert cert.tiers.tracking and cert.tightening.terminal_law.has_rows
+    done = certified_run(sc, cert.tightening)
+    run = done.run
+    assert done.broken == () and done.metrics["outcome"] == {"safe": "certified, kept", "tracking": "certified, kept"}
+    assert {p.name: p for p in done.promises}["plan_available"].ok and not run.backup_active.any()
+    assert int(run.rejected.sum()) <= 0.05 * len(run.rejected)
+    jump = sc.limits.jump(sc.controller.dt)
+    v_hat = run.v_hat[:-1]                       # held over each period: it changes at period boundaries only
+    assert np.all(np.abs(np.diff(v_hat, axis=0)) <= jump + 1e-9) and np.all(np.abs(v_hat[0]) <= jump + 1e-9)
+
+
+def test_the_last_row_is_settled_onto_the_faces_within_the_jump(smooth):
+    """A plan whose last row is far from the law's row at its end: settled, the row lies inside the faces when the
+    jump from the row before allows it, else at the jump's edge nearest them; the other rows are untouched."""
+    sc, cert = smooth
+    law, dt = cert.tightening.terminal_law, sc.controller.dt
+    x0 = np.asarray(sc.initial_state, dtype=float)
+    jump = sc.limits.jump(dt)
+    plan = np.tile(np.array([0.2, 0.0, 0.0]), (sc.controller.horizon_steps, 1))
+    plan[-1] = [0.2 + 0.9 * jump[0], 0.9 * jump[1], -0.9 * jump[2]]
+    out = settle_last_row(sc, law, plan, x0, 0.0, np.asarray(cert.tightening.v_max), jump)
+    assert np.array_equal(out[:-1], plan[:-1]) and np.all(np.abs(out[-1] - out[-2]) <= jump + 1e-15)
+    from tubekit.loop.plan_check import plan_arcs
+    end = plan_arcs(x0, out, dt, 1)[-1, -1]
+    t_end = dt * len(out)
+    slacks = law.row_slacks(end, np.ravel(sc.trajectory.position(t_end)), np.ravel(sc.trajectory.velocity(t_end)),
+                            out[-1], dt)
+    faces = np.array([law.row_u, law.row_w, law.row_r])
+    assert min(slacks.values()) >= 0.5 * SETTLE_MARGIN * float(faces.min())
+    assert settle_last_row(sc, None, plan, x0, 0.0, np.asarray(cert.tightening.v_max), jump) is plan
+
+
+def test_at_the_start_the_law_s_rows_leave_rest_by_at_most_the_jump(smooth):
+    sc, cert = smooth
+    jump = sc.limits.jump(sc.controller.dt)
+    x0 = np.asarray(sc.initial_state, dtype=float)
+    plan = candidate_plan(sc, None, 0, x0, 0.0, np.asarray(cert.tightening.v_max), jump, 1.0,
+                          law=cert.tightening.terminal_law, v_last=np.zeros(3))
+    steps = np.diff(np.vstack([np.zeros(3), plan]), axis=0)
+    assert np.all(np.abs(steps) <= jump + 1e-15) and np.any(np.isclose(np.abs(steps[0]), jump))

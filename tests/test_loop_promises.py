@@ -22,6 +22,7 @@ from tubekit.scenario import Disturbance
 from tubekit.tightening import Tightening
 from tubekit.tiers import Tiers
 from tubekit.model.vehicles import PlantSettings
+from .tier_checks import refused_only_by_the_row_faces
 
 TICKS, STEPS = 10, 3
 TUBE = np.array([0.01, 0.01, 0.02])
@@ -452,7 +453,7 @@ def test_the_bluerov2_in_the_papers_current_keeps_every_safe_promise_with_its_sw
     from tubekit import load_scenario
     sc = load_scenario(SLOW.with_name("bluerov2_current.toml"))
     cert = verify.certify(sc)
-    assert cert.tiers.safe and [c.condition for c in cert.failures] == ["terminal_rate"]
+    assert cert.tiers.safe and refused_only_by_the_row_faces(c.condition for c in cert.failures)
     assert cert.velocity_loop.sway <= cert.disturbance.gamma < 0.01      # E_v below the sway ω̄ assumed
     run = tubekit.simulate(sc, cert.tightening, duration=20.0, progress=False)
     by = {p.name: p for p in check_promises(run)}
@@ -475,7 +476,7 @@ def test_the_bluerov2_over_twenty_percent_keeps_every_safe_promise_at_a_corner_o
     box = sc.plant.params
     assert box.loop_bandwidth == 20.0 and box.interval("X_uu") == pytest.approx((-169.2, -112.8))
     cert = verify.certify(sc)
-    assert cert.tiers.safe and [c.condition for c in cert.failures] == ["terminal_rate"]
+    assert cert.tiers.safe and refused_only_by_the_row_faces(c.condition for c in cert.failures)
     corner = dataclasses.replace(sc.plant, truth=tuple((k, box.interval(k)[end]) for k in box.interval_fields))
     run = tubekit.simulate(sc.with_changes(plant=corner), cert.tightening, duration=20.0, progress=False)
     by = {p.name: p for p in check_promises(run)}
@@ -494,7 +495,7 @@ def test_the_bluerov2_after_a_fifth_of_a_metre_per_second_in_the_papers_current_
     sc = load_scenario(SLOW.with_name("bluerov2_brisk_current.toml"))
     assert sc.trajectory.rate * sc.trajectory.radius == pytest.approx(0.2) and sc.disturbance.amplitude[0] == 0.1
     cert = verify.certify(sc)
-    assert cert.tiers.safe and [c.condition for c in cert.failures] == ["terminal_rate"]
+    assert cert.tiers.safe and refused_only_by_the_row_faces(c.condition for c in cert.failures)
     keep_up = next(c for c in cert.conditions if c.condition == "keep_up[u]")
     assert keep_up.ok and keep_up.rhs < keep_up.lhs == pytest.approx(0.35)
     run = tubekit.simulate(sc, cert.tightening, duration=20.0, progress=False)

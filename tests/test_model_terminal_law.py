@@ -11,7 +11,7 @@ from hypothesis import strategies as st
 
 from tubekit.exceptions import ConfigError
 from tubekit.model.kinematics import unicycle_step
-from tubekit.model.terminal_law import NO_BEARING, TerminalLaw, bearing, line_of_sight
+from tubekit.model.terminal_law import NO_BEARING, NO_ROWS, TerminalLaw, bearing, line_of_sight
 
 GOOD = dict(d_lo=0.6, d_hi=0.9, d_star=0.75, alpha_max=0.06, z_max=0.8, gain_d=1.5, gain_z=0.3, turn=0.6)
 
@@ -26,6 +26,9 @@ GOOD = dict(d_lo=0.6, d_hi=0.9, d_star=0.75, alpha_max=0.06, z_max=0.8, gain_d=1
     ({"z_max": float("nan")}, "terminal.z_max"),
     ({"bearing_max": 0.0}, "terminal.bearing_max"),
     ({"bearing_max": 3.5}, "terminal.bearing_max"),
+    ({"row_u": 0.01}, "terminal.row_u"),                                  # one face without the others
+    ({"row_u": -0.01, "row_w": 0.01, "row_r": 0.01}, "terminal.row_u"),   # a negative face
+    ({"row_r": float("inf"), "row_u": 0.01, "row_w": 0.01}, "terminal.row_r"),
 ])
 def test_a_bad_set_is_refused_naming_the_field(change, match):
     with pytest.raises(ConfigError, match=match):
@@ -39,10 +42,23 @@ def test_the_dict_round_trip_is_exact_and_a_missing_key_is_named():
         TerminalLaw.from_dict({k: v for k, v in GOOD.items() if k != "turn"}, "certificate.terminal")
 
 
-def test_a_bearing_face_survives_the_round_trip_and_is_the_ninth_key():
-    law = TerminalLaw(**GOOD, bearing_max=0.4)
+def test_a_bearing_face_and_row_faces_survive_the_round_trip_among_twelve_keys():
+    law = TerminalLaw(**GOOD, bearing_max=0.4, row_u=0.01, row_w=0.002, row_r=0.03)
     assert law.has_bearing and not TerminalLaw(**GOOD).has_bearing and TerminalLaw(**GOOD).bearing_max == NO_BEARING
-    assert len(law.to_dict()) == 9 and TerminalLaw.from_dict(law.to_dict()) == law
+    assert law.has_rows and not TerminalLaw(**GOOD).has_rows and TerminalLaw(**GOOD).row_u == NO_ROWS
+    assert len(law.to_dict()) == 12 and TerminalLaw.from_dict(law.to_dict()) == law
+
+
+def test_the_row_faces_by_hand():
+    """The vehicle 1 m behind a target moving at 0.2 m/s along +x, pointing at it: the law's row is
+    u = 0.2 + 1.5 (1 − 0.75) = 0.575 m/s, w = −0.3 · 0.1 = −0.03 m/s (e_z = 0.1 m) and r = 0; a last row
+    (0.58, −0.03, 0.02) then has the slacks 0.01 − 0.005, 0.002 − 0 and 0.03 − 0.02."""
+    law = TerminalLaw(**GOOD, row_u=0.01, row_w=0.002, row_r=0.03)
+    state = np.array([-1.0, 0.0, 0.1, 0.0])
+    slacks = law.row_slacks(state, np.zeros(3), np.array([0.2, 0.0, 0.0]), np.array([0.58, -0.03, 0.02]), 0.1)
+    assert slacks == pytest.approx({"terminal set: |v_u - kappa_f|": 0.005, "terminal set: |v_w - kappa_f|": 0.002,
+                                    "terminal set: |v_r - kappa_f|": 0.01})
+    assert TerminalLaw(**GOOD).row_slacks(state, np.zeros(3), np.zeros(3), np.zeros(3), 0.1) == {}
 
 
 @pytest.mark.parametrize("state, target, velocity, expected", [

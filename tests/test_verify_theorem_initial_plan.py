@@ -33,3 +33,23 @@ def test_a_start_pointing_away_is_refused_naming_the_tightest_row(pc_cert):
     cond = initial_plan_condition(sc, pc_cert.design, pc_cert.region, pc_cert.design.terminal,
                                   pc_cert.backup.safe_set)
     assert not cond.ok and cond.lhs < 0 and "tightest:" in cond.detail
+
+
+def test_under_rate_limited_plans_the_plan_leaves_rest_by_the_jump_and_is_the_loops_candidate():
+    """examples/smooth_line.toml: the law's rows from the start are clipped to within J of the row before them,
+    the first of rest (the run starts at rest), as the loop's candidate is; the loop's check (the row faces
+    against the last row included) accepts them and agrees with ``initial_terminal``."""
+    from pathlib import Path
+    from tubekit.loop.candidate import candidate_plan
+    sc = load_scenario(Path(__file__).resolve().parents[1] / "examples" / "smooth_line.toml")
+    cert = verify.certify(sc)
+    tight, jump = cert.tightening, sc.limits.jump(sc.controller.dt)
+    rows, _, _ = law_plan(sc, cert.design.terminal, np.asarray(cert.design.v_bar))
+    assert np.all(np.abs(np.diff(np.vstack([np.zeros(3), rows]), axis=0)) <= jump + 1e-15)
+    x0 = np.asarray(sc.initial_state, float)
+    loop_rows = candidate_plan(sc, None, 0, x0, 0.0, tight.v_max, jump, 1.0, law=tight.terminal_law,
+                               v_last=np.zeros(3))
+    np.testing.assert_allclose(loop_rows, rows, rtol=0, atol=1e-12)
+    cond = initial_plan_condition(sc, cert.design, cert.region, cert.design.terminal, cert.backup.safe_set)
+    check = check_plan(sc, tight, 0.0, x0, loop_rows, sc.obstacles, -1, v_last=np.zeros(3))
+    assert cond.ok and check.ok and cond.lhs == pytest.approx(check.slack, abs=1e-9)

@@ -14,6 +14,7 @@ from tubekit.scenario import load_scenario, scenario_from_dict
 from verify.certificate.certify import Certificate, certify
 from verify.vehicle.compose import PLAN_CHECK_TOLERANCE, plan_jumps
 from verify.studies.recheck import recheck
+from .tier_checks import refused_only_by_the_row_faces
 
 PAPER_CURRENTS = "verify/scenarios/paper_currents.toml"
 
@@ -114,7 +115,7 @@ def test_the_slow_bluerov2_scenario_certifies_the_safe_tier_with_a_closed_fixed_
     search chose is certified and its per-tick jumps are what the loop bound used. Tracking is refused by name:
     the tracking theorem does not cover rate-limited plans yet (``terminal_rate``), and nothing else fails."""
     assert slow_cert.tiers == Tiers(True, False)
-    assert [c.condition for c in slow_cert.failures] == ["terminal_rate"]
+    assert refused_only_by_the_row_faces(c.condition for c in slow_cert.failures)
     consistent = next(c for c in slow_cert.plant_conditions if c.condition == "loop_consistent")
     assert consistent.ok and consistent.lhs < 1.0
     loop, law = slow_cert.velocity_loop, slow_cert.backup.law
@@ -253,7 +254,7 @@ def test_a_start_that_does_not_close_is_followed_by_the_next_start(monkeypatch):
     consistent = next(c for c in first.conditions if c.condition == "loop_consistent")
     assert not compose._closed(first) and consistent.ok is False and 1.0 < consistent.lhs < 1.01
     assert compose._closed(kept) and cert.velocity_loop.error == kept.loop.error
-    assert cert.tiers.safe and [c.condition for c in cert.failures] == ["terminal_rate"]
+    assert cert.tiers.safe and refused_only_by_the_row_faces(c.condition for c in cert.failures)
     report = recheck(json.loads(json.dumps(cert.to_dict())))  # the stored law's loop re-derived at the stored E_a
     assert report.ok, report.failed[:3]
 
@@ -320,6 +321,6 @@ def test_a_target_at_two_tenths_of_a_metre_per_second_certifies_the_safe_tier_on
     sc = load_scenario("examples/bluerov2_brisk.toml")
     assert sc.trajectory.rate * sc.trajectory.radius == pytest.approx(0.2)
     cert = verify.certify(sc)
-    assert cert.tiers.safe and [c.condition for c in cert.failures] == ["terminal_rate"]
+    assert cert.tiers.safe and refused_only_by_the_row_faces(c.condition for c in cert.failures)
     stronger = verify.certify(sc.with_changes(**{"disturbance.amplitude": (0.1, 0.1, 0.1)}))
     assert not stronger.tiers.tracking and "keep_up[u]" in [c.condition for c in stronger.failures]

@@ -143,6 +143,7 @@ class ConvexSubproblem:
         self._weights = np.vstack([np.tile(nlp.dt * nlp.q, (N, 1)), nlp.p])   # (N+1, 3) for k = 0..N
         self._wref = self._weights[1:, (0, 0, 1)].T  # (3, N) weights of x, y, z at k = 1..N
         self._anchor_offset = np.zeros(3)  # the backup anchor's offset from p_N in this linearisation (m)
+        self._end_velocity: np.ndarray | None = None  # the target's velocity at the plan's end (m/s), for the row faces
         self._lookahead = nlp.lookahead_margins()  # (N,) m added to the nodes' obstacle rows (controller.lookahead)
         self._build()
         self.clarabel_settings = {**DEFAULT_CLARABEL_SETTINGS, **(clarabel_settings or {})}
@@ -381,6 +382,25 @@ class ConvexSubproblem:
         self._write_cost_constants(ref, eo0)
         if bt is not None and self.max_obstacles:
             self._write_backup_obstacles(len(obs))
+        if nlp.terminal_rows is not None and self._end_velocity is not None:
+            self._write_last_row(s[-1] + np.array([o[0], o[1], o[2], 0.0]), ref[-1] + o)
+
+    def write_target_velocity(self, velocity: np.ndarray | None) -> None:
+        """The target's velocity (3,) at the plan's end (m/s), read by the last row's face box
+        (:meth:`tubekit.fhocp.nlp.FhocpNlp.last_row_box`); None: the box is not written."""
+        self._end_velocity = None if velocity is None else np.asarray(velocity, dtype=float).reshape(3)
+
+    def _write_last_row(self, end: np.ndarray, p_end: np.ndarray) -> None:
+        """The last row's bounds intersected with the row faces' box about the law's row at the linearisation's
+        end; where they do not meet, pinned to the end of the trust box nearest the faces (the subproblem stays
+        feasible and the plan moves toward them)."""
+        lo, hi = self.nlp.last_row_box(end, p_end, self._end_velocity)
+        pv, last = self.param_vector, self.nlp.n - 1
+        for c, (name_lo, name_hi) in enumerate((("ulo", "uhi"), ("wlo", "whi"), ("rlo", "rhi"))):
+            i_lo, i_hi = self._cols[name_lo][last], self._cols[name_hi][last]
+            a, b = pv[i_lo], pv[i_hi]
+            new_lo = min(max(a, lo[c]), b)
+            pv[i_lo], pv[i_hi] = new_lo, max(min(b, hi[c]), new_lo)
 
     def _write_cost_constants(self, ref: np.ndarray, eo0: float) -> None:
         """p_d(N) of the terminal set and the cost's constant term (node 0 and the reference's squares)."""

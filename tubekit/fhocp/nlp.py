@@ -74,17 +74,20 @@ from tubekit.exceptions import ConfigError, ShapeError
 from tubekit.fhocp.rows import RATE_MARGIN, BackupTerminal, rate_penalty_cost, rate_violation
 from tubekit.fhocp.linearisation import ED_FLOOR, compiled
 from tubekit.model.kinematics import unicycle_step
+from tubekit.model.terminal_law import TerminalLaw
 from tubekit.scenario import Obstacle, Scenario, TerminalMode
 from tubekit.tightening import Tightening
 from tubekit.validation import as_vector, choice, positive
 
-__all__ = ["TERMINAL_MODES", "TERMINAL_PAD", "discrete_step", "rollout", "obstacle_array", "select_obstacles",
-           "FhocpNlp", "NlpEvaluation", "BackupTerminal"]
+__all__ = ["TERMINAL_MODES", "TERMINAL_PAD", "ROW_FACE_PAD", "discrete_step", "rollout", "obstacle_array",
+           "select_obstacles", "FhocpNlp", "NlpEvaluation", "BackupTerminal"]
 
 TERMINAL_MODES: tuple[str, ...] = TerminalMode.values()
 #: The share of X_f's widths (e_d band, heading room, depth band) by which the FHOCP's last node keeps inside the
 #: tracking theorem's terminal set: a plan the solver ends on a face (to its tolerance) then passes the exact check.
 TERMINAL_PAD = 0.01
+#: The last row aims this fraction inside X_f's row faces (:meth:`FhocpNlp.last_row_box`).
+ROW_FACE_PAD = 0.2
 
 
 #: Exact zero-order-hold step F(s, v, dt) of the nominal kinematics (the model's own exact arc).
@@ -218,6 +221,10 @@ class FhocpNlp:
         The command c of the terminal rest |v_{N-1} - c| <= J (m/s, m/s, rad/s): ``Tightening.terminal_command``
         (0 for station keeping, (u_l, 0, 0) for the loiter). None (default): zeros; always an array after
         construction.
+    terminal_rows : TerminalLaw or None
+        The tracking theorem's terminal law when its X_f has row faces (rate-limited plans): the last row is kept
+        within (1 - ROW_FACE_PAD) S of the law's row at the linearisation's end (:meth:`last_row_box`; a planning
+        aid like the pad on X_f, the exact check decides). None: no such rows.
     lookahead : float
         lambda_f >= 0 (``controller.lookahead``): node k's obstacle rows also keep lambda_f k/N of the backup's
         footprint (:meth:`lookahead_margins`), so a plan turns away from an obstacle before its end has to; a
@@ -248,6 +255,7 @@ class FhocpNlp:
     v_min: np.ndarray | None = None
     terminal_command: np.ndarray | None = None
     lookahead: float = 0.0
+    terminal_rows: TerminalLaw | None = None
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "dt", positive("dt", self.dt))
@@ -335,7 +343,20 @@ class FhocpNlp:
                    backup_terminal=backup, rate_jump=None if jump is None else jump * (1.0 - RATE_MARGIN),
                    terminal_rest=jump is not None and tightening.terminal_rest, rate_penalty=rate_penalty,
                    tracking_terminal=_tracking_terminal(tightening), v_min=tightening.v_low,
-                   terminal_command=tightening.terminal_command, lookahead=c.lookahead)
+                   terminal_command=tightening.terminal_command, lookahead=c.lookahead,
+                   terminal_rows=_terminal_rows(tightening))
+
+    def last_row_box(self, end: np.ndarray, p_end: np.ndarray, v_end: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """(lo, hi) (3,) of the last row: the law's row at the plan's end ``end`` (4,) against the target's
+        ``p_end``, ``v_end`` (3,) at that time, widened by (1 - ROW_FACE_PAD) of the row faces S
+        (m/s, m/s, rad/s). Only with :attr:`terminal_rows`."""
+        law = self.terminal_rows
+        if law is None:
+            raise ValueError("last_row_box: this NLP has no row faces")
+        row = law.command(np.asarray(end, dtype=float), np.asarray(p_end, dtype=float),
+                          np.asarray(v_end, dtype=float), self.dt)
+        faces = (1.0 - ROW_FACE_PAD) * np.array([law.row_u, law.row_w, law.row_r])
+        return row - faces, row + faces
 
     def lookahead_margins(self) -> np.ndarray:
         """(N,) distances (m) added to the clearance of node k = 1..N's obstacle rows: lambda_f (k/N) of the backup
@@ -439,6 +460,12 @@ class FhocpNlp:
         per_step = {"e_d_min": viol[0], "obstacle": viol[1], "e_o": viol[2], "box": viol[3]}
         return NlpEvaluation(cost=cost, merit=merit, violations=violations, per_step=per_step,
                              max_violation=mv)
+
+
+def _terminal_rows(tightening: Tightening) -> TerminalLaw | None:
+    """The tightening's terminal law when it proves tracking and its X_f has row faces, else None."""
+    law = tightening.terminal_law if tightening.plan_always_available else None
+    return law if law is not None and law.has_rows else None
 
 
 def _tracking_terminal(tightening: Tightening) -> tuple[float, float, float, float] | None:

@@ -322,6 +322,8 @@ class FHOCP:
         obs = self.select_obstacles(s0, obstacles)
         nlp = self.nlp
         ref = nlp.reference(self.scenario.trajectory, t)
+        if nlp.terminal_rows is not None:
+            self.subproblem.write_target_velocity(self.scenario.trajectory.velocity(t + nlp.n * nlp.dt))
         guess, warm = self.warm_start_inputs(t)
         guess = _rate_fit(nlp, nlp.clip(guess), last)
         realtime = warm and self.mode is FhocpMode.REALTIME

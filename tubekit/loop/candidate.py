@@ -29,11 +29,15 @@ from tubekit.loop.plan_check import plan_arcs
 from tubekit.model.terminal_law import TerminalLaw
 from tubekit.scenario import Scenario
 
-__all__ = ["candidate_plan", "completion_row", "pursuit_input", "PURSUIT_GAIN"]
+__all__ = ["candidate_plan", "completion_row", "pursuit_input", "settle_last_row", "PURSUIT_GAIN", "SETTLE_MARGIN",
+           "SETTLE_ROUNDS"]
 
 #: Gain (1/s) of the completion law on the distance and depth errors (a period's worth of correction at δ = 0.1 s
 #: over about four periods).
 PURSUIT_GAIN = 2.5
+#: :func:`settle_last_row` aims this fraction inside the row faces, and iterates this many rounds.
+SETTLE_MARGIN = 0.1
+SETTLE_ROUNDS = 3
 
 
 def _lower(v_max: np.ndarray, v_min: np.ndarray | None) -> np.ndarray:
@@ -77,13 +81,14 @@ def completion_row(scenario: Scenario, law: TerminalLaw | None, end: np.ndarray,
 
 def candidate_plan(scenario: Scenario, plan: np.ndarray | None, age: int, x0: np.ndarray, t0: float,
                    v_max: np.ndarray, jump: np.ndarray | None, e_d_goal: float,
-                   law: TerminalLaw | None = None, *, v_min: np.ndarray | None = None) -> np.ndarray | None:
+                   law: TerminalLaw | None = None, *, v_min: np.ndarray | None = None,
+                   v_last: np.ndarray | None = None) -> np.ndarray | None:
     """The candidate at ``t0`` (s) from the measured ``x0`` (4,): rows ``age + 1 ..`` of the last accepted
     ``plan`` (N, 3), ``age`` periods old, completed row by row (:func:`completion_row`, inside V̄ =
     [``v_min``, ``v_max``], ``v_min`` None: −``v_max``; each completion row within ``jump`` (3,) of the row
     before it, when the plans are rate-limited). With the certified terminal ``law`` and no plan (``plan`` None,
-    e.g. at t = 0), the candidate is the law's own N rows; without a law, None when nothing of the plan is left
-    to shift."""
+    e.g. at t = 0), the candidate is the law's own N rows, the first within ``jump`` of ``v_last`` (3,; the command
+    before it) when both are given; without a law, None when nothing of the plan is left to shift."""
     n = scenario.controller.horizon_steps
     if plan is None:
         if law is None:
@@ -99,7 +104,36 @@ def candidate_plan(scenario: Scenario, plan: np.ndarray | None, age: int, x0: np
     for _ in range(n - len(rows)):
         end = plan_arcs(x0, np.asarray(rows), dt, 1)[-1, -1] if rows else np.asarray(x0, dtype=float)
         v = completion_row(scenario, law, end, t0 + dt * len(rows), v_max, e_d_goal, v_min=v_min)
-        if jump is not None and rows:
-            v = np.clip(v, rows[-1] - jump, rows[-1] + jump)
+        before = rows[-1] if rows else v_last
+        if jump is not None and before is not None:
+            v = np.clip(np.clip(v, before - jump, before + jump), _lower(v_max, v_min), np.asarray(v_max, dtype=float))
         rows.append(v)
     return np.asarray(rows, dtype=float)
+
+
+def settle_last_row(scenario: Scenario, law: TerminalLaw | None, plan: np.ndarray, x0: np.ndarray, t0: float,
+                    v_max: np.ndarray, jump: np.ndarray | None, *, v_min: np.ndarray | None = None) -> np.ndarray:
+    """``plan`` (N, 3) from the measured ``x0`` (4,) at ``t0`` (s) with its last row moved onto the row faces of
+    the certified ``law`` (within (1 − :data:`SETTLE_MARGIN`) S of the law's row at the plan's end, a few
+    fixed-point rounds: the end moves with the row), then within ``jump`` of the row before it and inside
+    V̄ = [``v_min``, ``v_max``]. The solver does not know the faces (``docs/verify.md`` step 17c); the exact check
+    still decides. ``plan`` itself when the law has no row faces."""
+    plan = np.asarray(plan, dtype=float)
+    if law is None or not law.has_rows or len(plan) < 2:
+        return plan
+    dt = scenario.controller.dt
+    out = plan.copy()
+    head = plan_arcs(x0, out[:-1], dt, 1)[-1, -1]
+    t_end = t0 + dt * len(out)
+    p = np.asarray(scenario.trajectory.position(t_end), dtype=float).reshape(3)
+    v = np.asarray(scenario.trajectory.velocity(t_end), dtype=float).reshape(3)
+    faces = (1.0 - SETTLE_MARGIN) * np.array([law.row_u, law.row_w, law.row_r])
+    bound = np.asarray(v_max, dtype=float)
+    low, high = _lower(bound, v_min), bound
+    if jump is not None:
+        low, high = np.maximum(low, out[-2] - jump), np.minimum(high, out[-2] + jump)
+    for _ in range(SETTLE_ROUNDS):
+        end = plan_arcs(head, out[-1:], dt, 1)[-1, -1]
+        target = law.command(end, p, v, dt)
+        out[-1] = np.clip(np.clip(out[-1], target - faces, target + faces), low, high)
+    return out

@@ -64,7 +64,7 @@ import numpy as np
 
 from tubekit.model.ancillary import AncillaryLaw
 from tubekit.exceptions import ConfigError, SolverError
-from tubekit.loop.candidate import candidate_plan
+from tubekit.loop.candidate import candidate_plan, settle_last_row
 from tubekit.loop.memory import ZERO_INPUT, PlanMemory
 from tubekit.loop.plan_check import PlanCheck, check_plan, check_rates, check_sway
 from tubekit.loop.setup import (Clock, build_solver, progress_bar, saturate, silence_fallback_warnings, status_text,
@@ -201,6 +201,10 @@ class _ClosedLoop:
             else:
                 result = self.solver.solve(tk, xk.copy(), known)
             plan = self.plan_of(result)
+            tight = self.tightening
+            if tight.plan_always_available and tight.terminal_law is not None:
+                plan = settle_last_row(self.scenario, tight.terminal_law, plan, xk, tk, self.v_bar,
+                                       self.scenario.limits.jump(self.scenario.controller.dt), v_min=self.v_low)
         except SolverError as exc:
             _LOG.debug("period %d: solver result refused: %s", k, exc)
         self.log.record_solve(k, k * self.clock.ticks, result, time.perf_counter() - c0)
@@ -229,7 +233,8 @@ class _ClosedLoop:
             return None
         goal = tight.e_d_min + CANDIDATE_GOAL * (tight.e_d_max - tight.e_d_min)
         plan = candidate_plan(self.scenario, previous, memory.age, xk, tk, self.v_bar,
-                              self.scenario.limits.jump(self.scenario.controller.dt), goal, law=law, v_min=self.v_low)
+                              self.scenario.limits.jump(self.scenario.controller.dt), goal, law=law, v_min=self.v_low,
+                              v_last=self.v_last)
         if plan is None:
             return None
         check = check_sway(self.sway_last, self.release) or \

@@ -20,7 +20,9 @@ follows), that
 * the vehicle ball inflated by M_pos[j] is clear of every known obstacle and
   inside the workspace;
 * with the tracking theorem's terminal law (``tightening.terminal_law``), the plan's nominal end lies in its
-  terminal set X_f ("terminal set: ...", :meth:`tubekit.model.terminal_law.TerminalLaw.slacks`);
+  terminal set X_f ("terminal set: ...", :meth:`tubekit.model.terminal_law.TerminalLaw.slacks`), and under
+  rate-limited plans its last row within the row faces of the law's row there
+  (:meth:`tubekit.model.terminal_law.TerminalLaw.row_slacks`);
 * when the tightening has a certified backup (``tightening.terminal_backup``), the plan's nominal end position
   meets the terminal condition (:func:`tubekit.loop.terminal.terminal_condition`: the backup's
   safe set there, inflated by the vehicle ball, is clear of every known obstacle, inside the
@@ -227,10 +229,13 @@ def check_plan(scenario: Scenario, tight: Tightening, t0: float, x0: np.ndarray,
     if tight.terminal_law is not None and tracking_checked(tight):
         end_time = t0 + dt * n
         end_target = np.asarray(scenario.trajectory.position(end_time), dtype=float).reshape(3)
+        law = tight.terminal_law
         end_velocity = (np.asarray(scenario.trajectory.velocity(end_time), dtype=float).reshape(3)
-                        if tight.terminal_law.has_bearing else None)  # only the bearing face reads it
-        slacks.update({k: np.array([v]) for k, v in
-                       tight.terminal_law.slacks(arcs[-1, -1], end_target, end_velocity).items()})
+                        if law.has_bearing or law.has_rows else None)  # only the bearing and row faces read it
+        faces = law.slacks(arcs[-1, -1], end_target, end_velocity)
+        if law.has_rows:
+            faces.update(law.row_slacks(arcs[-1, -1], end_target, end_velocity, inputs[n - 1], dt))
+        slacks.update({k: np.array([v]) for k, v in faces.items()})
     worst_name, worst = _worst(slacks)
     if safe_worst < worst or math.isnan(safe_worst):
         worst_name, worst = safe_name, safe_worst

@@ -5,12 +5,14 @@ period and completed at its end by a terminal law that keeps the error in a term
 set is, with d the horizontal distance to the target, α = ψ − λ_los the heading's angle to the line of
 sight λ_los = atan2(y_d − y, x_d − x) (α = 0: pointing at the target; e_o = −sin α) and e_z = z − z_d,
 
-    X_f = {d_lo <= d <= d_hi, |α| <= α_f, |e_z| <= z_f, |φ| <= φ_f},
+    X_f = {d_lo <= d <= d_hi, |α| <= α_f, |e_z| <= z_f, |φ| <= φ_f, |v_{N−1} − κ_f(x_N)| <= S},
 
 φ the bearing: the angle between the target's horizontal velocity and the line of sight (φ = 0: the vehicle
 trails the target). The bearing face is used only under a minimum surge (φ_f = π otherwise: no face); there it
 keeps the target's speed along the line of sight, hence the law's surge, above the floor (``docs/verify.md``,
-step 17b). The law, held over one period δ (a plan's row) from the state at time t, is
+step 17b). The *row faces* |v_{N−1} − κ_f(x_N)| <= S = (S_u, S_w, S_r), the plan's last row against the law's own
+row at the plan's end, are used only for rate-limited plans (S = 0 otherwise: no face); there they keep the
+completion's row within the plans' jump J of the row before it (step 17c). The law, held over one period δ (a plan's row) from the state at time t, is
 
 * r = −g α / δ (turn the fraction g of the way onto the line of sight);
 * u = (V_r + λ (d − d*)) / (S(g α / 2) cos(α (1 − g / 2))), V_r = ṗ_d(t) · (p_d − p) / d the target's
@@ -36,10 +38,12 @@ from tubekit.exceptions import ConfigError
 from tubekit.model.kinematics import sinc
 from tubekit.validation import finite, positive
 
-__all__ = ["TerminalLaw", "line_of_sight", "bearing", "NO_BEARING"]
+__all__ = ["TerminalLaw", "line_of_sight", "bearing", "NO_BEARING", "NO_ROWS"]
 
 #: ``bearing_max`` of a terminal set without the bearing face (rad).
 NO_BEARING = math.pi
+#: ``row_u``, ``row_w``, ``row_r`` of a terminal set without the row faces.
+NO_ROWS = 0.0
 
 
 def line_of_sight(state: np.ndarray, p_d: np.ndarray) -> tuple[float, float, float]:
@@ -73,6 +77,9 @@ class TerminalLaw:
     gain_z: float
     turn: float
     bearing_max: float = NO_BEARING
+    row_u: float = NO_ROWS
+    row_w: float = NO_ROWS
+    row_r: float = NO_ROWS
 
     def __post_init__(self) -> None:
         for f in fields(self):
@@ -90,6 +97,27 @@ class TerminalLaw:
                 raise ConfigError(f"terminal.{name}", ">= 0 (1/s)", getattr(self, name))
         if not 0.0 < self.bearing_max <= NO_BEARING:
             raise ConfigError("terminal.bearing_max", "in (0, pi] rad (pi: no bearing face)", self.bearing_max)
+        rows = (self.row_u, self.row_w, self.row_r)
+        if any(r < 0.0 for r in rows) or (any(r == NO_ROWS for r in rows) and any(r > 0.0 for r in rows)):
+            raise ConfigError("terminal.row_u", "row_u, row_w, row_r all > 0 (m/s, m/s, rad/s), or all 0 (no row "
+                              "faces)", list(rows))
+
+    @property
+    def has_rows(self) -> bool:
+        """True when X_f has the row faces |v_{N−1} − κ_f(x_N)| <= (S_u, S_w, S_r) (rate-limited plans)."""
+        return self.row_u > NO_ROWS
+
+    def row_slacks(self, state: np.ndarray, p_d: np.ndarray, pd_dot: np.ndarray, last_row: np.ndarray,
+                   dt: float) -> dict[str, float]:
+        """Slack (>= 0: inside) of each row face: S_c − |v_c − κ_f(state)_c| for the plan's last row ``last_row``
+        (3,) and the law's row at its end ``state`` (4,), the target's ``p_d``, ``pd_dot`` (3,) at the same time and
+        the period ``dt`` (s); empty without the faces."""
+        if not self.has_rows:
+            return {}
+        gap = np.abs(np.asarray(last_row, dtype=float) - self.command(state, p_d, pd_dot, dt))
+        bands = (self.row_u, self.row_w, self.row_r)
+        return {f"terminal set: |v_{c} - kappa_f|": float(s - g) if math.isfinite(g) else -math.inf
+                for c, s, g in zip("uwr", bands, gap)}
 
     @property
     def has_bearing(self) -> bool:
@@ -127,7 +155,7 @@ class TerminalLaw:
         return np.array([u, v[2] - self.gain_z * e_z, -g * alpha / dt])
 
     def to_dict(self) -> dict[str, float]:
-        """The nine numbers by name."""
+        """The twelve numbers by name."""
         return {k: float(v) for k, v in asdict(self).items()}
 
     @classmethod

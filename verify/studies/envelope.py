@@ -31,7 +31,9 @@ two verdicts, not a proof that every amplitude below certifies.
 A point *certifies* when the safe tier and every condition of the tracking tier hold, except the tracking
 theorem's conditions on the geometry of one mission — the start (``initial_terminal``), the obstacles along
 the path (``path_*``) and the plans' rate limit (``terminal_rate``), :data:`GEOMETRY_CONDITIONS` — which a
-speed and a current do not decide (:func:`frontier_verdict`).
+speed and a current do not decide, and, under rate-limited plans once a row face fails (``terminal_rate[...]``),
+the terminal law's conditions (``terminal_*``: its row faces are sized by the plans' rates, which the envelope
+does not vary; ``docs/verify.md`` step 17c) (:func:`frontier_verdict`).
 
 The ratio certified / necessary per speed (1 = the certificate loses nothing to
 physics) and its min and median summarise the conservatism. The scenario's own point
@@ -319,8 +321,9 @@ GEOMETRY_CONDITIONS = ("initial_terminal", "path_", "terminal_rate")
 
 def frontier_verdict(cert: Certificate) -> tuple[bool, str]:
     """(certifies, first failed condition or "") of a point (module doc)."""
-    failed = [c.condition for tier in ("safe", "tracking") for c in cert.tier_conditions[tier]
-              if c.ok is not True and not c.condition.startswith(GEOMETRY_CONDITIONS)]
+    failed = [c.condition for tier in ("safe", "tracking") for c in cert.tier_conditions[tier] if c.ok is not True]
+    left = GEOMETRY_CONDITIONS + (("terminal_",) if any(n.startswith("terminal_rate[") for n in failed) else ())
+    failed = [n for n in failed if not n.startswith(left)]
     return (not failed, failed[0] if failed else "")
 
 

@@ -47,6 +47,7 @@ class TerminalBounds:
     room_z: float
     speed_floor_xy: float = 0.0  # the target's least horizontal speed (m/s; 0: it may stop)
     surge_floor: float | None = None  # u_min + kappa_bar_u under a minimum surge (m/s), else None
+    jumps: tuple[float, float, float] | None = None  # the plans' jump J per period (m/s, m/s, rad/s), else None
 
 
 @dataclass(frozen=True)

@@ -6,7 +6,8 @@ target's path are known exactly, so :func:`initial_plan_condition` evaluates tha
 exactly as the acceptance check does (``tubekit.loop.plan_check``, whose rows it re-states here: ``verify`` does
 not import the loop): every arc at ``ARC_SAMPLES`` + 1 points, e inside R shrunk by the arc's margin M_j and
 the pad rate · (δ / ARC_SAMPLES) / 2, the heading toward the target, the vehicle ball (r̄ + M_pos,j + pad)
-clear of every obstacle of the scenario and inside the workspace, the end in X_f, the backup's footprint
+clear of every obstacle of the scenario and inside the workspace, the end in X_f (with its row faces, against the
+plan's last row, under rate-limited plans: then the rows start from rest and move by at most J), the backup's footprint
 about the end clear and inside the workspace, its safe set within the region sensed from the start. The
 smallest slack must exceed :data:`verify.theorem.completion_bounds.FLOAT_SLACK` (the same floats, computed by two
 codes). Condition ``initial_terminal``: then a plan exists at t = 0, and by the completion's invariance at
@@ -35,8 +36,12 @@ __all__ = ["law_plan", "initial_plan_condition"]
 def law_plan(scenario: Scenario, law: TerminalLaw, v_bar: np.ndarray, v_low: np.ndarray | None = None
              ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """(rows (N, 3), arcs (N, ARC_SAMPLES + 1, 4), times (N, ARC_SAMPLES + 1)) of the law's plan from the start,
-    each row clipped to [``v_low``, ``v_bar``] (``v_low`` None: −``v_bar``)."""
+    each row clipped to [``v_low``, ``v_bar``] (``v_low`` None: −``v_bar``); with rate-limited plans each row first
+    clipped to within the jump J of the row before it, the first of rest (the run starts at rest, the loop's
+    ``v_last``), as the loop's candidate is."""
     low = -np.asarray(v_bar, dtype=float) if v_low is None else np.asarray(v_low, dtype=float)
+    jump = scenario.limits.jump(float(scenario.controller.dt))
+    last = np.clip(np.zeros(3), low, v_bar)
     ctrl = scenario.controller
     dt, n = float(ctrl.dt), int(ctrl.horizon_steps)
     tau = np.linspace(0.0, dt, ARC_SAMPLES + 1)
@@ -46,7 +51,10 @@ def law_plan(scenario: Scenario, law: TerminalLaw, v_bar: np.ndarray, v_low: np.
         t = j * dt
         p = np.asarray(scenario.trajectory.position(t), dtype=float).reshape(3)
         v = np.asarray(scenario.trajectory.velocity(t), dtype=float).reshape(3)
-        rows[j] = np.clip(law.command(x, p, v, dt), low, v_bar)
+        row = law.command(x, p, v, dt)
+        if jump is not None:
+            row = np.clip(row, last - jump, last + jump)
+        rows[j] = last = np.clip(row, low, v_bar)
         arcs[j] = unicycle_step(np.broadcast_to(x, (ARC_SAMPLES + 1, 4)), np.broadcast_to(rows[j], (ARC_SAMPLES + 1, 3)),
                                 tau)
         x = arcs[j, -1]
@@ -119,6 +127,7 @@ def initial_plan_condition(scenario: Scenario, design: Design, region: Region, l
     slacks = _arc_slacks(scenario, design, region, arcs, times)
     slacks.update(_footprint_slacks(scenario, end, safe))
     slacks.update(law.slacks(end, end_target, end_velocity))
+    slacks.update(law.row_slacks(end, end_target, end_velocity, rows[-1], float(scenario.controller.dt)))
     where, worst = min(slacks.items(), key=lambda kv: kv[1])
     start = np.asarray(scenario.initial_state, dtype=float)
     p0 = np.asarray(scenario.trajectory.position(0.0), dtype=float).reshape(3)

@@ -55,6 +55,7 @@ from verify.theorem.path_clearance import PathFootprint, horizon_end, path_clear
 from verify.theorem.completion_bounds import FLOAT_SLACK, CompletionArc, TerminalBounds, completion_arc
 from verify.theorem.completion_bounds import slack_condition as _cond  # lhs + FLOAT_SLACK <= rhs, in Arb
 from verify.theorem.terminal_bearing import bearing_conditions, bearing_sets
+from verify.theorem.terminal_rows import row_conditions, row_sets
 
 __all__ = ["TerminalBounds", "terminal_bounds", "law_conditions", "footprint_of", "sensing_condition",
            "design_terminal", "with_terminal", "FLOAT_SLACK", "TERMINAL_PREFIXES"]
@@ -78,6 +79,7 @@ def terminal_bounds(scenario: Scenario, design: Design, region: Region) -> Termi
     dev_xy = upper(arb(tube.p_xy) + arb(p.u_max) * arb(tube.psi) * arb(dt) * (n - 1))
     md, mz, mo = m.e_d[-1], m.e_z[-1], m.e_o[-1]
     ax, az = scenario.trajectory.acceleration_bound()
+    jump = scenario.limits.jump(dt)
     return TerminalBounds(
         dt=dt, steps=n, v_bar=tuple(float(v) for v in design.v_bar), speed_xy=p.pd_xy, speed_z=p.pd_z,
         accel_xy=float(ax), accel_z=float(az), dev_xy=dev_xy, dev_z=tube.p_z, dev_psi=tube.psi,
@@ -86,7 +88,8 @@ def terminal_bounds(scenario: Scenario, design: Design, region: Region) -> Termi
         room_z=lower(arb(min(-region.e_z[0], region.e_z[1])) - arb(mz) - arb(pad[1])),
         speed_floor_xy=float(scenario.trajectory.horizontal_speed_floor()),
         surge_floor=None if scenario.limits.u_min is None else upper(arb(scenario.limits.u_min)
-                                                                    + arb(design.tube.kappa[0])))
+                                                                    + arb(design.tube.kappa[0])),
+        jumps=None if jump is None else (float(jump[0]), float(jump[1]), float(jump[2])))
 
 
 def _input_conditions(b: TerminalBounds, law: TerminalLaw, arc: CompletionArc) -> list[Condition]:
@@ -143,7 +146,18 @@ def law_conditions(b: TerminalBounds, law: TerminalLaw) -> tuple[Condition, ...]
                           f"the replay's deviation {b.dev_xy:.4g} m or the heading room does not fit this set"),)
     bearing = bearing_conditions(b, law, arc) if b.surge_floor is not None else []
     return tuple(_input_conditions(b, law, arc) + _invariance_conditions(b, law, arc) + _region_conditions(b, law, arc)
-                 + bearing)
+                 + bearing + _rate_conditions(b, law, arc))
+
+
+def _rate_conditions(b: TerminalBounds, law: TerminalLaw, arc: CompletionArc) -> list[Condition]:
+    """Under rate-limited plans the row faces' conditions (:mod:`verify.theorem.terminal_rows`, step 17c); a set
+    without them fails by name."""
+    if b.jumps is None:
+        return []
+    if not law.has_rows:
+        return [Condition("terminal_rate", "row faces |v_(N-1) - kappa_f(x_N)| <= S (the completion's row within "
+                          "the plans' jump J of the plan's last)", None, None, False, "this set has none")]
+    return row_conditions(b, law, arc, b.jumps)
 
 
 def footprint_of(scenario: Scenario, design: Design, b: TerminalBounds, law: TerminalLaw,
@@ -173,6 +187,8 @@ def _sets(b: TerminalBounds) -> list[TerminalLaw]:
     """The grid of terminal sets and their gains, largest first (module doc); under a surge floor each with its
     bearing face (:func:`verify.theorem.terminal_bearing.bearing_sets`)."""
     laws = _grid(b)
+    if b.jumps is not None:
+        laws = row_sets(b, laws)
     return bearing_sets(b, laws) if b.surge_floor is not None else laws
 
 
@@ -216,47 +232,50 @@ def _no_set(b: TerminalBounds) -> Condition:
 
 
 def _not_covered(scenario: Scenario, region: Region) -> tuple[Condition, ...]:
-    """The designs the theorem does not cover yet, named (whatever the backup): rate-limited plans, a minimum
-    surge after a target that may stop, a region whose heading is not ``toward``."""
+    """The designs the theorem does not cover yet, named (whatever the backup): a minimum surge after a target
+    that may stop, a region whose heading is not ``toward``."""
     if scenario.limits.u_min is not None and not scenario.trajectory.horizontal_speed_floor() > 0.0:
         return (Condition("terminal_surge_floor", "under a minimum surge, a target whose horizontal speed has a "
                           "positive floor (the terminal law's surge follows the target's speed along the line of "
                           "sight; a target that stops or turns toward the vehicle makes it negative)", None, None,
                           False, f"limits.u_min = {scenario.limits.u_min:g} m/s, trajectory "
                           f"{scenario.trajectory.kind!r} has no speed floor; the safe tier does not need it"),)
-    if scenario.limits.rate is not None:
-        return (Condition("terminal_rate", "plans without a rate limit (the completion's row is not proved "
-                          "within J of the plan's last)", None, None, False,
-                          "the tracking theorem covers plans without limits.rate"),)
     if region.heading != "toward":
         return (Condition("terminal_heading", "region.heading = toward (the terminal law points at the "
                           "target)", None, None, False, f"heading {region.heading!r}"),)
     return ()
 
 
-def design_terminal(scenario: Scenario, design: Design, region: Region, safe: SafeSet
+def design_terminal(scenario: Scenario, design: Design, region: Region, safe: SafeSet | None
                     ) -> tuple[TerminalLaw | None, tuple[Condition, ...]]:
     """(law, conditions): the first set of the grid meeting every condition (module doc), else None and the
-    conditions of the set most favourable to the path (the invariant one with the smallest reach, or the first
-    tried)."""
+    conditions of the set most favourable to the path (the invariant one with the smallest reach), or, when no
+    set meets its own conditions, those of the set closest to it (:func:`_shortfall`; they do not read the backup,
+    so they are the verdict whatever ``safe`` is). ``safe`` None (no certified backup): ``terminal_backup`` once a
+    set meets its own conditions."""
     refused = _not_covered(scenario, region)
     if refused:
         return None, refused
     b = terminal_bounds(scenario, design, region)
-    sensing = sensing_condition(scenario, b, safe)
+    sensing = None if safe is None else sensing_condition(scenario, b, safe)
     path = path_samples(scenario, horizon_end(scenario))
 
     def geometry(law: TerminalLaw) -> tuple[Condition, ...]:
         foot = footprint_of(scenario, design, b, law, safe)
         return path_clearance(scenario, foot, path) + path_workspace(scenario, foot, path)
 
-    first: tuple[Condition, ...] | None = None
+    closest: tuple[tuple[int, float], tuple[Condition, ...]] | None = None
     narrowest: tuple[float, TerminalLaw, tuple[Condition, ...]] | None = None
     for law in _sets(b):
         own = law_conditions(b, law)
-        first = first or own
         if not all(c.ok for c in own):
+            miss = _shortfall(own)
+            if closest is None or miss < closest[0]:
+                closest = (miss, own)
             continue
+        if safe is None or sensing is None:
+            return None, (Condition("terminal_backup", "a backup safe set for the terminal condition", None, None,
+                                    False, "no backup"),)
         conds = own + (sensing, initial_plan_condition(scenario, design, region, law, safe))
         if all(c.ok for c in conds):  # the path is sampled only for sets that pass everything else
             conds = conds + geometry(law)
@@ -267,21 +286,35 @@ def design_terminal(scenario: Scenario, design: Design, region: Region, safe: Sa
     if narrowest is not None:
         _, law, conds = narrowest
         return None, conds if any(c.condition.startswith("path_") for c in conds) else conds + geometry(law)
-    return None, (first or (_no_set(b),)) + (sensing,)
+    return None, closest[1] if closest is not None else (_no_set(b),)
 
 
-def with_terminal(scenario: Scenario, design: Design, region: Region, safe: SafeSet | None) -> Design:
+def _shortfall(conds: tuple[Condition, ...]) -> tuple[int, float]:
+    """How far a set is from meeting its conditions: the number that fail, then the largest lhs / rhs among
+    them (inf where a side is not finite or positive): the set reported when none of the grid holds."""
+    failed = [c for c in conds if not c.ok]
+    worst = max((c.lhs / c.rhs if c.lhs is not None and c.rhs is not None and c.rhs > 0 and math.isfinite(c.lhs)
+                 else math.inf for c in failed), default=0.0)
+    return len(failed), worst
+
+
+def with_terminal(scenario: Scenario, design: Design, region: Region, safe: SafeSet | None,
+                  rests: bool = False) -> Design:
     """``design`` with the terminal ingredients' conditions appended and its ``terminal`` law set when they all
-    hold; unchanged when it has no finite margins or V̄ (nothing to complete)."""
+    hold; unchanged when it has no finite margins or V̄ (nothing to complete). ``rests``: the backup does not blend
+    from the last command, so rate-limited plans must end within J of its hand-over command (refused by name
+    under a rate limit: the terminal law's row does not end there)."""
     m = design.margins
     if m is None or design.v_bar is None or not all(math.isfinite(x) for x in m.position + m.e_d + m.e_z + m.e_o):
         return design
     refused = _not_covered(scenario, region)
+    if scenario.limits.rate is not None and rests:
+        refused = refused + (Condition("terminal_rate", "under rate-limited plans a backup that blends from the "
+                                       "last command (a plan's last row need not end at the backup's hand-over "
+                                       "command, where the terminal law's row is not)", None, None, False,
+                                       f"controller.backup = {scenario.controller.backup!r} starts from its own "
+                                       "command"),)
     if refused:
         return dataclasses.replace(design, conditions=design.conditions + refused)
-    if safe is None:
-        return dataclasses.replace(design, conditions=design.conditions + (
-            Condition("terminal_backup", "a backup safe set for the terminal condition", None, None, False,
-                      "no backup"),))
     law, conds = design_terminal(scenario, design, region, safe)
     return dataclasses.replace(design, conditions=design.conditions + conds, terminal=law)

@@ -152,6 +152,13 @@ def _with_reach(bc: BackupCertificate, certify: Callable[[float], BackupCertific
     return dataclasses.replace(moved, anchor_reach=reach) if moved.certified else bc
 
 
+def _smooth(scenario: Scenario) -> bool:
+    """True when the backup is designed smooth (faded, ramped from the last command, continuous yaw): on the
+    dynamic plant, whose velocity loop pays for the command's jumps, and under rate-limited plans, whose last row
+    the terminal law's completion must stay within J of (a backup without the ramp makes plans end at rest)."""
+    return scenario.plant.dynamic or scenario.limits.rate is not None
+
+
 def backup_of(scenario: Scenario, dist: DisturbanceBounds, margins: HorizonMargins | None,
               fits: Fits | None = None, kind: str | None = None) -> BackupCertificate:
     """The backup law of ``kind`` designed by its proof (:meth:`verify.backup.BackupProof.design`, found by
@@ -166,7 +173,7 @@ def backup_of(scenario: Scenario, dist: DisturbanceBounds, margins: HorizonMargi
     hand = _handover(margins)
     bc = proof.design(omega_xy=dist.omega_xy, omega_z=dist.omega_z, limits=limits, tick=tick,
                       handover=hand if math.isfinite(hand[0]) else (0.0, 0.0),
-                      yaw_rate_error=dist.yaw_rate_error, smooth=scenario.plant.dynamic, fits=fits,
+                      yaw_rate_error=dist.yaw_rate_error, smooth=_smooth(scenario), fits=fits,
                       surge_floor=scenario.limits.u_min)
     if not math.isfinite(hand[0]):
         bc = proof.certify(bc.law, bc.safe_set, omega_xy=dist.omega_xy, omega_z=dist.omega_z, limits=limits,
@@ -194,7 +201,8 @@ def solve_tiers(scenario: Scenario, region: Region, gains: GainBounds, sigmas: t
         completed = {}
         for d in ranked:  # the first certified σ, by choose_design's order, whose terminal ingredients hold
             backup = backup_of(scenario, dist, d.margins, fits)
-            completed[id(d)] = with_terminal(scenario, d, region, backup.safe_set if backup.certified else None)
+            completed[id(d)] = with_terminal(scenario, d, region, backup.safe_set if backup.certified else None,
+                                             rests=backup.certified and not backup.law.blends)
             if completed[id(d)].certified:
                 best = completed[id(d)]
                 break

@@ -1,0 +1,180 @@
+"""Tracking with rate-limited plans: X_f's row faces keep the completion within the plans' jump (step 17c).
+
+Rate-limited plans (``limits.rate``) change v̂ by at most J = ρ δ per period, and the candidate's completion row
+must too. The terminal law is memoryless, so its row moves with the state: from one period to the next by what
+the replay's deviation and one completion arc move the state, times the law's gains. X_f gets a face per channel,
+the plan's last row v_{N−1} against the law's row at the plan's end x_N (both at t_N):
+
+    |v_{N−1} − κ_f(x_N)|_c <= S_c,   c = u, w, r
+
+(:meth:`tubekit.model.terminal_law.TerminalLaw.row_slacks`, checked exactly at acceptance). With the completion
+started at x̃ (within the deviation D of x_N) and ended at x' (one arc later, in X_f by step 17):
+
+* ``terminal_rate[c]`` — the completion's row is within J of the plan's last:
+  |κ_f(x̃) − v_{N−1}| <= S + |κ_f(x̃) − κ_f(x_N)| <= S + K_c(deviation) <= J_c;
+* ``terminal_invariant[row_c]`` — the candidate's own last row κ_f(x̃) meets the face at its end x':
+  |κ_f(x̃) − κ_f(x')| <= K_c(arc) <= S_c.
+
+K_c bounds the law's change between two states. With W_α = D_ψ + asin(D_xy / d_lo) (the heading's angle to the
+line of sight moved by the deviation), τ = atan(Y / x_min) (the line of sight's turn over the arc, step 17), the
+start set's |α| <= A_0, its distances within Δ of d* and the arc's radial bounds (``CompletionArc``):
+
+* yaw, r = −g α / δ: K_r = (g / δ) |Δα|, |Δα| <= W_α (deviation) or g A_0 + τ (the arc turns the heading by
+  −g α̃ and the line of sight by τ);
+* heave, w = ż_d − λ_z e_z: K_w = λ_z D_z (deviation; the same time) or A_z δ + λ_z (λ_z δ (z_f + D_z) + A_z δ² / 2)
+  (the arc: ż_d moves by A_z δ, e_z by the law's fraction and the target's curvature);
+* surge, u = N / Den, N = V_r + λ (d − d*), Den = S(g α / 2) cos(α (1 − g / 2)) >= Den_min = S(g A_0 / 2) cos β:
+  |ΔN| / Den_min + (P + λ Δ) L |Δα|, with L = sup |d(1/Den)/dα| <= ((g/2)(g A_0 / 2) / 3 + (1 − g/2) sin β) /
+  Den_min² (|S'(x)| <= x / 3), |ΔN| <= P asin(D_xy / d_lo) + λ D_xy (deviation: the line of sight turns, d moves)
+  or A_xy δ + P τ + λ (λ δ Δ + A_xy δ² / 2 + Y² / (2 x_min)) (the arc: the target's velocity changes by A_xy δ,
+  the line of sight turns by τ, and d' = hypot(q'_x, q'_y) is within Y² / (2 x_min) of q'_x).
+
+By induction with step 17, every candidate is rate-limited, ends in X_f with its faces, and a plan exists at every
+period. The law's gains are chosen as small as X_f's invariance allows (:func:`gentle_law`): the row's change
+grows with them. Each face is as wide as the jump leaves, S = J − K(deviation) less a thousandth of J, never
+narrower than K(arc): the plans meet a wide face more easily, and the completion still lands within J. Every inequality is in Arb with the slack :data:`verify.theorem.completion_bounds.FLOAT_SLACK`.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+
+from flint import arb
+
+from tubekit.model.terminal_law import TerminalLaw
+
+from verify.kernel.intervals import lower, upper
+from verify.theorem.design import Condition
+from verify.theorem.completion_bounds import CompletionArc, TerminalBounds, completion_arc
+from verify.theorem.completion_bounds import slack_condition as _cond
+
+__all__ = ["RowChanges", "row_changes", "row_conditions", "gentle_law", "row_sets", "GAIN_FACTORS"]
+
+#: The smallest invariant gains are tried times these factors (the Arb conditions need a little room).
+GAIN_FACTORS = (1.02, 1.1, 1.3)
+#: Each smallest gain closes its face by this much more (m or rad) than the deviation needs: the Arb conditions
+#: ask a slack of FLOAT_SLACK, and a channel without deviation (no vertical current) would otherwise get gain 0.
+GAIN_SLACK = 1e-8
+#: The narrowest face S is the arc's bound times (1 + this) plus twice FLOAT_SLACK.
+FACE_INFLATION = 1e-6
+#: The widest face leaves this share of J to the rate condition's slack.
+FACE_ROOM = 1e-3
+
+
+@dataclasses.dataclass(frozen=True)
+class RowChanges:
+    """The law's largest row change per channel (u, w, r; m/s, m/s, rad/s), in Arb: across the replay's
+    deviation (same time) and across one completion arc (one period later)."""
+
+    deviation: tuple[arb, arb, arb]
+    arc: tuple[arb, arb, arb]
+
+
+def row_changes(b: TerminalBounds, law: TerminalLaw, arc: CompletionArc) -> RowChanges:
+    """:class:`RowChanges` of ``law`` (module doc) on the start set about X_f and its completion arc."""
+    dt, g, lam, lam_z = arb(b.dt), arb(law.turn), arb(law.gain_d), arb(law.gain_z)
+    dxy, p, a_xy = arb(b.dev_xy), arb(b.speed_xy), arb(b.accel_xy)
+    seen = (dxy / arb(law.d_lo)).asin()
+    w_alpha = arb(b.dev_psi) + seen
+    tau = (arc.lateral / arc.x_min).atan()
+    arc_alpha = g * arc.a0 + tau
+    den_min = (g * arc.a0 / 2).sinc() * arc.beta.cos()
+    den_slope = (g / 2) * (g * arc.a0 / 2) / 3 + (1 - g / 2) * arc.beta.sin()
+    slope = den_slope / (den_min * den_min)
+    n_max = p + lam * arc.spread
+    curve = a_xy * dt * dt / 2
+    radial_arc = lam * dt * arc.spread + curve + arc.lateral ** 2 / (2 * arc.x_min)
+    u_dev = (p * seen + lam * dxy) / den_min + n_max * slope * w_alpha
+    u_arc = (a_xy * dt + p * tau + lam * radial_arc) / den_min + n_max * slope * arc_alpha
+    dz, a_z, z_f = arb(b.dev_z), arb(b.accel_z), arb(law.z_max)
+    w_dev = lam_z * dz
+    w_arc = a_z * dt + lam_z * (lam_z * dt * (z_f + dz) + a_z * dt * dt / 2)
+    return RowChanges(deviation=(u_dev, w_dev, g / dt * w_alpha), arc=(u_arc, w_arc, g / dt * arc_alpha))
+
+
+def row_conditions(b: TerminalBounds, law: TerminalLaw, arc: CompletionArc,
+                   jumps: tuple[float, float, float]) -> list[Condition]:
+    """``terminal_rate[u|w|r]`` and ``terminal_invariant[row_u|row_w|row_r]`` (module doc) for the plans' jumps
+    J = ``jumps`` (m/s, m/s, rad/s per period)."""
+    ch = row_changes(b, law, arc)
+    faces = (arb(law.row_u), arb(law.row_w), arb(law.row_r))
+    out = []
+    for c, face, dev, along, jump in zip("uwr", faces, ch.deviation, ch.arc, jumps):
+        out.append(_cond(f"terminal_rate[{c}]", f"S_{c} + K_{c}(deviation) <= J_{c} (the completion's row within "
+                         "the plans' jump of the plan's last row)", face + dev, arb(jump)))
+        out.append(_cond(f"terminal_invariant[row_{c}]", f"K_{c}(arc) <= S_{c} (the candidate's last row meets the "
+                         "face at its end)", along, face))
+    return out
+
+
+def _smallest_gains(b: TerminalBounds, law: TerminalLaw) -> tuple[float, float, float] | None:
+    """(g, λ, λ_z): the smallest turn and gains (floats) under which X_f of ``law`` is invariant (step 17's
+    ``terminal_invariant[d_lo|d_hi|alpha|e_z]``), found by a few fixed-point rounds (Y depends on g and λ);
+    None when the set cannot be invariant."""
+    dt, dxy, curve = b.dt, b.dev_xy, b.accel_xy * b.dt * b.dt / 2
+    seen = b.dev_psi + math.asin(min(1.0, dxy / law.d_lo))
+    a0 = law.alpha_max + seen
+    g, lam = 0.01, 0.0
+    below = law.d_star - law.d_lo + dxy
+    for _ in range(12):
+        beta = a0 * (1 - g / 2)
+        if beta >= math.pi / 2:
+            return None
+        spread = max(law.d_hi + dxy - law.d_star, below)
+        lateral = dt * b.speed_xy / math.cos(beta) + math.tan(beta) * lam * dt * spread + curve
+        x_min = (law.d_lo - dxy) * (1 - lam * dt) + lam * dt * law.d_star - curve
+        if x_min <= 0.0:
+            return None
+        x_max = (law.d_hi + dxy) * (1 - lam * dt) + lam * dt * law.d_star + curve
+        overshoot = math.hypot(x_max, lateral) - x_max
+        lam_lo = (dxy + curve + GAIN_SLACK) / (dt * below)
+        lam_hi = (dxy + curve + overshoot + GAIN_SLACK) / (dt * (law.d_hi + dxy - law.d_star))
+        lam = max(lam_lo, lam_hi)
+        g = (a0 - law.alpha_max + math.atan(lateral / x_min) + GAIN_SLACK) / a0
+        if not (0.0 < g <= 1.0 and lam * dt <= 1.0):
+            return None
+    lam_z = (b.dev_z + b.accel_z * dt * dt / 2 + GAIN_SLACK) / (dt * (law.z_max + b.dev_z))
+    return g, lam, lam_z
+
+
+def gentle_law(b: TerminalBounds, law: TerminalLaw, factor: float) -> TerminalLaw | None:
+    """``law``'s set with its smallest invariant gains times ``factor`` and the row faces S its arc needs
+    (module doc); None when the set cannot be invariant or the formulas' premises fail."""
+    gains = _smallest_gains(b, law)
+    if gains is None:
+        return None
+    g, lam, lam_z = (factor * x for x in gains)
+    if not (g <= 1.0 and lam * b.dt <= 1.0 and lam_z * b.dt <= 1.0):
+        return None
+    trial = dataclasses.replace(law, turn=g, gain_d=lam, gain_z=lam_z, row_u=1.0, row_w=1.0, row_r=1.0)
+    arc = completion_arc(b, trial)
+    if arc is None:
+        return None
+    changes = row_changes(b, trial, arc)
+    jumps = b.jumps if b.jumps is not None else (math.inf,) * 3
+    faces = [_face(k_arc, k_dev, jump) for k_arc, k_dev, jump in zip(changes.arc, changes.deviation, jumps)]
+    if not all(math.isfinite(s) and s > 0.0 for s in faces):
+        return None
+    return dataclasses.replace(trial, row_u=faces[0], row_w=faces[1], row_r=faces[2])
+
+
+def _face(k_arc: arb, k_dev: arb, jump: float) -> float:
+    """S for one channel: the widest face the jump leaves, J − K(deviation) less :data:`FACE_ROOM` J (plans meet a
+    wide face more easily; the completion still lands within J), never narrower than the arc's K(arc) (then the
+    rate condition fails, by name)."""
+    tight = upper(k_arc * (1 + arb(FACE_INFLATION))) + 2e-9
+    if not math.isfinite(jump):
+        return tight
+    return max(tight, lower(arb(jump) * (1 - arb(FACE_ROOM)) - k_dev))
+
+
+def row_sets(b: TerminalBounds, laws: list[TerminalLaw]) -> list[TerminalLaw]:
+    """Each set of the grid ``laws`` with gentle gains (:data:`GAIN_FACTORS`) and its row faces, in order."""
+    out = []
+    for law in laws:
+        for factor in GAIN_FACTORS:
+            gentle = gentle_law(b, law, factor)
+            if gentle is not None:
+                out.append(gentle)
+    return out

@@ -42,6 +42,8 @@ CASES = [
                                                      {"center": [1.6, 0.0, 0.0], "radius": 0.4}]},
      "safe_only.obstacles[0,1]", ["vehicle_radius"]),
     ("rate beyond the rudder's authority", REMUS, {}, "rate_authority[u]", ["limits.rate[0]"]),
+    ("plans too slow for the yaw row's face", CURRENTS, {"limits.rate": [0.1, 0.1, 0.2]}, "terminal_rate[r]",
+     ["limits.rate[2]"]),
 ]
 
 
@@ -151,6 +153,17 @@ def test_the_dynamic_plant_has_a_knob_for_the_rate_only(failing):
     named = {name: [k.field for k in ks] for name, ks in failure_knobs(cert).items() if ks}
     assert named == {"rate_authority[u]": ["limits.rate[0]"]}      # a_w, a_r < 0: no rate passes
     assert {"keep_up[u]", "yaw_budget", "rate_authority[w]"} <= set(failure_knobs(cert))
+
+
+def test_a_row_face_s_knob_passes_for_its_set_though_another_set_may_need_less():
+    """``terminal_rate[u]`` on the paper's scenario with slow plans: the knob's rate makes the reported set's rate
+    condition hold (re-certified); it is exact for that set only, so a little below it another set of the grid
+    may still pass, unlike the closed-form rows of the table."""
+    table, cert = _certify(CURRENTS, {"limits.rate": [0.1, 0.1, 0.2]})
+    (knob,) = knobs_for(cert, _condition(cert, "terminal_rate[u]"))
+    assert knob.field == "limits.rate[0]" and knob.relation == ">="
+    fixed = verify.certify(scenario_from_dict(_with_knob(table, knob)))
+    assert _condition(fixed, "terminal_rate[u]").ok is True
 
 
 def test_a_condition_that_holds_has_no_knob(pc_cert):

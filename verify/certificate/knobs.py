@@ -17,7 +17,10 @@ disturbance bounds:
 * ``sensing`` (T ‖(ū, w̄)‖ + M_pos + r̄_v < R̄): ``sensing_range`` >= lhs;
 * ``obstacles[i,j]`` (‖p_i − p_j‖ > 2 (r̄_v + M_pos) + r_i + r_j): ``vehicle_radius`` <= r̄_v − (rhs − lhs) / 2;
 * ``sway_bound`` (declared >= γ̄): ``disturbance.sway.bound`` >= rhs;
-* ``rate_authority[c]`` (ρ_c <= a_c): ``limits.rate[c]`` <= rhs (when a_c > 0).
+* ``rate_authority[c]`` (ρ_c <= a_c): ``limits.rate[c]`` <= rhs (when a_c > 0);
+* ``terminal_rate[c]`` (S + K(deviation) <= J = ρ_c δ, the reported set's face at its narrowest): ``limits.rate[c]``
+  >= lhs / (δ (1 − FACE_ROOM)) (kinematic plant: neither K depends on the rates); exact for the reported set,
+  another set of the grid may pass with less.
 
 The rows of ``keep_up`` and ``yaw_budget`` hold only for a design at σ = 0 (then κ̄ = 0 and V̄ = V; at
 σ > 0 the tube, hence κ̄, moves with every one of those fields) on the kinematic plant, with the scenario's
@@ -47,6 +50,7 @@ from tubekit.scenario import Scenario
 
 from verify.certificate.record import CertificateRecord
 from verify.theorem.design import Condition, Design, DisturbanceBounds
+from verify.theorem.terminal_rows import FACE_ROOM
 from verify.theorem.tiers import SAFE_PREFIX
 
 __all__ = ["Knob", "KnobRule", "KNOB_TABLE", "knobs_for", "failure_knobs", "DIGITS", "MARGIN"]
@@ -218,6 +222,17 @@ def _rate_authority(c: _Failed, ctx: _Context) -> list[Knob]:
     return c.knob(f"limits.rate[{axis}]", "<=", c.rhs, ("m/s^2", "m/s^2", "rad/s^2")[axis])
 
 
+def _terminal_rate(c: _Failed, ctx: _Context) -> list[Knob]:
+    """S + K(deviation) <= J with S at its narrowest (the face's K(arc): the jump left no wider one), so the
+    reported set passes once J >= lhs / (1 − FACE_ROOM) (S is then J (1 − FACE_ROOM) − K(deviation) >= K(arc)).
+    Kinematic plant only: on the dynamic one the deviation grows with the jumps through the velocity loop's bound."""
+    if ctx.dynamic or ctx.design is None:
+        return []
+    axis = "uwr".index(c.name[-2])
+    dt = float(ctx.scenario.controller.dt)
+    return c.knob(f"limits.rate[{axis}]", ">=", c.lhs / (dt * (1.0 - FACE_ROOM)), ("m/s^2", "m/s^2", "rad/s^2")[axis])
+
+
 @dataclass(frozen=True)
 class KnobRule:
     """One row of :data:`KNOB_TABLE`: the condition names it matches, the fields it may name, its solver."""
@@ -240,6 +255,7 @@ KNOB_TABLE: tuple[KnobRule, ...] = (
     KnobRule(r"obstacles\[\d+,\d+\]", ("vehicle_radius",), _obstacles),
     KnobRule(r"sway_bound", ("disturbance.sway.bound",), _sway_bound),
     KnobRule(r"rate_authority\[[uwr]\]", ("limits.rate",), _rate_authority),
+    KnobRule(r"terminal_rate\[[uwr]\]", ("limits.rate",), _terminal_rate),
 )
 
 

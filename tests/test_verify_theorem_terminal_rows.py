@@ -161,3 +161,13 @@ def test_where_the_faces_do_not_fit_the_rate_conditions_name_the_channel():
     cert = verify.certify(sc)
     assert cert.tiers.safe and not cert.tiers.tracking
     assert {c.condition for c in cert.failures} == {"terminal_rate[u]", "terminal_rate[r]"}
+
+
+def test_a_channel_without_current_still_gets_a_gain_that_keeps_its_face():
+    """A steady horizontal current and none in depth: the depth channel has no deviation (D_z = 0), and its
+    smallest invariant gain would be 0, which fails the face by the float slack; the gains close each face by a
+    little more than the deviation needs, so tracking holds with a positive λ_z."""
+    sc = SMOOTH.with_changes(**{"disturbance.amplitude": (0.0, 0.0, 0.0), "disturbance.constant": (0.0, 0.045, 0.0)})
+    cert = verify.certify(sc)
+    b = terminal_bounds(sc, cert.design, cert.region)
+    assert b.dev_z == 0.0 and cert.tiers.tracking and cert.design.terminal.gain_z > 0.0

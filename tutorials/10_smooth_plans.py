@@ -1,0 +1,123 @@
+# ---
+# jupyter:
+#   jupytext:
+#     text_representation:
+#       extension: .py
+#       format_name: percent
+# ---
+
+# %% [markdown]
+# # 10 — Smooth plans: tracking with a rate limit
+#
+# A thruster, or a velocity loop under the kinematic controller, follows a command better when the command
+# changes slowly. `[limits] rate = [ρ_u, ρ_w, ρ_r]` makes every plan change v̂ by at most J = ρ δ per period. The
+# tracking theorem keeps a plan available by a *candidate*: the last plan shifted by one period and completed by
+# one row of a terminal law. Under a rate limit that row must also stay within J of the plan's last row, and
+# this tutorial shows how the certificate proves it, and where it cannot:
+#
+# 1. the terminal set X_f gets **row faces** |v_{N−1} − κ_f(x_N)| <= S: the plan's last row near the terminal
+#    law's own row at the plan's end;
+# 2. the law's gains are the smallest that keep X_f invariant, because its row moves with them;
+# 3. where the faces do not fit, the certificate names the channel (`terminal_rate[u|w|r]`) and, on the
+#    kinematic plant, the rate that would fit.
+#
+# The proof is `docs/verify.md`, step 17c.
+
+# %%
+import os
+import sys
+from pathlib import Path
+
+import matplotlib
+
+if "ipykernel" not in sys.modules:  # a script draws off-screen; a notebook keeps its inline figures
+    matplotlib.use("Agg")
+import matplotlib.pyplot as plt
+import numpy as np
+
+import verify
+from tubekit import check_promises, load_scenario, simulate
+
+QUICK = os.environ.get("TUBEKIT_QUICK") == "1"
+FIGURES = (Path(os.environ["TUBEKIT_FIGURES"]) if "TUBEKIT_FIGURES" in os.environ
+           else Path(__file__).resolve().parent / "figures")
+FIGURES.mkdir(parents=True, exist_ok=True)
+EXAMPLES = Path(verify.__file__).resolve().parent.parent / "examples"
+DURATION = 10.0 if QUICK else 30.0
+
+# %% [markdown]
+# ## 1. Slow plans on the paper's scenario: refused, with the rate that would fit
+# `verify/scenarios/paper_currents.toml` certifies both tiers without a rate limit. With plans limited to
+# (0.1, 0.1, 0.2) per second the candidate's surge and yaw rows would move by more than J a period:
+
+# %%
+paper = load_scenario(verify.SCENARIOS_DIR / "paper_currents.toml")
+slow = paper.with_changes(**{"limits.rate": (0.1, 0.1, 0.2)})
+cert_slow = verify.certify(slow)
+print("tiers:", cert_slow.tier_failures)
+print(cert_slow.summary().splitlines()[2])
+print(cert_slow.summary().splitlines()[3])
+
+# %% [markdown]
+# ## 2. Both tiers on a line, with row faces
+# `examples/smooth_line.toml`: a line target at 0.2 m/s, plans limited to (0.5, 0.5, 1.0) per second, so
+# J = (0.05, 0.05, 0.1) per period. Each face is as wide as the jump leaves once the replay's deviation is paid,
+# and at least as wide as one completion moves the law's row (the two conditions per channel):
+
+# %%
+smooth = load_scenario(EXAMPLES / "smooth_line.toml").with_changes(duration=DURATION)
+cert = verify.certify(smooth)
+law = cert.design.terminal
+print("tiers:", cert.tier_failures)
+print(f"X_f: d in [{law.d_lo:.3f}, {law.d_hi:.3f}] m, |alpha| <= {law.alpha_max:.3f} rad; turn g = {law.turn:.3f}, "
+      f"radial gain {law.gain_d:.3f} 1/s, depth gain {law.gain_z:.3f} 1/s")
+print(f"row faces S = ({law.row_u:.4f} m/s, {law.row_w:.4f} m/s, {law.row_r:.4f} rad/s)")
+for c in cert.design.conditions:
+    if c.condition.startswith(("terminal_rate", "terminal_invariant[row")):
+        print(f"  [{'ok' if c.ok else 'FAIL'}] {c.condition}: {c.lhs:.5g} <= {c.rhs:.5g}")
+
+# %% [markdown]
+# ## 3. Fly it
+# Every promise of both tiers holds, a plan is accepted at every period (the solver's own almost always: the
+# FHOCP keeps its last row inside the faces), and v̂ never changes by more than J.
+
+# %%
+run = simulate(smooth, cert, progress=False)
+promises = check_promises(run)
+print("broken promises:", [p.name for p in promises if not p.ok])
+print("plan_available:", next(p for p in promises if p.name == "plan_available").detail)
+jump = np.asarray(smooth.limits.jump(smooth.controller.dt))
+steps = np.abs(np.diff(run.v_hat[:-1], axis=0)).max(axis=0)
+print("largest change of v_hat per period:", np.round(steps, 4), "against J", jump)
+print(f"tracking RMSE {run.metrics['tracking_rmse']:.3f} m; the vehicle stays at d >= {law.d_lo:.2f} m at each "
+      "plan's end")
+
+# %%
+fig, (rows, dist) = plt.subplots(1, 2, figsize=(12, 4.2))
+for i, (name, unit) in enumerate((("u", "m/s"), ("w", "m/s"), ("r", "rad/s"))):
+    rows.plot(run.t[:-1], run.v_hat[:-1, i], lw=1.2, label=f"{name} ({unit})")
+rows.set_xlabel("t (s)")
+rows.set_title("v_hat: every change within J = rate x delta")
+rows.legend()
+dist.plot(run.t, run.errors[:, 0], "C0", lw=1.2, label="e_d")
+dist.axhspan(law.d_lo, law.d_hi, color="C2", alpha=0.2, label="X_f's distance band")
+dist.set_xlabel("t (s)")
+dist.set_ylabel("m")
+dist.set_title("distance to the target")
+dist.legend()
+fig.tight_layout()
+fig.savefig(FIGURES / "10_smooth_plans.png", dpi=100)
+print("wrote", FIGURES / "10_smooth_plans.png")
+
+# %% [markdown]
+# ## 4. Where the faces do not fit: the BlueROV2
+# On the dynamic plant the replay's deviation includes the velocity loop's error, which the plans' own jumps
+# drive: raising the rates raises the deviation with them, and no knob is printed. `examples/bluerov2_slow.toml`
+# keeps its safe tier, and tracking is refused by name:
+
+# %%
+rov = load_scenario(EXAMPLES / "bluerov2_slow.toml")
+cert_rov = verify.certify(rov)
+print("tiers:", cert_rov.tier_failures)
+for c in cert_rov.failures:
+    print(f"  {c.condition}: {c.lhs:.4g} > {c.rhs:.4g} ({c.lhs / c.rhs:.1f}x J)")

@@ -113,7 +113,7 @@ def slow_cert():
 def test_the_slow_bluerov2_scenario_certifies_the_safe_tier_with_a_closed_fixed_point(slow_cert):
     """The fixed point closes: the derived E is below the assumed E_a in every channel, the backup that the gentle
     search chose is certified and its per-tick jumps are what the loop bound used. Tracking is refused by name:
-    the tracking theorem does not cover rate-limited plans yet (``terminal_rate``), and nothing else fails."""
+    the yaw row's face does not fit the plans' jump (``terminal_rate[r]``), and nothing else fails."""
     assert slow_cert.tiers == Tiers(True, False)
     assert refused_only_by_the_row_faces(c.condition for c in slow_cert.failures)
     consistent = next(c for c in slow_cert.plant_conditions if c.condition == "loop_consistent")
@@ -315,12 +315,60 @@ def test_the_sway_loop_is_what_certifies_the_papers_current():
 
 def test_a_target_at_two_tenths_of_a_metre_per_second_certifies_the_safe_tier_on_the_heavy():
     """examples/bluerov2_brisk.toml: a 0.2 m/s target (2.5x bluerov2_slow's) in 0.05 m/s of current per axis; the
-    safe tier holds, tracking refused only for ``terminal_rate``; the same scenario in 0.1 m/s fails ``keep_up[u]``
-    (the target and the current outrun u_max 0.35 m/s)."""
+    safe tier holds, tracking refused only by the row faces; the same scenario in 0.15 m/s fails ``keep_up[u]``
+    (the target and the current outrun u_max 0.35 m/s even with the plans-only loop error of step 17d; at 0.1 m/s
+    the tracking design keeps up and only the row faces refuse it)."""
     import verify
     sc = load_scenario("examples/bluerov2_brisk.toml")
     assert sc.trajectory.rate * sc.trajectory.radius == pytest.approx(0.2)
     cert = verify.certify(sc)
     assert cert.tiers.safe and refused_only_by_the_row_faces(c.condition for c in cert.failures)
     stronger = verify.certify(sc.with_changes(**{"disturbance.amplitude": (0.1, 0.1, 0.1)}))
-    assert not stronger.tiers.tracking and "keep_up[u]" in [c.condition for c in stronger.failures]
+    assert stronger.tiers.safe and refused_only_by_the_row_faces(c.condition for c in stronger.failures)
+    strongest = verify.certify(sc.with_changes(**{"disturbance.amplitude": (0.15, 0.15, 0.15)}))
+    assert not strongest.tiers.tracking and "keep_up[u]" in [c.condition for c in strongest.failures]
+
+
+# ---- the tracking tier's own loop bound (docs/verify.md step 17d) ---------------------------------------------
+
+TRACKED = "examples/bluerov2_tracked.toml"
+
+
+@pytest.fixture(scope="module")
+def tracked_cert():
+    return certify(load_scenario(TRACKED))
+
+
+def test_the_tracking_tier_is_derived_at_the_plans_only_loop_bound(slow_cert):
+    """The tracking design's ω̄ is the plans-only loop bound's, below the certificate's (which covers the backup's
+    command), and the safe tier keeps the certificate's: on bluerov2_slow E_plans is below E in every channel
+    (under half of it in surge and yaw), the tracking design's ω̄_xy and yaw-rate error are smaller, and the safe-only design is derived at E."""
+    from verify.vehicle.compose import _plans_only, tracking_disturbance
+    sc = load_scenario(SLOW)
+    plans, track = _plans_only(sc), tracking_disturbance(sc)
+    full = slow_cert.velocity_loop.error
+    assert plans.certified and all(p < e for p, e in zip(plans.error, full))
+    assert plans.error[0] < 0.5 * full[0] and plans.error[2] < 0.5 * full[2]      # surge and yaw: the backup's share
+    assert track is not None and track.yaw_rate_error == pytest.approx(plans.error[2])
+    problem, dist = slow_cert.design.problem, slow_cert.disturbance
+    assert problem.omega_xy == pytest.approx(track.omega_xy) and problem.omega_xy < dist.omega_xy
+    assert problem.yaw_rate_error < dist.yaw_rate_error
+    assert slow_cert.safe_design.problem.omega_xy == pytest.approx(dist.omega_xy)
+
+
+def test_the_tracked_bluerov2_certifies_both_tiers_and_keeps_them_flown(tracked_cert):
+    """examples/bluerov2_tracked.toml: both tiers on the dynamic plant (the row faces fit at the plans-only bound),
+    re-checked CONFIRMED; flown for 30 s at a corner of the coefficient box, every promise of both tiers is kept,
+    a plan is accepted at every period and the tube (derived at the plans-only bound) holds."""
+    import tubekit
+    assert tracked_cert.tiers == Tiers(True, True) and tracked_cert.design.terminal.has_rows
+    raw = json.loads(json.dumps(tracked_cert.to_dict()))
+    assert recheck(raw).ok
+    sc = load_scenario(TRACKED)
+    corner = {k: v[1] for k, v in vars(sc.plant.params).items() if not k.startswith("_") and isinstance(v, tuple)}
+    sc = sc.with_changes(plant=sc.plant.__class__(kind="dynamic", vehicle="bluerov2_heavy",
+                                                  overrides=sc.plant.overrides, truth=tuple(corner.items())))
+    run = tubekit.simulate(sc, tracked_cert, duration=30.0, progress=False)
+    promises = {p.name: p for p in tubekit.check_promises(run)}
+    assert all(p.ok for p in promises.values() if p.given), [p for p in promises.values() if p.given and not p.ok]
+    assert promises["plan_available"].ok and promises["tube"].ok and not run.backup_active.any()

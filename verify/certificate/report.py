@@ -138,6 +138,7 @@ def certificate_text(cert: CertificateRecord) -> str:
              "Region R (every bound holds over it):", cert.region.describe(),
              f"Disturbance: ||omega_xy|| <= {_f(dist.omega_xy)} m/s, |omega_z| <= {_f(dist.omega_z)} m/s "
              f"(sway gamma_bar = {_f(dist.gamma)} m/s from the sway model over V; declared {_f(dist.declared_sway)})"]
+    lines += _tracking_bound_lines(cert)
     lines += _tube_lines(cert)
     if getattr(cert, "velocity_loop", None) is not None:  # dynamic plant: the derived loop bound
         lines += cert.velocity_loop.summary_lines()
@@ -215,6 +216,16 @@ def _short_backup_lines(cert: CertificateRecord) -> list[str]:
     return out
 
 
+def _tracking_bound_lines(cert: CertificateRecord) -> list[str]:
+    """On the dynamic plant, where the tracking design's ω̄ is the plans-only loop bound's (``docs/verify.md`` step
+    17d), that ω̄; nothing where it is the certificate's."""
+    p, dist = cert.design.problem, cert.disturbance
+    if getattr(cert, "velocity_loop", None) is None or (p.omega_xy, p.omega_z) == (dist.omega_xy, dist.omega_z):
+        return []
+    return [f"Tracking tier's disturbance: ||omega_xy|| <= {_f(p.omega_xy)} m/s, |omega_z| <= {_f(p.omega_z)} m/s, "
+            f"yaw-rate error <= {_f(p.yaw_rate_error)} rad/s (the plans-only loop bound: no backup runs under that tier)"]
+
+
 def summary_text(cert: CertificateRecord) -> str:
     """The short certificate (``tubekit certify``): at most about 25 lines — the verdict with the tiers, each failed
     condition with both numbers and the field and value that would make it hold (:mod:`verify.certificate.knobs`),
@@ -223,6 +234,7 @@ def summary_text(cert: CertificateRecord) -> str:
     lines = [verdict_line(cert)] + _failure_lines(cert)
     lines.append(f"Disturbance: ||omega_xy|| <= {_f(dist.omega_xy)} m/s, |omega_z| <= {_f(dist.omega_z)} m/s "
                  f"(sway gamma_bar = {_f(dist.gamma)} m/s)")
+    lines += _tracking_bound_lines(cert)
     lines += _short_tube_lines(cert) + _short_backup_lines(cert)
     lines.append(f"Design key: {cert.design_key} (theorem {THEOREM_VERSION})")
     lines.append("Full text (every number, condition, premise and assumption): tubekit certify -v, "

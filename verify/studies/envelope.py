@@ -20,10 +20,10 @@ current amplitude plus constant current plus the sway the model produces over V)
   and holding e_o at e_d = epsilon needs the bearing rate omega_bar_xy / epsilon <= r_max,
   so omega_bar_xy <= min(u_max - s, r_max epsilon).
 
-On the dynamic plant (``[plant] kind = "dynamic"``) each point is a dynamic certificate: omega_bar_xy is the
-certificate's own (current + the hull's sway + the velocity loop's error, derived from the vehicle; the part
-that is not current grows with the current, through the backup's command and E), ``gamma`` is that part at
-zero current, and the certified frontier is the certificate's omega_bar_xy at the certified amplitude. The
+On the dynamic plant (``[plant] kind = "dynamic"``) each point is a dynamic certificate: omega_bar_xy is its
+tracking design's (current + the sway loop's or the hull's sway + the velocity loop's error under plans alone,
+the plans-only bound of ``docs/verify.md`` step 17d, derived from the vehicle), ``gamma`` is the part that is not
+current at zero current, and the certified frontier is that omega_bar_xy at the certified amplitude. The
 bisection assumes the verdict monotone in the amplitude; on the dynamic plant the backup's design search is
 not proved monotone, so there each point is a certificate of its own and the edge between them a bracket of
 two verdicts, not a proof that every amplitude below certifies.
@@ -327,13 +327,19 @@ def frontier_verdict(cert: Certificate) -> tuple[bool, str]:
     return (not failed, failed[0] if failed else "")
 
 
+def _tracking_omega(cert: Certificate) -> float:
+    """ω̄_xy (m/s) the tracking design was derived at: the certificate's on the kinematic plant, the plans-only loop
+    bound's on the dynamic one (``docs/verify.md`` step 17d): what keep-up and the yaw budget read."""
+    return float(cert.design.problem.omega_xy)
+
+
 def _own_point(scenario: Scenario, law: str, eps: float) -> dict:
     """The scenario's own speed (m/s), omega_bar_xy (m/s) and epsilon (m), and its verdict at ``eps``
     (the ``own_*`` fields of :class:`EnvelopeResult`)."""
     cert = certify(scenario.with_changes(epsilon=eps), law)
     certifies, failure = frontier_verdict(cert)
     if scenario.plant.dynamic:
-        omega, current = cert.disturbance.omega_xy, _current_xy(scenario)
+        omega, current = _tracking_omega(cert), _current_xy(scenario)
     else:
         kinematic = disturbance_bounds(scenario)
         omega, current = kinematic.omega_xy, kinematic.omega_xy - kinematic.gamma
@@ -346,12 +352,12 @@ def _own_point(scenario: Scenario, law: str, eps: float) -> dict:
 def _frontier_at(scenario: Scenario, law: str, speed: float, eps: float, top: float,
                  steps: int, zero: Certificate | None = None) -> tuple[float, float, str, float, float]:
     """Bisection on the amplitude in [0, top] (m/s): certified a (NaN: none), refuted a (NaN: top certifies),
-    the first failure at the refuted a, the sigma (1/s) of the certified design and its certificate's omega_bar_xy
+    the first failure at the refuted a, the sigma (1/s) of the certified design and its tracking design's omega_bar_xy
     (m/s) at the certified a (NaN: none). ``zero``: the certificate at a = 0, when the caller has it already."""
     def verdict(a: float) -> tuple[bool, str, float, float]:
         cert = zero if a == 0.0 and zero is not None else certify(
             scenario_at(scenario, speed=speed, amplitude_xy=a, epsilon=eps), law)
-        return (*frontier_verdict(cert), cert.design.sigma, float(cert.disturbance.omega_xy))
+        return (*frontier_verdict(cert), cert.design.sigma, _tracking_omega(cert))
 
     ok, fail, sigma, omega = verdict(0.0)
     if not ok:
@@ -406,10 +412,10 @@ def envelope(scenario: Scenario, law: str | None = None, *, eps: float | None = 
         raise ConfigError("steps", "an integer >= 1", steps)
     lim, dynamic = scenario.limits, scenario.plant.dynamic
     first = scenario_at(scenario, speed=float(grid[0]), amplitude_xy=0.0, epsilon=eps)
-    if dynamic:  # gamma: the part of the dynamic certificate's omega_bar_xy that is not current, at zero current
+    if dynamic:  # gamma: the part of the tracking design's omega_bar_xy that is not current, at zero current
         offset = _current_xy(first)
         zero = certify(first, law)  # also the first speed's verdict at a = 0 (not certified twice)
-        omega0 = float(zero.disturbance.omega_xy)
+        omega0 = _tracking_omega(zero)
         gamma = max(omega0 - offset, 0.0) if math.isfinite(omega0) else math.nan
     else:
         dist, zero = disturbance_bounds(first), None

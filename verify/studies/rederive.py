@@ -239,6 +239,16 @@ def _plant_bounds(cert: CertificateRecord, scenario: Scenario, region: Region, s
     return dist, plant
 
 
+def _tracking_bounds(scenario: Scenario, dist: DisturbanceBounds) -> DisturbanceBounds:
+    """The bound the tracking design is derived at: on the dynamic plant the plans-only loop bound's
+    (:func:`verify.vehicle.compose.tracking_disturbance`, ``docs/verify.md`` step 17d), else ``dist``."""
+    if not scenario.plant.dynamic:
+        return dist
+    from verify.vehicle.compose import tracking_disturbance
+    track = tracking_disturbance(scenario)
+    return dist if track is None else track
+
+
 def rederive(raw: dict, cert: CertificateRecord, led: Ledger, gain_boxes: int) -> None:
     """Every re-check after the checksum (module doc), appended to ``led`` in order."""
     from verify.theorem.design import disturbance_bounds, tube_problem
@@ -258,14 +268,15 @@ def rederive(raw: dict, cert: CertificateRecord, led: Ledger, gain_boxes: int) -
     sigma = cert.design.sigma
     dist, plant = _plant_bounds(cert, scenario, region, sigma, led) if scenario.plant.dynamic else (
         disturbance_bounds(scenario), ())
-    design = tracking_design(scenario, region, cert.gains, sigma, dist)
+    track = _tracking_bounds(scenario, dist)
+    design = tracking_design(scenario, region, cert.gains, sigma, track)
     tiers = derive_tiers(cert, scenario, region, dist, design)
     design = tiers.design or design
     safe, backup = tiers.safe, tiers.backup
     _key(raw, cert, led, handed_sigma(tiers_of(design, safe, backup, plant), sigma))
     _inputs(raw, cert, scenario, region, dist, led)
     _gains(cert, region, gain_boxes, led)
-    _problem(cert, tube_problem(scenario, region, cert.gains, sigma, dist), led)
+    _problem(cert, tube_problem(scenario, region, cert.gains, sigma, track), led)
     _tube(raw, cert, design, led)
     _e_bar(raw, region, design, led)
     led.equal("terminal", None if cert.design.terminal is None else cert.design.terminal.to_dict(),

@@ -188,13 +188,17 @@ def backup_of(scenario: Scenario, dist: DisturbanceBounds, margins: HorizonMargi
 
 
 def solve_tiers(scenario: Scenario, region: Region, gains: GainBounds, sigmas: tuple[float, ...],
-                dist: DisturbanceBounds, fits: Fits | None = None,
+                dist: DisturbanceBounds, fits: Fits | None = None, tracking_dist: DisturbanceBounds | None = None,
                 ) -> tuple[tuple[Design, ...], Design, Design | None, BackupCertificate]:
     """(designs, best, safe, backup) at ``dist``: the tracking design per σ (1/s) of ``sigmas``, the chosen one
     (:func:`verify.theorem.design.choose_design`; when it certifies, with the terminal ingredients of
     :func:`verify.theorem.terminal.with_terminal` proved against the backup designed for its margins), the
-    safe-only design when it does not certify, and the backup (:func:`backup_of`, ``fits`` passed on)."""
-    designs = tuple(tracking_design(scenario, region, gains, s, dist) for s in sigmas)
+    safe-only design when it does not certify, and the backup (:func:`backup_of` at ``dist``, ``fits`` passed on).
+    ``tracking_dist``: the bound the tracking designs are derived at instead of ``dist`` (on the dynamic plant the
+    plans-only loop bound's, :func:`verify.vehicle.compose.tracking_disturbance`: under the tracking tier the
+    loop never leaves the plans, ``docs/verify.md`` step 17d)."""
+    at = dist if tracking_dist is None else tracking_dist
+    designs = tuple(tracking_design(scenario, region, gains, s, at) for s in sigmas)
     best = choose_design(list(designs))
     if best.certified:
         ranked = sorted((d for d in designs if d.certified), key=lambda d: (d.score, d.sigma), reverse=True)

@@ -66,8 +66,8 @@ from verify.kernel.region import Region
 from verify.theorem.tiers import solve_tiers
 from verify.vehicle.bound import LoopBound, rate_authority_conditions, velocity_loop_bound
 
-__all__ = ["DynamicSolution", "LawLoop", "solve_dynamic", "loop_for_law", "plan_jumps", "handover_jump",
-           "surge_floor_of", "FIXED_POINT_ROUNDS", "FIXED_POINT_RESTARTS", "PLAN_CHECK_TOLERANCE"]
+__all__ = ["DynamicSolution", "LawLoop", "solve_dynamic", "loop_for_law", "tracking_disturbance", "plan_jumps",
+           "handover_jump", "surge_floor_of", "FIXED_POINT_ROUNDS", "FIXED_POINT_RESTARTS", "PLAN_CHECK_TOLERANCE"]
 
 #: The plan check's rate tolerance, carried by the proof (one number: :data:`tubekit.design_inputs.RATE_TOLERANCE`).
 PLAN_CHECK_TOLERANCE = RATE_TOLERANCE
@@ -147,7 +147,25 @@ def _kappa_condition(sigma: float) -> Condition:
 def _tiers_at(scenario: Scenario, region: Region, gains: GainBounds, sigmas: tuple[float, ...],
               assumed: tuple[float, float, float], sway: float | None = None):
     dist = disturbance_bounds(scenario, loop_error=assumed, loop_sway=sway)
-    return (dist, *solve_tiers(scenario, region, gains, sigmas, dist, fits=_fits(scenario, dist, assumed, sway)))
+    return (dist, *solve_tiers(scenario, region, gains, sigmas, dist, fits=_fits(scenario, dist, assumed, sway),
+                               tracking_dist=tracking_disturbance(scenario)))
+
+
+def tracking_disturbance(scenario: Scenario) -> DisturbanceBounds | None:
+    """ω̄ of the tracking tier (``docs/verify.md`` step 17d): with the plans-only loop bound (:func:`_plans_only`: the
+    plans' jumps J, the first command within J of rest, no backup) in place of the fixed point's E. Under the
+    tracking tier a plan is accepted at every period (step 17), so every command is a plan's row and the backup
+    never runs: the loop error stays within the plans-only bound, which carries the induction's premise along (at
+    period k the commands so far are plans' rows, so the deviation over period k is the plans-only one, so the
+    candidate passes at k + 1). None where that bound does not hold (its own conditions fail): the tracking designs
+    then use the safe tier's bound."""
+    first = _plans_only(scenario)
+    if not first.certified or not all(math.isfinite(e) for e in first.error):
+        return None
+    sway = first.sway if scenario.plant.params.lateral else None
+    if sway is not None and not math.isfinite(sway):
+        return None
+    return disturbance_bounds(scenario, loop_error=first.error, loop_sway=sway)
 
 
 def _ratio(error: tuple[float, ...], assumed: tuple[float, ...]) -> float:

@@ -145,21 +145,21 @@ def _kappa_condition(sigma: float) -> Condition:
 
 
 def _tiers_at(scenario: Scenario, region: Region, gains: GainBounds, sigmas: tuple[float, ...],
-              assumed: tuple[float, float, float], sway: float | None = None):
+              assumed: tuple[float, float, float], sway: float | None, plans: LoopBound):
     dist = disturbance_bounds(scenario, loop_error=assumed, loop_sway=sway)
     return (dist, *solve_tiers(scenario, region, gains, sigmas, dist, fits=_fits(scenario, dist, assumed, sway),
-                               tracking_dist=tracking_disturbance(scenario)))
+                               tracking_dist=tracking_disturbance(scenario, plans)))
 
 
-def tracking_disturbance(scenario: Scenario) -> DisturbanceBounds | None:
+def tracking_disturbance(scenario: Scenario, plans: LoopBound | None = None) -> DisturbanceBounds | None:
     """ω̄ of the tracking tier (``docs/verify.md`` step 17d): with the plans-only loop bound (:func:`_plans_only`: the
     plans' jumps J, the first command within J of rest, no backup) in place of the fixed point's E. Under the
     tracking tier a plan is accepted at every period (step 17), so every command is a plan's row and the backup
     never runs: the loop error stays within the plans-only bound, which carries the induction's premise along (at
     period k the commands so far are plans' rows, so the deviation over period k is the plans-only one, so the
     candidate passes at k + 1). None where that bound does not hold (its own conditions fail): the tracking designs
-    then use the safe tier's bound."""
-    first = _plans_only(scenario)
+    then use the safe tier's bound. ``plans``: that bound when the caller has it (:func:`_plans_only`)."""
+    first = _plans_only(scenario) if plans is None else plans
     if not first.certified or not all(math.isfinite(e) for e in first.error):
         return None
     sway = first.sway if scenario.plant.params.lateral else None
@@ -426,13 +426,13 @@ def _solve_from(scenario: Scenario, region: Region, gains: GainBounds, sigmas: t
         v_max = tuple(float(x) for x in scenario.limits.vector)
         assumed = tuple(e if math.isfinite(e) else x for e, x in zip(first.error, v_max))
         sway = None if sway is None else (sway if math.isfinite(sway) else v_max[0])
-        dist, designs, best, safe, backup = _tiers_at(scenario, region, gains, sigmas, assumed, sway)
+        dist, designs, best, safe, backup = _tiers_at(scenario, region, gains, sigmas, assumed, sway, first)
         return DynamicSolution(loop=first, assumed=assumed, dist=dist, designs=designs, best=best, safe=safe,
                                backup=backup, assumed_sway=sway,
                                conditions=_plant_conditions(scenario, first, assumed, best.sigma, sway))
     fixed = _LoopInputs.of(scenario)
     for rounds in range(1, FIXED_POINT_ROUNDS + 1):
-        dist, designs, best, safe, backup = _tiers_at(scenario, region, gains, sigmas, assumed, sway)
+        dist, designs, best, safe, backup = _tiers_at(scenario, region, gains, sigmas, assumed, sway, first)
         loop = fixed.loop(backup.law, backup.safe_set, dist, assumed)
         if not loop.certified or _loop_ratio(loop, assumed, sway) < 1.0 or rounds == FIXED_POINT_ROUNDS:
             break  # the last round keeps its E_a: raising it now would compare E with a bound ω̄ never used

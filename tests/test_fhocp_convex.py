@@ -146,3 +146,42 @@ def test_the_lookahead_moves_only_the_known_obstacles_rows_by_its_margins():
     for sub in (sub_p, sub_a):
         sub.linearise(state, rollout(state, v, plain.nlp.dt), v, np.zeros((n + 1, 3)), obs[:0], 0.1)
     np.testing.assert_array_equal(sub_a.param_vector[sub_a._gidx["obs"]], sub_p.param_vector[sub_p._gidx["obs"]])
+
+
+def test_the_last_rows_bounds_meet_the_row_faces_or_pin_to_the_nearest_trust_edge():
+    """With a tracking tightening whose X_f has row faces (examples/smooth_line.toml), the last row's bounds are the
+    trust box intersected with the faces' box about the law's row at the linearisation's end; where the two are
+    apart, both bounds sit on the trust box's end nearest the faces; the other rows' bounds are the trust box's."""
+    from pathlib import Path
+
+    import verify
+    from tubekit import load_scenario
+    from tubekit.fhocp.nlp import rollout
+    sc = load_scenario(Path(__file__).resolve().parents[1] / "examples" / "smooth_line.toml")
+    solver = FHOCP(sc, verify.certify(sc).tightening, mode="realtime")
+    sub, nlp = solver.subproblem, solver.nlp
+    assert nlp.terminal_rows is not None
+    state = np.asarray(sc.initial_state, dtype=float)
+    ref = np.asarray(nlp.reference(sc.trajectory, 0.0), dtype=float)
+    velocity = np.asarray(sc.trajectory.velocity(nlp.n * nlp.dt), dtype=float).reshape(3)
+    sub.write_target_velocity(velocity)
+    names = (("ulo", "uhi"), ("wlo", "whi"), ("rlo", "rhi"))
+    seen = set()
+    for cruise, radius in ((0.15, 1.0), (0.0, 0.05)):       # near the law's surge; far from it with a small trust box
+        v = np.tile([cruise, 0.0, 0.0], (nlp.n, 1))
+        s = rollout(state, v, nlp.dt)
+        sub.linearise(state, s, v, ref, np.zeros((0, 4)), radius)
+        lo, hi = nlp.last_row_box(s[-1], ref[-1], velocity)
+        for c, (a, b) in enumerate(names):
+            low, high = sub.param_vector[sub._cols[a]], sub.param_vector[sub._cols[b]]
+            reach = radius * nlp.v_max[c]
+            trust = (max(nlp.v_min[c], v[-1, c] - reach), min(nlp.v_max[c], v[-1, c] + reach))
+            assert low[0] == pytest.approx(trust[0]) and high[0] == pytest.approx(trust[1])   # the first row: the trust box
+            if lo[c] <= trust[1] and hi[c] >= trust[0]:
+                assert low[-1] == pytest.approx(max(trust[0], lo[c])) and high[-1] == pytest.approx(min(trust[1], hi[c]))
+                seen.add("meet")
+            else:
+                edge = trust[1] if lo[c] > trust[1] else trust[0]
+                assert low[-1] == pytest.approx(edge) and high[-1] == pytest.approx(edge)
+                seen.add("apart")
+    assert seen == {"meet", "apart"}

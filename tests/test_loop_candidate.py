@@ -176,3 +176,16 @@ def test_at_the_start_the_law_s_rows_leave_rest_by_at_most_the_jump(smooth):
                           law=cert.tightening.terminal_law, v_last=np.zeros(3))
     steps = np.diff(np.vstack([np.zeros(3), plan]), axis=0)
     assert np.all(np.abs(steps) <= jump + 1e-15) and np.any(np.isclose(np.abs(steps[0]), jump))
+
+
+def test_a_run_under_way_starts_its_first_plan_within_the_jump_of_the_initial_command(smooth):
+    """``limits.initial`` = (0.2, 0, 0): the loop's first ``v_last`` is that command, so the first plan's surge lies
+    within J of 0.2 m/s (from rest it would be at most J); both tiers are certified and kept for 5 s."""
+    sc, _ = smooth
+    moving = sc.with_changes(duration=5.0, **{"limits.initial": (0.2, 0.0, 0.0)})
+    cert = verify.certify(moving)
+    done = certified_run(moving, cert.tightening)
+    jump = moving.limits.jump(moving.controller.dt)
+    first = done.run.v_hat[0]
+    assert np.all(np.abs(first - np.array([0.2, 0.0, 0.0])) <= jump + 1e-9) and first[0] > jump[0]
+    assert done.broken == () and done.metrics["outcome"] == {"safe": "certified, kept", "tracking": "certified, kept"}

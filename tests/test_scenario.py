@@ -337,3 +337,32 @@ def test_the_lookahead_is_written_only_when_on_and_is_not_a_certificate_input():
     assert "lookahead" not in base.to_dict()["controller"] and on.to_dict()["controller"]["lookahead"] == 1.5
     assert scenario_from_dict(on.to_dict()) == on
     assert DesignInputs.of(on).key() == DesignInputs.of(base).key()
+
+
+# ---- limits.initial: the command before t = 0 ------------------------------------------------------------------
+
+def test_an_initial_command_is_off_by_default_in_the_dict_only_when_set_and_round_trips(tmp_path):
+    """Without it the run starts at rest (the box's point nearest it) and the dict is unchanged; with it the command
+    before t = 0 is the one given, and the scenario round-trips through TOML."""
+    base = paper_scenario().with_changes(**{"limits.rate": (0.5, 0.5, 1.0)})
+    assert base.limits.initial is None and "initial" not in base.to_dict()["limits"]
+    assert list(base.limits.start_command) == [0.0, 0.0, 0.0]
+    floored = base.with_changes(**{"limits.u_min": 0.1})
+    assert list(floored.limits.start_command) == [0.1, 0.0, 0.0]
+    sc = base.with_changes(**{"limits.initial": (0.2, 0.0, -0.1)})
+    assert list(sc.limits.start_command) == [0.2, 0.0, -0.1] and sc.to_dict()["limits"]["initial"] == [0.2, 0.0, -0.1]
+    path = tmp_path / "under_way.toml"
+    path.write_text(_to_toml(sc.to_dict()))
+    assert load_scenario(path) == sc
+
+
+@pytest.mark.parametrize("table, match", [
+    ({"initial": [0.2, 0.0, 0.0]}, r"^limits\.initial: expected only with limits\.rate"),
+    ({"rate": [0.5, 0.5, 1.0], "initial": [0.5, 0.0, 0.0]}, r"^limits\.initial: expected a command inside the box"),
+    ({"rate": [0.5, 0.5, 1.0], "u_min": 0.1, "initial": [0.05, 0.0, 0.0]}, r"^limits\.initial: expected a command"),
+    ({"rate": [0.5, 0.5, 1.0], "initial": [0.2, 0.0]}, r"^limits\.initial"),
+    ({"rate": [0.5, 0.5, 1.0], "initial": "cruise"}, r"^limits\.initial"),
+])
+def test_initial_command_errors_name_the_field(table, match):
+    with pytest.raises(ConfigError, match=match):
+        scenario_from_dict({"limits": table})

@@ -372,3 +372,17 @@ def test_the_tracked_bluerov2_certifies_both_tiers_and_keeps_them_flown(tracked_
     promises = {p.name: p for p in tubekit.check_promises(run)}
     assert all(p.ok for p in promises.values() if p.given), [p for p in promises.values() if p.given and not p.ok]
     assert promises["plan_available"].ok and promises["tube"].ok and not run.backup_active.any()
+
+
+def test_a_vehicle_under_way_starts_the_loop_bound_at_its_initial_command():
+    """``limits.initial``: the first command lies within J of the command before t = 0, so the loop bound's start
+    box is |c_0| + J per channel (by hand: 0.079 + 0.006 m/s in surge), against J alone from rest; the tracked
+    BlueROV2 under way at the target's speed keeps both tiers."""
+    from verify.vehicle.compose import _LoopInputs
+    sc = load_scenario(TRACKED)
+    under_way = sc.with_changes(**{"limits.initial": (0.079, 0.0, 0.0)})
+    rest, moving = _LoopInputs.of(sc).start, _LoopInputs.of(under_way).start
+    assert rest[0] == pytest.approx(0.006, abs=1e-8) and moving[0] == pytest.approx(0.085, abs=1e-8)
+    assert moving[1:] == rest[1:]
+    cert = certify(under_way)
+    assert cert.tiers == Tiers(True, True) and cert.velocity_loop.first_command[0] == pytest.approx(0.085, abs=1e-8)

@@ -194,6 +194,8 @@ class Scenario:
             d["limits"]["rate"] = list(self.limits.rate)
         if self.limits.u_min is not None:  # likewise: a symmetric box keeps its dict (and its design key)
             d["limits"]["u_min"] = self.limits.u_min
+        if self.limits.initial is not None:  # likewise: a start at rest keeps its dict
+            d["limits"]["initial"] = list(self.limits.initial)
         if self.workspace is not None:
             d["workspace"] = [list(self.workspace[0]), list(self.workspace[1])]
         if self.plant != PlantSettings():  # the default kinematic plant leaves the dict as before
@@ -267,10 +269,10 @@ def scenario_from_dict(d: dict) -> Scenario:
                 built.append(Obstacle(o["center"], o["radius"]))
         kw["obstacles"] = tuple(built)
     if "limits" in d:
-        lim = _table(d, "limits", InputLimits, {"u_max", "w_max", "r_max", "rate", "u_min"})
+        lim = _table(d, "limits", InputLimits, {"u_max", "w_max", "r_max", "rate", "u_min", "initial"})
         b = base.limits
         kw["limits"] = InputLimits(lim.get("u_max", b.u_max), lim.get("w_max", b.w_max), lim.get("r_max", b.r_max),
-                                   lim.get("rate", b.rate), lim.get("u_min", b.u_min))
+                                   lim.get("rate", b.rate), lim.get("u_min", b.u_min), lim.get("initial", b.initial))
     for key in ("vehicle_radius", "sensing_range", "epsilon", "duration"):
         if key in d:
             kw[key] = d[key]

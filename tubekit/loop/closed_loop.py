@@ -151,7 +151,8 @@ class _ClosedLoop:
         self.log = _Log.allocate(clock)
         self.sign = HEMISPHERE_SIGN[scenario.region.heading]
         # the last tick's command: initially the plans' box's point nearest rest (0, or (u_min + κ̄_u, 0, 0))
-        self.v_last = None if scenario.limits.rate is None else np.clip(np.zeros(3), self.v_low, self.v_bar)
+        self.v_last = (None if scenario.limits.rate is None
+                       else np.clip(scenario.limits.start_command, self.v_low, self.v_bar))
         self.passes_v_last = takes_v_last(solver)
         self.t_h, self.v_h = 0.0, (0.0, 0.0, 0.0)  # the last hand-over to the backup: time (s), applied command
         self.sway_last = 0.0  # the last tick's sway command (m/s): a lateral backup's, else 0

@@ -9,11 +9,12 @@ The disturbance is evaluated (and the plant integrated) in :mod:`tubekit.plant.k
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Callable
 
 import numpy as np
 
 from tubekit.exceptions import ConfigError
-from tubekit.validation import nonnegative, positive
+from tubekit.validation import finite, nonnegative, positive
 
 __all__ = [
     "InputLimits",
@@ -27,16 +28,29 @@ __all__ = [
 ]
 
 
-def _rate_triple(value: object) -> tuple[float, float, float]:
-    """``limits.rate`` as three positive finite floats; strings and booleans refused (ConfigError)."""
+def _triple(field: str, value: object, expected: str, item: str,
+            check: Callable[[str, object], float]) -> tuple[float, float, float]:
+    """``value`` as three floats, each passed through ``check`` (``positive``, ``finite``); strings and booleans
+    refused (ConfigError naming ``field`` or ``field[i]``, ``expected`` / ``item`` the expected texts)."""
     if isinstance(value, (str, bytes)) or not isinstance(value, (list, tuple, np.ndarray)) or len(value) != 3:
-        raise ConfigError("limits.rate", "three numbers > 0 [rho_u, rho_w, rho_r] (m/s^2, m/s^2, rad/s^2)", value)
+        raise ConfigError(field, expected, value)
     out = []
     for i, x in enumerate(value):
         if isinstance(x, (str, bytes, bool, np.bool_)) or not isinstance(x, (int, float, np.integer, np.floating)):
-            raise ConfigError(f"limits.rate[{i}]", "a number > 0", x)
-        out.append(positive(f"limits.rate[{i}]", x))
+            raise ConfigError(f"{field}[{i}]", item, x)
+        out.append(check(f"{field}[{i}]", x))
     return (out[0], out[1], out[2])
+
+
+def _rate_triple(value: object) -> tuple[float, float, float]:
+    """``limits.rate`` as three positive finite floats; strings and booleans refused (ConfigError)."""
+    return _triple("limits.rate", value, "three numbers > 0 [rho_u, rho_w, rho_r] (m/s^2, m/s^2, rad/s^2)",
+                   "a number > 0", positive)
+
+
+def _command_triple(value: object) -> tuple[float, float, float]:
+    """``limits.initial`` as three finite floats; strings and booleans refused (ConfigError)."""
+    return _triple("limits.initial", value, "three numbers [u, w, r] (m/s, m/s, rad/s)", "a number", finite)
 
 
 @dataclass(frozen=True)
@@ -56,6 +70,10 @@ class InputLimits:
     u_min : float or None
         The smallest surge command (m/s), in [0, u_max): a vehicle that must keep moving (fins without
         authority at rest) never commands less. None (default): the symmetric box, u >= -u_max.
+    initial : (float, float, float) or None
+        With a rate limit, the command applied before t = 0 (m/s, m/s, rad/s), inside the box: the vehicle is
+        already under way, and the first plan's first row lies within J of it. None (default): the box's point
+        nearest rest (:attr:`start_command`).
     """
 
     u_max: float
@@ -63,6 +81,7 @@ class InputLimits:
     r_max: float
     rate: tuple[float, float, float] | None = None
     u_min: float | None = None
+    initial: tuple[float, float, float] | None = None
 
     def __post_init__(self) -> None:
         for name in ("u_max", "w_max", "r_max"):
@@ -74,6 +93,23 @@ class InputLimits:
             if floor >= self.u_max:
                 raise ConfigError("limits.u_min", f"a surge in [0, u_max = {self.u_max:g}) m/s", self.u_min)
             object.__setattr__(self, "u_min", floor)
+        if self.initial is not None:
+            if self.rate is None:
+                raise ConfigError("limits.initial", "only with limits.rate (without a rate limit a plan's first row "
+                                  "may be anywhere in V)", self.initial)
+            start = _command_triple(self.initial)
+            if not self.contains(np.array(start), tol=0.0):
+                raise ConfigError("limits.initial", f"a command inside the box [{self.surge_floor:g}, {self.u_max:g}] x "
+                                  f"[-{self.w_max:g}, {self.w_max:g}] x [-{self.r_max:g}, {self.r_max:g}]", self.initial)
+            object.__setattr__(self, "initial", start)
+
+    @property
+    def start_command(self) -> np.ndarray:
+        """(3,) the command before t = 0 (m/s, m/s, rad/s): ``initial``, else the box's point nearest rest
+        (u_min, 0, 0) under a minimum surge, 0 otherwise."""
+        if self.initial is not None:
+            return np.array(self.initial, dtype=float)
+        return np.clip(np.zeros(3), self.lower, self.vector)
 
     @property
     def surge_floor(self) -> float:

@@ -37,11 +37,11 @@ def law_plan(scenario: Scenario, law: TerminalLaw, v_bar: np.ndarray, v_low: np.
              ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """(rows (N, 3), arcs (N, ARC_SAMPLES + 1, 4), times (N, ARC_SAMPLES + 1)) of the law's plan from the start,
     each row clipped to [``v_low``, ``v_bar``] (``v_low`` None: −``v_bar``); with rate-limited plans each row first
-    clipped to within the jump J of the row before it, the first of rest (the run starts at rest, the loop's
-    ``v_last``), as the loop's candidate is."""
+    clipped to within the jump J of the row before it, the first of the command before t = 0 (``limits.initial``,
+    else rest: the loop's first ``v_last``), as the loop's candidate is."""
     low = -np.asarray(v_bar, dtype=float) if v_low is None else np.asarray(v_low, dtype=float)
     jump = scenario.limits.jump(float(scenario.controller.dt))
-    last = np.clip(np.zeros(3), low, v_bar)
+    last = np.clip(scenario.limits.start_command, low, v_bar)
     ctrl = scenario.controller
     dt, n = float(ctrl.dt), int(ctrl.horizon_steps)
     tau = np.linspace(0.0, dt, ARC_SAMPLES + 1)

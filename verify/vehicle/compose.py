@@ -18,7 +18,8 @@ jumps; the command jumps
 The run starts trimmed at its first command (``docs/plant.md`` section 2), so the loop's start transient is
 d(ν(0))/m, which vanishes at rest. With a rate limit that command is within J of the loop's initial command: the
 plan check compares a plan's first node with the last applied command, initially the box's point nearest rest, and a
-blending backup starts from that command. The start is then bounded over |ν(0)| <= (u_min + J_u, J_w, J_r)
+blending backup starts from that command. The start is then bounded over |ν(0)| <= |c_0| + J per channel, c_0 the
+command before t = 0 (``limits.initial``, else (u_min, 0, 0): so (u_min + J_u, J_w, J_r))
 (``first_command`` of the loop bound, u_min = 0 without a minimum surge); for a law that does not blend, over V.
 Under a minimum surge the fins' authority is taken over u >= u_min − E_u (``surge_floor``, :func:`surge_floor_of`).
 
@@ -202,18 +203,21 @@ class _LoopInputs:
     period: float
     plans: tuple[float, float, float]
     surge_floor: float = 0.0
+    initial: tuple[float, float, float] = (0.0, 0.0, 0.0)
 
     @classmethod
     def of(cls, scenario: Scenario) -> "_LoopInputs":
         return cls(params=scenario.plant.params, v_max=tuple(float(x) for x in scenario.limits.vector),
                    tick=1.0 / float(scenario.controller.ancillary_rate_hz), period=float(scenario.controller.dt),
-                   plans=plan_jumps(scenario), surge_floor=surge_floor_of(scenario))
+                   plans=plan_jumps(scenario), surge_floor=surge_floor_of(scenario),
+                   initial=tuple(float(x) for x in scenario.limits.start_command))
 
     @property
     def start(self) -> tuple[float, float, float]:
-        """F: the first command lies within J of the loop's initial command, the box's point nearest rest
-        (u_min, 0, 0) under a minimum surge, else 0 (m/s, m/s, rad/s)."""
-        return (upper(arb(self.surge_floor) + arb(self.plans[0])), self.plans[1], self.plans[2])
+        """F: the first command lies within J of the loop's initial command (``limits.initial``, else the box's
+        point nearest rest: (u_min, 0, 0) under a minimum surge, 0 otherwise), so |y_c(0)| <= |c_0| + J per channel
+        (m/s, m/s, rad/s)."""
+        return tuple(upper(arb(abs(c)) + arb(j)) for c, j in zip(self.initial, self.plans))
 
     def loop(self, law: BackupLaw, safe: SafeSet, dist: DisturbanceBounds,
              assumed: tuple[float, float, float]) -> LoopBound:

@@ -386,3 +386,24 @@ def test_a_vehicle_under_way_starts_the_loop_bound_at_its_initial_command():
     assert moving[1:] == rest[1:]
     cert = certify(under_way)
     assert cert.tiers == Tiers(True, True) and cert.velocity_loop.first_command[0] == pytest.approx(0.085, abs=1e-8)
+
+
+@pytest.mark.parametrize("end", [0, 1])
+def test_under_the_tracking_tier_the_simulated_loop_error_stays_within_the_plans_only_bound(tracked_cert, end):
+    """Step 17d's premise, measured: flown for 30 s with both tiers at a corner of the coefficient box, in a steady
+    cross current on the certified bound, the velocity loop's error never leaves the plans-only bound E_plans that
+    the tracking design was derived at (the certificate's E, which covers the backup, is larger)."""
+    import tubekit
+    from verify.vehicle.compose import _plans_only
+    sc = load_scenario(TRACKED).with_changes(**{"disturbance.amplitude": (0.0, 0.0, 0.0),
+                                                 "disturbance.constant": (0.0, 0.04, 0.0)})
+    cert = certify(sc)
+    assert cert.tiers == Tiers(True, True)
+    corner = {k: v[end] for k, v in vars(sc.plant.params).items() if not k.startswith("_") and isinstance(v, tuple)}
+    flown = sc.with_changes(plant=sc.plant.__class__(kind="dynamic", vehicle="bluerov2_heavy",
+                                                     overrides=sc.plant.overrides, truth=tuple(corner.items())))
+    run = tubekit.simulate(flown, cert, duration=30.0, progress=False)
+    worst = np.nanmax(np.abs(run.velocity_error[:-1]), axis=0)
+    plans = np.asarray(_plans_only(sc).error)
+    assert not run.backup_active.any() and np.all(worst <= plans), (worst, plans)
+    assert np.all(plans < np.asarray(cert.velocity_loop.error))

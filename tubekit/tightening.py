@@ -222,6 +222,12 @@ class Tightening:
         return self.tiers.tracking and self.terminal_law is not None and self.horizon_arcs > 0
 
     @property
+    def proven_terminal_law(self) -> TerminalLaw | None:
+        """The terminal law when :attr:`plan_always_available` (the candidate completes plans with it, the FHOCP
+        aims at its set), else None."""
+        return self.terminal_law if self.plan_always_available else None
+
+    @property
     def terminal_backup(self) -> BackupPlan | None:
         """The backup whose safe set every accepted plan must end in (the terminal condition).
 

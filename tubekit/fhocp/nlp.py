@@ -464,13 +464,13 @@ class FhocpNlp:
 
 def _terminal_rows(tightening: Tightening) -> TerminalLaw | None:
     """The tightening's terminal law when it proves tracking and its X_f has row faces, else None."""
-    law = tightening.terminal_law if tightening.plan_always_available else None
+    law = tightening.proven_terminal_law
     return law if law is not None and law.has_rows else None
 
 
 def _tracking_terminal(tightening: Tightening) -> tuple[float, float, float, float] | None:
     """(d_lo, d_hi, sin α_f, z_f) of the tightening's terminal law when it proves tracking, else None."""
-    law = tightening.terminal_law if tightening.plan_always_available else None
+    law = tightening.proven_terminal_law
     if law is None:
         return None
     return (law.d_lo, law.d_hi, math.sin(law.alpha_max), law.z_max)

@@ -202,10 +202,8 @@ class _ClosedLoop:
             else:
                 result = self.solver.solve(tk, xk.copy(), known)
             plan = self.plan_of(result)
-            tight = self.tightening
-            if tight.plan_always_available and tight.terminal_law is not None:
-                plan = settle_last_row(self.scenario, tight.terminal_law, plan, xk, tk, self.v_bar,
-                                       self.scenario.limits.jump(self.scenario.controller.dt), v_min=self.v_low)
+            plan = settle_last_row(self.scenario, self.tightening.proven_terminal_law, plan, xk, tk, self.v_bar,
+                                   self.scenario.limits.jump(self.scenario.controller.dt), v_min=self.v_low)
         except SolverError as exc:
             _LOG.debug("period %d: solver result refused: %s", k, exc)
         self.log.record_solve(k, k * self.clock.ticks, result, time.perf_counter() - c0)
@@ -226,7 +224,7 @@ class _ClosedLoop:
         """v̂ of the shifted candidate (:mod:`tubekit.loop.candidate`) when it passes the exact check (with
         ``recovery``: its safe part) — it is then the accepted plan — else None. Only where plans are checked."""
         memory, tight = self.memory, self.tightening
-        law = tight.terminal_law if tight.plan_always_available else None
+        law = tight.proven_terminal_law
         if not self.scenario.controller.candidate or tight.horizon_arcs == 0:
             return None
         previous = None if memory.plan is None or memory.exhausted else memory.plan

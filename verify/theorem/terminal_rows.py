@@ -110,23 +110,17 @@ def row_conditions(b: TerminalBounds, law: TerminalLaw, arc: CompletionArc,
 
 def _smallest_gains(b: TerminalBounds, law: TerminalLaw) -> tuple[float, float, float] | None:
     """(g, λ, λ_z): the smallest turn and gains (floats) under which X_f of ``law`` is invariant (step 17's
-    ``terminal_invariant[d_lo|d_hi|alpha|e_z]``), found by a few fixed-point rounds (Y depends on g and λ);
-    None when the set cannot be invariant."""
+    ``terminal_invariant[d_lo|d_hi|alpha|e_z]``), found by a few fixed-point rounds on the completion's own bounds
+    (:func:`verify.theorem.completion_bounds.completion_arc`: Y depends on g and λ); None when the set cannot be
+    invariant. A sizing: the Arb conditions decide."""
     dt, dxy, curve = b.dt, b.dev_xy, b.accel_xy * b.dt * b.dt / 2
-    seen = b.dev_psi + math.asin(min(1.0, dxy / law.d_lo))
-    a0 = law.alpha_max + seen
-    g, lam = 0.01, 0.0
     below = law.d_star - law.d_lo + dxy
+    g, lam = 0.01, 0.0
     for _ in range(12):
-        beta = a0 * (1 - g / 2)
-        if beta >= math.pi / 2:
+        arc = completion_arc(b, dataclasses.replace(law, turn=g, gain_d=lam))
+        if arc is None or not arc.x_min > 0:
             return None
-        spread = max(law.d_hi + dxy - law.d_star, below)
-        lateral = dt * b.speed_xy / math.cos(beta) + math.tan(beta) * lam * dt * spread + curve
-        x_min = (law.d_lo - dxy) * (1 - lam * dt) + lam * dt * law.d_star - curve
-        if x_min <= 0.0:
-            return None
-        x_max = (law.d_hi + dxy) * (1 - lam * dt) + lam * dt * law.d_star + curve
+        a0, lateral, x_min, x_max = (float(x.mid()) for x in (arc.a0, arc.lateral, arc.x_min, arc.x_max))
         overshoot = math.hypot(x_max, lateral) - x_max
         lam_lo = (dxy + curve + GAIN_SLACK) / (dt * below)
         lam_hi = (dxy + curve + overshoot + GAIN_SLACK) / (dt * (law.d_hi + dxy - law.d_star))
@@ -141,7 +135,12 @@ def _smallest_gains(b: TerminalBounds, law: TerminalLaw) -> tuple[float, float, 
 def gentle_law(b: TerminalBounds, law: TerminalLaw, factor: float) -> TerminalLaw | None:
     """``law``'s set with its smallest invariant gains times ``factor`` and the row faces S its arc needs
     (module doc); None when the set cannot be invariant or the formulas' premises fail."""
-    gains = _smallest_gains(b, law)
+    return _with_gains(b, law, _smallest_gains(b, law), factor)
+
+
+def _with_gains(b: TerminalBounds, law: TerminalLaw, gains: tuple[float, float, float] | None,
+                factor: float) -> TerminalLaw | None:
+    """:func:`gentle_law` for the smallest gains ``gains`` already found (None: none)."""
     if gains is None:
         return None
     g, lam, lam_z = (factor * x for x in gains)
@@ -173,8 +172,9 @@ def row_sets(b: TerminalBounds, laws: list[TerminalLaw]) -> list[TerminalLaw]:
     """Each set of the grid ``laws`` with gentle gains (:data:`GAIN_FACTORS`) and its row faces, in order."""
     out = []
     for law in laws:
+        gains = _smallest_gains(b, law)  # once per set: the factors scale it
         for factor in GAIN_FACTORS:
-            gentle = gentle_law(b, law, factor)
+            gentle = _with_gains(b, law, gains, factor)
             if gentle is not None:
                 out.append(gentle)
     return out

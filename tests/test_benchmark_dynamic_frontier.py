@@ -10,12 +10,13 @@ def _module():
 
 
 def test_the_shipped_point_certifies_and_the_paper_current_does_not():
-    """u_max 0.3 m/s with 0.04 m/s of current is the shipped scenario (the safe tier; tracking refused only by the
-    row faces); at the paper's current with u_max 0.2 m/s the safe tier fails too (its backup: ``backup_level_set``
+    """u_max 0.3 m/s with 0.04 m/s of current is the shipped scenario (the safe tier; tracking refused only at the
+    start: the row-faced set the refinement finds begins beyond 2 m, the start is 1 m from the target); at the
+    paper's current with u_max 0.2 m/s the safe tier fails too (its backup: ``backup_level_set``
     among the named failures; at 0.25-0.3 m/s, with the sway loop, the paper's current certifies:
     tests/test_verify_vehicle_compose.py)."""
     mod = _module()
-    assert mod.cell(0.3, 0.04) == "safe"
+    assert mod.cell(0.3, 0.04) == "safe; tracking: initial_terminal"
     lines = mod.table([0.2], [0.1])
     assert lines[0].startswith("| u_max") and len(lines) == 3
     assert lines[2].startswith("| 0.2 | ") and "backup_level_set" in lines[2] and "safe" not in lines[2]

@@ -42,7 +42,7 @@ CASES = [
                                                      {"center": [1.6, 0.0, 0.0], "radius": 0.4}]},
      "safe_only.obstacles[0,1]", ["vehicle_radius"]),
     ("rate beyond the rudder's authority", REMUS, {}, "rate_authority[u]", ["limits.rate[0]"]),
-    ("plans too slow for the yaw row's face", CURRENTS, {"limits.rate": [0.1, 0.1, 0.2]}, "terminal_rate[r]",
+    ("plans too slow for the yaw row's face", CURRENTS, {"limits.rate": [0.1, 0.1, 0.1]}, "terminal_rate[r]",
      ["limits.rate[2]"]),
 ]
 
@@ -111,6 +111,8 @@ def test_each_knob_makes_its_condition_hold(case, base, edits, name, fields, fai
         assert knob.condition == name and knob.value > 0
         fixed = verify.certify(scenario_from_dict(_with_knob(table, knob)))
         assert _condition(fixed, name).ok is True, (knob.text(), _condition(fixed, name))
+        if name.startswith("terminal_rate["):
+            continue  # exact for the reported set only: another set may pass a little below it (test below)
         # the value solves the inequality: 2 % on the wrong side of it and the condition fails again
         wrong = 0.98 if knob.relation == ">=" else 1.02
         again = verify.certify(scenario_from_dict(_with_knob(table, knob, wrong)))

@@ -44,7 +44,7 @@ def test_the_papers_obstacles_on_the_circle_refuse_tracking_by_name():
 
 
 @pytest.mark.parametrize("change, name", [
-    ({"limits.rate": (0.1, 0.1, 0.2)}, "terminal_rate[r]"),
+    ({"limits.rate": (0.1, 0.1, 0.1)}, "terminal_rate[r]"),
     ({"region.heading": "both"}, "terminal_heading"),
 ])
 def test_designs_outside_the_theorem_are_named(change, name):
@@ -107,3 +107,42 @@ def test_a_surge_floor_with_an_obstacle_near_the_path_leaves_tracking_refused_by
     assert [x.condition for x in failed] == ["path_clearance[0]"]
     assert "binding: the backup's footprint" in failed[0].detail
     assert "path_clearance[0]" not in {x.condition for x in c.tier_conditions["safe"]}
+
+
+# ---- the search: the grid's refinement and the path's shortcut ------------------------------------------------
+
+BRISK_TRACKED = "examples/bluerov2_brisk_tracked.toml"
+
+
+def test_where_no_coarse_set_fits_the_rows_the_refinement_finds_one_that_meets_every_condition(monkeypatch):
+    """``examples/bluerov2_brisk_tracked.toml`` (0.2 m/s in 0.1 m/s of current, rate-limited plans): the coarse
+    grid alone has no set meeting every condition (the nearest whose rows fit the plans' jump cannot be reached
+    from the start, 6 m behind the target: ``initial_terminal``); with the refinement the kept set meets every
+    condition, and its lower end is not a point of the coarse grid."""
+    import verify.theorem.terminal as terminal
+    sc = load_scenario(BRISK_TRACKED)
+    cert = verify.certify(sc)
+    law = cert.design.terminal
+    assert cert.tiers.tracking and law is not None and law.has_rows
+    assert all(c.ok for c in cert.design.conditions if c.condition.startswith(TERMINAL_PREFIXES))
+    b = terminal_bounds(sc, cert.design, cert.region)
+    coarse_lows = {round(s.d_lo, 9) for s in terminal._sets(b)}
+    assert round(law.d_lo, 9) not in coarse_lows
+    monkeypatch.setattr(terminal, "_refined", lambda bounds: iter(()))
+    found, conds = terminal.design_terminal(sc, cert.design, cert.region, cert.backup.safe_set)
+    assert found is None and {c.condition for c in conds if not c.ok} == {"initial_terminal"}
+
+
+def test_the_path_shortcut_rests_on_a_footprint_that_grows_with_the_sets_reach(pc_cert):
+    """A set whose path clearance fails blocks every wider one unsampled: that is sound because the footprint of a
+    completion contains the footprint of any set that reaches less (same heights and ball, larger reach and outer
+    radius), so its clearance can only be smaller."""
+    from verify.theorem.terminal import _sets, footprint_of
+    b = terminal_bounds(PC, pc_cert.design, pc_cert.region)
+    laws = sorted(_sets(b), key=lambda law: law.d_hi)
+    safe = pc_cert.backup.safe_set
+    feet = [footprint_of(PC, pc_cert.design, b, law, safe) for law in laws]
+    assert len({round(law.d_hi, 9) for law in laws}) > 3
+    for near, far in zip(feet, feet[1:]):
+        assert far.reach >= near.reach and far.outer >= near.outer
+        assert (far.rise, far.outer_height, far.ball) == (near.rise, near.outer_height, near.ball)

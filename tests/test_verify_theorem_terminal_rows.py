@@ -154,10 +154,10 @@ def test_a_backup_that_does_not_blend_refuses_rate_limited_tracking_by_name():
 
 
 def test_where_the_faces_do_not_fit_the_rate_conditions_name_the_channel():
-    """The paper's scenario with plans limited to (0.1, 0.1, 0.2) per second: surge and yaw rows would move by
-    more than J a period over every set whose other conditions hold."""
+    """The paper's scenario with plans limited to (0.1, 0.1, 0.1) per second: surge and yaw rows would move by
+    more than J a period over every set whose other conditions hold, the refinement's included."""
     sc = load_scenario(ROOT / "verify" / "scenarios" / "paper_currents.toml").with_changes(
-        **{"limits.rate": (0.1, 0.1, 0.2)})
+        **{"limits.rate": (0.1, 0.1, 0.1)})
     cert = verify.certify(sc)
     assert cert.tiers.safe and not cert.tiers.tracking
     assert {c.condition for c in cert.failures} == {"terminal_rate[u]", "terminal_rate[r]"}

@@ -38,7 +38,9 @@ condition.
 from __future__ import annotations
 
 import dataclasses
+import itertools
 import math
+from typing import Iterator
 
 from flint import arb
 
@@ -69,6 +71,11 @@ WIDTHS = (1.0, 0.6, 0.35, 0.2, 0.1)
 LOWER_ENDS = (0.0, 0.1, 0.2, 0.35, 0.5)
 #: Fractions of the free heading room α_f is tried at, largest first.
 ANGLES = (1.0, 0.6, 0.3)
+#: The refinement, tried only when no set of the grid above meets every condition: X_f's lower end at every
+#: twentieth of the free band and a narrower width (rate-limited plans need the gentlest law a set allows, and its
+#: gains move with both ends; ``python benchmarks/terminal_rate.py`` measured what the coarse grid misses).
+FINE_LOWER_ENDS = tuple(i / 20 for i in range(20))
+FINE_WIDTHS = (1.0, 0.6, 0.35, 0.2, 0.1, 0.05)
 
 
 def terminal_bounds(scenario: Scenario, design: Design, region: Region) -> TerminalBounds:
@@ -183,17 +190,33 @@ def sensing_condition(scenario: Scenario, b: TerminalBounds, safe: SafeSet) -> C
                  spread, arb(scenario.sensing_range) - arb(scenario.vehicle_radius))
 
 
-def _sets(b: TerminalBounds) -> list[TerminalLaw]:
+def _sets(b: TerminalBounds, fine: bool = False) -> list[TerminalLaw]:
     """The grid of terminal sets and their gains, largest first (module doc); under a surge floor each with its
-    bearing face (:func:`verify.theorem.terminal_bearing.bearing_sets`)."""
-    laws = _grid(b)
+    bearing face (:func:`verify.theorem.terminal_bearing.bearing_sets`). ``fine``: the refinement's sets that the
+    coarse grid does not have (:data:`FINE_LOWER_ENDS`, :data:`FINE_WIDTHS`)."""
+    if fine:
+        coarse = set(_grid_points(WIDTHS, LOWER_ENDS))
+        points = [p for p in _grid_points(FINE_WIDTHS, FINE_LOWER_ENDS) if p not in coarse]
+    else:
+        points = _grid_points(WIDTHS, LOWER_ENDS)
+    laws = _grid(b, points)
     if b.jumps is not None:
         laws = row_sets(b, laws)
     return bearing_sets(b, laws) if b.surge_floor is not None else laws
 
 
-def _grid(b: TerminalBounds) -> list[TerminalLaw]:
-    """The grid of terminal sets without the bearing face."""
+def _refined(b: TerminalBounds) -> Iterator[TerminalLaw]:
+    """The refinement's sets, built only when the loop asks for them (the coarse grid found none)."""
+    yield from _sets(b, fine=True)
+
+
+def _grid_points(widths: tuple[float, ...], lower_ends: tuple[float, ...]) -> list[tuple[float, float]]:
+    """(width, lower end) fractions in the grid's order: widest first, then the lower end upward."""
+    return [(w, f) for w in widths for f in lower_ends]
+
+
+def _grid(b: TerminalBounds, points: list[tuple[float, float]]) -> list[TerminalLaw]:
+    """The grid of terminal sets without the bearing face at the (width, lower end) fractions ``points``."""
     dt, (ub, wb, rb) = b.dt, b.v_bar
     half_run = (ub + b.speed_xy) * dt / 2
     lo_min = b.room_d[0] + b.dev_xy + half_run + 1e-6
@@ -202,25 +225,25 @@ def _grid(b: TerminalBounds) -> list[TerminalLaw]:
     if hi_max <= lo_min or z_f <= 0.0 or lo_min <= b.dev_xy:
         return []
     out = []
-    for width in WIDTHS:
-        for d_lo in (lo_min + f * (hi_max - lo_min) for f in LOWER_ENDS):
-            d_hi = d_lo + width * (hi_max - d_lo)
-            seen = b.dev_psi + math.asin(min(1.0, b.dev_xy / d_lo))
-            turn = math.asin(min(1.0, 2 * half_run / (d_lo - b.dev_xy)))
-            room = math.asin(min(b.room_o, 0.999)) - seen - turn if b.room_o > 0 else -1.0
-            for frac in ANGLES:
-                alpha_f = min(frac * room, 1.2)
-                if alpha_f <= 0.0:
-                    continue
-                a0 = alpha_f + seen
-                g = min(1.0, rb * dt / a0 * (1 - 1e-6))
-                beta = a0 * (1 - g / 2)
-                spread = (d_hi - d_lo) / 2 + b.dev_xy
-                lam = max(0.0, min(1.0 / dt, (ub * math.sin(g * a0 / 2) / (g * a0 / 2) * math.cos(beta) - b.speed_xy)
-                                   / spread) * (1 - 1e-6))
-                lam_z = max(0.0, min(1.0 / dt, (wb - b.speed_z) / (z_f + b.dev_z)) * (1 - 1e-6))
-                out.append(TerminalLaw(d_lo=d_lo, d_hi=d_hi, d_star=(d_lo + d_hi) / 2, alpha_max=alpha_f, z_max=z_f,
-                                       gain_d=lam, gain_z=lam_z, turn=g))
+    for width, lower_end in points:
+        d_lo = lo_min + lower_end * (hi_max - lo_min)
+        d_hi = d_lo + width * (hi_max - d_lo)
+        seen = b.dev_psi + math.asin(min(1.0, b.dev_xy / d_lo))
+        turn = math.asin(min(1.0, 2 * half_run / (d_lo - b.dev_xy)))
+        room = math.asin(min(b.room_o, 0.999)) - seen - turn if b.room_o > 0 else -1.0
+        for frac in ANGLES:
+            alpha_f = min(frac * room, 1.2)
+            if alpha_f <= 0.0:
+                continue
+            a0 = alpha_f + seen
+            g = min(1.0, rb * dt / a0 * (1 - 1e-6))
+            beta = a0 * (1 - g / 2)
+            spread = (d_hi - d_lo) / 2 + b.dev_xy
+            lam = max(0.0, min(1.0 / dt, (ub * math.sin(g * a0 / 2) / (g * a0 / 2) * math.cos(beta) - b.speed_xy)
+                               / spread) * (1 - 1e-6))
+            lam_z = max(0.0, min(1.0 / dt, (wb - b.speed_z) / (z_f + b.dev_z)) * (1 - 1e-6))
+            out.append(TerminalLaw(d_lo=d_lo, d_hi=d_hi, d_star=(d_lo + d_hi) / 2, alpha_max=alpha_f, z_max=z_f,
+                                   gain_d=lam, gain_z=lam_z, turn=g))
     return out
 
 
@@ -266,7 +289,8 @@ def design_terminal(scenario: Scenario, design: Design, region: Region, safe: Sa
 
     closest: tuple[tuple[int, float], tuple[Condition, ...]] | None = None
     narrowest: tuple[float, TerminalLaw, tuple[Condition, ...]] | None = None
-    for law in _sets(b):
+    blocked = math.inf  # the smallest reach whose path failed: the footprint grows with d_hi (z_max is common)
+    for law in itertools.chain(_sets(b), _refined(b)):
         own = law_conditions(b, law)
         if not all(c.ok for c in own):
             miss = _shortfall(own)
@@ -277,10 +301,11 @@ def design_terminal(scenario: Scenario, design: Design, region: Region, safe: Sa
             return None, (Condition("terminal_backup", "a backup safe set for the terminal condition", None, None,
                                     False, "no backup"),)
         conds = own + (sensing, initial_plan_condition(scenario, design, region, law, safe))
-        if all(c.ok for c in conds):  # the path is sampled only for sets that pass everything else
+        if all(c.ok for c in conds) and law.d_hi < blocked:  # the path is sampled only for sets that pass the rest
             conds = conds + geometry(law)
             if all(c.ok for c in conds):
                 return law, conds
+            blocked = law.d_hi
         if narrowest is None or law.d_hi < narrowest[0]:
             narrowest = (law.d_hi, law, conds)
     if narrowest is not None:

@@ -1,0 +1,30 @@
+"""benchmarks/brisk_tracked.py: the variants of the brisk tracked BlueROV2, certified on their own and flown."""
+
+from __future__ import annotations
+
+from .scripts import load_script
+
+
+def _module():
+    return load_script("benchmarks/brisk_tracked.py", "bench_brisk_tracked")
+
+
+def test_the_variants_change_what_their_names_say():
+    """The steady currents lie on the certified bound along their axis, the moved rocks stay 22-23 m beside the
+    path, and the corners put every interval's end into the simulated hull."""
+    variants = _module().variants()
+    base = variants["as shipped"]
+    assert variants["steady -y"].disturbance.constant == (0.0, -0.1, 0.0)
+    assert variants["steady -y"].disturbance.amplitude == (0.0, 0.0, 0.0)
+    assert all(abs(o.center[1]) >= 22.0 for name in ("rocks mirrored", "rocks moved along", "rocks 22 m off")
+               for o in variants[name].obstacles)
+    lower = dict(variants["hull at the lower corner"].plant.truth)
+    assert lower["X_uu"] == base.plant.params.X_uu[0] and lower["X_uu"] != dict(
+        variants["hull at the upper corner"].plant.truth)["X_uu"]
+
+
+def test_a_short_flight_reports_both_tiers_kept_with_a_plan_at_every_period():
+    row = _module().fly("as shipped", _module().variants()["as shipped"], duration=3.0)
+    assert row["certified"] == [True, True] and row["broken"] == [] and row["backup_s"] == 0.0
+    assert row["steps"] == 30 and row["plan_available"].endswith("periods without an accepted plan 0")
+    assert row["e_d"][0] > 4.0   # the plans end in X_f, 4.48 m or more behind the target: trailing is the price

@@ -1,18 +1,18 @@
 """Both tiers on the BlueROV2 at 0.2 m/s in 0.1 m/s of current, flown: ``examples/bluerov2_brisk_tracked.toml`` and
 its variants, each certified on its own and flown for 60 s.
 
-The variants: the current steady on its bound along ±x and ±y (each mirrors the other); the rocks mirrored to the other side of
-the path, moved along it, or brought to the nearest the certificate allows; the simulated hull at either corner of
-the coefficient box. Each row reports the tiers certified and kept, the periods without an accepted plan, the
-solver plans replaced by the candidate, the backup's time, the smallest clearance, e_d's range and the tracking
-RMSE. Nothing is timed.
+The variants (of ``--scenario``, default the example): the current steady on its bound along ±x and ±y (each
+mirrors the other); the rocks mirrored to the other side of the path or moved 10 m back along it; the simulated
+hull at either corner of the coefficient box. Each row reports the tiers certified and kept, the periods without an
+accepted plan, the solver plans replaced by the candidate, the backup's time, the smallest clearance, e_d's range
+and the tracking RMSE. Nothing is timed.
 
 ``--frontier``: which missions of the same shape certify both tiers, with the target's speed, the current (per
 axis) and the coefficient box changed (:func:`frontier_cell`; the box widened about von Benzon's values), and how
 near the path a rock may lie (:func:`nearest_rock`: the smallest distance from the path at which the certificate
 still gives both tiers, with the station-keeping backup and with the hold). Certificates only, nothing flown.
 
-Usage: ``python benchmarks/brisk_tracked.py [--duration 60] [--only NAME ...] [--frontier]``
+Usage: ``python benchmarks/brisk_tracked.py [--scenario FILE] [--duration 60] [--only NAME ...] [--frontier]``
 """
 
 from __future__ import annotations
@@ -48,21 +48,22 @@ def _corner(scenario, end: int):
                                                                 truth=tuple(corner.items())))
 
 
-def variants() -> dict:
-    """The example and its variants (module doc), by name."""
+def variants(path: Path = SCENARIO) -> dict:
+    """The scenario at ``path`` and its variants (module doc), by name; the rocks are moved from where it has
+    them."""
     from tubekit.scenario import Obstacle, load_scenario
-    base = load_scenario(SCENARIO)
+    base = load_scenario(path)
     steady = {"disturbance.amplitude": (0.0, 0.0, 0.0)}
-    rocks = lambda *centres: base.with_changes(obstacles=tuple(Obstacle(center=c, radius=0.4) for c in centres))
+    moved = lambda f: base.with_changes(obstacles=tuple(Obstacle(center=f(o.center), radius=o.radius)
+                                                        for o in base.obstacles))
     return {
         "as shipped": base,
         "steady +x": base.with_changes(**steady, **{"disturbance.constant": (0.1, 0.0, 0.0)}),
         "steady -x": base.with_changes(**steady, **{"disturbance.constant": (-0.1, 0.0, 0.0)}),
         "steady +y": base.with_changes(**steady, **{"disturbance.constant": (0.0, 0.1, 0.0)}),
         "steady -y": base.with_changes(**steady, **{"disturbance.constant": (0.0, -0.1, 0.0)}),
-        "rocks mirrored": rocks((10.0, -23.0, 0.0), (25.0, 23.0, 0.0)),
-        "rocks moved along": rocks((0.0, 23.0, 0.0), (5.0, -23.0, 0.0)),
-        "rocks 22 m off": rocks((6.0, 22.0, 0.0), (12.0, -22.0, 0.0)),
+        "rocks mirrored": moved(lambda c: (c[0], -c[1], c[2])),
+        "rocks moved along": moved(lambda c: (c[0] - 10.0, c[1], c[2])),
         "hull at the lower corner": _corner(base, 0),
         "hull at the upper corner": _corner(base, 1),
     }
@@ -113,23 +114,25 @@ def _verdict(cert) -> str:
     return ", ".join(names[:3]) + (", ..." if len(names) > 3 else "")
 
 
-def frontier_cell(speed: float, current: float, spread: float = 0.1) -> str:
+def frontier_cell(speed: float, current: float, spread: float = 0.1, backup: str | None = None) -> str:
     """The verdict of the example with the target at ``speed`` (m/s), the current ``current`` (m/s per axis), the
     coefficient box ± ``spread`` and u_max = speed + current + :data:`SURGE_ROOM`; the start stays 6 m behind,
-    under way at the target's speed."""
+    under way at the target's speed. ``backup``: ``controller.backup`` (None: the example's)."""
     import verify
     from tubekit.scenario import load_scenario
     sc = load_scenario(SCENARIO)
     sc = sc.with_changes(**{"trajectory.direction_velocity": (speed, 0.0, 0.0), "limits.initial": (speed, 0.0, 0.0),
                             "disturbance.amplitude": (current, current, current),
                             "limits.u_max": round(speed + current + SURGE_ROOM, 6)})
+    if backup is not None:
+        sc = sc.with_changes(**{"controller.backup": backup})
     return _verdict(verify.certify(_widened(sc, spread)))
 
 
 def nearest_rock(backup: str) -> tuple[float | None, str]:
     """(the smallest of :data:`ROCK_DISTANCES` at which one rock beside the path keeps both tiers, the verdict at
-    the next distance) with the backup ``backup`` (``station_keeping`` or ``hold``; the hold with the pier
-    example's thrusters, sway's share 30 %)."""
+    the next distance) with the backup ``backup`` (``station_keeping``, ``hold`` with the pier example's
+    thrusters, sway's share 30 %, or ``none``)."""
     import verify
     from tubekit.scenario import Obstacle, load_scenario
     sc = load_scenario(SCENARIO).with_changes(**{"controller.backup": backup})
@@ -148,18 +151,20 @@ def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--duration", type=float, default=60.0, help="seconds flown per variant")
     ap.add_argument("--only", nargs="+", default=None, help="variant names to fly")
+    ap.add_argument("--scenario", type=Path, default=SCENARIO, help="the scenario whose variants are flown")
     ap.add_argument("--frontier", action="store_true", help="the speed x current x box table and the nearest rock")
+    ap.add_argument("--backup", default=None, help="controller.backup for the frontier's table (default: the example's)")
     args = ap.parse_args(argv)
     if args.frontier:
         for spread in SPREADS:
             print(f"box +-{spread:g}: | speed \\ current | " + " | ".join(f"{c:g}" for c in CURRENTS) + " |")
             for speed in SPEEDS:
-                print(f"| {speed:g} | " + " | ".join(frontier_cell(speed, c, spread) for c in CURRENTS) + " |",
+                print(f"| {speed:g} | " + " | ".join(frontier_cell(speed, c, spread, args.backup) for c in CURRENTS) + " |",
                       flush=True)
-        for backup in ("station_keeping", "hold"):
+        for backup in ("station_keeping", "hold", "none"):
             print(backup, nearest_rock(backup), flush=True)
         return 0
-    for name, scenario in variants().items():
+    for name, scenario in variants(args.scenario).items():
         if args.only and name not in args.only:
             continue
         print(fly(name, scenario, args.duration), flush=True)

@@ -10,6 +10,7 @@ from tubekit.model.ancillary import LAWS, AncillaryLaw, get_law, jacobian_at, re
 from tubekit.model.errors import bearing, error_coordinates, heading_cosine, numeric
 from tubekit.model.loiter import Loiter  # registers the loiter backup law (kind "loiter")
 from tubekit.model.hold import Hold  # registers the hold backup law (kind "hold", lateral thrust)
+from tubekit.model.no_backup import NoBackup  # registers "none": safety from the tracking tier alone
 from tubekit.model.kinematics import (InputLimits, SwayModel, dsinc, kinematics, nominal_kinematics, sinc,
                                       unicycle_step)
 from tubekit.model.thrusters import ThrusterGeometry
@@ -21,5 +22,5 @@ __all__ = [
     "error_coordinates", "bearing", "heading_cosine", "numeric",
     "AncillaryLaw", "LAWS", "get_law", "register_law", "jacobian_at",
     "Trajectory", "Circle", "Helix", "Line", "Waypoints", "trajectory_from_dict",
-    "VehicleParams", "VEHICLES", "PlantSettings", "vehicle_params", "Loiter", "Hold", "ThrusterGeometry",
+    "VehicleParams", "VEHICLES", "PlantSettings", "vehicle_params", "Loiter", "Hold", "NoBackup", "ThrusterGeometry",
 ]

@@ -80,6 +80,9 @@ def _backup(raw: dict, cert: CertificateRecord, derived: DerivedTiers, led: Ledg
     if stored is None or bk is None:
         led.check("backup", False, None, "a backup block", "every certificate carries its backup")
         return
+    named = cert.inputs.scenario.controller.backup
+    led.check("backup.law.kind", stored.law.kind == named, stored.law.kind, named,
+              "the law the scenario names (controller.backup): the loop runs the certificate's law")
     for k in ("omega_xy", "omega_z", "rate_bound", "yaw_rate_error"):
         led.at_least(f"backup.{k}", getattr(stored, k), getattr(bk, k))
     led.equal("backup.tick", stored.tick, bk.tick)

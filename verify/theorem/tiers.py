@@ -26,6 +26,7 @@ import numpy as np
 from flint import arb
 
 from tubekit.model.backup import BackupLaw, SafeSet
+from tubekit.model.no_backup import NO_BACKUP_KIND
 from tubekit.scenario import Scenario
 from tubekit.tiers import Tiers
 
@@ -245,7 +246,10 @@ def surge_floor_condition(scenario: Scenario, law: BackupLaw) -> Condition:
 
 
 def _with_initial(scenario: Scenario, bc: BackupCertificate) -> BackupCertificate:
-    """``bc`` with ``backup_initial`` (and ``backup_min_surge`` under a minimum surge) appended."""
+    """``bc`` with ``backup_initial`` (and ``backup_min_surge`` under a minimum surge) appended; without a backup
+    law (``"none"``) nothing: the start is the tracking theorem's ``initial_terminal``."""
+    if bc.law.kind == NO_BACKUP_KIND:
+        return bc
     extra = (initial_backup(scenario, bc.law, bc.safe_set),)
     if scenario.limits.u_min is not None:
         extra += (surge_floor_condition(scenario, bc.law),)
@@ -255,11 +259,15 @@ def _with_initial(scenario: Scenario, bc: BackupCertificate) -> BackupCertificat
 def tier_conditions(design: Design, safe_design: Design | None, backup: BackupCertificate | None,
                     plant: tuple[Condition, ...] = ()) -> dict[str, tuple[Condition, ...]]:
     """The conditions each tier depends on (module doc); ``safe_design`` replaces the tracking design's
-    safe conditions when given. A missing backup leaves both tiers uncertified (an empty backup part is
+    safe conditions when given; without a backup law (``"none"``, step 13g) the safe tier depends on every tracking
+    condition. A missing backup leaves both tiers uncertified (an empty backup part is
     represented by a failed ``backup`` condition). ``plant``: the dynamic plant's conditions
     (:func:`verify.vehicle.compose.solve_dynamic`), which both tiers depend on (ω̄ holds only with the loop's bound)."""
     bk = backup.conditions if backup is not None else (
         Condition("backup", "a certified backup law", None, None, False, "no backup"),)
+    if backup is not None and backup.law.kind == NO_BACKUP_KIND:  # step 13g: safety is tracking's corollary
+        return {"safe": tuple(design.conditions) + tuple(bk) + tuple(plant),
+                "tracking": tuple(design.conditions) + tuple(bk) + tuple(plant)}
     safe_src = safe_design.conditions if safe_design is not None else tuple(
         c for c in design.conditions if is_safe_condition(c.condition))
     return {"safe": tuple(safe_src) + tuple(bk) + tuple(plant),

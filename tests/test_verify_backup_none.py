@@ -18,6 +18,8 @@ from tubekit.tiers import Tiers
 from verify.backup import BACKUP_PROOFS, NO_BACKUP_PROOF, certify_none
 from verify.studies.recheck import recheck
 
+from .corners import at_corner
+
 ROOT = Path(__file__).resolve().parents[1]
 NO_BACKUP = ROOT / "examples" / "bluerov2_no_backup.toml"
 PC = load_scenario(verify.SCENARIOS_DIR / "paper_currents.toml")
@@ -91,11 +93,7 @@ def test_flown_at_a_corner_of_the_box_both_tiers_are_kept_and_no_law_ever_runs(n
     """20 s of examples/bluerov2_no_backup.toml with the hull at the box's upper corner: a plan at every period,
     every promise of both tiers kept, the backup never active."""
     import tubekit
-    sc = load_scenario(NO_BACKUP)
-    corner = {k: v[1] for k, v in vars(sc.plant.params).items() if not k.startswith("_") and isinstance(v, tuple)}
-    flown = sc.with_changes(plant=sc.plant.__class__(kind="dynamic", vehicle="bluerov2_heavy",
-                                                     overrides=sc.plant.overrides, truth=tuple(corner.items())))
-    run = tubekit.simulate(flown, no_backup_cert, duration=20.0, progress=False)
+    run = tubekit.simulate(at_corner(load_scenario(NO_BACKUP), 1), no_backup_cert, duration=20.0, progress=False)
     promises = {p.name: p for p in tubekit.check_promises(run)}
     assert all(p.ok for p in promises.values() if p.given), [p for p in promises.values() if p.given and not p.ok]
     assert promises["plan_available"].ok and not run.backup_active.any()

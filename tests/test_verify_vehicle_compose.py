@@ -14,6 +14,7 @@ from tubekit.scenario import load_scenario, scenario_from_dict
 from verify.certificate.certify import Certificate, certify
 from verify.vehicle.compose import PLAN_CHECK_TOLERANCE, plan_jumps
 from verify.studies.recheck import recheck
+from .corners import at_corner
 from .tier_checks import refused_only_by_the_row_faces
 
 PAPER_CURRENTS = "verify/scenarios/paper_currents.toml"
@@ -429,11 +430,7 @@ def test_the_brisk_tracked_bluerov2_certifies_both_tiers_at_the_owners_speed_and
     cross = sc.with_changes(**{"disturbance.amplitude": (0.0, 0.0, 0.0), "disturbance.constant": (0.0, 0.1, 0.0)})
     cross_cert = certify(cross)
     assert cross_cert.tiers == Tiers(True, True)
-    corner = {k: v[1] for k, v in vars(sc.plant.params).items() if not k.startswith("_") and isinstance(v, tuple)}
-    flown = cross.with_changes(plant=cross.plant.__class__(kind="dynamic", vehicle="bluerov2_heavy",
-                                                           overrides=cross.plant.overrides,
-                                                           truth=tuple(corner.items())))
-    run = tubekit.simulate(flown, cross_cert, duration=20.0, progress=False)
+    run = tubekit.simulate(at_corner(cross, 1), cross_cert, duration=20.0, progress=False)
     promises = {p.name: p for p in tubekit.check_promises(run)}
     assert all(p.ok for p in promises.values() if p.given), [p for p in promises.values() if p.given and not p.ok]
     assert promises["plan_available"].ok and promises["tube"].ok and not run.backup_active.any()

@@ -22,7 +22,7 @@ import math
 from dataclasses import dataclass
 from typing import Any, ClassVar
 
-from tubekit.model.backup import register_backup_law
+from tubekit.model.backup import NoSway, register_backup_law
 
 __all__ = ["NoBackup", "NO_BACKUP_KIND", "POINT_SET"]
 
@@ -34,12 +34,10 @@ POINT_SET = 1e-3
 
 @register_backup_law
 @dataclass(frozen=True)
-class NoBackup:
+class NoBackup(NoSway):
     """No backup law (module doc): the command applied last is kept, and the certificate claims nothing for it."""
 
     kind: ClassVar[str] = NO_BACKUP_KIND
-    #: The law commands no sway.
-    lateral: ClassVar[bool] = False
 
     @property
     def blends(self) -> bool:
@@ -50,16 +48,6 @@ class NoBackup:
     def bounds(self) -> tuple[float, float, float]:
         """(0, 0, 0): the law adds no command of its own (it keeps the last one, which lies in V)."""
         return 0.0, 0.0, 0.0
-
-    @property
-    def sway_bound(self) -> float:
-        """0 (m/s): no sway command."""
-        return 0.0
-
-    @property
-    def sway_release(self) -> float:
-        """∞: no sway command to release."""
-        return math.inf
 
     @property
     def min_surge(self) -> float:
@@ -80,12 +68,6 @@ class NoBackup:
                 ) -> tuple[float, float, float]:
         """``start``: the command applied at the hand-over, kept (m/s, m/s, rad/s)."""
         return float(start[0]), float(start[1]), float(start[2])
-
-    def lateral_command(self, state: tuple[float, float, float, float], anchor: tuple[float, float, float],
-                        elapsed: float = math.inf, start: tuple[float, float, float] = (0.0, 0.0, 0.0)
-                        ) -> tuple[float, float, float, float]:
-        """(:meth:`command`, 0): no sway command."""
-        return (*self.command(state, anchor, elapsed, start), 0.0)
 
     def to_dict(self) -> dict[str, Any]:
         """``{"kind": "none"}``."""

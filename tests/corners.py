@@ -1,0 +1,17 @@
+"""A scenario's simulated hull at a corner of its coefficient box (a helper, not a test module)."""
+
+from __future__ import annotations
+
+from tubekit.scenario import Scenario
+
+__all__ = ["at_corner"]
+
+
+def at_corner(scenario: Scenario, end: int) -> Scenario:
+    """``scenario`` with the simulated hull (``[plant.truth]``) at the lower (``end`` 0) or upper (1) end of every
+    interval of its vehicle's coefficient box; the certificate's box is unchanged."""
+    params = scenario.plant.params
+    corner = {k: v[end] for k, v in vars(params).items() if not k.startswith("_") and isinstance(v, tuple)}
+    return scenario.with_changes(plant=scenario.plant.__class__(kind="dynamic", vehicle=scenario.plant.vehicle,
+                                                                overrides=scenario.plant.overrides,
+                                                                truth=tuple(corner.items())))

@@ -11,7 +11,11 @@ a line at P along x, u_min ``--u-min``, u_max ``--u-max``, r_max ``--r-max``, ε
 Each cell prints the tiers (``both``, ``safe``, or the first failed conditions) and the loiter's certified radius.
 Nothing is timed.
 
-Usage: ``python benchmarks/survey_frontier.py [--speed 0.6 1.0 1.5] [--current 0.1 0.2 0.3] [--offset 5 30]``
+``--backup none``: no backup law (``docs/verify.md`` step 13g); the completion's footprint is then X_f's own, the
+sector behind the target that its bearing face allows (step 17b), with no loiter about its end.
+
+Usage: ``python benchmarks/survey_frontier.py [--speed 0.6 1.0 1.5] [--current 0.1 0.2 0.3] [--offset 5 30]
+[--backup none]``
 (about a second per cell).
 """
 
@@ -30,8 +34,9 @@ __all__ = ["survey", "cell", "main"]
 
 
 def survey(speed: float, current: float, offset: float, *, u_min: float = 0.5, u_max: float = 2.0,
-           r_max: float = 0.2, epsilon: float = 3.0):
-    """The survey scenario of the module doc (a :class:`tubekit.scenario.Scenario`)."""
+           r_max: float = 0.2, epsilon: float = 3.0, backup: str = "loiter"):
+    """The survey scenario of the module doc (a :class:`tubekit.scenario.Scenario`), with ``controller.backup``
+    ``backup`` (the loiter, or ``none``: the safe tier as the tracking tier's corollary)."""
     from tubekit import load_scenario
     from tubekit.model.trajectory import Line
     from tubekit.scenario import Obstacle
@@ -40,17 +45,18 @@ def survey(speed: float, current: float, offset: float, *, u_min: float = 0.5, u
         name="survey", trajectory=Line(start=(0.0, 0.0, 0.0), direction_velocity=(speed, 0.0, 0.0)),
         obstacles=(Obstacle((40.0, offset, 0.0), 0.5),), epsilon=epsilon, duration=60.0, sensing_range=80.0,
         workspace=((-100.0, -100.0, -10.0), (300.0, 100.0, 10.0)), initial_state=(-(epsilon + 2.0), 0.0, 0.0, 0.0),
-        **{"limits.u_max": u_max, "limits.u_min": u_min, "limits.r_max": r_max,
+        **{"limits.u_max": u_max, "limits.u_min": u_min, "limits.r_max": r_max, "controller.backup": backup,
            "disturbance.amplitude": (current, current, 0.05), "region.e_d_max": epsilon + 5.0})
 
 
-def cell(speed: float, current: float, offset: float, **limits: float) -> dict:
+def cell(speed: float, current: float, offset: float, **limits: float | str) -> dict:
     """The verdict of one cell: ``tiers`` (both / safe / none), the failed conditions and the loiter's radius (m)."""
     import verify
 
     cert = verify.certify(survey(speed, current, offset, **limits))
     tiers = "both" if cert.tiers.tracking else "safe" if cert.tiers.safe else "none"
-    radius = cert.backup.safe_set.radius if cert.backup is not None and cert.backup.safe_set is not None else None
+    loiter = cert.backup is not None and cert.backup.law.kind == "loiter"
+    radius = cert.backup.safe_set.radius if loiter else None
     return {"tiers": tiers, "failed": [c.condition for c in cert.failures], "loiter_radius": radius}
 
 
@@ -71,11 +77,13 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--u-max", type=float, default=2.0)
     ap.add_argument("--r-max", type=float, default=0.2)
     ap.add_argument("--epsilon", type=float, default=3.0)
+    ap.add_argument("--backup", default="loiter", help="controller.backup: loiter (default) or none")
     args = ap.parse_args(argv)
-    limits = {"u_min": args.u_min, "u_max": args.u_max, "r_max": args.r_max, "epsilon": args.epsilon}
+    limits = {"u_min": args.u_min, "u_max": args.u_max, "r_max": args.r_max, "epsilon": args.epsilon,
+              "backup": args.backup}
     for offset in args.offset:
         print(f"obstacle {offset:g} m off the path; u_min {args.u_min:g}, u_max {args.u_max:g} m/s, "
-              f"r_max {args.r_max:g} rad/s, epsilon {args.epsilon:g} m")
+              f"r_max {args.r_max:g} rad/s, epsilon {args.epsilon:g} m, backup {args.backup}")
         print("| target (m/s) \\ current (m/s) | " + " | ".join(f"{c:g}" for c in args.current) + " |")
         print("|---" * (len(args.current) + 1) + "|")
         for speed in args.speed:

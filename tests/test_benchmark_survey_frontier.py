@@ -23,3 +23,13 @@ def test_a_target_barely_faster_than_the_surge_floor_cannot_keep_the_law_above_i
     """0.6 m/s against u_min 0.5 m/s: P_min cos(Phi_0) less the radial correction falls below the floor."""
     res = STUDY.cell(0.6, 0.1, 30.0, r_max=0.3)
     assert res["tiers"] == "safe" and "terminal_surge_floor" in res["failed"]
+
+
+def test_without_a_backup_the_sector_behind_the_target_passes_a_rock_three_metres_from_the_path():
+    """The same survey with no backup law (``docs/verify.md`` step 13g): the completion's footprint is X_f's own,
+    and its bearing face narrows it to the sector behind the target (step 17b), so a rock 3 m from the path keeps
+    both tiers; the loiter's safe set, which the completion's end must keep clear, refuses it."""
+    none = STUDY.cell(1.0, 0.3, 3.0, r_max=0.3, backup="none")
+    loiter = STUDY.cell(1.0, 0.3, 3.0, r_max=0.3)
+    assert none["tiers"] == "both" and none["failed"] == [] and none["loiter_radius"] is None
+    assert loiter["tiers"] == "safe" and loiter["failed"] == ["path_clearance[0]"]

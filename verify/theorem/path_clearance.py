@@ -8,6 +8,13 @@ horizontally and ``rise`` (m) vertically of the target p_d(t), and ends, in X_f,
 * the backup's footprint (R_f, H_f) about the completion's end (the terminal condition, step 11 (a)) misses o
   when the cylinder (R_f + d_hi, H_f + z_f) about p_d(t) lies farther than r_o from o's centre.
 
+With X_f's bearing face (step 17b: the completion starts with its bearing within Φ_0 = φ_f + asin(D_xy / d_lo) of
+behind the target and ends within φ_f), the vehicle lies, at the completion's start and end, in the sector of
+half-angle Φ_0 behind the target's horizontal velocity and radius d_hi + D_xy (start) or d_hi (end), and in
+between within the half-run (ū + P) δ / 2 of one of them, so each cylinder's horizontal disc is narrowed to that
+sector, inflated by the same pads (:func:`_sector_distance`). The sector turns with the target's velocity, at most
+A / P_min rad/s, which adds (radius) (A / P_min) h / 2 to the allowance.
+
 :func:`path_clearance` checks both for every t ∈ [0, T_end] on a dense sample of :data:`PATH_SAMPLES` points:
 each distance is 1-Lipschitz in p_d, so between samples it changes by at most v̄ h / 2 (v̄ the target's speed
 bound, h the spacing), which is subtracted (with a relative 1e-9 for the float evaluation). Its lhs is the
@@ -17,6 +24,7 @@ the obstacle's centre. :func:`path_workspace` does the same for the workspace wa
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -35,13 +43,22 @@ PATH_SAMPLES = 20001
 @dataclass(frozen=True)
 class PathFootprint:
     """What must clear the obstacles about the target (m): the completion arc's cylinder (``reach``, ``rise``)
-    carrying a ball of ``ball``, and the backup footprint's cylinder (``outer``, ``outer_height``) about it."""
+    carrying a ball of ``ball``, and the backup footprint's cylinder (``outer``, ``outer_height``) about it.
+
+    With a bearing face (``cone`` < π, rad: the completion keeps the vehicle's bearing from behind the target within
+    it, step 17b) each cylinder is narrowed to the sector of half-angle ``cone`` behind the target's horizontal
+    velocity, of radius ``cone_reach`` (arc) or ``cone_outer`` (end), inflated by the rest of ``reach`` or ``outer``;
+    ``turn_rate`` (rad/s) bounds how fast the target's velocity turns (the sector's Lipschitz allowance)."""
 
     reach: float
     rise: float
     ball: float
     outer: float
     outer_height: float
+    cone: float = math.pi
+    cone_reach: float = 0.0
+    cone_outer: float = 0.0
+    turn_rate: float = 0.0
 
 
 @dataclass(frozen=True)
@@ -79,26 +96,64 @@ def _cylinder_distance(centre: np.ndarray, p: np.ndarray, radius: float, half: f
     return np.where((h <= 0.0) & (v <= 0.0), np.maximum(h, v), outside)
 
 
+def _sector_distance(centre: np.ndarray, p: np.ndarray, back: np.ndarray, cone: float, radius: float,
+                     half: float) -> np.ndarray:
+    """Signed distance (m) from ``centre`` (3,) to the sectors of half-angle ``cone`` (rad, <= π) and ``radius``
+    about each row of ``p`` (n, 3) around the horizontal unit directions ``back`` (n, 2), extruded to half-height
+    ``half``: outside the angular range the nearer edge segment, inside it |w| − radius (negative inside)."""
+    w = centre[:2][None, :] - p[:, :2]
+    dist = np.hypot(w[:, 0], w[:, 1])
+    cos_in = np.einsum("ij,ij->i", w, back)
+    inside = cos_in >= dist * math.cos(cone)
+    edges = []
+    for sign in (1.0, -1.0):
+        c, s = math.cos(sign * cone), math.sin(sign * cone)
+        e = np.stack([c * back[:, 0] - s * back[:, 1], s * back[:, 0] + c * back[:, 1]], axis=1)
+        along = np.clip(np.einsum("ij,ij->i", w, e), 0.0, radius)
+        edges.append(np.hypot(w[:, 0] - along * e[:, 0], w[:, 1] - along * e[:, 1]))
+    h = np.where(inside, dist - radius, np.minimum(*edges))
+    v = np.abs(p[:, 2] - centre[2]) - half
+    outside = np.hypot(np.maximum(0.0, h), np.maximum(0.0, v))
+    return np.where((h <= 0.0) & (v <= 0.0), np.maximum(h, v), outside)
+
+
+def _footprints(scenario: Scenario, foot: PathFootprint, t: np.ndarray, p: np.ndarray, c: np.ndarray
+                ) -> tuple[np.ndarray, np.ndarray, float]:
+    """(arc, end, extra allowance): the distances of :func:`path_clearance` from the obstacle centre ``c`` before
+    the radii are taken off, the cylinders' or, with a bearing face, the sectors' (:class:`PathFootprint`)."""
+    if foot.cone >= math.pi:
+        return (_cylinder_distance(c, p, foot.reach, foot.rise),
+                _cylinder_distance(c, p, foot.outer, foot.outer_height), 0.0)
+    vel = np.asarray(scenario.trajectory.velocity(t), dtype=float)[:, :2]
+    back = -vel / np.linalg.norm(vel, axis=1)[:, None]
+    arc = _sector_distance(c, p, back, foot.cone, foot.cone_reach, foot.rise) - (foot.reach - foot.cone_reach)
+    end = _sector_distance(c, p, back, foot.cone, foot.cone_outer, foot.outer_height) - (foot.outer - foot.cone_outer)
+    spacing = float(t[1] - t[0]) if t.size > 1 else 0.0
+    return arc, end, foot.turn_rate * max(foot.cone_reach, foot.cone_outer) * spacing / 2.0
+
+
 def path_clearance(scenario: Scenario, foot: PathFootprint, t_end: PathSamples | float) -> tuple[Condition, ...]:
     """``path_clearance[i]`` for each obstacle (module doc); ``t_end``: the end time (s) or its samples."""
     t, p, allowance = _samples(scenario, t_end)
     out = []
     for i, o in enumerate(scenario.obstacles):
         c = np.asarray(o.center, dtype=float)
-        arc = _cylinder_distance(c, p, foot.reach, foot.rise) - (o.radius + foot.ball)
-        end = _cylinder_distance(c, p, foot.outer, foot.outer_height) - o.radius
+        arc, end, turning = _footprints(scenario, foot, t, p, c)
+        arc, end = arc - (o.radius + foot.ball), end - o.radius
         both = np.minimum(arc, end)
         k = int(np.argmin(both))
-        slack = float(both[k]) - allowance - 1e-9 * (1.0 + abs(float(both[k])))
+        slack = float(both[k]) - allowance - turning - 1e-9 * (1.0 + abs(float(both[k])))
         part = "the completion arc's ball" if arc[k] <= end[k] else "the backup's footprint at the completion's end"
         has = float(np.hypot(p[k, 0] - c[0], p[k, 1] - c[1]))
         need = (foot.reach + o.radius + foot.ball) if arc[k] <= end[k] else (foot.outer + o.radius)
+        head = (f"needs {need:.3g} m, has {has:.3g} m" if foot.cone >= math.pi else
+                f"the sector within {foot.cone:.3g} rad of behind the target short by {max(0.0, -slack):.3g} m, "
+                f"the path {has:.3g} m from the obstacle's centre")
         out.append(Condition(
             f"path_clearance[{i}]", "smallest clearance of the candidate's completion from the obstacle over the "
             "target's path, minus the Lipschitz allowance, > 0", slack, 0.0, slack > 0.0,
-            f"needs {need:.3g} m, has {has:.3g} m at t = {t[k]:.1f} s (the target's horizontal distance from "
-            f"the obstacle's centre; binding: {part}; X_f reaches {foot.reach:.3g} m, footprint "
-            f"{foot.outer:.3g} m)"))
+            f"{head} at t = {t[k]:.1f} s (the target's horizontal distance from the obstacle's centre; binding: "
+            f"{part}; X_f reaches {foot.reach:.3g} m, footprint {foot.outer:.3g} m)"))
     return tuple(out)
 
 

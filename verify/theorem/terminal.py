@@ -175,10 +175,16 @@ def footprint_of(scenario: Scenario, design: Design, b: TerminalBounds, law: Ter
     rise = arb(law.z_max) + arb(b.dev_z) + (arb(b.v_bar[1]) + arb(b.speed_z)) * dt / 2
     pad = arb(0.5) * dt / ARC_SAMPLES * arb(design.rates[3])
     rv = arb(scenario.vehicle_radius)
+    cone = {}
+    if law.bearing_max < math.pi and b.speed_floor_xy > 0.0:  # step 17b's face: the sector behind the target
+        start = arb(law.bearing_max) + (arb(b.dev_xy) / arb(law.d_lo)).asin()
+        if start < arb(math.pi):
+            cone = {"cone": upper(start), "cone_reach": upper(arb(law.d_hi) + arb(b.dev_xy)),
+                    "cone_outer": upper(arb(law.d_hi)), "turn_rate": upper(arb(b.accel_xy) / arb(b.speed_floor_xy))}
     return PathFootprint(reach=upper(reach), rise=upper(rise),
                          ball=upper(rv + arb(design.margins.position[-1]) + pad),
                          outer=upper(arb(safe.radius) + rv + arb(law.d_hi)),
-                         outer_height=upper(arb(safe.depth) + rv + arb(law.z_max)))
+                         outer_height=upper(arb(safe.depth) + rv + arb(law.z_max)), **cone)
 
 
 def sensing_condition(scenario: Scenario, b: TerminalBounds, safe: SafeSet) -> Condition:

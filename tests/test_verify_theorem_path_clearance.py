@@ -13,8 +13,8 @@ import verify
 from tubekit import load_scenario
 from tubekit.model.trajectory import Line
 from tubekit.scenario import Obstacle
-from verify.theorem.path_clearance import (PathFootprint, _cylinder_distance, _sector_distance, horizon_end,
-                                          path_clearance, path_workspace)
+from verify.theorem.path_clearance import (PathFootprint, _cylinder_distance, _sector_distance, contains,
+                                          horizon_end, path_clearance, path_workspace)
 
 BASE = load_scenario(verify.SCENARIOS_DIR / "paper_currents.toml")
 FOOT = PathFootprint(reach=1.0, rise=0.5, ball=0.3, outer=1.5, outer_height=0.8)
@@ -111,3 +111,25 @@ def test_a_narrow_sector_behind_a_line_target_clears_a_rock_beside_the_path_that
     cond = path_clearance(sc, sector, horizon_end(sc))[0]
     assert cond.ok and cond.lhs == pytest.approx(2.2 - 0.4 - 4.0 * math.sin(0.2) - 0.6, abs=6e-3)
     assert "within 0.2 rad of behind the target" in cond.detail
+
+
+def _foot(reach: float, pad: float, cone: float | None, ball: float, rise: float) -> PathFootprint:
+    """A footprint with the sector radius ``reach`` and the pad ``pad`` (m), a disc when ``cone`` is None."""
+    sector = {} if cone is None else {"cone": cone, "cone_reach": reach, "cone_outer": reach}
+    return PathFootprint(reach=reach + pad, rise=rise, ball=ball, outer=reach + pad, outer_height=rise + 0.3, **sector)
+
+
+@settings(max_examples=40, deadline=None, derandomize=True)
+@given(reach=st.floats(0.5, 5.0), pad=st.floats(0.0, 0.5), cone=st.one_of(st.none(), st.floats(0.05, 3.0)),
+       ball=st.floats(0.1, 0.5), rise=st.floats(0.2, 1.0), shrink=st.tuples(*[st.floats(0.3, 1.0)] * 5),
+       offset=st.floats(0.5, 8.0))
+def test_a_footprint_that_contains_another_clears_no_more(reach, pad, cone, ball, rise, shrink, offset):
+    """Property: a footprint shrunk in every extent is contained in the original (:func:`contains`), and the path's
+    clearance of every obstacle is no larger for the original (the premise of the search's shortcut)."""
+    big = _foot(reach, pad, cone, ball, rise)
+    small = _foot(reach * shrink[0], pad * shrink[1], None if cone is None else cone * shrink[2], ball * shrink[3],
+                  rise * shrink[4])
+    assert contains(big, small)
+    sc = _line(offset)
+    for wide, narrow in zip(path_clearance(sc, big, 40.0), path_clearance(sc, small, 40.0)):
+        assert wide.lhs <= narrow.lhs + 1e-9

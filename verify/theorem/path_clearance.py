@@ -33,7 +33,7 @@ from tubekit.scenario import Scenario
 
 from verify.theorem.design import Condition
 
-__all__ = ["PathFootprint", "PathSamples", "path_samples", "path_clearance", "path_workspace", "horizon_end",
+__all__ = ["PathFootprint", "contains", "PathSamples", "path_samples", "path_clearance", "path_workspace", "horizon_end",
            "PATH_SAMPLES"]
 
 #: Sample count of the target's path over [0, T_end].
@@ -61,14 +61,36 @@ class PathFootprint:
     turn_rate: float = 0.0
 
 
+def contains(big: PathFootprint, small: PathFootprint) -> bool:
+    """True when ``big`` holds ``small`` about every point of the path: every extent at least as large (the
+    sector's half-angle and radii included, π standing for the disc) and the same turn allowance or more. Then
+    every clearance of :func:`path_clearance` is no larger for ``big`` (a search shortcut of
+    :func:`verify.theorem.terminal.design_terminal`, never a proof step)."""
+    sizes = [(big.rise, small.rise), (big.ball, small.ball), (big.outer_height, small.outer_height),
+             (big.cone, small.cone), (big.turn_rate, small.turn_rate)]
+    for which in ("reach", "outer"):  # the sector's radius and the pad about it, each no smaller
+        sizes += [(_sector_radius(big, which), _sector_radius(small, which)),
+                  (getattr(big, which) - _sector_radius(big, which), getattr(small, which) - _sector_radius(small, which))]
+    return all(a >= b for a, b in sizes)
+
+
+def _sector_radius(foot: PathFootprint, which: str) -> float:
+    """The sector's radius of the arc (``reach``) or the end (``outer``): the whole extent for the disc."""
+    if foot.cone >= math.pi:
+        return foot.reach if which == "reach" else foot.outer
+    return foot.cone_reach if which == "reach" else foot.cone_outer
+
+
 @dataclass(frozen=True)
 class PathSamples:
-    """The target's path over [0, t_end] (s): ``times`` (n,), ``positions`` (n, 3) (m) and the Lipschitz
-    ``allowance`` v̄ h / 2 (m) between samples; built once (:func:`path_samples`) for every set tried."""
+    """The target's path over [0, t_end] (s): ``times`` (n,), ``positions`` (n, 3) (m), the Lipschitz
+    ``allowance`` v̄ h / 2 (m) between samples and ``backward`` (n, 2), the unit horizontal direction opposite the
+    target's velocity (None where it may stop); built once (:func:`path_samples`) for every set tried."""
 
     times: np.ndarray
     positions: np.ndarray
     allowance: float
+    backward: np.ndarray | None = None
 
 
 def path_samples(scenario: Scenario, t_end: float) -> PathSamples:
@@ -76,14 +98,15 @@ def path_samples(scenario: Scenario, t_end: float) -> PathSamples:
     t = np.linspace(0.0, t_end, PATH_SAMPLES)
     p = np.asarray(scenario.trajectory.position(t), dtype=float)
     speed = float(np.linalg.norm(np.asarray(scenario.trajectory.velocity_bound(), dtype=float)))
-    return PathSamples(t, p, speed * (t_end / (PATH_SAMPLES - 1)) / 2.0)
+    vel = np.asarray(scenario.trajectory.velocity(t), dtype=float)[:, :2]
+    norm = np.linalg.norm(vel, axis=1)
+    backward = -vel / norm[:, None] if np.all(norm > 0.0) else None
+    return PathSamples(t, p, speed * (t_end / (PATH_SAMPLES - 1)) / 2.0, backward)
 
 
-def _samples(scenario: Scenario, path: PathSamples | float) -> tuple[np.ndarray, np.ndarray, float]:
-    """(times, positions, allowance) of ``path`` (samples, or the end time t_end (s) to sample up to)."""
-    if not isinstance(path, PathSamples):
-        path = path_samples(scenario, float(path))
-    return path.times, path.positions, path.allowance
+def _samples(scenario: Scenario, path: PathSamples | float) -> PathSamples:
+    """``path``, or the samples up to the end time ``path`` (s)."""
+    return path if isinstance(path, PathSamples) else path_samples(scenario, float(path))
 
 
 def _cylinder_distance(centre: np.ndarray, p: np.ndarray, radius: float, half: float) -> np.ndarray:
@@ -117,29 +140,44 @@ def _sector_distance(centre: np.ndarray, p: np.ndarray, back: np.ndarray, cone: 
     return np.where((h <= 0.0) & (v <= 0.0), np.maximum(h, v), outside)
 
 
-def _footprints(scenario: Scenario, foot: PathFootprint, t: np.ndarray, p: np.ndarray, c: np.ndarray
-                ) -> tuple[np.ndarray, np.ndarray, float]:
-    """(arc, end, extra allowance): the distances of :func:`path_clearance` from the obstacle centre ``c`` before
-    the radii are taken off, the cylinders' or, with a bearing face, the sectors' (:class:`PathFootprint`)."""
-    if foot.cone >= math.pi:
-        return (_cylinder_distance(c, p, foot.reach, foot.rise),
-                _cylinder_distance(c, p, foot.outer, foot.outer_height), 0.0)
-    vel = np.asarray(scenario.trajectory.velocity(t), dtype=float)[:, :2]
-    back = -vel / np.linalg.norm(vel, axis=1)[:, None]
+def _sectors(foot: PathFootprint, c: np.ndarray, radius: float, p: np.ndarray, back: np.ndarray
+             ) -> tuple[np.ndarray, np.ndarray]:
+    """(arc, end): the clearances of :class:`PathFootprint`'s sectors from the obstacle (centre ``c``, ``radius``)
+    at the samples ``p``, ``back``."""
     arc = _sector_distance(c, p, back, foot.cone, foot.cone_reach, foot.rise) - (foot.reach - foot.cone_reach)
     end = _sector_distance(c, p, back, foot.cone, foot.cone_outer, foot.outer_height) - (foot.outer - foot.cone_outer)
+    return arc - (radius + foot.ball), end - radius
+
+
+def _footprints(foot: PathFootprint, path: PathSamples, c: np.ndarray, radius: float
+                ) -> tuple[np.ndarray, np.ndarray, float]:
+    """(arc, end, extra allowance): the clearances of :func:`path_clearance` from the obstacle (centre ``c``,
+    ``radius``) at every sample, the cylinders' or, with a bearing face, the sectors' (:class:`PathFootprint`; the
+    disc where the target may stop, which a bearing face excludes)."""
+    t, p, back = path.times, path.positions, path.backward
+    arc = _cylinder_distance(c, p, foot.reach, foot.rise) - (radius + foot.ball)
+    end = _cylinder_distance(c, p, foot.outer, foot.outer_height) - radius
+    if foot.cone >= math.pi or back is None:
+        return arc, end, 0.0
+    # the sector lies in the disc of the same reach, so the disc's clearance bounds the sector's from below: the
+    # sector is measured where that bound is below the sector's value at the bound's smallest (the rest cannot bind)
+    lower = np.minimum(arc, end)
+    first = int(np.argmin(lower))
+    at_first = _sectors(foot, c, radius, p[first:first + 1], back[first:first + 1])
+    near = np.flatnonzero(lower <= min(float(at_first[0][0]), float(at_first[1][0])))
+    arc[near], end[near] = _sectors(foot, c, radius, p[near], back[near])
     spacing = float(t[1] - t[0]) if t.size > 1 else 0.0
     return arc, end, foot.turn_rate * max(foot.cone_reach, foot.cone_outer) * spacing / 2.0
 
 
 def path_clearance(scenario: Scenario, foot: PathFootprint, t_end: PathSamples | float) -> tuple[Condition, ...]:
     """``path_clearance[i]`` for each obstacle (module doc); ``t_end``: the end time (s) or its samples."""
-    t, p, allowance = _samples(scenario, t_end)
+    path = _samples(scenario, t_end)
+    t, p, allowance = path.times, path.positions, path.allowance
     out = []
     for i, o in enumerate(scenario.obstacles):
         c = np.asarray(o.center, dtype=float)
-        arc, end, turning = _footprints(scenario, foot, t, p, c)
-        arc, end = arc - (o.radius + foot.ball), end - o.radius
+        arc, end, turning = _footprints(foot, path, c, o.radius)
         both = np.minimum(arc, end)
         k = int(np.argmin(both))
         slack = float(both[k]) - allowance - turning - 1e-9 * (1.0 + abs(float(both[k])))
@@ -162,7 +200,8 @@ def path_workspace(scenario: Scenario, foot: PathFootprint, t_end: PathSamples |
     empty without a workspace."""
     if scenario.workspace is None:
         return ()
-    t, p, allowance = _samples(scenario, t_end)
+    path = _samples(scenario, t_end)
+    t, p, allowance = path.times, path.positions, path.allowance
     lo, hi = (np.asarray(b, dtype=float) for b in scenario.workspace)
     horizontal = max(foot.reach + foot.ball, foot.outer)
     vertical = max(foot.rise + foot.ball, foot.outer_height)

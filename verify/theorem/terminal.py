@@ -53,7 +53,8 @@ from verify.kernel.intervals import lower, upper
 from verify.kernel.region import Region
 from verify.theorem.design import Condition, Design
 from verify.theorem.initial_plan import initial_plan_condition
-from verify.theorem.path_clearance import PathFootprint, horizon_end, path_clearance, path_samples, path_workspace
+from verify.theorem.path_clearance import (PathFootprint, contains, horizon_end, path_clearance, path_samples,
+                                          path_workspace)
 from verify.theorem.completion_bounds import FLOAT_SLACK, CompletionArc, TerminalBounds, completion_arc
 from verify.theorem.completion_bounds import slack_condition as _cond  # lhs + FLOAT_SLACK <= rhs, in Arb
 from verify.theorem.terminal_bearing import bearing_conditions, bearing_sets
@@ -71,9 +72,9 @@ WIDTHS = (1.0, 0.6, 0.35, 0.2, 0.1)
 LOWER_ENDS = (0.0, 0.1, 0.2, 0.35, 0.5)
 #: Fractions of the free heading room α_f is tried at, largest first.
 ANGLES = (1.0, 0.6, 0.3)
-#: The refinement, tried only when no set of the grid above meets every condition: X_f's lower end at every
-#: twentieth of the free band and a narrower width (rate-limited plans need the gentlest law a set allows, and its
-#: gains move with both ends; ``python benchmarks/terminal_rate.py`` measured what the coarse grid misses).
+#: The refinement, tried under rate-limited plans when no set of the grid above meets every condition: X_f's lower
+#: end at every twentieth of the free band and a narrower width (the row faces need the gentlest law a set allows,
+#: and its gains move with both ends; ``python benchmarks/terminal_rate.py`` measured what the coarse grid misses).
 FINE_LOWER_ENDS = tuple(i / 20 for i in range(20))
 FINE_WIDTHS = (1.0, 0.6, 0.35, 0.2, 0.1, 0.05)
 
@@ -212,8 +213,10 @@ def _sets(b: TerminalBounds, fine: bool = False) -> list[TerminalLaw]:
 
 
 def _refined(b: TerminalBounds) -> Iterator[TerminalLaw]:
-    """The refinement's sets, built only when the loop asks for them (the coarse grid found none)."""
-    yield from _sets(b, fine=True)
+    """The refinement's sets under rate-limited plans (the row faces: their gains must be the gentlest a set
+    allows), built only when the loop asks for them (the coarse grid found none); none without rate limits."""
+    if b.jumps is not None:
+        yield from _sets(b, fine=True)
 
 
 def _grid_points(widths: tuple[float, ...], lower_ends: tuple[float, ...]) -> list[tuple[float, float]]:
@@ -295,7 +298,7 @@ def design_terminal(scenario: Scenario, design: Design, region: Region, safe: Sa
 
     closest: tuple[tuple[int, float], tuple[Condition, ...]] | None = None
     narrowest: tuple[float, TerminalLaw, tuple[Condition, ...]] | None = None
-    blocked = math.inf  # the smallest reach whose path failed: the footprint grows with d_hi (z_max is common)
+    blocked: list[PathFootprint] = []  # footprints whose path failed: one that contains any of them fails too
     for law in itertools.chain(_sets(b), _refined(b)):
         own = law_conditions(b, law)
         if not all(c.ok for c in own):
@@ -307,11 +310,13 @@ def design_terminal(scenario: Scenario, design: Design, region: Region, safe: Sa
             return None, (Condition("terminal_backup", "a backup safe set for the terminal condition", None, None,
                                     False, "no backup"),)
         conds = own + (sensing, initial_plan_condition(scenario, design, region, law, safe))
-        if all(c.ok for c in conds) and law.d_hi < blocked:  # the path is sampled only for sets that pass the rest
-            conds = conds + geometry(law)
-            if all(c.ok for c in conds):
-                return law, conds
-            blocked = law.d_hi
+        if all(c.ok for c in conds):  # the path is sampled only for sets that pass the rest, and are not blocked
+            foot = footprint_of(scenario, design, b, law, safe)
+            if not any(contains(foot, small) for small in blocked):
+                conds = conds + geometry(law)
+                if all(c.ok for c in conds):
+                    return law, conds
+                blocked.append(foot)
         if narrowest is None or law.d_hi < narrowest[0]:
             narrowest = (law.d_hi, law, conds)
     if narrowest is not None:

@@ -133,3 +133,21 @@ for name in ("bluerov2_slow", "bluerov2_tracked", "bluerov2_brisk_tracked"):
     if law is not None:
         print(f"  X_f: d in [{law.d_lo:.2f}, {law.d_hi:.2f}] m, faces S = ({law.row_u:.4f}, {law.row_w:.4f}, "
               f"{law.row_r:.4f}) against J = {np.round(rov.limits.jump(rov.controller.dt), 4)}")
+
+# %% [markdown]
+# ## 5. No backup law: the safe tier as the tracking tier's corollary
+# Once tracking is a theorem a plan is accepted at every period, so the backup never runs; what it still costs is
+# its footprint (plans must end where its safe set clears every obstacle) and, on the dynamic plant, its command,
+# which the velocity loop's bound is charged for at every tick. `controller.backup = "none"` (`docs/verify.md` step
+# 13g) drops both: the certificate then gives the safe tier only together with tracking. On
+# `examples/bluerov2_no_backup.toml` (the brisk mission over +-15 % of every coefficient, rocks 10 m from the path)
+# compare it with station keeping:
+
+# %%
+no_backup = load_scenario(EXAMPLES / "bluerov2_no_backup.toml")
+for backup in ("none", "station_keeping"):
+    cert_b = verify.certify(no_backup.with_changes(**{"controller.backup": backup}))
+    error = "diverges" if cert_b.velocity_loop is None or not cert_b.velocity_loop.certified else \
+        tuple(round(e, 4) for e in cert_b.velocity_loop.error)
+    print(f"backup {backup}: tiers {cert_b.tiers.to_dict()}, loop error E {error}, "
+          f"failed {[c.condition for c in cert_b.failures][:3]}")

@@ -148,8 +148,8 @@ def test_under_rate_limited_plans_the_row_faced_law_keeps_a_solver_plan_and_the_
 
 
 def test_the_last_row_is_settled_onto_the_faces_within_the_jump(smooth):
-    """A plan whose last row is far from the law's row at its end: settled, the row lies inside the faces when the
-    jump from the row before allows it, else at the jump's edge nearest them; the other rows are untouched."""
+    """A plan whose last row is far from the law's row at its end, where the jump from the row before allows the
+    faces: settled, the row lies inside the faces and within the jump; the other rows are untouched."""
     sc, cert = smooth
     law, dt = cert.tightening.terminal_law, sc.controller.dt
     x0 = np.asarray(sc.initial_state, dtype=float)
@@ -166,6 +166,28 @@ def test_the_last_row_is_settled_onto_the_faces_within_the_jump(smooth):
     faces = np.array([law.row_u, law.row_w, law.row_r])
     assert min(slacks.values()) >= 0.5 * SETTLE_MARGIN * float(faces.min())
     assert settle_last_row(sc, None, plan, x0, 0.0, np.asarray(cert.tightening.v_max), jump) is plan
+
+
+def test_where_the_jump_cannot_reach_the_faces_the_rows_before_follow_the_settled_last_row(smooth):
+    """Every row 0.3 m/s of surge above the law's row at the plan's end (more than J + S away): the last row goes
+    onto the faces and the rows before it follow, each within J of the next and inside V̄; the first rows, already
+    within reach, are untouched."""
+    sc, cert = smooth
+    law, dt = cert.tightening.terminal_law, sc.controller.dt
+    x0 = np.asarray(sc.initial_state, dtype=float)
+    jump, v_max = sc.limits.jump(dt), np.asarray(cert.tightening.v_max)
+    plan = np.tile(np.array([0.2, 0.0, 0.0]), (sc.controller.horizon_steps, 1))
+    plan[:, 0] += np.linspace(0.0, 0.3, len(plan))          # a ramp up to 0.5 m/s, J_u = 0.05 a row
+    plan[:, 0] = np.minimum(plan[:, 0], v_max[0])
+    out = settle_last_row(sc, law, plan, x0, 0.0, v_max, jump)
+    from tubekit.loop.plan_check import plan_arcs
+    end = plan_arcs(x0, out, dt, 1)[-1, -1]
+    t_end = dt * len(out)
+    slacks = law.row_slacks(end, np.ravel(sc.trajectory.position(t_end)), np.ravel(sc.trajectory.velocity(t_end)),
+                            out[-1], dt)
+    assert min(slacks.values()) >= 0.0
+    assert np.all(np.abs(np.diff(out, axis=0)) <= jump + 1e-12) and np.all(np.abs(out) <= v_max + 1e-12)
+    assert not np.array_equal(out[-2], plan[-2]) and np.array_equal(out[0], plan[0])
 
 
 def test_at_the_start_the_law_s_rows_leave_rest_by_at_most_the_jump(smooth):

@@ -115,25 +115,41 @@ def settle_last_row(scenario: Scenario, law: TerminalLaw | None, plan: np.ndarra
                     v_max: np.ndarray, jump: np.ndarray | None, *, v_min: np.ndarray | None = None) -> np.ndarray:
     """``plan`` (N, 3) from the measured ``x0`` (4,) at ``t0`` (s) with its last row moved onto the row faces of
     the certified ``law`` (within (1 − :data:`SETTLE_MARGIN`) S of the law's row at the plan's end, a few
-    fixed-point rounds: the end moves with the row), then within ``jump`` of the row before it and inside
-    V̄ = [``v_min``, ``v_max``]. The solver does not know the faces (``docs/verify.md`` step 17c); the exact check
-    still decides. ``plan`` itself when the law has no row faces."""
+    fixed-point rounds: the end moves with the row), within ``jump`` of the row before it and inside
+    V̄ = [``v_min``, ``v_max``]. Where the face and the jump about the row before it do not meet (the measured start
+    moved the law's row by more than the solver's box allowed), the last row goes onto the face and the rows before
+    it follow, each within ``jump`` of the next (:func:`_chain_back`). The solver does not know the faces
+    (``docs/verify.md`` step 17c); the exact check still decides. ``plan`` itself when the law has no row faces."""
     plan = np.asarray(plan, dtype=float)
     if law is None or not law.has_rows or len(plan) < 2:
         return plan
     dt = scenario.controller.dt
     out = plan.copy()
-    head = plan_arcs(x0, out[:-1], dt, 1)[-1, -1]
     t_end = t0 + dt * len(out)
     p = np.asarray(scenario.trajectory.position(t_end), dtype=float).reshape(3)
     v = np.asarray(scenario.trajectory.velocity(t_end), dtype=float).reshape(3)
     faces = (1.0 - SETTLE_MARGIN) * np.array([law.row_u, law.row_w, law.row_r])
-    bound = np.asarray(v_max, dtype=float)
-    low, high = _lower(bound, v_min), bound
-    if jump is not None:
-        low, high = np.maximum(low, out[-2] - jump), np.minimum(high, out[-2] + jump)
+    low, high = _lower(np.asarray(v_max, dtype=float), v_min), np.asarray(v_max, dtype=float)
     for _ in range(SETTLE_ROUNDS):
-        end = plan_arcs(head, out[-1:], dt, 1)[-1, -1]
+        end = plan_arcs(x0, out, dt, 1)[-1, -1]
         target = law.command(end, p, v, dt)
-        out[-1] = np.clip(np.clip(out[-1], target - faces, target + faces), low, high)
+        on_face = np.clip(np.clip(out[-1], target - faces, target + faces), low, high)
+        if jump is None:
+            out[-1] = on_face
+            continue
+        near = np.clip(on_face, np.maximum(low, out[-2] - jump), np.minimum(high, out[-2] + jump))
+        if np.all(np.abs(near - target) <= faces):
+            out[-1] = near
+        else:
+            out[-1] = on_face
+            out = _chain_back(out, np.asarray(jump, dtype=float), low, high)
+    return out
+
+
+def _chain_back(rows: np.ndarray, jump: np.ndarray, low: np.ndarray, high: np.ndarray) -> np.ndarray:
+    """``rows`` (N, 3) with each row from the second last down moved within ``jump`` of the row after it (and into
+    [``low``, ``high``]): the last row stays where it is, the others move no more than it takes."""
+    out = rows.copy()
+    for i in range(len(out) - 2, -1, -1):
+        out[i] = np.clip(np.clip(out[i], out[i + 1] - jump, out[i + 1] + jump), low, high)
     return out

@@ -103,3 +103,16 @@ def test_budget_validation_in_python():
         falsify(paper_scenario(), "paper", budget=-5)
     with pytest.raises(ConfigError, match="budget"):
         falsify_closed_loop(paper_scenario(), budget=0)
+
+
+def test_on_the_dynamic_plant_the_closed_loop_attack_draws_the_water_current_within_its_own_bound():
+    """On the dynamic plant the attack's disturbance replaces the water current only (the sway and the loop's
+    error are the plant's own), so it is drawn within the current's bound, the premise the certificate assumes,
+    not within ω̄: on examples/bluerov2_tracked.toml (0.04 m/s per axis, ω̄_xy 0.085 m/s) no run breaks a premise and
+    the attack still pushes the tube past half its radius."""
+    from pathlib import Path
+    sc = load_scenario(Path(__file__).resolve().parents[1] / "examples" / "bluerov2_tracked.toml")
+    cert = verify.certify(sc)
+    res = falsify_closed_loop(sc, budget=3, seed=0, duration=3.0, certificate=cert)
+    assert res.omega_bar == (0.04, 0.04) and res.omega_bar[0] < cert.disturbance.omega_xy
+    assert res.vacuous_runs == 0 and not res.found and 0.5 < res.worst.ratio < 1.0

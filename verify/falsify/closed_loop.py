@@ -35,7 +35,7 @@ from tubekit.exceptions import ConfigError
 from tubekit.loop.pipeline import certified_run
 from tubekit.plant.base import PiecewiseOmega
 from verify.falsify.outcome import SearchOutcome
-from tubekit.loop.promises import PREMISES, Promise
+from tubekit.loop.promises import PREMISES, Promise, current_bound
 from tubekit.scenario import HEMISPHERE_SIGN, Scenario
 from tubekit.tightening import Tightening
 from tubekit.validation import duration_seconds
@@ -304,6 +304,8 @@ def _setup(scenario: Scenario, law: str | None, duration: float, certificate: Ce
     short = scenario.with_changes(duration=float(max(duration, scenario.controller.dt)),
                                   controller=replace(scenario.controller, law=name))
     wxy, wz = tight.disturbance.omega_xy, tight.disturbance.omega_z
+    if scenario.plant.dynamic:  # the override replaces the water current only: its bound is the premise
+        wxy, wz = current_bound(scenario)
     return _Attack(short, tight, law_obj, wxy, wz), cert
 
 

@@ -130,8 +130,9 @@ def settle_last_row(scenario: Scenario, law: TerminalLaw | None, plan: np.ndarra
     v = np.asarray(scenario.trajectory.velocity(t_end), dtype=float).reshape(3)
     faces = (1.0 - SETTLE_MARGIN) * np.array([law.row_u, law.row_w, law.row_r])
     low, high = _lower(np.asarray(v_max, dtype=float), v_min), np.asarray(v_max, dtype=float)
+    head = plan_arcs(x0, out[:-1], dt, 1)[-1, -1]  # the state before the last row; moves only with a chain-back
     for _ in range(SETTLE_ROUNDS):
-        end = plan_arcs(x0, out, dt, 1)[-1, -1]
+        end = plan_arcs(head, out[-1:], dt, 1)[-1, -1]
         target = law.command(end, p, v, dt)
         on_face = np.clip(np.clip(out[-1], target - faces, target + faces), low, high)
         if jump is None:
@@ -143,6 +144,7 @@ def settle_last_row(scenario: Scenario, law: TerminalLaw | None, plan: np.ndarra
         else:
             out[-1] = on_face
             out = _chain_back(out, np.asarray(jump, dtype=float), low, high)
+            head = plan_arcs(x0, out[:-1], dt, 1)[-1, -1]
     return out
 
 

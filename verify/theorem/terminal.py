@@ -292,8 +292,7 @@ def design_terminal(scenario: Scenario, design: Design, region: Region, safe: Sa
     sensing = None if safe is None else sensing_condition(scenario, b, safe)
     path = path_samples(scenario, horizon_end(scenario))
 
-    def geometry(law: TerminalLaw) -> tuple[Condition, ...]:
-        foot = footprint_of(scenario, design, b, law, safe)
+    def geometry(foot: PathFootprint) -> tuple[Condition, ...]:
         return path_clearance(scenario, foot, path) + path_workspace(scenario, foot, path)
 
     closest: tuple[tuple[int, float], tuple[Condition, ...]] | None = None
@@ -313,7 +312,7 @@ def design_terminal(scenario: Scenario, design: Design, region: Region, safe: Sa
         if all(c.ok for c in conds):  # the path is sampled only for sets that pass the rest, and are not blocked
             foot = footprint_of(scenario, design, b, law, safe)
             if not any(contains(foot, small) for small in blocked):
-                conds = conds + geometry(law)
+                conds = conds + geometry(foot)
                 if all(c.ok for c in conds):
                     return law, conds
                 blocked.append(foot)
@@ -321,7 +320,9 @@ def design_terminal(scenario: Scenario, design: Design, region: Region, safe: Sa
             narrowest = (law.d_hi, law, conds)
     if narrowest is not None:
         _, law, conds = narrowest
-        return None, conds if any(c.condition.startswith("path_") for c in conds) else conds + geometry(law)
+        if any(c.condition.startswith("path_") for c in conds):
+            return None, conds
+        return None, conds + geometry(footprint_of(scenario, design, b, law, safe))
     return None, closest[1] if closest is not None else (_no_set(b),)
 
 

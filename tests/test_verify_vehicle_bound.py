@@ -398,3 +398,66 @@ def test_over_twenty_percent_on_a_twenty_rad_per_second_loop_the_bound_holds_at_
             assert np.all(error <= np.array(b.error)), (corner, error, b.error)
             assert _largest_sway(run, settings_, truth) <= b.sway
             assert error.max() > 0.0
+
+
+def _von_benzon_box(fraction: float, bandwidth: float):
+    """The bundled BlueROV2 Heavy with von Benzon's values ± ``fraction`` (zero coefficients stay 0), the loop at
+    ``bandwidth`` rad/s."""
+    box = {k: tuple(sorted((v * (1 - fraction), v * (1 + fraction)))) for k, v in _VON_BENZON.items()}
+    return BLUEROV2_HEAVY.nominal.with_overrides({**box, "Y_v": 0.0, "N_r": 0.0, "loop_bandwidth": bandwidth}), box
+
+
+#: examples/bluerov2_no_backup.toml: its command box V, its plans' jumps J, and its first command's box |c_0| + J (it
+#: starts under way at 0.2 m/s; a start at rest lies in the same box)
+_NO_BACKUP_V, _NO_BACKUP_PLANS, _NO_BACKUP_FIRST = (0.37, 0.15, 0.2), (0.006, 0.003, 0.012), (0.206, 0.003, 0.012)
+
+
+def test_with_the_mass_in_the_state_twenty_percent_closes_where_the_first_decomposition_diverges(monkeypatch):
+    """Over von Benzon's values ±20 % on a 20 rad/s loop, with bluerov2_no_backup's command box and plans' jumps,
+    the first decomposition alone diverges (its (μ − 1) ṡ input charges Ẑ/T_thr); with the second (the mass
+    mismatch in the state, module doc) the fixed point closes."""
+    import verify.vehicle.bound as bound
+    box, _ = _von_benzon_box(0.2, 20.0)
+    kwargs = dict(v_max=_NO_BACKUP_V, tick=H, period=H * TICKS, jump_tick=(0.0, 0.0, 0.0), jump_period=_NO_BACKUP_PLANS,
+                  first_command=_NO_BACKUP_FIRST)
+    both = velocity_loop_bound(box, **kwargs)
+    assert both.certified, both.reason
+    monkeypatch.setattr(bound, "_mass_in_state", lambda *args: math.inf)
+    first = velocity_loop_bound(box, **kwargs)
+    assert not first.certified and "diverged" in next(c for c in first.conditions
+                                                      if c.condition == "loop_fixed_point").detail
+
+
+def test_with_the_mass_in_the_state_the_bound_holds_at_the_corners_of_a_twenty_percent_box():
+    """Property: the bound of the test above holds on the simulated plant at three corners of the ±20 % box (the
+    controller's feedforward keeps the box's centre), under commands that sweep the command box at the plans' rate
+    (triangle waves, where the drag's slope and the mass mismatch matter most) and under commands whose jumps add
+    up against the nominal loop's response."""
+    box, widened = _von_benzon_box(0.2, 20.0)
+    b = velocity_loop_bound(box, v_max=_NO_BACKUP_V, tick=H, period=H * TICKS, jump_tick=(0.0, 0.0, 0.0),
+                            jump_period=_NO_BACKUP_PLANS, first_command=_NO_BACKUP_FIRST)
+    assert b.certified, b.reason
+    signs = _response_signs(20.0, 100.0, box.thruster_time_constant, 400)
+
+    def commands(sign_of, total: int) -> list[tuple[float, float, float]]:
+        cmd, out = [0.0, 0.0, 0.0], []
+        for k in range(total):
+            step = [j * sign_of(k, c) if k % TICKS == 0 else 0.0 for c, j in enumerate(_NO_BACKUP_PLANS)]
+            cmd = [min(max(x + s, -lim), lim) for x, s, lim in zip(cmd, step, _NO_BACKUP_V)]
+            out.append(tuple(cmd))
+        return out
+
+    def triangle(k: int, c: int) -> float:  # up to +V, down to -V, up again, at the plans' largest rate
+        periods_across = _NO_BACKUP_V[c] / _NO_BACKUP_PLANS[c]
+        return 1.0 if (k // TICKS + periods_across) % (4 * periods_across) < 2 * periods_across else -1.0
+    runs = [commands(triangle, 1600), commands(lambda k, c: signs[300 - k % 300] if k % 300 else 0.0, 600)]
+    settings_ = PlantSettings("dynamic", vehicle="bluerov2_heavy",
+                              overrides={**widened, "Y_v": 0.0, "N_r": 0.0, "loop_bandwidth": 20.0})
+    low = {k: box.interval(k)[0] for k in box.interval_fields}
+    high = {k: box.interval(k)[1] for k in box.interval_fields}
+    for corner in (low, high, {**low, "X_udot": high["X_udot"], "N_rdot": high["N_rdot"], "Z_wdot": high["Z_wdot"]}):
+        truth = box.with_point(corner)
+        for run in runs:
+            error = _largest_error(run, substeps=4, plant_settings=settings_, truth=truth)
+            assert np.all(error <= np.array(b.error)), (corner, error, b.error)
+            assert error.max() > 0.0

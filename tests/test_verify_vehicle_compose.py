@@ -122,9 +122,10 @@ def test_the_slow_bluerov2_scenario_certifies_the_safe_tier_with_a_closed_fixed_
     consistent = next(c for c in slow_cert.plant_conditions if c.condition == "loop_consistent")
     assert consistent.ok and consistent.lhs < 1.0
     loop, law = slow_cert.velocity_loop, slow_cert.backup.law
-    assert all(0.0 < e < 0.07 for e in loop.error)
+    assert all(0.0 < e < 0.08 for e in loop.error)
     assert law.yaw_law == "continuous" and law.blends and law.yaw_band == pytest.approx(law.unstable / 2)
-    assert slow_cert.backup.certified and slow_cert.backup.safe_set.level > 5.0  # the gentle set, not the smallest
+    # the gentle set the search chose, not the smallest the design grid certifies
+    assert slow_cert.backup.certified and slow_cert.backup.safe_set.level > 4.0
 
 
 def test_a_run_of_the_slow_scenario_keeps_every_promise(slow_cert):
@@ -237,11 +238,11 @@ def _widened(sc, fraction: float):
 
 
 def test_a_start_that_does_not_close_is_followed_by_the_next_start(monkeypatch):
-    """bluerov2_slow over von Benzon's values ±5 %: from the first start (1.25 × the plans-only bound) the fixed point
-    ends 0.2 % above its assumption (``loop_consistent``); the next start of ``FIXED_POINT_RESTARTS`` closes, and that
+    """bluerov2_slow over von Benzon's values ±15 %: from the first start (1.25 × the plans-only bound) the fixed point
+    ends 0.04 % above its assumption (``loop_consistent``); the next start of ``FIXED_POINT_RESTARTS`` closes, and that
     certificate is what ``certify`` returns, and ``recheck`` agrees with it number for number."""
     import verify.vehicle.compose as compose
-    sc = _widened(load_scenario(SLOW), 0.05)
+    sc = _widened(load_scenario(SLOW), 0.15)
     starts: list[tuple[float, object]] = []
     solve_from = compose._solve_from
 
@@ -434,3 +435,40 @@ def test_the_brisk_tracked_bluerov2_certifies_both_tiers_at_the_owners_speed_and
     promises = {p.name: p for p in tubekit.check_promises(run)}
     assert all(p.ok for p in promises.values() if p.given), [p for p in promises.values() if p.given and not p.ok]
     assert promises["plan_available"].ok and promises["tube"].ok and not run.backup_active.any()
+
+
+# ---- ±20 % with the mass mismatch in the loop's state (docs/verify.md section 9, step 5b) ---------------------
+
+WIDE = "examples/bluerov2_wide_box.toml"
+
+
+@pytest.fixture(scope="module")
+def wide_cert():
+    return certify(load_scenario(WIDE))
+
+
+def test_the_wide_box_example_certifies_both_tiers_where_the_first_decomposition_alone_does_not(wide_cert, monkeypatch):
+    """examples/bluerov2_wide_box.toml (no backup, every coefficient von Benzon's ±20 %): both tiers, recheck
+    agreeing; with the loop bound's second decomposition switched off the same file certifies nothing, refused by
+    the loop's fixed point over the plans alone."""
+    import verify.vehicle.bound as bound
+    import verify.vehicle.compose as compose
+    assert wide_cert.tiers == Tiers(True, True)
+    assert all(0.0 < e < 0.07 for e in wide_cert.velocity_loop.error)
+    assert recheck(json.loads(json.dumps(wide_cert.to_dict()))).ok
+    monkeypatch.setattr(bound, "_mass_in_state", lambda *args: math.inf)
+    compose._SOLVED.clear()
+    first_only = certify(load_scenario(WIDE))
+    compose._SOLVED.clear()
+    assert first_only.tiers == Tiers(False, False)
+    assert "loop_fixed_point" in [c.condition for c in first_only.failures]
+
+
+def test_the_wide_box_example_flown_at_a_corner_keeps_both_tiers_with_a_plan_at_every_period(wide_cert):
+    """20 s of examples/bluerov2_wide_box.toml with the hull at the box's lower corner: every promise of both tiers
+    kept (the velocity loop's error within the E of step 5b among them), a plan at every period, no backup."""
+    import tubekit
+    run = tubekit.simulate(at_corner(load_scenario(WIDE), 0), wide_cert, duration=20.0, progress=False)
+    promises = {p.name: p for p in tubekit.check_promises(run)}
+    assert all(p.ok for p in promises.values() if p.given), [p for p in promises.values() if p.given and not p.ok]
+    assert promises["plan_available"].ok and promises["velocity_loop"].ok and not run.backup_active.any()

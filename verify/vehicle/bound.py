@@ -22,6 +22,16 @@ transient.
 response: jumps (J_tick at every tick, J_period − J_tick more at period boundaries, worst phase),
 the inputs Ẇ and w_n (L1), and the free response from x(0) (peak).
 
+**Second decomposition: the mass mismatch in the state.** The first one charges the mass mismatch through
+(μ − 1) ṡ, whose Ẑ/T_thr term is large for a fast actuator. Instead, with W' = d/m_c and Ĩ = I + W'/(μ k_i)
+(μ is constant), the same loop is exactly ẋ = A(μ) x + (1/k_i, 0, 0) ḋ/m̂_c + (0, 0, −1) w_n with
+A(μ) = A + (μ − 1) (0, −1, k_p − λ_c)(k_i, k_p, 1)ᵀ and ẏ = μ (k_i, k_p, 1) x, a = (k_i, k_p, 0) x − d/m̂_c.
+Since (k_i, k_p, 1) x = ẏ/μ, the mass mismatch is the input (1 − 1/μ) ẏ along (0, −1, k_p − λ_c) =
+−(0, 1, −k_p) + λ_c (0, 0, −1), whose L1 gain is at most h Σ g_J + |λ_c| h Σ g_n (the jump's and w_n's
+columns, already summed); ḋ/m̂_c enters where Ẇ did, and x(0) = (d(ν(0))/(m̂_c k_i), 0, 0). The jumps are the
+same. :func:`computed_bounds` takes, output by output, the smaller of the two (both hold under the same
+assumptions); the second is what closes the loop over wider coefficient boxes (``docs/plant.md`` section 4).
+
 **Theorem (first exit).** Let (E, Â, Ẑ, Ŷ) be assumed bounds of (|e|, |a|, |z|, |ẏ|) per channel.
 While they hold on [0, t): ν lies in the box |y_c| <= V_c + E_c, |v| <= γ̄ (hull ISS bound,
 :func:`verify.theorem.design.hull_sway_bound`); no channel saturates (``loop_saturation``), so the model
@@ -57,7 +67,7 @@ from verify.vehicle.saturation import (SURGE_BANDS, actuator_authority, rate_aut
                                        saturation_conditions, triple)
 
 __all__ = ["LoopBound", "velocity_loop_bound", "actuator_authority", "loop_matrix", "computed_bounds",
-           "input_bounds", "start_bounds", "Inputs", "rate_authority_conditions", "LOOP_MAX_ITERATIONS", "LOOP_INFLATION",
+           "input_bounds", "start_bounds", "start_bounds_nominal", "Inputs", "rate_authority_conditions", "LOOP_MAX_ITERATIONS", "LOOP_INFLATION",
            "SURGE_BANDS"]
 
 #: Default bound on the fixed-point iterations (a count, not seconds).
@@ -94,6 +104,11 @@ class Inputs:
         sup|W| <= sup|1 − 1/μ| Ŷ + sup|d|/m̂ (m/s², m/s², rad/s²): a = (k_i, k_p, 0) x − W.
     sway : float
         γ̄ (m/s) over the assumed velocity box.
+    start_mass, rate_mass, mass : (3,) floats, optional
+        The second decomposition (module doc, "mass in the state"): sup|d_c(ν(0))|/m̂_c, sup|ḋ_c|/m̂_c and
+        sup|1 − 1/μ| Ŷ_c (m/s², m/s³, m/s³; rad for yaw); None: only the first decomposition is bounded.
+    mass_ratio : (3,) floats, optional
+        sup μ = sup m̂_c/m_c per channel: ẏ = μ (k_i, k_p, 1) x in the second decomposition.
     """
 
     start: tuple[float, float, float]
@@ -101,6 +116,10 @@ class Inputs:
     drag: tuple[float, float, float]
     mismatch: tuple[float, float, float]
     sway: float
+    start_mass: tuple[float, float, float] | None = None
+    rate_mass: tuple[float, float, float] | None = None
+    mass: tuple[float, float, float] | None = None
+    mass_ratio: tuple[float, float, float] | None = None
 
 
 class _Loop:
@@ -192,60 +211,98 @@ def start_bounds(loop: _Loop, first_command: Sequence[float]) -> tuple[float, fl
     return tuple(upper(abs(d[c]) / loop.m_true[c]) for c in range(len(loop.names)))
 
 
+def start_bounds_nominal(loop: _Loop, first_command: Sequence[float]) -> tuple[float, float, float]:
+    """sup|d_c|/m̂_c over the first command's box (m/s², m/s², rad/s²): the start transient of the second
+    decomposition (its Ĩ(0) = d/(m̂ k_i); module doc)."""
+    d = channel_mismatch(loop.nominal, loop.hull,
+                         velocity_box(first_command[0], 0.0, first_command[1], first_command[2]), loop.lateral)
+    return tuple(upper(abs(d[c]) / loop.m_hat[c]) for c in range(len(loop.names)))
+
+
 def input_bounds(loop: _Loop, error: Sequence[float], z_bound: Sequence[float],
-                 accel: Sequence[float], start: Sequence[float] | None = None) -> Inputs:
+                 accel: Sequence[float], start: Sequence[float] | None = None,
+                 start_mass: Sequence[float] | None = None) -> Inputs:
     """The model's input bounds over the box |y_c| <= V_c + E_c, |v| <= γ̄ and Θ, given Ẑ and Ŷ = sup|ẏ|;
-    ``start`` is sup|W(0)| (:func:`start_bounds`; None: sup|d|/m over that same box).
+    ``start`` is sup|W(0)| (:func:`start_bounds`; None: sup|d|/m over that same box), ``start_mass`` the second
+    decomposition's (:func:`start_bounds_nominal`; None: sup|d|/m̂ over that box).
 
     ŵ_n = (sup|∂n̂_c/∂y_c − λ_c m̂_c| Ŷ_c + Σ_{j ≠ c} sup|∂n̂_c/∂ν_j| |ν̇_j|)/m̂_c;
-    sup|Ẇ| = sup|μ − 1| (Ẑ/T_thr + |λ_c| Ŷ_c + ŵ_n) + Σ_j sup|∂d_c/∂ν_j| |ν̇_j| / m_c.
+    sup|Ẇ| = sup|μ − 1| (Ẑ/T_thr + |λ_c| Ŷ_c + ŵ_n) + Σ_j sup|∂d_c/∂ν_j| |ν̇_j| / m_c;
+    the second decomposition: sup|ḋ_c|/m̂_c = Σ_j sup|∂d_c/∂ν_j| |ν̇_j| / m̂_c and sup|1 − 1/μ| Ŷ_c.
     """
     box, gamma = loop.box(error)
     n = len(loop.names)
     if not math.isfinite(gamma) or not all(math.isfinite(x) for x in (*box, *z_bound, *accel)):
         inf = (math.inf,) * n
-        return Inputs(start=inf, rate=inf, drag=inf, mismatch=inf, sway=math.inf)
+        return Inputs(start=inf, rate=inf, drag=inf, mismatch=inf, sway=math.inf, start_mass=inf, rate_mass=inf,
+                      mass=inf, mass_ratio=inf)
     nu = velocity_box(box[0], gamma, box[1], box[2])
     rates = _rates(loop, nu, accel)
     grads = channel_gradient(loop.nominal, nu, loop.lateral)
     d = channel_mismatch(loop.nominal, loop.hull, nu, loop.lateral)
     d_grad = channel_mismatch_gradient(loop.nominal, loop.hull, nu, loop.lateral)
-    rate, drag, mismatch = [], [], []
+    rate, drag, mismatch, rate_mass, mass, ratio = [], [], [], [], [], []
     for c in range(n):
         own, lam, y_dot = loop.own[c], arb(loop.slope[c]), arb(accel[c])
         cross = sum((abs(g) * x for j, (g, x) in enumerate(zip(grads[c], rates)) if j != own), arb(0))
         w_n = (abs(grads[c][own] - lam * loop.m_hat[c]) * y_dot + cross) / loop.m_hat[c]
         s_dot = arb(z_bound[c]) / arb(loop.lag) + abs(lam) * y_dot + w_n
         mu = loop.m_hat[c] / loop.m_true[c]
-        d_dot = sum((abs(g) * x for g, x in zip(d_grad[c], rates)), arb(0)) / loop.m_true[c]
-        rate.append(upper(abs(mu - 1) * s_dot + d_dot))
+        d_change = sum((abs(g) * x for g, x in zip(d_grad[c], rates)), arb(0))
+        rate.append(upper(abs(mu - 1) * s_dot + d_change / loop.m_true[c]))
         drag.append(upper(w_n))
         mismatch.append(upper(abs(1 - 1 / mu) * y_dot + abs(d[c]) / loop.m_hat[c]))
+        rate_mass.append(upper(d_change / loop.m_hat[c]))
+        mass.append(upper(abs(1 - 1 / mu) * y_dot))
+        ratio.append(upper(mu))
     if start is None:
         start = tuple(upper(abs(d[c]) / loop.m_true[c]) for c in range(n))
-    return Inputs(start=tuple(start), rate=tuple(rate), drag=tuple(drag), mismatch=tuple(mismatch), sway=gamma)
+    if start_mass is None:
+        start_mass = tuple(upper(abs(d[c]) / loop.m_hat[c]) for c in range(n))
+    return Inputs(start=tuple(start), rate=tuple(rate), drag=tuple(drag), mismatch=tuple(mismatch), sway=gamma,
+                  start_mass=tuple(start_mass), rate_mass=tuple(rate_mass), mass=tuple(mass), mass_ratio=tuple(ratio))
 
 
 def computed_bounds(loop: _Loop, jump_tick: Sequence[float], jump_period: Sequence[float],
                     inputs: Inputs | None = None) -> list[list[float]]:
     """[sup|e|, sup|a|, sup|z|, sup|ẏ|] per channel; ``inputs`` None: jumps only (the first guess).
 
-    Row o (e, a + W, z, ẏ): J_tick Σ g_J + (J_period − J_tick) max_phase Σ_period g_J + h Σ g_W sup|Ẇ|
-    + h Σ g_n sup|w_n| + peak g_W sup|W(0)|; sup|a| adds sup|W|.
+    Each output is the smaller of the module doc's two decompositions, both valid under the same assumptions.
+    Row o of the first (e, a + W, z, ẏ): J_tick Σ g_J + (J_period − J_tick) max_phase Σ_period g_J
+    + h Σ g_W sup|Ẇ| + h Σ g_n sup|w_n| + peak g_W sup|W(0)|; sup|a| adds sup|W|. The second
+    (:func:`_mass_in_state`) replaces sup|Ẇ| and sup|W(0)| by sup|ḋ|/m̂ and sup|d(ν(0))|/m̂ and adds the input
+    (1 − 1/μ) ẏ along (0, −1, k_p − λ_c); its ẏ row is μ (k_i, k_p, 1) x.
     """
     out = []
     for c in range(len(loop.names)):
         jt, jp = arb(jump_tick[c]), arb(jump_period[c])
-        if inputs is not None:
-            rate, drag, start = arb(inputs.rate[c]), arb(inputs.drag[c]), arb(inputs.start[c])
         row = []
         for o, (g_tick, g_period, h_rate, h_drag, peak) in enumerate(loop.gain_balls[c]):
             x = jt * g_tick + (jp - jt) * g_period
-            if inputs is not None:
-                x += h_rate * rate + h_drag * drag + peak * start + (arb(inputs.mismatch[c]) if o == 1 else 0)
-            row.append(upper(x))
+            if inputs is None:
+                row.append(upper(x))
+                continue
+            first = x + h_rate * arb(inputs.rate[c]) + h_drag * arb(inputs.drag[c]) + peak * arb(inputs.start[c])
+            first += arb(inputs.mismatch[c]) if o == 1 else 0
+            row.append(min(upper(first), _mass_in_state(loop, c, o, x, inputs)))
         out.append(row)
     return out
+
+
+def _mass_in_state(loop: _Loop, c: int, o: int, jumps: arb, inputs: Inputs) -> float:
+    """Output ``o`` of channel ``c`` in the second decomposition (module doc), given its jumps' part ``jumps``;
+    +inf when ``inputs`` has no second decomposition."""
+    if inputs.mass is None or inputs.rate_mass is None or inputs.start_mass is None or inputs.mass_ratio is None:
+        return math.inf
+    g_tick, _, h_rate, h_drag, peak = loop.gain_balls[c][o]
+    along = arb(loop.tick) * g_tick + abs(arb(loop.slope[c])) * h_drag  # L1 of (0, −1, k_p − λ) = −b_J + λ b_n
+    x = (jumps + h_rate * arb(inputs.rate_mass[c]) + h_drag * arb(inputs.drag[c]) + along * arb(inputs.mass[c])
+         + peak * arb(inputs.start_mass[c]))
+    if o == 1:
+        x += arb(inputs.mismatch[c])
+    if o == 3:
+        x *= arb(inputs.mass_ratio[c])
+    return upper(x)
 
 
 def _validate(params: VehicleParams, v_max: Any, tick: Any, period: Any, jump_tick: Any, jump_period: Any,
@@ -308,7 +365,7 @@ def velocity_loop_bound(params: VehicleParams, *, v_max: Sequence[float], tick: 
                                                                                       first_command), v))
     sway_max, sway_tick, sway_period = _sway_command(params, sway)
     loop = _loop_of(params, v, h, ticks, sway_max)
-    start = start_bounds(loop, first)
+    start, start_mass = start_bounds(loop, first), start_bounds_nominal(loop, first)
     floor_u = nonnegative("surge_floor", surge_floor)
     # the sway channel's command: 0 under plans, a lateral backup's own jumps
     jt_int, jp_int = with_sway(jt, sway_tick, loop.lateral), with_sway(jp, sway_period, loop.lateral)
@@ -320,7 +377,7 @@ def velocity_loop_bound(params: VehicleParams, *, v_max: Sequence[float], tick: 
     while loop.stable and k < max_iterations and not found:
         k += 1
         inputs = input_bounds(loop, [r[0] for r in assumed], [r[2] for r in assumed], [r[3] for r in assumed],
-                              start)
+                              start, start_mass)
         computed = computed_bounds(loop, jt_int, jp_int, inputs)
         found = all(computed[c][o] < assumed[c][o] for c in range(n) for o in range(4))
         if growth is None:

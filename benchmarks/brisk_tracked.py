@@ -54,14 +54,15 @@ def variants(path: Path = SCENARIO) -> dict:
     from tubekit.scenario import Obstacle, load_scenario
     base = load_scenario(path)
     steady = {"disturbance.amplitude": (0.0, 0.0, 0.0)}
+    c = max(base.disturbance.amplitude[:2])  # the steady current: the scenario's own horizontal bound, on an axis
     moved = lambda f: base.with_changes(obstacles=tuple(Obstacle(center=f(o.center), radius=o.radius)
                                                         for o in base.obstacles))
     return {
         "as shipped": base,
-        "steady +x": base.with_changes(**steady, **{"disturbance.constant": (0.1, 0.0, 0.0)}),
-        "steady -x": base.with_changes(**steady, **{"disturbance.constant": (-0.1, 0.0, 0.0)}),
-        "steady +y": base.with_changes(**steady, **{"disturbance.constant": (0.0, 0.1, 0.0)}),
-        "steady -y": base.with_changes(**steady, **{"disturbance.constant": (0.0, -0.1, 0.0)}),
+        "steady +x": base.with_changes(**steady, **{"disturbance.constant": (c, 0.0, 0.0)}),
+        "steady -x": base.with_changes(**steady, **{"disturbance.constant": (-c, 0.0, 0.0)}),
+        "steady +y": base.with_changes(**steady, **{"disturbance.constant": (0.0, c, 0.0)}),
+        "steady -y": base.with_changes(**steady, **{"disturbance.constant": (0.0, -c, 0.0)}),
         "rocks mirrored": moved(lambda c: (c[0], -c[1], c[2])),
         "rocks moved along": moved(lambda c: (c[0] - 10.0, c[1], c[2])),
         "hull at the lower corner": _corner(base, 0),

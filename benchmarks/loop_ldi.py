@@ -66,7 +66,8 @@ from scipy.spatial import ConvexHull, QhullError
 from tubekit.model.vehicles import VEHICLES
 from verify.kernel.intervals import enclose, lower, upper
 from verify.theorem.design import hull_sway_bound
-from verify.vehicle.bound import _loop_of, _rates, velocity_loop_bound
+from verify.vehicle.bound import _rates, velocity_loop_bound
+from verify.vehicle.loop_data import loop_data_of
 from verify.vehicle.model import (channel_gradient, channel_masses, channel_mismatch, channel_mismatch_gradient,
                                   hull_balls, nominal_balls, velocity_box)
 
@@ -431,7 +432,7 @@ def unit_rate_gain(channel: LdiChannel, tick: float) -> float:
 def study_bound(params: VehicleParams, v_max: Sequence[float], jump_tick: Sequence[float],
                 jump_period: Sequence[float], tick: float = 0.01, ticks: int = 10) -> LdiBound:
     """:func:`ldi_bound` for a vehicle with the gains, lag, sway bound and sway rate of :mod:`verify.vehicle.bound`."""
-    loop = _loop_of(params, tuple(v_max), tick, ticks)
+    loop = loop_data_of(params, tuple(v_max), tick, ticks)
 
     def sway_rate(box: Sequence[float], gamma: float, accel: Sequence[float]) -> float:
         return upper(_rates(loop, velocity_box(box[0], gamma, box[1], box[2]), accel)[1])
@@ -453,7 +454,7 @@ def main() -> int:
     print("decoupled gain sup|e| per unit command rate (s), u / w / r, and the decay rate proved (1/s); V = (0.4, "
           "0.3, 0.3) + 10 %")
     for label, params in _boxes():
-        loop = _loop_of(params, (0.4, 0.3, 0.3), 0.01, 10)
+        loop = loop_data_of(params, (0.4, 0.3, 0.3), 0.01, 10)
         box = (0.44, 0.33, 0.33)
         chans = [ps[0] for ps in _channels_at(params, box, upper(hull_sway_bound(params, box[0], box[2])),
                                               loop.k_p, loop.k_i, loop.lag, 0.01)]

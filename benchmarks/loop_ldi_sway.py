@@ -23,7 +23,7 @@ from typing import Iterator, Sequence
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 import loop_ldi  # noqa: E402 - the study this what-if reruns
 
-from verify.vehicle.bound import _loop_of  # noqa: E402
+from verify.vehicle.loop_data import loop_data_of  # noqa: E402
 
 __all__ = ["SWAY_CASES", "BOXES", "coupled", "rows", "main"]
 
@@ -38,7 +38,7 @@ def coupled(params, sway: tuple[float, float] | None) -> "loop_ldi.LdiBound":
     """The coupled LDI bound on :data:`V_SLOW` with the plans' jumps, the sway as ``sway`` assumes (None: the hull)."""
     if sway is None:
         return loop_ldi.study_bound(params, V_SLOW, (0.0, 0.0, 0.0), PLANS)
-    loop = _loop_of(params, V_SLOW, 0.01, 10)
+    loop = loop_data_of(params, V_SLOW, 0.01, 10)
     return loop_ldi.ldi_bound(params, v_max=V_SLOW, k_p=loop.k_p, k_i=loop.k_i, lag=loop.lag, tick=0.01, ticks=10,
                               jump_tick=(0.0, 0.0, 0.0), jump_period=PLANS,
                               sway_bound=lambda u, r: sway[0], sway_rate=lambda box, gamma, accel: sway[1])

@@ -24,7 +24,7 @@ import numpy as np
 
 from verify.kernel.intervals import upper
 from verify.theorem.design import hull_sway_bound
-from verify.vehicle.bound import _loop_of
+from verify.vehicle.loop_data import loop_data_of
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 import loop_ldi as study  # noqa: E402 - the LDI study's vertex sets, the same boxes
@@ -78,7 +78,7 @@ def _holds(p: np.ndarray | None, mats: Sequence[np.ndarray], columns: Sequence[n
 
 def channel_gain(params, channel: int, box: Sequence[float] = (0.44, 0.33, 0.33), tick: float = 0.01) -> float:
     """γ (s) of ``channel`` over the velocity box ``box`` and the vehicle's coefficient box (the LDI's vertex sets)."""
-    loop = _loop_of(params, (0.4, 0.3, 0.3), tick, 10)
+    loop = loop_data_of(params, (0.4, 0.3, 0.3), tick, 10)
     data = study._channel_data(params, box, upper(hull_sway_bound(params, box[0], box[2])), channel, loop.k_p,
                                loop.k_i, loop.lag, tick)
     mats = [study._floats(a) for a in study.vertex_matrices(data.k_p, data.k_i, data.lag, data.m_hat, data.pairs,

@@ -24,6 +24,16 @@ def test_the_variants_change_what_their_names_say():
         variants["hull at the upper corner"].plant.truth)["X_uu"]
 
 
+def test_a_scenario_with_a_smaller_current_bound_gets_its_own_steady_current():
+    """The steady variants take the scenario's own horizontal bound (0.04 m/s on the published-spread example), so
+    each variant stays inside what its certificate assumes."""
+    from pathlib import Path
+    published = Path(__file__).resolve().parent.parent / "examples" / "bluerov2_published.toml"
+    variants = _module().variants(published)
+    assert variants["steady +x"].disturbance.constant == (0.04, 0.0, 0.0)
+    assert variants["steady -y"].disturbance.constant == (0.0, -0.04, 0.0)
+
+
 def test_a_short_flight_reports_both_tiers_kept_with_a_plan_at_every_period():
     row = _module().fly("as shipped", _module().variants()["as shipped"], duration=3.0)
     assert row["certified"] == [True, True] and row["broken"] == [] and row["backup_s"] == 0.0

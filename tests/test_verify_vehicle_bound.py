@@ -180,17 +180,42 @@ def test_a_vehicle_that_is_not_one_is_refused():
 
 def test_a_diverging_fixed_point_is_one_root_cause_and_no_astronomical_number():
     """Issue 32: over the published spread the small-gain fixed point diverges; the certificate used to print
-    loop_saturation[X] = 1.5e+267 from the last assumed bounds. Now the fixed point names why and how fast it grew,
-    and the conditions that need its E say they were not evaluated because of it."""
+    loop_saturation[X] = 1.5e+267 from the last assumed bounds. Now the fixed point names the channel that cannot
+    close on its own and the three parts of its own loop gain (the coefficient intervals an owner can narrow), and
+    the conditions that need its E say they were not evaluated because of it."""
     bound = velocity_loop_bound(BLUEROV2_HEAVY, **PAPER)
     by_name = {c.condition: c for c in bound.conditions}
     fixed = by_name["loop_fixed_point"]
-    assert fixed.ok is False and "diverged" in fixed.detail and "first round multiplied the bounds by" in fixed.detail
+    assert fixed.ok is False and "diverged" in fixed.detail and "channel u cannot close on its own" in fixed.detail
+    assert all(part in fixed.detail for part in ("drag mismatch's slope", "nominal drag's slope", "added-mass"))
     assert "loop_bandwidth" in fixed.detail  # the knobs an owner has, the loop's speed among them
     for name in ("loop_saturation[X]", "loop_saturation[Z]", "loop_saturation[N]", "loop_sway"):
         assert by_name[name].ok is False and "root cause: loop_fixed_point" in by_name[name].detail
     numbers = [x for c in bound.conditions for x in (c.lhs, c.rhs) if x is not None]
     assert all(not math.isfinite(x) or abs(x) < 1e6 for x in numbers)
+
+
+def test_where_every_channel_closes_on_its_own_the_diagnosis_names_the_coupling():
+    """The published spread on a 20 rad/s loop with bluerov2_no_backup's command box and plans: every channel's own
+    loop gain is below 1, yet the fixed point diverges, so the diagnosis names the channels' coupling, not a
+    channel."""
+    box = BLUEROV2_HEAVY.with_overrides({"loop_bandwidth": 20.0})
+    bound = velocity_loop_bound(box, v_max=(0.37, 0.15, 0.2), tick=H, period=H * TICKS, jump_tick=(0.0, 0.0, 0.0),
+                                jump_period=(0.006, 0.003, 0.012), first_command=(0.206, 0.003, 0.012))
+    fixed = next(c for c in bound.conditions if c.condition == "loop_fixed_point")
+    assert fixed.ok is False and "drive one another" in fixed.detail and "cannot close on its own" not in fixed.detail
+
+
+def test_a_point_vehicle_has_no_mismatch_and_no_mass_part_in_its_own_gain():
+    """At a point of the coefficient box the controller's model is the plant: the own loop gain's mismatch part is
+    exactly 0 (the mismatch is the model at the coefficients' differences), its mass part 0 up to the balls' rounding,
+    and only the nominal drag's slope over V remains (> 0: quadratic drag)."""
+    from verify.vehicle.bound import own_gains
+    from verify.vehicle.loop_data import loop_data_of
+    loop = loop_data_of(BLUEROV2_HEAVY.nominal, V, H, TICKS)
+    gains = own_gains(loop, (0.01, 0.01, 0.01, 0.01) if loop.lateral else (0.01, 0.01, 0.01))
+    assert all(mism == 0.0 and 0.0 <= mass < 1e-12 and drag >= 0.0 for mism, drag, mass in gains)
+    assert max(drag for _, drag, _ in gains) > 0.0
 
 
 #: von Benzon's BlueROV2 Heavy (kg, kg/s, kg/m), the midpoint of the ±10 % box below (docs/plant.md section 3.2).

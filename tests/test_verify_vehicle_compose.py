@@ -472,3 +472,46 @@ def test_the_wide_box_example_flown_at_a_corner_keeps_both_tiers_with_a_plan_at_
     promises = {p.name: p for p in tubekit.check_promises(run)}
     assert all(p.ok for p in promises.values() if p.given), [p for p in promises.values() if p.given and not p.ok]
     assert promises["plan_available"].ok and promises["velocity_loop"].ok and not run.backup_active.any()
+
+
+# ---- the published coefficient spread (the bundled box) ------------------------------------------------------
+
+PUBLISHED = "examples/bluerov2_published.toml"
+
+
+@pytest.fixture(scope="module")
+def published_cert():
+    return certify(load_scenario(PUBLISHED))
+
+
+def test_over_the_published_spread_both_tiers_hold_and_the_box_is_the_bundled_one(published_cert):
+    """examples/bluerov2_published.toml: the bundled BlueROV2 Heavy's own coefficient box (no interval narrowed:
+    N_r anywhere in [-4.64, 0]), both tiers, recheck agreeing; the loop bound's first decomposition alone does not
+    close there (``loop_fixed_point``)."""
+    import verify.vehicle.bound as bound
+    import verify.vehicle.compose as compose
+    from tubekit.model.vehicle_sets import BLUEROV2_HEAVY
+    sc = load_scenario(PUBLISHED)
+    bundled = BLUEROV2_HEAVY
+    assert all(sc.plant.params.interval(k) == bundled.interval(k) for k in bundled.interval_fields)
+    assert published_cert.tiers == Tiers(True, True)
+    assert recheck(json.loads(json.dumps(published_cert.to_dict()))).ok
+    original = bound._mass_in_state
+    try:
+        bound._mass_in_state = lambda *args: math.inf
+        compose._SOLVED.clear()
+        first_only = certify(sc)
+    finally:
+        bound._mass_in_state = original
+        compose._SOLVED.clear()
+    assert "loop_fixed_point" in [c.condition for c in first_only.failures]
+
+
+def test_over_the_published_spread_a_hull_without_linear_yaw_damping_keeps_every_promise(published_cert):
+    """20 s of examples/bluerov2_published.toml with the hull at the box's upper corner (N_r = 0, the least drag in
+    every channel): every promise of both tiers kept, a plan at every period, no backup."""
+    import tubekit
+    run = tubekit.simulate(at_corner(load_scenario(PUBLISHED), 1), published_cert, duration=20.0, progress=False)
+    promises = {p.name: p for p in tubekit.check_promises(run)}
+    assert all(p.ok for p in promises.values() if p.given), [p for p in promises.values() if p.given and not p.ok]
+    assert promises["plan_available"].ok and promises["velocity_loop"].ok and not run.backup_active.any()

@@ -49,7 +49,6 @@ def test_a_smaller_sway_box_gives_at_least_the_authority_of_the_hulls():
 def test_the_lateral_thrust_limit_is_the_sway_loops_saturation_condition(bluerov_point):
     """The sway loop's need sup|n̂_2| + m̂_22 sup|a_v| against Y_max: a lateral limit below the need fails
     ``loop_saturation[Y]`` by name (the hand check: the Coriolis force m̂_11 u r alone at the box's corner)."""
-    import dataclasses
     sat = {c.condition: c for c in bluerov_point.conditions}["loop_saturation[Y]"]
     p = BLUEROV2_HEAVY.nominal
     coriolis = p.mass_entries[0] * V[0] * V[2]

@@ -45,12 +45,11 @@ little after t* (the signals are right-continuous, jumps isolated): a contradict
 
 from __future__ import annotations
 
-import functools
 import math
 from dataclasses import dataclass
 from typing import Any, Sequence
 
-from flint import arb, ctx
+from flint import arb
 
 from tubekit.exceptions import ConfigError
 from tubekit.validation import finite, nonnegative, positive
@@ -58,34 +57,20 @@ from verify.theorem.design import Condition, hull_sway_bound
 from verify.kernel.intervals import upper
 from verify.vehicle.result import LoopBound
 from tubekit.model.vehicle_params import VehicleParams
-from verify.vehicle.model import (arb_body_forces, channel_gradient, channel_masses, channel_mismatch,
-                                  channel_mismatch_gradient, hull_balls, nominal_balls, nominal_params,
-                                  point_time_constant, velocity_box, with_sway, without_sway,
-                                  CHANNELS, LATERAL_CHANNELS)
-from verify.vehicle.response import RESPONSE_PREC, ResponseSums, impulse_sums
+from verify.vehicle.model import (arb_body_forces, channel_gradient, channel_mismatch, channel_mismatch_gradient,
+                                  point_time_constant, velocity_box, with_sway, without_sway)
+from verify.vehicle.loop_data import LoopData, loop_data_of, loop_matrix
 from verify.vehicle.saturation import (SURGE_BANDS, actuator_authority, rate_authority_conditions,
                                        saturation_conditions, triple)
 
 __all__ = ["LoopBound", "velocity_loop_bound", "actuator_authority", "loop_matrix", "computed_bounds",
-           "input_bounds", "start_bounds", "start_bounds_nominal", "Inputs", "rate_authority_conditions", "LOOP_MAX_ITERATIONS", "LOOP_INFLATION",
-           "SURGE_BANDS"]
+           "input_bounds", "start_bounds", "start_bounds_nominal", "own_gains", "Inputs", "rate_authority_conditions",
+           "LOOP_MAX_ITERATIONS", "LOOP_INFLATION", "SURGE_BANDS"]
 
 #: Default bound on the fixed-point iterations (a count, not seconds).
 LOOP_MAX_ITERATIONS = 60
 #: Each iteration assumes (1 + LOOP_INFLATION) x the bounds it computed.
 LOOP_INFLATION = 0.05
-
-
-def loop_matrix(k_p: float, k_i: float, time_constant: float, slope: float = 0.0) -> list[list[arb]]:
-    """A (1/s) of the module doc for gains k_p (1/s), k_i (1/s²), the actuator lag T_thr (s) and λ_c (1/s).
-
-    With λ_c = ``slope`` the z row loses λ_c (k_i, k_p, 1): the part λ_c ẏ of w_n moved into A.
-    """
-    with ctx.workprec(RESPONSE_PREC):
-        kp, ki, t, lam = arb(k_p), arb(k_i), arb(time_constant), arb(slope)
-        zero = arb(0)
-        return [[zero, arb(1), zero], [-ki, -kp, arb(-1)],
-                [kp * ki - lam * ki, kp * kp - ki - lam * kp, kp - 1 / t - lam]]
 
 
 @dataclass(frozen=True)
@@ -122,76 +107,7 @@ class Inputs:
     mass_ratio: tuple[float, float, float] | None = None
 
 
-class _Loop:
-    """The vehicle's fixed data for the fixed point: balls, gains, slopes λ_c, the response sums per channel."""
-
-    def __init__(self, params: VehicleParams, v_max: Sequence[float], tick: float, ticks: int,
-                 sway_max: float = 0.0) -> None:
-        self.params, self.v_max, self.tick = params, tuple(v_max), tick
-        # with lateral thrust a fourth channel, sway (index 1), regulated to its command: the command box is
-        # |v_c| <= sway_max (0 but under a backup law that commands sway, verify.backup.hold)
-        self.lateral = bool(getattr(params, "lateral", False))
-        self.names = LATERAL_CHANNELS if self.lateral else CHANNELS
-        self.own = (0, 1, 2, 3) if self.lateral else (0, 2, 3)
-        self.forces = "XYZN" if self.lateral else "XZN"
-        self.v_int = with_sway(self.v_max, float(sway_max), self.lateral)
-        self.nominal, self.hull = nominal_balls(params), hull_balls(params)
-        nom = nominal_params(params)
-        self.k_p, self.k_i = float(nom.loop_bandwidth), 0.25 * float(nom.loop_bandwidth) ** 2
-        self.lag = point_time_constant(params)
-        self.m_hat = channel_masses(self.nominal, self.lateral)
-        self.m_true = channel_masses(self.hull, self.lateral)
-        box, gamma = self.box((0.0,) * len(self.names))
-        self.slope = tuple(float(x.mid()) for x in self.slopes(box, gamma)) if math.isfinite(gamma) \
-            else (0.0,) * len(self.names)
-        kp, ki = arb(self.k_p), arb(self.k_i)
-        self.sums: tuple[ResponseSums, ...] = tuple(impulse_sums(
-            loop_matrix(self.k_p, self.k_i, self.lag, lam), [[0, 1, -kp], [1 / ki, 0, 0], [0, 0, -1]],
-            [[0, 1, 0], [ki, kp, 0], [0, 0, 1], [ki, kp, 1]], tick=tick, ticks_per_period=ticks)
-            for lam in self.slope)
-        h = arb(tick)
-        # the sums as balls, per channel and output row: (jump per tick, jump per period, h Ẇ, h w_n, start peak)
-        self.gain_balls = tuple(tuple((arb(s.tick[o][0]), arb(s.period[o][0]), h * arb(s.tick[o][1]),
-                                       h * arb(s.tick[o][2]), arb(s.peak[o][1])) for o in range(4))
-                                for s in self.sums)
-
-    @property
-    def stable(self) -> bool:
-        """Every channel's sampled loop is stable."""
-        return all(s.stable for s in self.sums)
-
-    def box(self, error: Sequence[float]) -> tuple[tuple[float, float, float], float]:
-        """(ū, w̄, r̄) = V + E and the sway's bound over it (m/s, m/s, rad/s; m/s): with lateral thrust the sway
-        channel's E_v (``error`` then has the sway channel at index 1), else γ̄ of the free hull."""
-        bar = tuple(upper(arb(v) + arb(e)) for v, e in zip(self.v_int, error))
-        if self.lateral:
-            return without_sway(bar, True), bar[1]
-        return bar, upper(hull_sway_bound(self.params, bar[0], bar[2]))
-
-    def slopes(self, box: Sequence[float], gamma: float) -> list[arb]:
-        """∂n̂_c/∂y_c / m̂_c over the velocity box (1/s): the drag's slope in the channel's own speed."""
-        grads = channel_gradient(self.nominal, velocity_box(box[0], gamma, box[1], box[2]), self.lateral)
-        return [grads[c][self.own[c]] / self.m_hat[c] for c in range(len(self.names))]
-
-
-@functools.lru_cache(maxsize=8)
-def _cached_loop(params: VehicleParams, v_max: tuple, tick: float, ticks: int, prec: int,
-                 sway_max: float = 0.0) -> _Loop:
-    """:class:`_Loop` memoised on its inputs and the working precision ``prec`` (bits) it is built at."""
-    return _Loop(params, v_max, tick, ticks, sway_max)
-
-
-def _loop_of(params: VehicleParams, v_max: tuple, tick: float, ticks: int, sway_max: float = 0.0) -> _Loop:
-    """The :class:`_Loop` (its impulse-response sums) of a vehicle, V and h, built once per (hashable) vehicle: it
-    does not depend on the jump bounds, which the fixed point of :mod:`verify.vehicle.compose` changes each round."""
-    try:
-        hash(params)
-    except TypeError:
-        return _Loop(params, v_max, tick, ticks, sway_max)
-    return _cached_loop(params, v_max, tick, ticks, ctx.prec, sway_max)
-
-
-def _rates(loop: _Loop, nu: Sequence[arb], accel: Sequence[float]) -> tuple[arb, arb, arb, arb]:
+def _rates(loop: LoopData, nu: Sequence[arb], accel: Sequence[float]) -> tuple[arb, arb, arb, arb]:
     """Bounds of |u̇|, |v̇|, |ẇ|, |ṙ|: the channels' Ŷ, and the sway row m22 v̇ = −n2 − m24 ṙ over Θ (with lateral
     thrust the sway channel's own Ŷ_v)."""
     if len(accel) != len(loop.names):
@@ -203,7 +119,7 @@ def _rates(loop: _Loop, nu: Sequence[arb], accel: Sequence[float]) -> tuple[arb,
     return arb(accel[0]), arb(upper(sway)), arb(accel[1]), arb(accel[2])
 
 
-def start_bounds(loop: _Loop, first_command: Sequence[float]) -> tuple[float, float, float]:
+def start_bounds(loop: LoopData, first_command: Sequence[float]) -> tuple[float, float, float]:
     """sup|W(0)| = sup|d_c|/m_c over the first command's box |y_c| <= F_c, v = 0, and Θ (m/s², m/s², rad/s²): the
     start transient of the trimmed start (module doc); it does not depend on the fixed point's assumption."""
     d = channel_mismatch(loop.nominal, loop.hull,
@@ -211,7 +127,7 @@ def start_bounds(loop: _Loop, first_command: Sequence[float]) -> tuple[float, fl
     return tuple(upper(abs(d[c]) / loop.m_true[c]) for c in range(len(loop.names)))
 
 
-def start_bounds_nominal(loop: _Loop, first_command: Sequence[float]) -> tuple[float, float, float]:
+def start_bounds_nominal(loop: LoopData, first_command: Sequence[float]) -> tuple[float, float, float]:
     """sup|d_c|/m̂_c over the first command's box (m/s², m/s², rad/s²): the start transient of the second
     decomposition (its Ĩ(0) = d/(m̂ k_i); module doc)."""
     d = channel_mismatch(loop.nominal, loop.hull,
@@ -219,7 +135,7 @@ def start_bounds_nominal(loop: _Loop, first_command: Sequence[float]) -> tuple[f
     return tuple(upper(abs(d[c]) / loop.m_hat[c]) for c in range(len(loop.names)))
 
 
-def input_bounds(loop: _Loop, error: Sequence[float], z_bound: Sequence[float],
+def input_bounds(loop: LoopData, error: Sequence[float], z_bound: Sequence[float],
                  accel: Sequence[float], start: Sequence[float] | None = None,
                  start_mass: Sequence[float] | None = None) -> Inputs:
     """The model's input bounds over the box |y_c| <= V_c + E_c, |v| <= γ̄ and Θ, given Ẑ and Ŷ = sup|ẏ|;
@@ -263,7 +179,7 @@ def input_bounds(loop: _Loop, error: Sequence[float], z_bound: Sequence[float],
                   start_mass=tuple(start_mass), rate_mass=tuple(rate_mass), mass=tuple(mass), mass_ratio=tuple(ratio))
 
 
-def computed_bounds(loop: _Loop, jump_tick: Sequence[float], jump_period: Sequence[float],
+def computed_bounds(loop: LoopData, jump_tick: Sequence[float], jump_period: Sequence[float],
                     inputs: Inputs | None = None) -> list[list[float]]:
     """[sup|e|, sup|a|, sup|z|, sup|ẏ|] per channel; ``inputs`` None: jumps only (the first guess).
 
@@ -289,7 +205,7 @@ def computed_bounds(loop: _Loop, jump_tick: Sequence[float], jump_period: Sequen
     return out
 
 
-def _mass_in_state(loop: _Loop, c: int, o: int, jumps: arb, inputs: Inputs) -> float:
+def _mass_in_state(loop: LoopData, c: int, o: int, jumps: arb, inputs: Inputs) -> float:
     """Output ``o`` of channel ``c`` in the second decomposition (module doc), given its jumps' part ``jumps``;
     +inf when ``inputs`` has no second decomposition."""
     if inputs.mass is None or inputs.rate_mass is None or inputs.start_mass is None or inputs.mass_ratio is None:
@@ -364,7 +280,7 @@ def velocity_loop_bound(params: VehicleParams, *, v_max: Sequence[float], tick: 
     first = v if first_command is None else tuple(min(f, x) for f, x in zip(triple("first_command",
                                                                                       first_command), v))
     sway_max, sway_tick, sway_period = _sway_command(params, sway)
-    loop = _loop_of(params, v, h, ticks, sway_max)
+    loop = loop_data_of(params, v, h, ticks, sway_max)
     start, start_mass = start_bounds(loop, first), start_bounds_nominal(loop, first)
     floor_u = nonnegative("surge_floor", surge_floor)
     # the sway channel's command: 0 under plans, a lateral backup's own jumps
@@ -372,6 +288,7 @@ def velocity_loop_bound(params: VehicleParams, *, v_max: Sequence[float], tick: 
     n = len(loop.names)
     base = computed_bounds(loop, jt_int, jp_int)
     assumed = [[x * (1 + LOOP_INFLATION) + 1e-12 for x in row] for row in base]
+    first_box = [row[0] for row in assumed]
     found, k, computed, inputs, growth = False, 0, base, None, None
     stop = f"no closing after {max_iterations} rounds"
     while loop.stable and k < max_iterations and not found:
@@ -394,7 +311,7 @@ def velocity_loop_bound(params: VehicleParams, *, v_max: Sequence[float], tick: 
         authority = actuator_authority(params, v, floor_u, upper(arb(sway_max) + arb(computed[1][0]))
                                        if loop.lateral else None)
     return _result(loop, params, (v, h, d, jt, jp, first, floor_u), assumed, computed, inputs, authority,
-                   (k, max_iterations), found, rho, _why_open(loop, found, stop, growth))
+                   (k, max_iterations), found, rho, _why_open(loop, found, stop, growth, first_box))
 
 
 def _sway_command(params: VehicleParams, sway: Sequence[float]) -> tuple[float, float, float]:
@@ -412,19 +329,54 @@ def _sway_command(params: VehicleParams, sway: Sequence[float]) -> tuple[float, 
 _QUANTITIES = ("sup|e|", "sup|a|", "sup|z|", "sup|ydot|")
 
 
-def _why_open(loop: _Loop, found: bool, stop: str, growth: list | None) -> str:
-    """The root cause of a fixed point that did not close (empty when it closed), in words an owner can act on."""
+def own_gains(loop: LoopData, error: Sequence[float]) -> tuple[tuple[float, float, float], ...]:
+    """Per channel, the three parts of its own small-gain loop in the second decomposition (module doc) over the box
+    |y_c| <= V_c + E_c (``error``): sup μ × the L1 gain to ẏ of (the mismatch's slope sup|∂d_c/∂y_c|/m̂_c, the
+    nominal drag's slope variation sup|∂n̂_c/∂y_c/m̂_c − λ_c|, the mass mismatch sup|1 − 1/μ|), each per unit Ŷ_c
+    (dimensionless). A channel whose parts add up to 1 or more cannot close whatever the others do."""
+    box, gamma = loop.box(error)
+    if not math.isfinite(gamma):
+        return tuple((math.inf,) * 3 for _ in loop.names)
+    nu = velocity_box(box[0], gamma, box[1], box[2])
+    grads = channel_gradient(loop.nominal, nu, loop.lateral)
+    d_grad = channel_mismatch_gradient(loop.nominal, loop.hull, nu, loop.lateral)
+    out = []
+    for c in range(len(loop.names)):
+        own, mu = loop.own[c], loop.m_hat[c] / loop.m_true[c]
+        g_tick, _, h_rate, h_drag, _ = loop.gain_balls[c][3]
+        along = arb(loop.tick) * g_tick + abs(arb(loop.slope[c])) * h_drag
+        parts = (h_rate * abs(d_grad[c][own]) / loop.m_hat[c],
+                 h_drag * abs(grads[c][own] / loop.m_hat[c] - arb(loop.slope[c])), along * abs(1 - 1 / mu))
+        out.append(tuple(upper(mu * x) for x in parts))
+    return tuple(out)
+
+
+def _why_open(loop: LoopData, found: bool, stop: str, growth: list | None, first_box: Sequence[float] = ()) -> str:
+    """The root cause of a fixed point that did not close (empty when it closed), in words an owner can act on: a
+    channel whose own loop gain (:func:`own_gains`, at the first round's box) is 1 or more, with its three parts,
+    else the coupling between the channels."""
     if found or growth is None:
         return ""
+    head = f"diverged ({stop})"
+    knobs = ("a narrower coefficient box, a smaller V, smaller command jumps (a gentler backup, a lower plan rate) "
+             "or a faster loop (plant.vehicle.loop_bandwidth, where the thrusters' lag and limits allow it) lower it")
+    gains = own_gains(loop, first_box) if first_box else ()
+    worst = max(range(len(gains)), key=lambda c: sum(gains[c]), default=None)
+    if worst is not None and sum(gains[worst]) >= 1.0:
+        mism, drag, mass = gains[worst]
+        return (f"{head}; channel {loop.names[worst]} cannot close on its own: its own loop gain is "
+                f"{mism + drag + mass:.3g} >= 1 ({mism:.3g} from the drag mismatch's slope, the intervals of its "
+                f"damping coefficients; {drag:.3g} from the nominal drag's slope over V + E; {mass:.3g} from its "
+                f"added-mass interval) (docs/plant.md, section 4); {knobs}")
     c, o = max(((c, o) for c in range(len(growth)) for o in range(4)), key=lambda co: growth[co[0]][co[1]])
-    return (f"diverged ({stop}); the first round multiplied the bounds by up to {growth[c][o]:.3g} "
-            f"({_QUANTITIES[o]} of channel {loop.names[c]}): the small-gain loop's gain is not below 1 here, the "
-            "coefficient mismatch entering it as an input that grows with E (docs/plant.md, section 4); a narrower "
-            "coefficient box, a smaller V, smaller command jumps (a gentler backup, a lower plan rate) or a faster "
-            "loop (plant.vehicle.loop_bandwidth, where the thrusters' lag and limits allow it) lower it")
+    own = f"; the largest own loop gain is {sum(gains[worst]):.3g} (channel {loop.names[worst]})" if gains else ""
+    return (f"{head}; the first round multiplied the bounds by up to {growth[c][o]:.3g} "
+            f"({_QUANTITIES[o]} of channel {loop.names[c]}): the channels drive one another through the cross terms "
+            f"(Coriolis, the mismatch's other slopes){own}, and together the small-gain loop's gain is not below 1 "
+            f"here (docs/plant.md, section 4); {knobs}")
 
 
-def _result(loop: _Loop, params: VehicleParams, given: tuple, assumed: list, computed: list, inputs: Inputs | None,
+def _result(loop: LoopData, params: VehicleParams, given: tuple, assumed: list, computed: list, inputs: Inputs | None,
             authority: tuple, iterations: tuple[int, int], found: bool, rho: tuple | None,
             why_open: str = "") -> LoopBound:
     """The :class:`LoopBound` with every condition of the theorem (bounds +inf when not certified)."""

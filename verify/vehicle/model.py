@@ -21,6 +21,7 @@ from typing import Mapping, Sequence
 from flint import arb
 
 from tubekit.exceptions import ConfigError
+from tubekit.model.vehicle_params import VehicleParams
 from verify.kernel.intervals import _abs, enclose, point, upper
 
 __all__ = ["COEFFICIENTS", "MASS_FIELDS", "field_ball", "nominal_params", "hull_balls", "nominal_balls",

@@ -3,7 +3,7 @@
 The conditions ``loop_saturation[X|(Y|)Z|N]`` of :func:`verify.vehicle.bound.velocity_loop_bound` (Step 7 of
 ``docs/verify.md`` section 9: the command never saturates, so the loop's linear model holds) and the acceleration
 each channel delivers against drag in V (``rate_authority[c]``: a plan's rate limit is something the vehicle can
-do). Each takes the loop's fixed data (:class:`verify.vehicle.bound._Loop`, read through the protocol
+do). Each takes the loop's fixed data (:class:`verify.vehicle.loop_data.LoopData`, read through the protocol
 :class:`_Loop`: its channels, nominal balls and masses).
 """
 
@@ -26,7 +26,7 @@ from verify.vehicle.model import CHANNELS, channel_forces, channel_masses, hull_
 
 
 class _Loop(Protocol):
-    """What these conditions read of the loop's fixed data (:class:`verify.vehicle.bound._Loop`)."""
+    """What these conditions read of the loop's fixed data (:class:`verify.vehicle.loop_data.LoopData`)."""
 
     lateral: bool
     names: str

@@ -1,0 +1,107 @@
+"""The velocity loop's fixed data per vehicle: its gains, balls, slopes and rigorous response sums.
+
+:class:`LoopData` holds what the fixed point of :mod:`verify.vehicle.bound` reads every round and never changes:
+the nominal and true coefficient balls, the gains k_p = ω_b and k_i = ω_b²/4, the actuator lag, the channels'
+masses, the constant drag slopes λ_c (the midpoint of ∂n̂_c/∂y_c / m̂_c over V) and, per channel, the impulse
+response sums of :func:`loop_matrix` (:func:`verify.vehicle.response.impulse_sums`). :func:`loop_data_of` builds
+it once per hashable vehicle, command box and tick.
+"""
+
+from __future__ import annotations
+
+import functools
+import math
+from typing import Sequence
+
+from flint import arb, ctx
+
+from tubekit.model.vehicle_params import VehicleParams
+from verify.kernel.intervals import upper
+from verify.theorem.design import hull_sway_bound
+from verify.vehicle.model import (channel_gradient, channel_masses, hull_balls, nominal_balls, nominal_params,
+                                  point_time_constant, velocity_box, with_sway, without_sway, CHANNELS,
+                                  LATERAL_CHANNELS)
+from verify.vehicle.response import RESPONSE_PREC, ResponseSums, impulse_sums
+
+__all__ = ["LoopData", "loop_data_of", "loop_matrix"]
+
+
+def loop_matrix(k_p: float, k_i: float, time_constant: float, slope: float = 0.0) -> list[list[arb]]:
+    """A (1/s) of the module doc for gains k_p (1/s), k_i (1/s²), the actuator lag T_thr (s) and λ_c (1/s).
+
+    With λ_c = ``slope`` the z row loses λ_c (k_i, k_p, 1): the part λ_c ẏ of w_n moved into A.
+    """
+    with ctx.workprec(RESPONSE_PREC):
+        kp, ki, t, lam = arb(k_p), arb(k_i), arb(time_constant), arb(slope)
+        zero = arb(0)
+        return [[zero, arb(1), zero], [-ki, -kp, arb(-1)],
+                [kp * ki - lam * ki, kp * kp - ki - lam * kp, kp - 1 / t - lam]]
+
+
+class LoopData:
+    """The vehicle's fixed data for the fixed point: balls, gains, slopes λ_c, the response sums per channel."""
+
+    def __init__(self, params: VehicleParams, v_max: Sequence[float], tick: float, ticks: int,
+                 sway_max: float = 0.0) -> None:
+        self.params, self.v_max, self.tick = params, tuple(v_max), tick
+        # with lateral thrust a fourth channel, sway (index 1), regulated to its command: the command box is
+        # |v_c| <= sway_max (0 but under a backup law that commands sway, verify.backup.hold)
+        self.lateral = bool(getattr(params, "lateral", False))
+        self.names = LATERAL_CHANNELS if self.lateral else CHANNELS
+        self.own = (0, 1, 2, 3) if self.lateral else (0, 2, 3)
+        self.forces = "XYZN" if self.lateral else "XZN"
+        self.v_int = with_sway(self.v_max, float(sway_max), self.lateral)
+        self.nominal, self.hull = nominal_balls(params), hull_balls(params)
+        nom = nominal_params(params)
+        self.k_p, self.k_i = float(nom.loop_bandwidth), 0.25 * float(nom.loop_bandwidth) ** 2
+        self.lag = point_time_constant(params)
+        self.m_hat = channel_masses(self.nominal, self.lateral)
+        self.m_true = channel_masses(self.hull, self.lateral)
+        box, gamma = self.box((0.0,) * len(self.names))
+        self.slope = tuple(float(x.mid()) for x in self.slopes(box, gamma)) if math.isfinite(gamma) \
+            else (0.0,) * len(self.names)
+        kp, ki = arb(self.k_p), arb(self.k_i)
+        self.sums: tuple[ResponseSums, ...] = tuple(impulse_sums(
+            loop_matrix(self.k_p, self.k_i, self.lag, lam), [[0, 1, -kp], [1 / ki, 0, 0], [0, 0, -1]],
+            [[0, 1, 0], [ki, kp, 0], [0, 0, 1], [ki, kp, 1]], tick=tick, ticks_per_period=ticks)
+            for lam in self.slope)
+        h = arb(tick)
+        # the sums as balls, per channel and output row: (jump per tick, jump per period, h Ẇ, h w_n, start peak)
+        self.gain_balls = tuple(tuple((arb(s.tick[o][0]), arb(s.period[o][0]), h * arb(s.tick[o][1]),
+                                       h * arb(s.tick[o][2]), arb(s.peak[o][1])) for o in range(4))
+                                for s in self.sums)
+
+    @property
+    def stable(self) -> bool:
+        """Every channel's sampled loop is stable."""
+        return all(s.stable for s in self.sums)
+
+    def box(self, error: Sequence[float]) -> tuple[tuple[float, float, float], float]:
+        """(ū, w̄, r̄) = V + E and the sway's bound over it (m/s, m/s, rad/s; m/s): with lateral thrust the sway
+        channel's E_v (``error`` then has the sway channel at index 1), else γ̄ of the free hull."""
+        bar = tuple(upper(arb(v) + arb(e)) for v, e in zip(self.v_int, error))
+        if self.lateral:
+            return without_sway(bar, True), bar[1]
+        return bar, upper(hull_sway_bound(self.params, bar[0], bar[2]))
+
+    def slopes(self, box: Sequence[float], gamma: float) -> list[arb]:
+        """∂n̂_c/∂y_c / m̂_c over the velocity box (1/s): the drag's slope in the channel's own speed."""
+        grads = channel_gradient(self.nominal, velocity_box(box[0], gamma, box[1], box[2]), self.lateral)
+        return [grads[c][self.own[c]] / self.m_hat[c] for c in range(len(self.names))]
+
+
+@functools.lru_cache(maxsize=8)
+def _cached_loop(params: VehicleParams, v_max: tuple, tick: float, ticks: int, prec: int,
+                 sway_max: float = 0.0) -> LoopData:
+    """:class:`LoopData` memoised on its inputs and the working precision ``prec`` (bits) it is built at."""
+    return LoopData(params, v_max, tick, ticks, sway_max)
+
+
+def loop_data_of(params: VehicleParams, v_max: tuple, tick: float, ticks: int, sway_max: float = 0.0) -> LoopData:
+    """The :class:`LoopData` (its impulse-response sums) of a vehicle, V and h, built once per (hashable) vehicle: it
+    does not depend on the jump bounds, which the fixed point of :mod:`verify.vehicle.compose` changes each round."""
+    try:
+        hash(params)
+    except TypeError:
+        return LoopData(params, v_max, tick, ticks, sway_max)
+    return _cached_loop(params, v_max, tick, ticks, ctx.prec, sway_max)

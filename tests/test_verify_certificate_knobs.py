@@ -176,3 +176,25 @@ def test_a_condition_that_holds_has_no_knob(pc_cert):
 def test_every_row_of_the_table_names_its_fields():
     assert all(rule.fields for rule in KNOB_TABLE)
     assert KNOB_TABLE[0].matches("keep_up[u]") and not KNOB_TABLE[0].matches("keep_up[w]")
+
+
+PUBLISHED = read_toml(Path(__file__).resolve().parent.parent / "examples" / "bluerov2_published.toml", "CONFIG")
+
+
+def _plant_condition(cert: verify.Certificate, name: str) -> verify.Condition:
+    return {c.condition: c for c in (*cert.conditions, *cert.plant_conditions)}[name]
+
+
+def test_without_a_backup_a_diverging_loop_gets_the_surge_limit_at_which_it_closes():
+    """The published-spread example with u_max 0.3 m/s: the loop's bound diverges (no numbers on the condition);
+    the knob names the largest surge limit a bisection finds, and re-certified there the loop closes. With a backup
+    (station keeping) the plans' bound is only necessary, so no knob is given."""
+    table, cert = _certify(PUBLISHED, {"limits.u_max": 0.3})
+    cond = _plant_condition(cert, "loop_fixed_point")
+    assert cond.ok is False and cond.lhs is None
+    (knob,) = knobs_for(cert, cond)
+    assert knob.field == "limits.u_max" and knob.relation == "<=" and 0.2 <= knob.value < 0.3
+    fixed = verify.certify(scenario_from_dict(_with_knob(table, knob)))
+    assert _plant_condition(fixed, "loop_fixed_point").ok is True
+    _, kept = _certify(PUBLISHED, {"limits.u_max": 0.3, "controller.backup": "station_keeping"})
+    assert knobs_for(kept, _plant_condition(kept, "loop_fixed_point")) == ()

@@ -20,13 +20,19 @@ disturbance bounds:
 * ``rate_authority[c]`` (ρ_c <= a_c): ``limits.rate[c]`` <= rhs (when a_c > 0);
 * ``terminal_rate[c]`` (S + K(deviation) <= J = ρ_c δ, the reported set's face at its narrowest): ``limits.rate[c]``
   >= lhs / (δ (1 − FACE_ROOM)) (kinematic plant: neither K depends on the rates); exact for the reported set,
-  another set of the grid may pass with less.
+  another set of the grid may pass with less;
+* ``loop_fixed_point`` (the velocity loop's bound closes) on the dynamic plant with ``controller.backup = "none"``
+  (then the loop is bounded for the plans' jumps alone, ``verify.vehicle.compose.plans_only_bound``):
+  ``limits.u_max`` <= the largest value a bisection over (0, ū) finds at which that bound closes, rounded down and
+  checked again at the rounded value (the only rule not in closed form: the bound is a fixed point; the value
+  shown passes, a smaller one is not promised to).
 
 The rows of ``keep_up`` and ``yaw_budget`` hold only for a design at σ = 0 (then κ̄ = 0 and V̄ = V; at
 σ > 0 the tube, hence κ̄, moves with every one of those fields) on the kinematic plant, with the scenario's
 own region (no ``region=`` override). ``safe_only.*`` conditions are the σ = 0 design's. On the dynamic plant
 ω̄, the tube and the backup are one fixed point of the velocity loop's error, which every field but the rate
-limit moves: only ``rate_authority[c]`` has a knob there (the authority a_c depends on V and the vehicle).
+limit moves: only ``rate_authority[c]`` has a knob there (the authority a_c depends on V and the vehicle), and
+``loop_fixed_point`` without a backup.
 Not solvable for one field, so silent: ``tube``, ``e_bar[*]`` (the margins move with the region through the
 gain bounds), ``v_bar[*]``, ``initial*``, ``target_in_workspace`` (two corners), the backup's and the
 velocity loop's conditions.
@@ -216,6 +222,37 @@ def _sway_bound(c: _Failed, ctx: _Context) -> list[Knob]:
     return [] if ctx.dynamic else c.knob("disturbance.sway.bound", ">=", c.rhs, "m/s")
 
 
+#: Bisection steps of the ``loop_fixed_point`` knob (each one plans-only loop bound, about 0.05 s).
+LOOP_BISECTION_STEPS = 12
+
+
+def _loop_closes(scenario: Scenario, u_max: float) -> bool:
+    """True when the plans-only loop bound of ``scenario`` with ``limits.u_max`` = ``u_max`` is certified (False
+    when that value is not a valid scenario, e.g. below ``limits.initial``)."""
+    from tubekit.exceptions import ConfigError
+    from verify.vehicle.compose import plans_only_bound
+    try:
+        return plans_only_bound(scenario.with_changes(**{"limits.u_max": u_max})).certified
+    except ConfigError:
+        return False
+
+
+def _loop_fixed_point(c: _Failed, ctx: _Context) -> list[Knob]:
+    """The largest ``limits.u_max`` below the scenario's at which the plans-only loop closes (module doc); with no
+    backup only (any backup adds its own jumps, which the plans' bound does not cover)."""
+    sc = ctx.scenario
+    if not ctx.dynamic or sc.controller.backup != "none":
+        return []
+    lo, hi = 0.0, float(sc.limits.u_max)
+    for _ in range(LOOP_BISECTION_STEPS):
+        mid = 0.5 * (lo + hi)
+        lo, hi = (mid, hi) if _loop_closes(sc, mid) else (lo, mid)
+    value = _rounded(lo, up=False)
+    if value is None or not _loop_closes(sc, value):
+        return []
+    return [Knob(c.name, "limits.u_max", "<=", value, "m/s")]
+
+
 def _rate_authority(c: _Failed, ctx: _Context) -> list[Knob]:
     """ρ_c <= a_c; a_c depends on V and the vehicle only."""
     axis = "uwr".index(c.name[-2])
@@ -240,6 +277,7 @@ class KnobRule:
     pattern: str
     fields: tuple[str, ...]
     solve: Callable[[_Failed, _Context], list[Knob]]
+    numbers: bool = True  # the rule reads the condition's two numbers (a failed one may lack them)
 
     def matches(self, name: str) -> bool:
         """True when ``name`` (without the ``safe_only.`` prefix) is a condition of this row."""
@@ -256,6 +294,7 @@ KNOB_TABLE: tuple[KnobRule, ...] = (
     KnobRule(r"sway_bound", ("disturbance.sway.bound",), _sway_bound),
     KnobRule(r"rate_authority\[[uwr]\]", ("limits.rate",), _rate_authority),
     KnobRule(r"terminal_rate\[[uwr]\]", ("limits.rate",), _terminal_rate),
+    KnobRule(r"loop_fixed_point", ("limits.u_max",), _loop_fixed_point, numbers=False),
 )
 
 
@@ -275,12 +314,16 @@ def _context(cert: CertificateRecord, name: str) -> tuple[_Context, str]:
 def knobs_for(cert: CertificateRecord, condition: Condition) -> tuple[Knob, ...]:
     """The knobs of one failed ``condition`` of ``cert`` (empty when it holds, when a side is missing, or when its
     inequality is not solvable for one field: module doc)."""
-    if condition.ok is not False or condition.lhs is None or condition.rhs is None:
+    if condition.ok is not False:
         return ()
     ctx, base = _context(cert, condition.condition)
     rule = next((r for r in KNOB_TABLE if r.matches(base)), None)
     if rule is None:
         return ()
+    if condition.lhs is None or condition.rhs is None:
+        if rule.numbers:
+            return ()
+        return tuple(rule.solve(_Failed(condition.condition, math.nan, math.nan), ctx))
     return tuple(rule.solve(_Failed(condition.condition, float(condition.lhs), float(condition.rhs)), ctx))
 
 

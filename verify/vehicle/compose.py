@@ -68,7 +68,7 @@ from verify.theorem.tiers import solve_tiers
 from verify.vehicle.bound import LoopBound, rate_authority_conditions, velocity_loop_bound
 
 __all__ = ["DynamicSolution", "LawLoop", "solve_dynamic", "loop_for_law", "tracking_disturbance", "plan_jumps",
-           "handover_jump", "surge_floor_of", "FIXED_POINT_ROUNDS", "FIXED_POINT_RESTARTS", "PLAN_CHECK_TOLERANCE"]
+           "handover_jump", "surge_floor_of", "plans_only_bound", "FIXED_POINT_ROUNDS", "FIXED_POINT_RESTARTS", "PLAN_CHECK_TOLERANCE"]
 
 #: The plan check's rate tolerance, carried by the proof (one number: :data:`tubekit.design_inputs.RATE_TOLERANCE`).
 PLAN_CHECK_TOLERANCE = RATE_TOLERANCE
@@ -270,6 +270,12 @@ def _consistent(loop: LoopBound, assumed: tuple[float, float, float], sway: floa
                      "backup (largest ratio over u, w, r" + ("" if sway is None else " and the sway loop") + ")",
                      ratio if math.isfinite(ratio) else None, 1.0, ok,
                      f"E = {[round(x, 6) for x in loop.error]}, assumed {[round(x, 6) for x in assumed]}{lateral}")
+
+
+def plans_only_bound(scenario: Scenario) -> LoopBound:
+    """The velocity loop's bound for the plans' jumps alone (:func:`_plans_only`): with ``controller.backup =
+    "none"`` the loop the certificate bounds; with any backup a necessary condition (a backup only adds jumps)."""
+    return _plans_only(scenario)
 
 
 def _plans_only(scenario: Scenario) -> LoopBound:

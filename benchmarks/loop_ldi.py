@@ -63,6 +63,7 @@ from flint import arb, arb_mat, ctx
 
 from scipy.spatial import ConvexHull, QhullError
 
+from tubekit.model.vehicle_params import VehicleParams
 from tubekit.model.vehicles import VEHICLES
 from verify.kernel.intervals import enclose, lower, upper
 from verify.theorem.design import hull_sway_bound
@@ -319,7 +320,7 @@ def channel_lyapunov(data: ChannelData, objective: str = "e") -> LdiChannel | No
 def _gains(data: ChannelData, p: np.ndarray, decay: float, mats: list, jumps: list) -> LdiChannel:
     """The gains of the module doc for a certified P."""
     pa = [[arb(float(x)) for x in row] for row in p]
-    kp, ki, m_hat = arb(data.k_p), arb(data.k_i), data.m_hat
+    kp, m_hat = arb(data.k_p), data.m_hat
     jump = max(_p_norm(pa, b) for b in jumps)
     start = _p_norm(pa, [arb(0), arb(1), arb(1)]) * data.mismatch
     coupling = tuple(0.0 if g is None else _p_norm(pa, g) for g in data.coupling)

@@ -297,8 +297,9 @@ def velocity_loop_bound(params: VehicleParams, *, v_max: Sequence[float], tick: 
                               start, start_mass)
         computed = computed_bounds(loop, jt_int, jp_int, inputs)
         found = all(computed[c][o] < assumed[c][o] for c in range(n) for o in range(4))
-        if growth is None:
-            growth = [[computed[c][o] / assumed[c][o] for o in range(4)] for c in range(n)]
+        if growth is None:  # against the jumps' own bounds only (an output no jump moves starts from ~0: no ratio)
+            growth = [[computed[c][o] / assumed[c][o] if base[c][o] > 0.0 else math.nan for o in range(4)]
+                      for c in range(n)]
         if not found:
             grown = [[x * (1 + LOOP_INFLATION) for x in row] for row in computed]
             if not all(math.isfinite(x) for row in grown for x in row):
@@ -325,10 +326,6 @@ def _sway_command(params: VehicleParams, sway: Sequence[float]) -> tuple[float, 
     return values[0], values[1], max(values[1], values[2])
 
 
-#: What the fixed point bounds, per channel, in the order of :func:`computed_bounds`' rows.
-_QUANTITIES = ("sup|e|", "sup|a|", "sup|z|", "sup|ydot|")
-
-
 def own_gains(loop: LoopData, error: Sequence[float]) -> tuple[tuple[float, float, float], ...]:
     """Per channel, the three parts of its own small-gain loop in the second decomposition (module doc) over the box
     |y_c| <= V_c + E_c (``error``): sup μ × the L1 gain to ẏ of (the mismatch's slope sup|∂d_c/∂y_c|/m̂_c, the
@@ -351,6 +348,10 @@ def own_gains(loop: LoopData, error: Sequence[float]) -> tuple[tuple[float, floa
     return tuple(out)
 
 
+#: What the fixed point bounds, per channel, in the order of :func:`computed_bounds`' rows.
+_QUANTITIES = ("sup|e|", "sup|a|", "sup|z|", "sup|ydot|")
+
+
 def _why_open(loop: LoopData, found: bool, stop: str, growth: list | None, first_box: Sequence[float] = ()) -> str:
     """The root cause of a fixed point that did not close (empty when it closed), in words an owner can act on: a
     channel whose own loop gain (:func:`own_gains`, at the first round's box) is 1 or more, with its three parts,
@@ -360,6 +361,11 @@ def _why_open(loop: LoopData, found: bool, stop: str, growth: list | None, first
     head = f"diverged ({stop})"
     knobs = ("a narrower coefficient box, a smaller V, smaller command jumps (a gentler backup, a lower plan rate) "
              "or a faster loop (plant.vehicle.loop_bandwidth, where the thrusters' lag and limits allow it) lower it")
+    rising = [(growth[c][o], c, o) for c in range(len(growth)) for o in range(4) if math.isfinite(growth[c][o])]
+    if rising:
+        g, c, o = max(rising)
+        head += (f"; the first round multiplied the bounds by up to {g:.3g} ({_QUANTITIES[o]} of channel "
+                 f"{loop.names[c]})")
     gains = own_gains(loop, first_box) if first_box else ()
     worst = max(range(len(gains)), key=lambda c: sum(gains[c]), default=None)
     if worst is not None and sum(gains[worst]) >= 1.0:
@@ -368,12 +374,12 @@ def _why_open(loop: LoopData, found: bool, stop: str, growth: list | None, first
                 f"{mism + drag + mass:.3g} >= 1 ({mism:.3g} from the drag mismatch's slope, the intervals of its "
                 f"damping coefficients; {drag:.3g} from the nominal drag's slope over V + E; {mass:.3g} from its "
                 f"added-mass interval) (docs/plant.md, section 4); {knobs}")
-    c, o = max(((c, o) for c in range(len(growth)) for o in range(4)), key=lambda co: growth[co[0]][co[1]])
-    own = f"; the largest own loop gain is {sum(gains[worst]):.3g} (channel {loop.names[worst]})" if gains else ""
-    return (f"{head}; the first round multiplied the bounds by up to {growth[c][o]:.3g} "
-            f"({_QUANTITIES[o]} of channel {loop.names[c]}): the channels drive one another through the cross terms "
-            f"(Coriolis, the mismatch's other slopes){own}, and together the small-gain loop's gain is not below 1 "
-            f"here (docs/plant.md, section 4); {knobs}")
+    if worst is None:
+        return f"{head}; the small-gain loop's gain is not below 1 here (docs/plant.md, section 4); {knobs}"
+    return (f"{head}; at the first round's box every channel's own loop gain is below 1 (the largest "
+            f"{sum(gains[worst]):.3g}, channel {loop.names[worst]}), but the channels drive one another through the "
+            f"cross terms (Coriolis, the mismatch's other slopes) and the slopes grow with E: together the small-gain "
+            f"loop's gain is not below 1 here (docs/plant.md, section 4); {knobs}")
 
 
 def _result(loop: LoopData, params: VehicleParams, given: tuple, assumed: list, computed: list, inputs: Inputs | None,

@@ -437,6 +437,29 @@ def test_the_brisk_tracked_bluerov2_certifies_both_tiers_at_the_owners_speed_and
     assert promises["plan_available"].ok and promises["tube"].ok and not run.backup_active.any()
 
 
+# ---- the loop bound's step 5b on the shipped examples (docs/verify.md section 9) -------------------------------
+
+def _certified_without_step_5b(monkeypatch, path: str) -> Certificate:
+    """``path`` certified with the loop bound's second decomposition switched off (the first alone); the memo of
+    dynamic solutions is cleared before and after, so no other test sees this certificate."""
+    import verify.vehicle.bound as bound
+    import verify.vehicle.compose as compose
+    monkeypatch.setattr(bound, "_mass_in_state", lambda *args: math.inf)
+    compose._SOLVED.clear()
+    try:
+        return certify(load_scenario(path))
+    finally:
+        compose._SOLVED.clear()
+
+
+def _flown_at_corner(path: str, end: int, cert: Certificate):
+    """(the promises by name, the run) of 20 s of ``path`` under ``cert`` with the hull at the lower (0) or upper (1)
+    corner of its coefficient box."""
+    import tubekit
+    run = tubekit.simulate(at_corner(load_scenario(path), end), cert, duration=20.0, progress=False)
+    return {p.name: p for p in tubekit.check_promises(run)}, run
+
+
 # ---- ±20 % with the mass mismatch in the loop's state (docs/verify.md section 9, step 5b) ---------------------
 
 WIDE = "examples/bluerov2_wide_box.toml"
@@ -451,15 +474,10 @@ def test_the_wide_box_example_certifies_both_tiers_where_the_first_decomposition
     """examples/bluerov2_wide_box.toml (no backup, every coefficient von Benzon's ±20 %): both tiers, recheck
     agreeing; with the loop bound's second decomposition switched off the same file certifies nothing, refused by
     the loop's fixed point over the plans alone."""
-    import verify.vehicle.bound as bound
-    import verify.vehicle.compose as compose
     assert wide_cert.tiers == Tiers(True, True)
     assert all(0.0 < e < 0.07 for e in wide_cert.velocity_loop.error)
     assert recheck(json.loads(json.dumps(wide_cert.to_dict()))).ok
-    monkeypatch.setattr(bound, "_mass_in_state", lambda *args: math.inf)
-    compose._SOLVED.clear()
-    first_only = certify(load_scenario(WIDE))
-    compose._SOLVED.clear()
+    first_only = _certified_without_step_5b(monkeypatch, WIDE)
     assert first_only.tiers == Tiers(False, False)
     assert "loop_fixed_point" in [c.condition for c in first_only.failures]
 
@@ -467,9 +485,7 @@ def test_the_wide_box_example_certifies_both_tiers_where_the_first_decomposition
 def test_the_wide_box_example_flown_at_a_corner_keeps_both_tiers_with_a_plan_at_every_period(wide_cert):
     """20 s of examples/bluerov2_wide_box.toml with the hull at the box's lower corner: every promise of both tiers
     kept (the velocity loop's error within the E of step 5b among them), a plan at every period, no backup."""
-    import tubekit
-    run = tubekit.simulate(at_corner(load_scenario(WIDE), 0), wide_cert, duration=20.0, progress=False)
-    promises = {p.name: p for p in tubekit.check_promises(run)}
+    promises, run = _flown_at_corner(WIDE, 0, wide_cert)
     assert all(p.ok for p in promises.values() if p.given), [p for p in promises.values() if p.given and not p.ok]
     assert promises["plan_available"].ok and promises["velocity_loop"].ok and not run.backup_active.any()
 
@@ -484,34 +500,23 @@ def published_cert():
     return certify(load_scenario(PUBLISHED))
 
 
-def test_over_the_published_spread_both_tiers_hold_and_the_box_is_the_bundled_one(published_cert):
+def test_over_the_published_spread_both_tiers_hold_and_the_box_is_the_bundled_one(published_cert, monkeypatch):
     """examples/bluerov2_published.toml: the bundled BlueROV2 Heavy's own coefficient box (no interval narrowed:
     N_r anywhere in [-4.64, 0]), both tiers, recheck agreeing; the loop bound's first decomposition alone does not
     close there (``loop_fixed_point``)."""
-    import verify.vehicle.bound as bound
-    import verify.vehicle.compose as compose
     from tubekit.model.vehicle_sets import BLUEROV2_HEAVY
     sc = load_scenario(PUBLISHED)
     bundled = BLUEROV2_HEAVY
     assert all(sc.plant.params.interval(k) == bundled.interval(k) for k in bundled.interval_fields)
     assert published_cert.tiers == Tiers(True, True)
     assert recheck(json.loads(json.dumps(published_cert.to_dict()))).ok
-    original = bound._mass_in_state
-    try:
-        bound._mass_in_state = lambda *args: math.inf
-        compose._SOLVED.clear()
-        first_only = certify(sc)
-    finally:
-        bound._mass_in_state = original
-        compose._SOLVED.clear()
+    first_only = _certified_without_step_5b(monkeypatch, PUBLISHED)
     assert "loop_fixed_point" in [c.condition for c in first_only.failures]
 
 
 def test_over_the_published_spread_a_hull_without_linear_yaw_damping_keeps_every_promise(published_cert):
     """20 s of examples/bluerov2_published.toml with the hull at the box's upper corner (N_r = 0, the least drag in
     every channel): every promise of both tiers kept, a plan at every period, no backup."""
-    import tubekit
-    run = tubekit.simulate(at_corner(load_scenario(PUBLISHED), 1), published_cert, duration=20.0, progress=False)
-    promises = {p.name: p for p in tubekit.check_promises(run)}
+    promises, run = _flown_at_corner(PUBLISHED, 1, published_cert)
     assert all(p.ok for p in promises.values() if p.given), [p for p in promises.values() if p.given and not p.ok]
     assert promises["plan_available"].ok and promises["velocity_loop"].ok and not run.backup_active.any()

@@ -119,19 +119,23 @@ def _rates(loop: LoopData, nu: Sequence[arb], accel: Sequence[float]) -> tuple[a
     return arb(accel[0]), arb(upper(sway)), arb(accel[1]), arb(accel[2])
 
 
+def _start_mismatch(loop: LoopData, first_command: Sequence[float]) -> tuple:
+    """The mismatch d_c (balls) over the first command's box |y_c| <= F_c, v = 0, and Θ."""
+    return channel_mismatch(loop.nominal, loop.hull,
+                            velocity_box(first_command[0], 0.0, first_command[1], first_command[2]), loop.lateral)
+
+
 def start_bounds(loop: LoopData, first_command: Sequence[float]) -> tuple[float, float, float]:
     """sup|W(0)| = sup|d_c|/m_c over the first command's box |y_c| <= F_c, v = 0, and Θ (m/s², m/s², rad/s²): the
     start transient of the trimmed start (module doc); it does not depend on the fixed point's assumption."""
-    d = channel_mismatch(loop.nominal, loop.hull,
-                         velocity_box(first_command[0], 0.0, first_command[1], first_command[2]), loop.lateral)
+    d = _start_mismatch(loop, first_command)
     return tuple(upper(abs(d[c]) / loop.m_true[c]) for c in range(len(loop.names)))
 
 
 def start_bounds_nominal(loop: LoopData, first_command: Sequence[float]) -> tuple[float, float, float]:
-    """sup|d_c|/m̂_c over the first command's box (m/s², m/s², rad/s²): the start transient of the second
-    decomposition (its Ĩ(0) = d/(m̂ k_i); module doc)."""
-    d = channel_mismatch(loop.nominal, loop.hull,
-                         velocity_box(first_command[0], 0.0, first_command[1], first_command[2]), loop.lateral)
+    """sup|d_c|/m̂_c over the same box (m/s², m/s², rad/s²): the start transient of the second decomposition (its
+    Ĩ(0) = d/(m̂ k_i); module doc)."""
+    d = _start_mismatch(loop, first_command)
     return tuple(upper(abs(d[c]) / loop.m_hat[c]) for c in range(len(loop.names)))
 
 

@@ -207,6 +207,19 @@ def test_where_every_channel_closes_on_its_own_the_diagnosis_names_the_coupling(
     assert "e+" not in fixed.detail  # no ratio against the sway channel's near-zero first assumption (was 2e+10)
 
 
+def test_a_torpedo_at_survey_speed_is_told_its_hulls_sway_couples_the_channels():
+    """REMUS 100 at its midpoint (no mismatch), 1.5 m/s under a 0.75 m/s surge floor: every channel's own gain is
+    below 1, yet the bound diverges through the hull's free sway (no lateral thrust), and the diagnosis says so."""
+    from tubekit.model.vehicles import vehicle_params
+    remus = vehicle_params("remus100")
+    point = remus.with_point({k: sum(remus.interval(k)) / 2 for k in remus.interval_fields})
+    bound = velocity_loop_bound(point, v_max=(1.5, 0.02, 0.1), tick=H, period=H * TICKS, jump_tick=(0.0, 0.0, 0.0),
+                                jump_period=(0.005, 0.001, 0.002), first_command=(0.755, 0.001, 0.002),
+                                surge_floor=0.75)
+    fixed = next(c for c in bound.conditions if c.condition == "loop_fixed_point")
+    assert fixed.ok is False and "hull's free sway" in fixed.detail and "cannot close on its own" not in fixed.detail
+
+
 def test_a_point_vehicle_has_no_mismatch_and_no_mass_part_in_its_own_gain():
     """At a point of the coefficient box the controller's model is the plant: the own loop gain's mismatch part is
     exactly 0 (the mismatch is the model at the coefficients' differences), its mass part 0 up to the balls' rounding,

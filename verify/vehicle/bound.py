@@ -380,10 +380,13 @@ def _why_open(loop: LoopData, found: bool, stop: str, growth: list | None, first
                 f"added-mass interval) (docs/plant.md, section 4); {knobs}")
     if worst is None:
         return f"{head}; the small-gain loop's gain is not below 1 here (docs/plant.md, section 4); {knobs}"
+    through = ("the cross terms (Coriolis, the mismatch's other slopes)" if loop.lateral else
+               "the cross terms and the hull's free sway (its bound γ̄ and its rate through the sway row, which grow "
+               "with E_u and E_r)")
     return (f"{head}; at the first round's box every channel's own loop gain is below 1 (the largest "
-            f"{sum(gains[worst]):.3g}, channel {loop.names[worst]}), but the channels drive one another through the "
-            f"cross terms (Coriolis, the mismatch's other slopes) and the slopes grow with E: together the small-gain "
-            f"loop's gain is not below 1 here (docs/plant.md, section 4); {knobs}")
+            f"{sum(gains[worst]):.3g}, channel {loop.names[worst]}), but the channels drive one another through "
+            f"{through} and the slopes grow with E: together the small-gain loop's gain is not below 1 here "
+            f"(docs/plant.md, section 4); {knobs}")
 
 
 def _result(loop: LoopData, params: VehicleParams, given: tuple, assumed: list, computed: list, inputs: Inputs | None,

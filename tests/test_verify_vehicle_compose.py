@@ -520,3 +520,25 @@ def test_over_the_published_spread_a_hull_without_linear_yaw_damping_keeps_every
     promises, run = _flown_at_corner(PUBLISHED, 1, published_cert)
     assert all(p.ok for p in promises.values() if p.given), [p for p in promises.values() if p.given and not p.ok]
     assert promises["plan_available"].ok and promises["velocity_loop"].ok and not run.backup_active.any()
+
+
+# ---- a pier within 3 m of the path, both tiers (no backup: the footprint is X_f's reach) ---------------------
+
+PIER_SLOW = "examples/bluerov2_pier_slow.toml"
+
+
+def test_a_pier_within_three_metres_of_the_path_keeps_both_tiers_and_is_passed():
+    """examples/bluerov2_pier_slow.toml: the pier's surface lies within 3 m of the target's path and the target passes
+    it inside the run (at t = 38 s); both tiers (no backup, ±15 %); flown the whole 60 s with the hull at the box's
+    upper corner: every promise kept, a plan at every period, the vehicle clear of the pier."""
+    sc = load_scenario(PIER_SLOW)
+    (pier,) = sc.obstacles
+    speed = sc.trajectory.direction_velocity[0]
+    assert abs(pier.center[1]) - pier.radius < 3.0 and 0.0 < pier.center[0] / speed < sc.duration
+    cert = certify(sc)
+    assert cert.tiers == Tiers(True, True)
+    import tubekit
+    run = tubekit.simulate(at_corner(sc, 1), cert, progress=False)
+    promises = {p.name: p for p in tubekit.check_promises(run)}
+    assert all(p.ok for p in promises.values() if p.given), [p for p in promises.values() if p.given and not p.ok]
+    assert promises["plan_available"].ok and promises["clearance"].ok and not run.backup_active.any()

@@ -452,11 +452,11 @@ def _certified_without_step_5b(monkeypatch, path: str) -> Certificate:
         compose._SOLVED.clear()
 
 
-def _flown_at_corner(path: str, end: int, cert: Certificate):
-    """(the promises by name, the run) of 20 s of ``path`` under ``cert`` with the hull at the lower (0) or upper (1)
-    corner of its coefficient box."""
+def _flown_at_corner(path: str, end: int, cert: Certificate, duration: float | None = 20.0):
+    """(the promises by name, the run) of ``duration`` s (None: the scenario's own) of ``path`` under ``cert`` with the
+    hull at the lower (0) or upper (1) corner of its coefficient box."""
     import tubekit
-    run = tubekit.simulate(at_corner(load_scenario(path), end), cert, duration=20.0, progress=False)
+    run = tubekit.simulate(at_corner(load_scenario(path), end), cert, duration=duration, progress=False)
     return {p.name: p for p in tubekit.check_promises(run)}, run
 
 
@@ -537,8 +537,6 @@ def test_a_pier_within_three_metres_of_the_path_keeps_both_tiers_and_is_passed()
     assert abs(pier.center[1]) - pier.radius < 3.0 and 0.0 < pier.center[0] / speed < sc.duration
     cert = certify(sc)
     assert cert.tiers == Tiers(True, True)
-    import tubekit
-    run = tubekit.simulate(at_corner(sc, 1), cert, progress=False)
-    promises = {p.name: p for p in tubekit.check_promises(run)}
+    promises, run = _flown_at_corner(PIER_SLOW, 1, cert, duration=None)
     assert all(p.ok for p in promises.values() if p.given), [p for p in promises.values() if p.given and not p.ok]
     assert promises["plan_available"].ok and promises["clearance"].ok and not run.backup_active.any()

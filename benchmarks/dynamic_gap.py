@@ -117,7 +117,7 @@ def first_round(sc) -> None:
     sway = compose._first_sway(sc, plans, compose._INFLATE)  # the first assumed sway (None: the free hull's)
     region = Region.from_scenario(sc)
     gains = gain_bounds(sc.controller.law, region)
-    dist, _, _, _, backup = compose._tiers_at(sc, region, gains, (0.0,), assumed, sway, compose._plans_only(sc))
+    dist, _, _, _, backup = compose._tiers_at(sc, region, gains, (0.0,), assumed, sway, compose.plans_only_bound(sc))
     loop = compose._loop_at(sc, backup.law, backup.safe_set, dist, assumed)
     ratio = compose._loop_ratio(loop, assumed, sway)
     law = backup.law

@@ -347,9 +347,9 @@ def test_the_tracking_tier_is_derived_at_the_plans_only_loop_bound(slow_cert):
     """The tracking design's ω̄ is the plans-only loop bound's, below the certificate's (which covers the backup's
     command), and the safe tier keeps the certificate's: on bluerov2_slow E_plans is below E in every channel
     (under half of it in surge and yaw), the tracking design's ω̄_xy and yaw-rate error are smaller, and the safe-only design is derived at E."""
-    from verify.vehicle.compose import _plans_only, tracking_disturbance
+    from verify.vehicle.compose import plans_only_bound, tracking_disturbance
     sc = load_scenario(SLOW)
-    plans, track = _plans_only(sc), tracking_disturbance(sc)
+    plans, track = plans_only_bound(sc), tracking_disturbance(sc)
     full = slow_cert.velocity_loop.error
     assert plans.certified and all(p < e for p, e in zip(plans.error, full))
     assert plans.error[0] < 0.5 * full[0] and plans.error[2] < 0.5 * full[2]      # surge and yaw: the backup's share
@@ -398,7 +398,7 @@ def test_under_the_tracking_tier_the_simulated_loop_error_stays_within_the_plans
     cross current on the certified bound, the velocity loop's error never leaves the plans-only bound E_plans that
     the tracking design was derived at (the certificate's E, which covers the backup, is larger)."""
     import tubekit
-    from verify.vehicle.compose import _plans_only
+    from verify.vehicle.compose import plans_only_bound
     sc = load_scenario(TRACKED).with_changes(**{"disturbance.amplitude": (0.0, 0.0, 0.0),
                                                  "disturbance.constant": (0.0, 0.04, 0.0)})
     cert = certify(sc)
@@ -408,7 +408,7 @@ def test_under_the_tracking_tier_the_simulated_loop_error_stays_within_the_plans
                                                      overrides=sc.plant.overrides, truth=tuple(corner.items())))
     run = tubekit.simulate(flown, cert, duration=30.0, progress=False)
     worst = np.nanmax(np.abs(run.velocity_error[:-1]), axis=0)
-    plans = np.asarray(_plans_only(sc).error)
+    plans = np.asarray(plans_only_bound(sc).error)
     assert not run.backup_active.any() and np.all(worst <= plans), (worst, plans)
     assert np.all(plans < np.asarray(cert.velocity_loop.error))
 

@@ -89,10 +89,10 @@ class Inputs:
         sup|W| <= sup|1 − 1/μ| Ŷ + sup|d|/m̂ (m/s², m/s², rad/s²): a = (k_i, k_p, 0) x − W.
     sway : float
         γ̄ (m/s) over the assumed velocity box.
-    start_mass, rate_mass, mass : (3,) floats, optional
+    start_mass, rate_mass, mass : (3,) floats
         The second decomposition (module doc, "mass in the state"): sup|d_c(ν(0))|/m̂_c, sup|ḋ_c|/m̂_c and
-        sup|1 − 1/μ| Ŷ_c (m/s², m/s³, m/s³; rad for yaw); None: only the first decomposition is bounded.
-    mass_ratio : (3,) floats, optional
+        sup|1 − 1/μ| Ŷ_c (m/s², m/s³, m/s³; rad for yaw).
+    mass_ratio : (3,) floats
         sup μ = sup m̂_c/m_c per channel: ẏ = μ (k_i, k_p, 1) x in the second decomposition.
     """
 
@@ -101,10 +101,10 @@ class Inputs:
     drag: tuple[float, float, float]
     mismatch: tuple[float, float, float]
     sway: float
-    start_mass: tuple[float, float, float] | None = None
-    rate_mass: tuple[float, float, float] | None = None
-    mass: tuple[float, float, float] | None = None
-    mass_ratio: tuple[float, float, float] | None = None
+    start_mass: tuple[float, float, float]
+    rate_mass: tuple[float, float, float]
+    mass: tuple[float, float, float]
+    mass_ratio: tuple[float, float, float]
 
 
 def _rates(loop: LoopData, nu: Sequence[arb], accel: Sequence[float]) -> tuple[arb, arb, arb, arb]:
@@ -128,15 +128,18 @@ def _start_mismatch(loop: LoopData, first_command: Sequence[float]) -> tuple:
 def start_bounds(loop: LoopData, first_command: Sequence[float]) -> tuple[float, float, float]:
     """sup|W(0)| = sup|d_c|/m_c over the first command's box |y_c| <= F_c, v = 0, and Θ (m/s², m/s², rad/s²): the
     start transient of the trimmed start (module doc); it does not depend on the fixed point's assumption."""
-    d = _start_mismatch(loop, first_command)
-    return tuple(upper(abs(d[c]) / loop.m_true[c]) for c in range(len(loop.names)))
+    return _per_mass(_start_mismatch(loop, first_command), loop.m_true)
 
 
 def start_bounds_nominal(loop: LoopData, first_command: Sequence[float]) -> tuple[float, float, float]:
     """sup|d_c|/m̂_c over the same box (m/s², m/s², rad/s²): the start transient of the second decomposition (its
     Ĩ(0) = d/(m̂ k_i); module doc)."""
-    d = _start_mismatch(loop, first_command)
-    return tuple(upper(abs(d[c]) / loop.m_hat[c]) for c in range(len(loop.names)))
+    return _per_mass(_start_mismatch(loop, first_command), loop.m_hat)
+
+
+def _per_mass(d: Sequence[arb], masses: Sequence[arb]) -> tuple[float, ...]:
+    """sup|d_c| / m_c per channel (rounded up)."""
+    return tuple(upper(abs(x) / m) for x, m in zip(d, masses))
 
 
 def input_bounds(loop: LoopData, error: Sequence[float], z_bound: Sequence[float],
@@ -175,10 +178,8 @@ def input_bounds(loop: LoopData, error: Sequence[float], z_bound: Sequence[float
         rate_mass.append(upper(d_change / loop.m_hat[c]))
         mass.append(upper(abs(1 - 1 / mu) * y_dot))
         ratio.append(upper(mu))
-    if start is None:
-        start = tuple(upper(abs(d[c]) / loop.m_true[c]) for c in range(n))
-    if start_mass is None:
-        start_mass = tuple(upper(abs(d[c]) / loop.m_hat[c]) for c in range(n))
+    start = _per_mass(d, loop.m_true) if start is None else start
+    start_mass = _per_mass(d, loop.m_hat) if start_mass is None else start_mass
     return Inputs(start=tuple(start), rate=tuple(rate), drag=tuple(drag), mismatch=tuple(mismatch), sway=gamma,
                   start_mass=tuple(start_mass), rate_mass=tuple(rate_mass), mass=tuple(mass), mass_ratio=tuple(ratio))
 
@@ -210,14 +211,10 @@ def computed_bounds(loop: LoopData, jump_tick: Sequence[float], jump_period: Seq
 
 
 def _mass_in_state(loop: LoopData, c: int, o: int, jumps: arb, inputs: Inputs) -> float:
-    """Output ``o`` of channel ``c`` in the second decomposition (module doc), given its jumps' part ``jumps``;
-    +inf when ``inputs`` has no second decomposition."""
-    if inputs.mass is None or inputs.rate_mass is None or inputs.start_mass is None or inputs.mass_ratio is None:
-        return math.inf
-    g_tick, _, h_rate, h_drag, peak = loop.gain_balls[c][o]
-    along = arb(loop.tick) * g_tick + abs(arb(loop.slope[c])) * h_drag  # L1 of (0, −1, k_p − λ) = −b_J + λ b_n
-    x = (jumps + h_rate * arb(inputs.rate_mass[c]) + h_drag * arb(inputs.drag[c]) + along * arb(inputs.mass[c])
-         + peak * arb(inputs.start_mass[c]))
+    """Output ``o`` of channel ``c`` in the second decomposition (module doc), given its jumps' part ``jumps``."""
+    _, _, h_rate, h_drag, peak = loop.gain_balls[c][o]
+    x = (jumps + h_rate * arb(inputs.rate_mass[c]) + h_drag * arb(inputs.drag[c])
+         + loop.mass_gain_balls[c][o] * arb(inputs.mass[c]) + peak * arb(inputs.start_mass[c]))
     if o == 1:
         x += arb(inputs.mismatch[c])
     if o == 3:
@@ -285,7 +282,8 @@ def velocity_loop_bound(params: VehicleParams, *, v_max: Sequence[float], tick: 
                                                                                       first_command), v))
     sway_max, sway_tick, sway_period = _sway_command(params, sway)
     loop = loop_data_of(params, v, h, ticks, sway_max)
-    start, start_mass = start_bounds(loop, first), start_bounds_nominal(loop, first)
+    d_start = _start_mismatch(loop, first)  # the start transient of both decompositions
+    start, start_mass = _per_mass(d_start, loop.m_true), _per_mass(d_start, loop.m_hat)
     floor_u = nonnegative("surge_floor", surge_floor)
     # the sway channel's command: 0 under plans, a lateral backup's own jumps
     jt_int, jp_int = with_sway(jt, sway_tick, loop.lateral), with_sway(jp, sway_period, loop.lateral)
@@ -344,10 +342,10 @@ def own_gains(loop: LoopData, error: Sequence[float]) -> tuple[tuple[float, floa
     out = []
     for c in range(len(loop.names)):
         own, mu = loop.own[c], loop.m_hat[c] / loop.m_true[c]
-        g_tick, _, h_rate, h_drag, _ = loop.gain_balls[c][3]
-        along = arb(loop.tick) * g_tick + abs(arb(loop.slope[c])) * h_drag
+        _, _, h_rate, h_drag, _ = loop.gain_balls[c][3]
         parts = (h_rate * abs(d_grad[c][own]) / loop.m_hat[c],
-                 h_drag * abs(grads[c][own] / loop.m_hat[c] - arb(loop.slope[c])), along * abs(1 - 1 / mu))
+                 h_drag * abs(grads[c][own] / loop.m_hat[c] - arb(loop.slope[c])),
+                 loop.mass_gain_balls[c][3] * abs(1 - 1 / mu))
         out.append(tuple(upper(mu * x) for x in parts))
     return tuple(out)
 

@@ -153,14 +153,14 @@ def _tiers_at(scenario: Scenario, region: Region, gains: GainBounds, sigmas: tup
 
 
 def tracking_disturbance(scenario: Scenario, plans: LoopBound | None = None) -> DisturbanceBounds | None:
-    """ω̄ of the tracking tier (``docs/verify.md`` step 17d): with the plans-only loop bound (:func:`_plans_only`: the
+    """ω̄ of the tracking tier (``docs/verify.md`` step 17d): with the plans-only loop bound (:func:`plans_only_bound`: the
     plans' jumps J, the first command within J of rest, no backup) in place of the fixed point's E. Under the
     tracking tier a plan is accepted at every period (step 17), so every command is a plan's row and the backup
     never runs: the loop error stays within the plans-only bound, which carries the induction's premise along (at
     period k the commands so far are plans' rows, so the deviation over period k is the plans-only one, so the
     candidate passes at k + 1). None where that bound does not hold (its own conditions fail): the tracking designs
-    then use the safe tier's bound. ``plans``: that bound when the caller has it (:func:`_plans_only`)."""
-    first = _plans_only(scenario) if plans is None else plans
+    then use the safe tier's bound. ``plans``: that bound when the caller has it (:func:`plans_only_bound`)."""
+    first = plans_only_bound(scenario) if plans is None else plans
     if not first.certified or not all(math.isfinite(e) for e in first.error):
         return None
     sway = first.sway if scenario.plant.params.lateral else None
@@ -273,14 +273,9 @@ def _consistent(loop: LoopBound, assumed: tuple[float, float, float], sway: floa
 
 
 def plans_only_bound(scenario: Scenario) -> LoopBound:
-    """The velocity loop's bound for the plans' jumps alone (:func:`_plans_only`): with ``controller.backup =
-    "none"`` the loop the certificate bounds; with any backup a necessary condition (a backup only adds jumps)."""
-    return _plans_only(scenario)
-
-
-def _plans_only(scenario: Scenario) -> LoopBound:
     """The loop bound for the plans' jumps alone (no backup), the first command within J of rest: the fixed
-    point's start (a smaller start transient only lowers the bound, so a failure here is a failure with any law)."""
+    point's start (a smaller start transient only lowers the bound, so a failure here is a failure with any law);
+    with ``controller.backup = "none"`` the loop the certificate bounds."""
     inputs = _LoopInputs.of(scenario)
     return velocity_loop_bound(inputs.params, v_max=inputs.v_max, tick=inputs.tick, period=inputs.period,
                                jump_tick=(0.0, 0.0, 0.0), jump_period=inputs.plans, first_command=inputs.start,
@@ -363,7 +358,7 @@ def loop_for_law(scenario: Scenario, law: BackupLaw, safe: SafeSet, assumed: tup
                           assumed_sway)
     sway = None if assumed_sway is None else nonnegative("assumed_sway", assumed_sway)
     dist = disturbance_bounds(scenario, loop_error=e_a, loop_sway=sway)
-    first = _plans_only(scenario)
+    first = plans_only_bound(scenario)
     loop = first if _first_assumption(first) is None else _LoopInputs.of(scenario).loop(law, safe, dist, e_a)
     return LawLoop(assumed=e_a, dist=dist, loop=loop, assumed_sway=sway,
                    conditions=_plant_conditions(scenario, loop, e_a, sigma, sway))
@@ -416,7 +411,7 @@ def _solve_dynamic(scenario: Scenario, region: Region, gains: GainBounds,
                    sigmas: tuple[float, ...]) -> DynamicSolution:
     """:func:`solve_dynamic` without the memo: from :data:`_INFLATE`, then, when that start did not close, each of
     :data:`FIXED_POINT_RESTARTS` until one closes."""
-    plans = _plans_only(scenario)
+    plans = plans_only_bound(scenario)
     first = _solve_from(scenario, region, gains, sigmas, plans, _INFLATE)
     if _closed(first) or _first_assumption(plans) is None:  # no round was run: another start changes nothing
         return first

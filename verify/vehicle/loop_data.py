@@ -70,6 +70,10 @@ class LoopData:
         self.gain_balls = tuple(tuple((arb(s.tick[o][0]), arb(s.period[o][0]), h * arb(s.tick[o][1]),
                                        h * arb(s.tick[o][2]), arb(s.peak[o][1])) for o in range(4))
                                 for s in self.sums)
+        # per channel and output row, the L1 gain of the direction (0, −1, k_p − λ_c) = −b_J + λ_c b_n along which
+        # the mass mismatch enters in verify.vehicle.bound's second decomposition: h Σ g_J + |λ_c| h Σ g_n
+        self.mass_gain_balls = tuple(tuple(h * g[0] + abs(arb(lam)) * g[3] for g in rows)
+                                     for rows, lam in zip(self.gain_balls, self.slope))
 
     @property
     def stable(self) -> bool:

@@ -186,15 +186,15 @@ def _plant_condition(cert: verify.Certificate, name: str) -> verify.Condition:
 
 
 def test_without_a_backup_a_diverging_loop_gets_the_surge_limit_at_which_it_closes():
-    """The published-spread example with u_max 0.3 m/s: the loop's bound diverges (no numbers on the condition);
+    """The published-spread example with u_max 0.6 m/s: the loop's bound diverges (no numbers on the condition);
     the knob names the largest surge limit a bisection finds, and re-certified there the loop closes. With a backup
     (station keeping) the plans' bound is only necessary, so no knob is given."""
-    table, cert = _certify(PUBLISHED, {"limits.u_max": 0.3})
+    table, cert = _certify(PUBLISHED, {"limits.u_max": 0.6})
     cond = _plant_condition(cert, "loop_fixed_point")
     assert cond.ok is False and cond.lhs is None
     (knob,) = knobs_for(cert, cond)
-    assert knob.field == "limits.u_max" and knob.relation == "<=" and 0.2 <= knob.value < 0.3
+    assert knob.field == "limits.u_max" and knob.relation == "<=" and 0.3 <= knob.value < 0.6
     fixed = verify.certify(scenario_from_dict(_with_knob(table, knob)))
     assert _plant_condition(fixed, "loop_fixed_point").ok is True
-    _, kept = _certify(PUBLISHED, {"limits.u_max": 0.3, "controller.backup": "station_keeping"})
+    _, kept = _certify(PUBLISHED, {"limits.u_max": 0.6, "controller.backup": "station_keeping"})
     assert knobs_for(kept, _plant_condition(kept, "loop_fixed_point")) == ()

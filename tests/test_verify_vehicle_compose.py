@@ -238,10 +238,13 @@ def _widened(sc, fraction: float):
 
 
 def test_a_start_that_does_not_close_is_followed_by_the_next_start(monkeypatch):
-    """bluerov2_slow over von Benzon's values ±15 %: from the first start (1.25 × the plans-only bound) the fixed point
-    ends 0.04 % above its assumption (``loop_consistent``); the next start of ``FIXED_POINT_RESTARTS`` closes, and that
-    certificate is what ``certify`` returns, and ``recheck`` agrees with it number for number."""
+    """bluerov2_slow over von Benzon's values ±15 %, the loop bound without its cells (step 5c, which closes this case
+    from the first start): from the first start (1.25 × the plans-only bound) the fixed point ends 0.04 % above its
+    assumption (``loop_consistent``); the next start of ``FIXED_POINT_RESTARTS`` closes, and that certificate is what
+    ``certify`` returns, and ``recheck`` (under the same switch) agrees with it number for number."""
+    import verify.vehicle.bound as bound
     import verify.vehicle.compose as compose
+    monkeypatch.setattr(bound, "_in_cells", lambda *args: math.inf)
     sc = _widened(load_scenario(SLOW), 0.15)
     starts: list[tuple[float, object]] = []
     solve_from = compose._solve_from
@@ -252,7 +255,10 @@ def test_a_start_that_does_not_close_is_followed_by_the_next_start(monkeypatch):
         return solution
     monkeypatch.setattr(compose, "_solve_from", recorded)
     compose._SOLVED.clear()
-    cert = certify(sc)
+    try:
+        cert = certify(sc)
+    finally:  # no other test may see a certificate derived without step 5c
+        compose._SOLVED.clear()
     assert [start for start, _ in starts] == [compose._INFLATE, compose.FIXED_POINT_RESTARTS[0]]
     first, kept = (solution for _, solution in starts)
     consistent = next(c for c in first.conditions if c.condition == "loop_consistent")
@@ -439,12 +445,14 @@ def test_the_brisk_tracked_bluerov2_certifies_both_tiers_at_the_owners_speed_and
 
 # ---- the loop bound's step 5b on the shipped examples (docs/verify.md section 9) -------------------------------
 
-def _certified_without_step_5b(monkeypatch, path: str) -> Certificate:
-    """``path`` certified with the loop bound's second decomposition switched off (the first alone); the memo of
-    dynamic solutions is cleared before and after, so no other test sees this certificate."""
+def _certified_by_the_first_decomposition(monkeypatch, path: str) -> Certificate:
+    """``path`` certified with the loop bound's second and third decompositions (steps 5b and 5c) switched off (the
+    first alone); the memo of dynamic solutions is cleared before and after, so no other test sees this
+    certificate."""
     import verify.vehicle.bound as bound
     import verify.vehicle.compose as compose
     monkeypatch.setattr(bound, "_mass_in_state", lambda *args: math.inf)
+    monkeypatch.setattr(bound, "_in_cells", lambda *args: math.inf)
     compose._SOLVED.clear()
     try:
         return certify(load_scenario(path))
@@ -477,7 +485,7 @@ def test_the_wide_box_example_certifies_both_tiers_where_the_first_decomposition
     assert wide_cert.tiers == Tiers(True, True)
     assert all(0.0 < e < 0.07 for e in wide_cert.velocity_loop.error)
     assert recheck(json.loads(json.dumps(wide_cert.to_dict()))).ok
-    first_only = _certified_without_step_5b(monkeypatch, WIDE)
+    first_only = _certified_by_the_first_decomposition(monkeypatch, WIDE)
     assert first_only.tiers == Tiers(False, False)
     assert "loop_fixed_point" in [c.condition for c in first_only.failures]
 
@@ -510,7 +518,7 @@ def test_over_the_published_spread_both_tiers_hold_and_the_box_is_the_bundled_on
     assert all(sc.plant.params.interval(k) == bundled.interval(k) for k in bundled.interval_fields)
     assert published_cert.tiers == Tiers(True, True)
     assert recheck(json.loads(json.dumps(published_cert.to_dict()))).ok
-    first_only = _certified_without_step_5b(monkeypatch, PUBLISHED)
+    first_only = _certified_by_the_first_decomposition(monkeypatch, PUBLISHED)
     assert "loop_fixed_point" in [c.condition for c in first_only.failures]
 
 

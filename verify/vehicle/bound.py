@@ -32,6 +32,12 @@ columns, already summed); ḋ/m̂_c enters where Ẇ did, and x(0) = (d(ν(0))/(
 same. :func:`computed_bounds` takes, output by output, the smaller of the two (both hold under the same
 assumptions); the second is what closes the loop over wider coefficient boxes (``docs/plant.md`` section 4).
 
+**Third decomposition: the channel's own coefficients in cells** (:mod:`verify.vehicle.cells`). θ is constant, so
+the channel's own mass entry and its linear and quadratic damping coefficient are split into cells; in each, the
+cell's centre (μ_k, δ_k) goes into the loop's matrix and only the residuals are inputs. Its bound is the largest over
+the cells (every θ lies in one); :func:`computed_bounds` keeps the smallest of the three. It is what closes the loop
+over the BlueROV2's published spread at the owners' speed.
+
 **Theorem (first exit).** Let (E, Â, Ẑ, Ŷ) be assumed bounds of (|e|, |a|, |z|, |ẏ|) per channel.
 While they hold on [0, t): ν lies in the box |y_c| <= V_c + E_c, |v| <= γ̄ (hull ISS bound,
 :func:`verify.theorem.design.hull_sway_bound`); no channel saturates (``loop_saturation``), so the model
@@ -60,6 +66,7 @@ from tubekit.model.vehicle_params import VehicleParams
 from verify.vehicle.model import (arb_body_forces, channel_gradient, channel_mismatch, channel_mismatch_gradient,
                                   point_time_constant, velocity_box, with_sway, without_sway)
 from verify.vehicle.loop_data import LoopData, loop_data_of, loop_matrix
+from verify.vehicle.cells import CellInputs, cell_bound, cell_inputs, cell_own_gains, cell_starts
 from verify.vehicle.saturation import (SURGE_BANDS, actuator_authority, rate_authority_conditions,
                                        saturation_conditions, triple)
 
@@ -94,6 +101,8 @@ class Inputs:
         sup|1 − 1/μ| Ŷ_c (m/s², m/s³, m/s³; rad for yaw).
     mass_ratio : (3,) floats
         sup μ = sup m̂_c/m_c per channel: ẏ = μ (k_i, k_p, 1) x in the second decomposition.
+    cells : per channel, per cell of :mod:`verify.vehicle.cells`, a CellInputs
+        The third decomposition's residuals (empty: that step is not used).
     """
 
     start: tuple[float, float, float]
@@ -105,6 +114,7 @@ class Inputs:
     rate_mass: tuple[float, float, float]
     mass: tuple[float, float, float]
     mass_ratio: tuple[float, float, float]
+    cells: tuple[tuple[CellInputs, ...], ...] = ()
 
 
 def _rates(loop: LoopData, nu: Sequence[arb], accel: Sequence[float]) -> tuple[arb, arb, arb, arb]:
@@ -144,10 +154,12 @@ def _per_mass(d: Sequence[arb], masses: Sequence[arb]) -> tuple[float, ...]:
 
 def input_bounds(loop: LoopData, error: Sequence[float], z_bound: Sequence[float],
                  accel: Sequence[float], start: Sequence[float] | None = None,
-                 start_mass: Sequence[float] | None = None) -> Inputs:
+                 start_mass: Sequence[float] | None = None,
+                 start_cells: Sequence[Sequence[float]] | None = None) -> Inputs:
     """The model's input bounds over the box |y_c| <= V_c + E_c, |v| <= γ̄ and Θ, given Ẑ and Ŷ = sup|ẏ|;
     ``start`` is sup|W(0)| (:func:`start_bounds`; None: sup|d|/m over that same box), ``start_mass`` the second
-    decomposition's (:func:`start_bounds_nominal`; None: sup|d|/m̂ over that box).
+    decomposition's (:func:`start_bounds_nominal`; None: sup|d|/m̂ over that box), ``start_cells`` the third's
+    (:func:`verify.vehicle.cells.cell_starts`; None: sup|d|/m̂ over that box, per cell).
 
     ŵ_n = (sup|∂n̂_c/∂y_c − λ_c m̂_c| Ŷ_c + Σ_{j ≠ c} sup|∂n̂_c/∂ν_j| |ν̇_j|)/m̂_c;
     sup|Ẇ| = sup|μ − 1| (Ẑ/T_thr + |λ_c| Ŷ_c + ŵ_n) + Σ_j sup|∂d_c/∂ν_j| |ν̇_j| / m_c;
@@ -180,8 +192,11 @@ def input_bounds(loop: LoopData, error: Sequence[float], z_bound: Sequence[float
         ratio.append(upper(mu))
     start = _per_mass(d, loop.m_true) if start is None else start
     start_mass = _per_mass(d, loop.m_hat) if start_mass is None else start_mass
+    cells = tuple(cell_inputs(loop, c, nu, rates, accel[c], None if start_cells is None else start_cells[c])
+                  for c in range(n))
     return Inputs(start=tuple(start), rate=tuple(rate), drag=tuple(drag), mismatch=tuple(mismatch), sway=gamma,
-                  start_mass=tuple(start_mass), rate_mass=tuple(rate_mass), mass=tuple(mass), mass_ratio=tuple(ratio))
+                  start_mass=tuple(start_mass), rate_mass=tuple(rate_mass), mass=tuple(mass), mass_ratio=tuple(ratio),
+                  cells=cells)
 
 
 def computed_bounds(loop: LoopData, jump_tick: Sequence[float], jump_period: Sequence[float],
@@ -205,9 +220,19 @@ def computed_bounds(loop: LoopData, jump_tick: Sequence[float], jump_period: Seq
                 continue
             first = x + h_rate * arb(inputs.rate[c]) + h_drag * arb(inputs.drag[c]) + peak * arb(inputs.start[c])
             first += arb(inputs.mismatch[c]) if o == 1 else 0
-            row.append(min(upper(first), _mass_in_state(loop, c, o, x, inputs)))
+            row.append(min(upper(first), _mass_in_state(loop, c, o, x, inputs), _in_cells(loop, c, o, jt, jp, inputs)))
         out.append(row)
     return out
+
+
+def _in_cells(loop: LoopData, c: int, o: int, jump_tick: arb, jump_period: arb, inputs: Inputs) -> float:
+    """Output ``o`` of channel ``c`` in the third decomposition (:mod:`verify.vehicle.cells`): the largest over the
+    channel's cells; +inf where the step is not used."""
+    cells = loop.cells[c] if inputs.cells else ()
+    if not cells:
+        return math.inf
+    return max(cell_bound(cell, o, jump_tick, jump_period, inputs.drag[c], ins)
+               for cell, ins in zip(cells, inputs.cells[c]))
 
 
 def _mass_in_state(loop: LoopData, c: int, o: int, jumps: arb, inputs: Inputs) -> float:
@@ -284,6 +309,7 @@ def velocity_loop_bound(params: VehicleParams, *, v_max: Sequence[float], tick: 
     loop = loop_data_of(params, v, h, ticks, sway_max)
     d_start = _start_mismatch(loop, first)  # the start transient of both decompositions
     start, start_mass = _per_mass(d_start, loop.m_true), _per_mass(d_start, loop.m_hat)
+    start_cells = cell_starts(loop, first)
     floor_u = nonnegative("surge_floor", surge_floor)
     # the sway channel's command: 0 under plans, a lateral backup's own jumps
     jt_int, jp_int = with_sway(jt, sway_tick, loop.lateral), with_sway(jp, sway_period, loop.lateral)
@@ -296,7 +322,7 @@ def velocity_loop_bound(params: VehicleParams, *, v_max: Sequence[float], tick: 
     while loop.stable and k < max_iterations and not found:
         k += 1
         inputs = input_bounds(loop, [r[0] for r in assumed], [r[2] for r in assumed], [r[3] for r in assumed],
-                              start, start_mass)
+                              start, start_mass, start_cells)
         computed = computed_bounds(loop, jt_int, jp_int, inputs)
         found = all(computed[c][o] < assumed[c][o] for c in range(n) for o in range(4))
         if growth is None:  # against the jumps' own bounds only (an output no jump moves starts from ~0: no ratio)
@@ -329,10 +355,12 @@ def _sway_command(params: VehicleParams, sway: Sequence[float]) -> tuple[float, 
 
 
 def own_gains(loop: LoopData, error: Sequence[float]) -> tuple[tuple[float, float, float], ...]:
-    """Per channel, the three parts of its own small-gain loop in the second decomposition (module doc) over the box
-    |y_c| <= V_c + E_c (``error``): sup μ × the L1 gain to ẏ of (the mismatch's slope sup|∂d_c/∂y_c|/m̂_c, the
-    nominal drag's slope variation sup|∂n̂_c/∂y_c/m̂_c − λ_c|, the mass mismatch sup|1 − 1/μ|), each per unit Ŷ_c
-    (dimensionless). A channel whose parts add up to 1 or more cannot close whatever the others do."""
+    """Per channel, the three parts of its own small-gain loop over the box |y_c| <= V_c + E_c (``error``), in the
+    decomposition where they add up to least: the second (module doc) or, in its worst cell, the third
+    (:func:`verify.vehicle.cells.cell_own_gains`). sup μ × the L1 gain to ẏ of (the mismatch's own slope — in a cell
+    its residual about δ_k —, the nominal drag's slope variation sup|∂n̂_c/∂y_c/m̂_c − λ_c|, the mass mismatch
+    sup|1 − 1/μ| — in a cell |1 − μ_k/μ|), each per unit Ŷ_c (dimensionless). A channel whose parts add up to 1 or
+    more cannot close whatever the others do."""
     box, gamma = loop.box(error)
     if not math.isfinite(gamma):
         return tuple((math.inf,) * 3 for _ in loop.names)
@@ -343,10 +371,11 @@ def own_gains(loop: LoopData, error: Sequence[float]) -> tuple[tuple[float, floa
     for c in range(len(loop.names)):
         own, mu = loop.own[c], loop.m_hat[c] / loop.m_true[c]
         _, _, h_rate, h_drag, _ = loop.gain_balls[c][3]
-        parts = (h_rate * abs(d_grad[c][own]) / loop.m_hat[c],
-                 h_drag * abs(grads[c][own] / loop.m_hat[c] - arb(loop.slope[c])),
-                 loop.mass_gain_balls[c][3] * abs(1 - 1 / mu))
-        out.append(tuple(upper(mu * x) for x in parts))
+        drag_slope = abs(grads[c][own] / loop.m_hat[c] - arb(loop.slope[c]))
+        parts = tuple(upper(mu * x) for x in (h_rate * abs(d_grad[c][own]) / loop.m_hat[c], h_drag * drag_slope,
+                                              loop.mass_gain_balls[c][3] * abs(1 - 1 / mu)))
+        in_cells = cell_own_gains(loop, c, nu, drag_slope)
+        out.append(parts if in_cells is None or sum(parts) <= sum(in_cells) else in_cells)
     return tuple(out)
 
 
@@ -375,7 +404,7 @@ def _why_open(loop: LoopData, found: bool, stop: str, growth: list | None, first
         return (f"{head}; channel {loop.names[worst]} cannot close on its own: its own loop gain is "
                 f"{mism + drag + mass:.3g} >= 1 ({mism:.3g} from the drag mismatch's slope, the intervals of its "
                 f"damping coefficients; {drag:.3g} from the nominal drag's slope over V + E; {mass:.3g} from its "
-                f"added-mass interval) (docs/plant.md, section 4); {knobs}")
+                f"added-mass interval; in the decomposition where they are least) (docs/plant.md, section 4); {knobs}")
     if worst is None:
         return f"{head}; the small-gain loop's gain is not below 1 here (docs/plant.md, section 4); {knobs}"
     through = ("the cross terms (Coriolis, the mismatch's other slopes)" if loop.lateral else

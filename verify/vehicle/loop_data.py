@@ -22,6 +22,7 @@ from verify.vehicle.model import (channel_gradient, channel_masses, hull_balls, 
                                   point_time_constant, velocity_box, with_sway, without_sway, CHANNELS,
                                   LATERAL_CHANNELS)
 from verify.vehicle.response import RESPONSE_PREC, ResponseSums, impulse_sums
+from verify.vehicle.cells import Cell, channel_cells
 
 __all__ = ["LoopData", "loop_data_of", "loop_matrix"]
 
@@ -43,7 +44,7 @@ class LoopData:
 
     def __init__(self, params: VehicleParams, v_max: Sequence[float], tick: float, ticks: int,
                  sway_max: float = 0.0) -> None:
-        self.params, self.v_max, self.tick = params, tuple(v_max), tick
+        self.params, self.v_max, self.tick, self.ticks = params, tuple(v_max), tick, int(ticks)
         # with lateral thrust a fourth channel, sway (index 1), regulated to its command: the command box is
         # |v_c| <= sway_max (0 but under a backup law that commands sway, verify.backup.hold)
         self.lateral = bool(getattr(params, "lateral", False))
@@ -74,6 +75,10 @@ class LoopData:
         # the mass mismatch enters in verify.vehicle.bound's second decomposition: h Σ g_J + |λ_c| h Σ g_n
         self.mass_gain_balls = tuple(tuple(h * g[0] + abs(arb(lam)) * g[3] for g in rows)
                                      for rows, lam in zip(self.gain_balls, self.slope))
+        # step 5c: per channel, its own constant coefficients split into cells (verify.vehicle.cells)
+        self.cells: tuple[tuple[Cell, ...], ...] = tuple(
+            channel_cells(self, c, loop_matrix(self.k_p, self.k_i, self.lag, lam)) for c, lam in enumerate(self.slope)) \
+            if self.stable else tuple(() for _ in self.names)
 
     @property
     def stable(self) -> bool:

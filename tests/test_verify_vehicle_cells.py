@@ -2,17 +2,25 @@
 
 from __future__ import annotations
 
+import json
 import math
 
 import numpy as np
+import pytest
 from flint import arb
 from hypothesis import given, settings, strategies as st
 
+from tubekit.scenario import load_scenario
 from tubekit.model.vehicle_sets import BLUEROV2_HEAVY
+from tubekit.tiers import Tiers
+from verify.certificate.certify import certify
+from verify.studies.recheck import recheck
 from verify.kernel.intervals import enclose, lower, upper
 from verify.vehicle.bound import velocity_loop_bound
 from verify.vehicle.cells import CELL_BUDGET, _cell_matrix, own_splits, split_ball
 from verify.vehicle.loop_data import loop_data_of, loop_matrix
+
+from .corners import at_corner
 
 H, TICKS = 0.01, 10
 
@@ -90,3 +98,64 @@ def test_over_the_published_spread_the_cells_close_the_loop_where_the_other_two_
     without = velocity_loop_bound(_published(), **kwargs)
     assert not without.certified and "diverged" in next(c for c in without.conditions
                                                         if c.condition == "loop_fixed_point").detail
+
+
+# ---- what step 5c opens: the published spread at the owners' speed (examples/bluerov2_published_brisk.toml) -------
+
+PUBLISHED_BRISK = "examples/bluerov2_published_brisk.toml"
+
+
+@pytest.fixture(scope="module")
+def brisk_cert():
+    return certify(load_scenario(PUBLISHED_BRISK))
+
+
+def test_the_published_spread_certifies_both_tiers_at_the_owners_speed_and_current(brisk_cert, monkeypatch):
+    """examples/bluerov2_published_brisk.toml: the bundled box as it is (no interval narrowed), a 0.2 m/s target in
+    0.1 m/s of current per axis, epsilon 1 m, no backup: both tiers, recheck agreeing number for number; with the
+    cells switched off the loop's fixed point does not close and nothing is certified."""
+    import verify.vehicle.bound as bound
+    import verify.vehicle.compose as compose
+    sc = load_scenario(PUBLISHED_BRISK)
+    assert all(sc.plant.params.interval(k) == BLUEROV2_HEAVY.interval(k) for k in BLUEROV2_HEAVY.interval_fields)
+    assert sc.trajectory.direction_velocity[0] >= 0.2 and min(sc.disturbance.amplitude[:2]) >= 0.1
+    assert sc.epsilon <= 1.0
+    assert brisk_cert.tiers == Tiers(True, True)
+    assert recheck(json.loads(json.dumps(brisk_cert.to_dict()))).ok
+    monkeypatch.setattr(bound, "_in_cells", lambda *args: math.inf)
+    compose._SOLVED.clear()
+    try:
+        without = certify(sc)
+    finally:  # no other test may see a certificate derived without step 5c
+        compose._SOLVED.clear()
+    assert without.tiers == Tiers(False, False) and "loop_fixed_point" in [c.condition for c in without.failures]
+
+
+@pytest.mark.parametrize("end", [0, 1])
+def test_at_the_owners_speed_a_hull_at_either_corner_of_the_published_box_keeps_every_promise(brisk_cert, end):
+    """20 s of examples/bluerov2_published_brisk.toml with the hull at the box's lower, then upper corner: every
+    promise of both tiers kept (the loop's error within the cells' E among them), a plan at every period."""
+    import tubekit
+    run = tubekit.simulate(at_corner(load_scenario(PUBLISHED_BRISK), end), brisk_cert, duration=20.0, progress=False)
+    promises = {p.name: p for p in tubekit.check_promises(run)}
+    assert all(p.ok for p in promises.values() if p.given), [p for p in promises.values() if p.given and not p.ok]
+    assert promises["plan_available"].ok and promises["velocity_loop"].ok and not run.backup_active.any()
+
+
+@settings(derandomize=True, max_examples=4, deadline=None)
+@given(fraction=st.floats(0.05, 0.3))
+def test_a_box_about_the_nominal_vehicle_is_never_bounded_below_the_nominal_vehicle_itself(fraction):
+    """Property: over von Benzon's values ± ``fraction`` (the cells of step 5c in use) E is, channel by channel, at
+    least the bound of the nominal point vehicle alone, whose loop has no mismatch (its E is the exact L1 sums of the
+    jumps and the nominal drag): a cell's centre in the loop's matrix never makes the box look better than its own
+    centre."""
+    nominal = BLUEROV2_HEAVY.nominal.with_overrides({"loop_bandwidth": 20.0})
+    names = ("X_uu", "Y_vv", "Z_ww", "N_rr", "X_udot", "Y_vdot", "Z_wdot", "N_rdot", "X_u", "Z_w")
+    box = nominal.with_overrides({k: tuple(sorted((getattr(nominal, k) * (1 - fraction),
+                                                   getattr(nominal, k) * (1 + fraction)))) for k in names})
+    kwargs = dict(v_max=_V, tick=H, period=H * TICKS, jump_tick=(0.0, 0.0, 0.0), jump_period=_PLANS,
+                  first_command=_FIRST)
+    point, wide = velocity_loop_bound(nominal, **kwargs), velocity_loop_bound(box, **kwargs)
+    assert point.certified and wide.certified, wide.reason
+    assert any(cells for cells in loop_data_of(box, _V, H, TICKS).cells)
+    assert all(w >= p for w, p in zip(wide.error, point.error)), (wide.error, point.error)

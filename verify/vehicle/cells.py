@@ -4,7 +4,8 @@ The coefficients θ are constant in a run; only the velocities change. The decom
 :mod:`verify.vehicle.bound` still charge a channel's own mass and damping mismatch as inputs whose size is the
 whole box's: the mass mismatch as (1 − 1/μ) ẏ, the drag mismatch's own slope as ∂d_c/∂y_c ẏ / m̂_c. Here the
 channel's own mass entry and its linear and quadratic damping coefficients (:data:`OWN_COEFFICIENTS`) are each
-split into :data:`CELL_SPLITS` sub-intervals; every θ lies in one cell (a product of sub-intervals, the other
+split into sub-intervals (:func:`own_splits`: at most :data:`CELL_BUDGET` cells a channel, none where a split lowers
+the residual by less than :data:`CELL_GAIN_STEP`); every θ lies in one cell (a product of sub-intervals, the other
 coefficients over the whole box), so a bound that holds in every cell holds for the vehicle.
 
 **Per cell** k, with μ_k the centre of μ = m̂_c/m_c and δ_k the centre of ∂d_c/∂y_c / m̂_c over the cell and

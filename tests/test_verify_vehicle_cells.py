@@ -159,3 +159,15 @@ def test_a_box_about_the_nominal_vehicle_is_never_bounded_below_the_nominal_vehi
     assert point.certified and wide.certified, wide.reason
     assert any(cells for cells in loop_data_of(box, _V, H, TICKS).cells)
     assert all(w >= p for w, p in zip(wide.error, point.error)), (wide.error, point.error)
+
+
+def test_at_the_owners_speed_a_run_started_under_way_at_the_targets_speed_is_not_bounded():
+    """The same file started under way at the target's 0.2 m/s instead of 0.08 m/s: the start transient
+    d(ν(0))/m̂ over the first command's box grows with its speed, and the plans-only loop bound diverges (what the
+    example's ``limits.initial`` avoids; docs/plant.md section 4)."""
+    from verify.vehicle.compose import plans_only_bound
+    sc = load_scenario(PUBLISHED_BRISK)
+    assert plans_only_bound(sc).certified
+    under_way = plans_only_bound(sc.with_changes(**{"limits.initial": (0.2, 0.0, 0.0)}))
+    assert not under_way.certified and "diverged" in next(c for c in under_way.conditions
+                                                          if c.condition == "loop_fixed_point").detail

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from tubekit.scenario import Scenario
 
-__all__ = ["at_corner"]
+__all__ = ["at_corner", "flown_at_corner"]
 
 
 def at_corner(scenario: Scenario, end: int) -> Scenario:
@@ -15,3 +15,11 @@ def at_corner(scenario: Scenario, end: int) -> Scenario:
     return scenario.with_changes(plant=scenario.plant.__class__(kind="dynamic", vehicle=scenario.plant.vehicle,
                                                                 overrides=scenario.plant.overrides,
                                                                 truth=tuple(corner.items())))
+
+
+def flown_at_corner(scenario: Scenario, end: int, cert, duration: float | None = 20.0) -> tuple[dict, object]:
+    """(the promises by name, the run) of ``duration`` s (None: the scenario's own) of ``scenario`` under the
+    certificate ``cert`` with the hull at the lower (``end`` 0) or upper (1) corner of its coefficient box."""
+    import tubekit
+    run = tubekit.simulate(at_corner(scenario, end), cert, duration=duration, progress=False)
+    return {p.name: p for p in tubekit.check_promises(run)}, run

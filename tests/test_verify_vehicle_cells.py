@@ -20,7 +20,8 @@ from verify.vehicle.bound import velocity_loop_bound
 from verify.vehicle.cells import CELL_BUDGET, _cell_matrix, own_splits, split_ball
 from verify.vehicle.loop_data import loop_data_of, loop_matrix
 
-from .corners import at_corner
+from .corners import flown_at_corner
+from .loop_steps import STEP_5C, certified_with_steps_off
 
 H, TICKS = 0.01, 10
 
@@ -94,7 +95,7 @@ def test_over_the_published_spread_the_cells_close_the_loop_where_the_other_two_
     with_cells = velocity_loop_bound(_published(), **kwargs)
     assert with_cells.certified, with_cells.reason
     assert with_cells.error[0] < 0.1 and with_cells.error[2] < 0.06
-    monkeypatch.setattr(bound, "_in_cells", lambda *args: math.inf)
+    monkeypatch.setattr(bound, STEP_5C, lambda *args: math.inf)
     without = velocity_loop_bound(_published(), **kwargs)
     assert not without.certified and "diverged" in next(c for c in without.conditions
                                                         if c.condition == "loop_fixed_point").detail
@@ -114,20 +115,13 @@ def test_the_published_spread_certifies_both_tiers_at_the_owners_speed_and_curre
     """examples/bluerov2_published_brisk.toml: the bundled box as it is (no interval narrowed), a 0.2 m/s target in
     0.1 m/s of current per axis, epsilon 1 m, no backup: both tiers, recheck agreeing number for number; with the
     cells switched off the loop's fixed point does not close and nothing is certified."""
-    import verify.vehicle.bound as bound
-    import verify.vehicle.compose as compose
     sc = load_scenario(PUBLISHED_BRISK)
     assert all(sc.plant.params.interval(k) == BLUEROV2_HEAVY.interval(k) for k in BLUEROV2_HEAVY.interval_fields)
     assert sc.trajectory.direction_velocity[0] >= 0.2 and min(sc.disturbance.amplitude[:2]) >= 0.1
     assert sc.epsilon <= 1.0
     assert brisk_cert.tiers == Tiers(True, True)
     assert recheck(json.loads(json.dumps(brisk_cert.to_dict()))).ok
-    monkeypatch.setattr(bound, "_in_cells", lambda *args: math.inf)
-    compose._SOLVED.clear()
-    try:
-        without = certify(sc)
-    finally:  # no other test may see a certificate derived without step 5c
-        compose._SOLVED.clear()
+    without = certified_with_steps_off(monkeypatch, sc, (STEP_5C,))
     assert without.tiers == Tiers(False, False) and "loop_fixed_point" in [c.condition for c in without.failures]
 
 
@@ -135,9 +129,7 @@ def test_the_published_spread_certifies_both_tiers_at_the_owners_speed_and_curre
 def test_at_the_owners_speed_a_hull_at_either_corner_of_the_published_box_keeps_every_promise(brisk_cert, end):
     """20 s of examples/bluerov2_published_brisk.toml with the hull at the box's lower, then upper corner: every
     promise of both tiers kept (the loop's error within the cells' E among them), a plan at every period."""
-    import tubekit
-    run = tubekit.simulate(at_corner(load_scenario(PUBLISHED_BRISK), end), brisk_cert, duration=20.0, progress=False)
-    promises = {p.name: p for p in tubekit.check_promises(run)}
+    promises, run = flown_at_corner(load_scenario(PUBLISHED_BRISK), end, brisk_cert)
     assert all(p.ok for p in promises.values() if p.given), [p for p in promises.values() if p.given and not p.ok]
     assert promises["plan_available"].ok and promises["velocity_loop"].ok and not run.backup_active.any()
 

@@ -14,7 +14,8 @@ from tubekit.scenario import load_scenario, scenario_from_dict
 from verify.certificate.certify import Certificate, certify
 from verify.vehicle.compose import PLAN_CHECK_TOLERANCE, plan_jumps
 from verify.studies.recheck import recheck
-from .corners import at_corner
+from .corners import flown_at_corner
+from .loop_steps import STEP_5B, STEP_5C, certified_with_steps_off, fresh_solutions
 from .tier_checks import refused_only_by_the_row_faces
 
 PAPER_CURRENTS = "verify/scenarios/paper_currents.toml"
@@ -244,7 +245,7 @@ def test_a_start_that_does_not_close_is_followed_by_the_next_start(monkeypatch):
     ``certify`` returns, and ``recheck`` (under the same switch) agrees with it number for number."""
     import verify.vehicle.bound as bound
     import verify.vehicle.compose as compose
-    monkeypatch.setattr(bound, "_in_cells", lambda *args: math.inf)
+    monkeypatch.setattr(bound, STEP_5C, lambda *args: math.inf)
     sc = _widened(load_scenario(SLOW), 0.15)
     starts: list[tuple[float, object]] = []
     solve_from = compose._solve_from
@@ -254,11 +255,8 @@ def test_a_start_that_does_not_close_is_followed_by_the_next_start(monkeypatch):
         starts.append((args[-1], solution))
         return solution
     monkeypatch.setattr(compose, "_solve_from", recorded)
-    compose._SOLVED.clear()
-    try:
+    with fresh_solutions():  # no other test may see a certificate derived without step 5c
         cert = certify(sc)
-    finally:  # no other test may see a certificate derived without step 5c
-        compose._SOLVED.clear()
     assert [start for start, _ in starts] == [compose._INFLATE, compose.FIXED_POINT_RESTARTS[0]]
     first, kept = (solution for _, solution in starts)
     consistent = next(c for c in first.conditions if c.condition == "loop_consistent")
@@ -427,7 +425,6 @@ def test_the_brisk_tracked_bluerov2_certifies_both_tiers_at_the_owners_speed_and
     von Benzon's value ±10 %: both tiers on the dynamic plant, the tracking design at the plans-only bound (its ω̄
     below the safe tier's), re-checked CONFIRMED; flown for 20 s with the hull at the box's upper corner in a
     steady cross current on the bound, a plan is accepted at every period and every promise of both tiers holds."""
-    import tubekit
     sc = load_scenario(BRISK_TRACKED)
     assert sc.trajectory.kind == "line" and max(sc.disturbance.amplitude[:2]) >= 0.1
     cert = certify(sc)
@@ -437,35 +434,9 @@ def test_the_brisk_tracked_bluerov2_certifies_both_tiers_at_the_owners_speed_and
     cross = sc.with_changes(**{"disturbance.amplitude": (0.0, 0.0, 0.0), "disturbance.constant": (0.0, 0.1, 0.0)})
     cross_cert = certify(cross)
     assert cross_cert.tiers == Tiers(True, True)
-    run = tubekit.simulate(at_corner(cross, 1), cross_cert, duration=20.0, progress=False)
-    promises = {p.name: p for p in tubekit.check_promises(run)}
+    promises, run = flown_at_corner(cross, 1, cross_cert)
     assert all(p.ok for p in promises.values() if p.given), [p for p in promises.values() if p.given and not p.ok]
     assert promises["plan_available"].ok and promises["tube"].ok and not run.backup_active.any()
-
-
-# ---- the loop bound's step 5b on the shipped examples (docs/verify.md section 9) -------------------------------
-
-def _certified_by_the_first_decomposition(monkeypatch, path: str) -> Certificate:
-    """``path`` certified with the loop bound's second and third decompositions (steps 5b and 5c) switched off (the
-    first alone); the memo of dynamic solutions is cleared before and after, so no other test sees this
-    certificate."""
-    import verify.vehicle.bound as bound
-    import verify.vehicle.compose as compose
-    monkeypatch.setattr(bound, "_mass_in_state", lambda *args: math.inf)
-    monkeypatch.setattr(bound, "_in_cells", lambda *args: math.inf)
-    compose._SOLVED.clear()
-    try:
-        return certify(load_scenario(path))
-    finally:
-        compose._SOLVED.clear()
-
-
-def _flown_at_corner(path: str, end: int, cert: Certificate, duration: float | None = 20.0):
-    """(the promises by name, the run) of ``duration`` s (None: the scenario's own) of ``path`` under ``cert`` with the
-    hull at the lower (0) or upper (1) corner of its coefficient box."""
-    import tubekit
-    run = tubekit.simulate(at_corner(load_scenario(path), end), cert, duration=duration, progress=False)
-    return {p.name: p for p in tubekit.check_promises(run)}, run
 
 
 # ---- ±20 % with the mass mismatch in the loop's state (docs/verify.md section 9, step 5b) ---------------------
@@ -485,7 +456,7 @@ def test_the_wide_box_example_certifies_both_tiers_where_the_first_decomposition
     assert wide_cert.tiers == Tiers(True, True)
     assert all(0.0 < e < 0.07 for e in wide_cert.velocity_loop.error)
     assert recheck(json.loads(json.dumps(wide_cert.to_dict()))).ok
-    first_only = _certified_by_the_first_decomposition(monkeypatch, WIDE)
+    first_only = certified_with_steps_off(monkeypatch, load_scenario(WIDE), (STEP_5B, STEP_5C))
     assert first_only.tiers == Tiers(False, False)
     assert "loop_fixed_point" in [c.condition for c in first_only.failures]
 
@@ -493,7 +464,7 @@ def test_the_wide_box_example_certifies_both_tiers_where_the_first_decomposition
 def test_the_wide_box_example_flown_at_a_corner_keeps_both_tiers_with_a_plan_at_every_period(wide_cert):
     """20 s of examples/bluerov2_wide_box.toml with the hull at the box's lower corner: every promise of both tiers
     kept (the velocity loop's error within the E of step 5b among them), a plan at every period, no backup."""
-    promises, run = _flown_at_corner(WIDE, 0, wide_cert)
+    promises, run = flown_at_corner(load_scenario(WIDE), 0, wide_cert)
     assert all(p.ok for p in promises.values() if p.given), [p for p in promises.values() if p.given and not p.ok]
     assert promises["plan_available"].ok and promises["velocity_loop"].ok and not run.backup_active.any()
 
@@ -518,14 +489,14 @@ def test_over_the_published_spread_both_tiers_hold_and_the_box_is_the_bundled_on
     assert all(sc.plant.params.interval(k) == bundled.interval(k) for k in bundled.interval_fields)
     assert published_cert.tiers == Tiers(True, True)
     assert recheck(json.loads(json.dumps(published_cert.to_dict()))).ok
-    first_only = _certified_by_the_first_decomposition(monkeypatch, PUBLISHED)
+    first_only = certified_with_steps_off(monkeypatch, load_scenario(PUBLISHED), (STEP_5B, STEP_5C))
     assert "loop_fixed_point" in [c.condition for c in first_only.failures]
 
 
 def test_over_the_published_spread_a_hull_without_linear_yaw_damping_keeps_every_promise(published_cert):
     """20 s of examples/bluerov2_published.toml with the hull at the box's upper corner (N_r = 0, the least drag in
     every channel): every promise of both tiers kept, a plan at every period, no backup."""
-    promises, run = _flown_at_corner(PUBLISHED, 1, published_cert)
+    promises, run = flown_at_corner(load_scenario(PUBLISHED), 1, published_cert)
     assert all(p.ok for p in promises.values() if p.given), [p for p in promises.values() if p.given and not p.ok]
     assert promises["plan_available"].ok and promises["velocity_loop"].ok and not run.backup_active.any()
 
@@ -545,6 +516,6 @@ def test_a_pier_within_three_metres_of_the_path_keeps_both_tiers_and_is_passed()
     assert abs(pier.center[1]) - pier.radius < 3.0 and 0.0 < pier.center[0] / speed < sc.duration
     cert = certify(sc)
     assert cert.tiers == Tiers(True, True)
-    promises, run = _flown_at_corner(PIER_SLOW, 1, cert, duration=None)
+    promises, run = flown_at_corner(sc, 1, cert, duration=None)
     assert all(p.ok for p in promises.values() if p.given), [p for p in promises.values() if p.given and not p.ok]
     assert promises["plan_available"].ok and promises["clearance"].ok and not run.backup_active.any()

@@ -35,10 +35,10 @@ from flint import arb, ctx
 
 from verify.kernel.intervals import _abs, enclose, lower, upper
 from verify.vehicle.model import channel_masses, channel_mismatch, channel_mismatch_gradient, velocity_box
-from verify.vehicle.response import RESPONSE_PREC, ResponseSums, impulse_sums
+from verify.vehicle.response import RESPONSE_PREC, gain_balls, impulse_sums
 
-__all__ = ["LoopFacts", "OWN_COEFFICIENTS", "CELL_BUDGET", "CELL_GAIN_STEP", "own_splits", "Cell", "CellInputs", "split_ball", "channel_cells", "cell_starts", "cell_inputs",
-           "cell_own_gains", "cell_bound"]
+__all__ = ["LoopFacts", "OWN_COEFFICIENTS", "CELL_BUDGET", "CELL_GAIN_STEP", "own_splits", "Cell", "CellInputs",
+           "split_ball", "channel_cells", "cell_starts", "cell_inputs", "cell_own_gains", "cell_bound"]
 
 #: Per channel name: its mass entry, linear and quadratic damping coefficient (the names of
 #: :func:`verify.vehicle.model.hull_balls`).
@@ -67,7 +67,6 @@ class LoopFacts(Protocol):
     tick: float
     ticks: int
     cells: tuple[tuple["Cell", ...], ...]
-
     gain_balls: tuple[tuple[tuple[arb, ...], ...], ...]
     mass_gain_balls: tuple[tuple[arb, ...], ...]
 
@@ -76,14 +75,17 @@ class LoopFacts(Protocol):
 
 @dataclass(frozen=True)
 class Cell:
-    """One cell of a channel: its coefficient balls, its centre (μ_k, δ_k) and the response sums of A_k.
+    """One cell of a channel: its own damping mismatch, its centre (μ_k, δ_k) and the response sums of A_k.
 
     Attributes
     ----------
-    hull : mapping of str to arb
-        :func:`verify.vehicle.model.hull_balls` with the channel's own coefficients narrowed to the cell.
+    damping : (2,) arb
+        Δa, Δb: the nominal minus the cell's linear and quadratic damping coefficient (balls; the channel's own
+        damping in :func:`verify.vehicle.model.arb_body_forces`).
     mu : arb
         m̂_c / m_c over the cell (dimensionless).
+    mass_residual : arb
+        |1 − μ_k/μ| over the cell (dimensionless): the mass residual's size per unit Ŷ_c.
     mu_centre, slope : float
         μ_k and δ_k (1/s), in A_k.
     gains : tuple
@@ -91,8 +93,9 @@ class Cell:
         peak g_r, h Σ g_v) as balls (s or dimensionless, as the rows of :class:`verify.vehicle.loop_data.LoopData`).
     """
 
-    hull: Mapping[str, arb]
+    damping: tuple[arb, arb]
     mu: arb
+    mass_residual: arb
     mu_centre: float
     slope: float
     gains: tuple[tuple[arb, ...], ...]
@@ -136,13 +139,6 @@ def _cell_matrix(base: Sequence[Sequence[arb]], k_i: arb, k_p: arb, lam: arb, mu
     u0 = (arb(0), arb(-1), k_p - lam)
     col = [mu_k * a - b for a, b in zip(v, u0)]
     return [[base[i][j] + col[i] * q[j] for j in range(3)] for i in range(3)]
-
-
-def _cell_gains(sums: ResponseSums, tick: float) -> tuple[tuple[arb, ...], ...]:
-    """The sums as balls per output row, in :class:`Cell`'s order."""
-    h = arb(tick)
-    return tuple((arb(sums.tick[o][0]), arb(sums.period[o][0]), h * arb(sums.tick[o][1]), h * arb(sums.tick[o][2]),
-                  arb(sums.peak[o][1]), h * arb(sums.tick[o][3])) for o in range(4))
 
 
 def own_splits(loop: LoopFacts, c: int, budget: int = CELL_BUDGET) -> tuple[int, int, int]:
@@ -195,16 +191,17 @@ def channel_cells(loop: LoopFacts, c: int, base: Sequence[Sequence[arb]],
                                 ticks_per_period=loop.ticks)
             if not sums.stable:
                 return ()
-            out.append(Cell(hull=hull, mu=mu, mu_centre=mu_k, slope=delta_k, gains=_cell_gains(sums, loop.tick)))
+            damping = (loop.nominal[names[1]] - combo[1], loop.nominal[names[2]] - combo[2])
+            out.append(Cell(damping=damping, mu=mu, mass_residual=abs(1 - arb(mu_k) / mu), mu_centre=mu_k,
+                            slope=delta_k, gains=gain_balls(sums, loop.tick)))
         return tuple(out)
 
 
-def _own_damping(loop: LoopFacts, c: int, hull: Mapping[str, arb], speed: arb) -> tuple[arb, arb]:
-    """The own damping's part of d_c and of ∂d_c/∂y_c in a cell: −(Δa + Δb |y|) y and −(Δa + 2 Δb |y|), Δ = nominal −
-    ``hull`` of the channel's linear and quadratic coefficient, y over the ball ``speed`` (as
-    :func:`verify.vehicle.model.arb_body_forces` writes every channel's own damping)."""
-    _, lin, quad = OWN_COEFFICIENTS[loop.names[c]]
-    d_a, d_b = loop.nominal[lin] - hull[lin], loop.nominal[quad] - hull[quad]
+def _own_damping(cell: Cell, speed: arb) -> tuple[arb, arb]:
+    """The own damping's part of d_c and of ∂d_c/∂y_c in ``cell``: −(Δa + Δb |y|) y and −(Δa + 2 Δb |y|) (Δ: the
+    cell's :attr:`Cell.damping`), y over the ball ``speed`` (as :func:`verify.vehicle.model.arb_body_forces` writes
+    every channel's own damping)."""
+    d_a, d_b = cell.damping
     size = _abs(speed)
     return -(d_a + d_b * size) * speed, -(d_a + 2 * d_b * size)
 
@@ -225,7 +222,7 @@ def cell_starts(loop: LoopFacts, first_command: Sequence[float]) -> tuple[tuple[
     out = []
     for c, cells in enumerate(loop.cells):
         d_rest = _rest(loop, c, first)[0] if cells else arb(0)
-        out.append(tuple(upper(abs(d_rest + _own_damping(loop, c, cell.hull, first[loop.own[c]])[0]) / loop.m_hat[c])
+        out.append(tuple(upper(abs(d_rest + _own_damping(cell, first[loop.own[c]])[0]) / loop.m_hat[c])
                          for cell in cells))
     return tuple(out)
 
@@ -243,9 +240,9 @@ def cell_inputs(loop: LoopFacts, c: int, nu: Sequence[arb], rates: Sequence[arb]
     cross = sum((abs(g) * x for j, (g, x) in enumerate(zip(g_rest, rates)) if j != own), arb(0)) / m_hat
     out = []
     for k, cell in enumerate(cells):
-        d_own, g_own = _own_damping(loop, c, cell.hull, nu[own])
+        d_own, g_own = _own_damping(cell, nu[own])
         rate = abs((g_rest[own] + g_own) / m_hat - arb(cell.slope)) * y_dot + cross
-        mass = abs(1 - arb(cell.mu_centre) / cell.mu) * y_dot
+        mass = cell.mass_residual * y_dot
         mismatch = upper(abs(d_rest + d_own) / m_hat)
         out.append(CellInputs(rate=upper(rate), mass=upper(mass), mismatch=mismatch,
                               start=mismatch if starts is None else starts[k]))
@@ -259,11 +256,11 @@ def cell_own_gains(loop: LoopFacts, c: int, nu: Sequence[arb], drag_slope: arb) 
     worst = None
     g_rest = _rest(loop, c, nu)[1][loop.own[c]] if loop.cells[c] else arb(0)
     for cell in loop.cells[c]:
-        grad = g_rest + _own_damping(loop, c, cell.hull, nu[loop.own[c]])[1]
+        grad = g_rest + _own_damping(cell, nu[loop.own[c]])[1]
         _, _, h_rate, h_drag, _, h_mass = cell.gains[3]
         parts = (upper(cell.mu * h_rate * abs(grad / loop.m_hat[c] - arb(cell.slope))),
                  upper(cell.mu * h_drag * drag_slope),
-                 upper(cell.mu * h_mass * abs(1 - arb(cell.mu_centre) / cell.mu)))
+                 upper(cell.mu * h_mass * cell.mass_residual))
         if worst is None or sum(parts) > sum(worst):
             worst = parts
     return worst
@@ -273,8 +270,8 @@ def cell_bound(cell: Cell, o: int, jump_tick: arb, jump_period: arb, w_n: float,
     """Output ``o`` (e, a, z, ẏ) of one cell for the jumps J_tick, J_period (m/s, rad/s), sup|w_n| and the cell's
     residuals."""
     g_tick, g_period, h_rate, h_drag, peak, h_mass = cell.gains[o]
-    x = (jump_tick * g_tick + (jump_period - jump_tick) * g_period + h_rate * arb(inputs.rate) + h_drag * arb(w_n) + h_mass * arb(inputs.mass)
-         + peak * arb(inputs.start))
+    x = (jump_tick * g_tick + (jump_period - jump_tick) * g_period + h_rate * arb(inputs.rate) + h_drag * arb(w_n)
+         + h_mass * arb(inputs.mass) + peak * arb(inputs.start))
     if o == 1:
         x += arb(inputs.mismatch)
     if o == 3:

@@ -21,7 +21,7 @@ from verify.theorem.design import hull_sway_bound
 from verify.vehicle.model import (channel_gradient, channel_masses, hull_balls, nominal_balls, nominal_params,
                                   point_time_constant, velocity_box, with_sway, without_sway, CHANNELS,
                                   LATERAL_CHANNELS)
-from verify.vehicle.response import RESPONSE_PREC, ResponseSums, impulse_sums
+from verify.vehicle.response import RESPONSE_PREC, ResponseSums, gain_balls, impulse_sums
 from verify.vehicle.cells import Cell, channel_cells
 
 __all__ = ["LoopData", "loop_data_of", "loop_matrix"]
@@ -62,22 +62,19 @@ class LoopData:
         self.slope = tuple(float(x.mid()) for x in self.slopes(box, gamma)) if math.isfinite(gamma) \
             else (0.0,) * len(self.names)
         kp, ki = arb(self.k_p), arb(self.k_i)
+        bases = tuple(loop_matrix(self.k_p, self.k_i, self.lag, lam) for lam in self.slope)  # A(λ_c) per channel
         self.sums: tuple[ResponseSums, ...] = tuple(impulse_sums(
-            loop_matrix(self.k_p, self.k_i, self.lag, lam), [[0, 1, -kp], [1 / ki, 0, 0], [0, 0, -1]],
-            [[0, 1, 0], [ki, kp, 0], [0, 0, 1], [ki, kp, 1]], tick=tick, ticks_per_period=ticks)
-            for lam in self.slope)
+            a, [[0, 1, -kp], [1 / ki, 0, 0], [0, 0, -1]], [[0, 1, 0], [ki, kp, 0], [0, 0, 1], [ki, kp, 1]],
+            tick=tick, ticks_per_period=ticks) for a in bases)
         h = arb(tick)
         # the sums as balls, per channel and output row: (jump per tick, jump per period, h Ẇ, h w_n, start peak)
-        self.gain_balls = tuple(tuple((arb(s.tick[o][0]), arb(s.period[o][0]), h * arb(s.tick[o][1]),
-                                       h * arb(s.tick[o][2]), arb(s.peak[o][1])) for o in range(4))
-                                for s in self.sums)
+        self.gain_balls = tuple(gain_balls(s, tick) for s in self.sums)
         # per channel and output row, the L1 gain of the direction (0, −1, k_p − λ_c) = −b_J + λ_c b_n along which
         # the mass mismatch enters in verify.vehicle.bound's second decomposition: h Σ g_J + |λ_c| h Σ g_n
         self.mass_gain_balls = tuple(tuple(h * g[0] + abs(arb(lam)) * g[3] for g in rows)
                                      for rows, lam in zip(self.gain_balls, self.slope))
         # step 5c: per channel, its own constant coefficients split into cells (verify.vehicle.cells)
-        self.cells: tuple[tuple[Cell, ...], ...] = tuple(
-            channel_cells(self, c, loop_matrix(self.k_p, self.k_i, self.lag, lam)) for c, lam in enumerate(self.slope)) \
+        self.cells: tuple[tuple[Cell, ...], ...] = tuple(channel_cells(self, c, a) for c, a in enumerate(bases)) \
             if self.stable else tuple(() for _ in self.names)
 
     @property

@@ -28,7 +28,7 @@ from flint import arb, arb_mat, ctx
 
 from verify.kernel.intervals import upper
 
-__all__ = ["ResponseSums", "impulse_sums", "RESPONSE_PREC", "INTRA_TICK_PIECES"]
+__all__ = ["ResponseSums", "impulse_sums", "gain_balls", "RESPONSE_PREC", "INTRA_TICK_PIECES"]
 
 #: Working precision (bits) of the response sums: the ball radii of A_d^i grow like ρ(|A_d|)^i.
 RESPONSE_PREC = 128
@@ -165,6 +165,16 @@ def impulse_sums(a: Sequence[Sequence[arb | float]], inputs: Sequence[Sequence[a
         # a single term of the tail is at most the whole tail
         peaks = tuple(tuple(max(peak[o][j], upper(tails[o][j])) for j in range(n_in)) for o in range(n_out))
         return ResponseSums(tick=tick_sums, period=period_sums, peak=peaks, rho=rho, terms=i)
+
+
+def gain_balls(sums: ResponseSums, tick: float) -> tuple[tuple[arb, ...], ...]:
+    """The velocity loop's sums as balls, per output row: (Σ g per tick and max-phase Σ g per period of the jump
+    column 0, h Σ g of columns 1 and 2, the peak of column 1, then h Σ g of every further column), h = ``tick`` (s):
+    the L1 gains of :mod:`verify.vehicle.bound` (jumps, Ẇ or r, w_n, the start along column 1, extra inputs)."""
+    h = arb(tick)
+    return tuple((arb(sums.tick[o][0]), arb(sums.period[o][0]), h * arb(sums.tick[o][1]), h * arb(sums.tick[o][2]),
+                  arb(sums.peak[o][1]), *(h * arb(x) for x in sums.tick[o][3:]))
+                 for o in range(len(sums.tick)))
 
 
 def _done(norm: arb, tol: float) -> bool:

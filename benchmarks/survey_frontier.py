@@ -14,8 +14,12 @@ Nothing is timed.
 ``--backup none``: no backup law (``docs/verify.md`` step 13g); the completion's footprint is then X_f's own, the
 sector behind the target that its bearing face allows (step 17b), with no loiter about its end.
 
+``--rate RU RW RR``: plans limited to these rates (``limits.rate``; a vehicle whose velocity loop is inside the
+theorem needs them, ``docs/verify.md`` step 17c), the terminal set then with its row faces and its bearing face
+together (``verify.theorem.terminal_bearing.bearing_row_sets``); ``--start``: the start's distance behind the target.
+
 Usage: ``python benchmarks/survey_frontier.py [--speed 0.6 1.0 1.5] [--current 0.1 0.2 0.3] [--offset 5 30]
-[--backup none]``
+[--backup none] [--rate 0.5 0.5 1.0] [--start 7]``
 (about a second per cell).
 """
 
@@ -34,22 +38,28 @@ __all__ = ["survey", "cell", "main"]
 
 
 def survey(speed: float, current: float, offset: float, *, u_min: float = 0.5, u_max: float = 2.0,
-           r_max: float = 0.2, epsilon: float = 3.0, backup: str = "loiter"):
+           r_max: float = 0.2, epsilon: float = 3.0, backup: str = "loiter",
+           rate: tuple[float, float, float] | None = None, start: float | None = None):
     """The survey scenario of the module doc (a :class:`tubekit.scenario.Scenario`), with ``controller.backup``
-    ``backup`` (the loiter, or ``none``: the safe tier as the tracking tier's corollary)."""
+    ``backup`` (the loiter, or ``none``: the safe tier as the tracking tier's corollary). ``rate``: the plans'
+    rate limit (m/s², m/s², rad/s²; ``limits.rate``), the command before t = 0 then the target's speed ahead;
+    ``start``: the start's distance behind the target (m; default ε + 2)."""
     from tubekit import load_scenario
     from tubekit.model.trajectory import Line
     from tubekit.scenario import Obstacle
 
+    behind = epsilon + 2.0 if start is None else start
+    limits = {} if rate is None else {"limits.rate": tuple(rate), "limits.initial": (speed, 0.0, 0.0)}
     return load_scenario(SCENARIO).with_changes(
         name="survey", trajectory=Line(start=(0.0, 0.0, 0.0), direction_velocity=(speed, 0.0, 0.0)),
         obstacles=(Obstacle((40.0, offset, 0.0), 0.5),), epsilon=epsilon, duration=60.0, sensing_range=80.0,
-        workspace=((-100.0, -100.0, -10.0), (300.0, 100.0, 10.0)), initial_state=(-(epsilon + 2.0), 0.0, 0.0, 0.0),
+        workspace=((-100.0, -100.0, -10.0), (300.0, 100.0, 10.0)), initial_state=(-behind, 0.0, 0.0, 0.0),
         **{"limits.u_max": u_max, "limits.u_min": u_min, "limits.r_max": r_max, "controller.backup": backup,
-           "disturbance.amplitude": (current, current, 0.05), "region.e_d_max": epsilon + 5.0})
+           "disturbance.amplitude": (current, current, 0.05), "region.e_d_max": epsilon + 5.0}, **limits)
 
 
-def cell(speed: float, current: float, offset: float, **limits: float | str) -> dict:
+def cell(speed: float, current: float, offset: float, **limits: float | str | tuple[float, float, float] | None
+         ) -> dict:
     """The verdict of one cell: ``tiers`` (both / safe / none), the failed conditions and the loiter's radius (m)."""
     import verify
 
@@ -78,12 +88,15 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--r-max", type=float, default=0.2)
     ap.add_argument("--epsilon", type=float, default=3.0)
     ap.add_argument("--backup", default="loiter", help="controller.backup: loiter (default) or none")
+    ap.add_argument("--rate", type=float, nargs=3, default=None, help="the plans' rate limit (m/s², m/s², rad/s²)")
+    ap.add_argument("--start", type=float, default=None, help="the start's distance behind the target (m)")
     args = ap.parse_args(argv)
     limits = {"u_min": args.u_min, "u_max": args.u_max, "r_max": args.r_max, "epsilon": args.epsilon,
-              "backup": args.backup}
+              "backup": args.backup, "rate": args.rate, "start": args.start}
     for offset in args.offset:
         print(f"obstacle {offset:g} m off the path; u_min {args.u_min:g}, u_max {args.u_max:g} m/s, "
-              f"r_max {args.r_max:g} rad/s, epsilon {args.epsilon:g} m, backup {args.backup}")
+              f"r_max {args.r_max:g} rad/s, epsilon {args.epsilon:g} m, backup {args.backup}, "
+              f"plans' rate {args.rate or 'none'}, start {args.start or args.epsilon + 2.0:g} m behind")
         print("| target (m/s) \\ current (m/s) | " + " | ".join(f"{c:g}" for c in args.current) + " |")
         print("|---" * (len(args.current) + 1) + "|")
         for speed in args.speed:

@@ -15,7 +15,8 @@ def test_at_one_metre_per_second_in_the_survey_current_both_tiers_hold_with_room
     far = STUDY.cell(1.0, 0.3, 30.0, r_max=0.3)
     near = STUDY.cell(1.0, 0.3, 5.0, r_max=0.3)
     assert far["tiers"] == "both" and far["failed"] == []
-    assert near["tiers"] == "safe" and near["failed"] == ["path_clearance[0]"]
+    assert near["tiers"] == "safe" and "path_clearance[0]" in near["failed"]
+    assert set(near["failed"]) <= {"path_clearance[0]", "initial_terminal"}  # the narrowest set's start, too near
     assert near["loiter_radius"] == far["loiter_radius"] > 5.0
 
 
@@ -32,4 +33,25 @@ def test_without_a_backup_the_sector_behind_the_target_passes_a_rock_three_metre
     none = STUDY.cell(1.0, 0.3, 3.0, r_max=0.3, backup="none")
     loiter = STUDY.cell(1.0, 0.3, 3.0, r_max=0.3)
     assert none["tiers"] == "both" and none["failed"] == [] and none["loiter_radius"] is None
-    assert loiter["tiers"] == "safe" and loiter["failed"] == ["path_clearance[0]"]
+    assert loiter["tiers"] == "safe" and "path_clearance[0]" in loiter["failed"]
+    assert set(loiter["failed"]) <= {"path_clearance[0]", "initial_terminal"}
+
+
+def test_under_rate_limited_plans_the_survey_keeps_both_tiers_with_a_rock_five_metres_off_in_a_current_toward_it():
+    """1 m/s in 0.3 m/s of current, no backup, plans limited to (0.5, 0.5, 1.0) per second, the start 7 m behind:
+    both tiers with the rock 5 m off (the row faces and the bearing face together, docs/verify.md step 17b), and
+    60 s flown in a steady 0.3 m/s current toward the rock keep every promise with the solver's plan at every
+    period and the surge never below u_min; with rates of 0.3 m/s² in surge the row face fails by name."""
+    import tubekit
+    import verify
+    rated = {"r_max": 0.3, "backup": "none", "rate": (0.5, 0.5, 1.0), "start": 7.0}
+    assert STUDY.cell(1.0, 0.3, 5.0, **rated) == {"tiers": "both", "failed": [], "loiter_radius": None}
+    slow = STUDY.cell(1.0, 0.3, 5.0, **{**rated, "rate": (0.3, 0.3, 0.6)})
+    assert slow["tiers"] == "none" and slow["failed"] == ["terminal_rate[u]"]
+    toward = STUDY.survey(1.0, 0.3, 5.0, **rated).with_changes(
+        **{"disturbance.amplitude": (0.0, 0.0, 0.0), "disturbance.constant": (0.0, 0.3, 0.0)})
+    cert = verify.certify(toward)
+    run = tubekit.simulate(toward, cert, progress=False)
+    broken = [p.name for p in tubekit.check_promises(run) if p.given and not p.ok]
+    assert cert.tiers.tracking and broken == [] and run.metrics["replaced_steps"] == 0
+    assert float(run.metrics["min_clearance"]) > 0.0

@@ -15,9 +15,12 @@ import verify
 from tubekit import load_scenario
 from tubekit.model.kinematics import unicycle_step
 from tubekit.model.terminal_law import bearing, line_of_sight
-from tubekit.model.trajectory import Circle, Waypoints
-from verify.theorem.terminal import law_conditions, terminal_bounds
-from verify.theorem.terminal_bearing import BEARING_STEP, smallest_bearing
+from tubekit.model.trajectory import Circle, Line, Waypoints
+from tubekit.scenario import Obstacle
+from verify.theorem.terminal import (FINE_LOWER_ENDS, FINE_WIDTHS, LOWER_ENDS, WIDTHS, _grid, _grid_points, law_conditions,
+                                     terminal_bounds)
+from verify.theorem.terminal_bearing import BEARING_STEP, bearing_row_sets, bearing_sets, smallest_bearing
+from verify.theorem.terminal_rows import row_sets
 
 TRACKED = load_scenario(Path(__file__).resolve().parents[1] / "examples" / "keep_moving_tracked.toml")
 #: The same vehicle after a target on a 10 m circle at 0.4 m/s (curvature: the velocity turns 0.004 rad a period).
@@ -86,11 +89,11 @@ def test_one_completion_keeps_the_cone_and_the_surge_above_its_floor(certs, whic
 
 
 def test_a_cone_narrower_than_the_proof_allows_is_refuted_and_left_by_a_completion(certs):
-    """Counterexample: half the smallest admissible phi_f. The condition fails, and a start on the cone's edge
-    pushed outward by the deviation (the vehicle moved sideways, its heading turned outward) ends outside it."""
+    """Counterexample: 0.3 of the smallest admissible phi_f. The condition fails, and a start on the cone's edge at
+    d_lo pushed outward by the deviation (the vehicle moved sideways, its heading turned outward) ends outside it."""
     sc, cert = TRACKED, certs["line"]
     b = terminal_bounds(sc, cert.design, cert.region)
-    narrow = dataclasses.replace(cert.design.terminal, bearing_max=0.5 * smallest_bearing(b, cert.design.terminal))
+    narrow = dataclasses.replace(cert.design.terminal, bearing_max=0.3 * smallest_bearing(b, cert.design.terminal))
     failed = {c.condition for c in law_conditions(b, narrow) if not c.ok}
     assert "terminal_invariant[bearing]" in failed
     dt, tr = sc.controller.dt, sc.trajectory
@@ -98,7 +101,7 @@ def test_a_cone_narrower_than_the_proof_allows_is_refuted_and_left_by_a_completi
     phi = narrow.bearing_max
     los = math.atan2(v[1], v[0]) - phi
     outward = (-math.sin(los), math.cos(los))     # the vehicle moved to the line of sight's left: the bearing grows
-    x = _state(narrow, b, p, v, narrow.d_hi, phi, narrow.alpha_max, 0.0, outward, 0.0)  # heading left of it too
+    x = _state(narrow, b, p, v, narrow.d_lo, phi, narrow.alpha_max, 0.0, outward, 0.0)  # heading left of it too
     assert bearing(x, p, v) > phi                           # the deviation alone already left the cone
     end = unicycle_step(x, narrow.command(x, p, v, dt), dt)
     p1, v1 = (np.asarray(g(10.0 + dt), float).reshape(3) for g in (tr.position, tr.velocity))
@@ -120,3 +123,69 @@ def test_without_a_speed_floor_no_bearing_is_admitted(certs):
     cert = certs["line"]
     b = dataclasses.replace(terminal_bounds(TRACKED, cert.design, cert.region), speed_floor_xy=0.0)
     assert smallest_bearing(b, cert.design.terminal) is None
+
+
+#: The torpedo survey at 1 m/s in 0.3 m/s of current per horizontal axis, u_min 0.5 m/s, no backup, a rock 5 m off the
+#: path, plans limited to (0.5 m/s², 0.5 m/s², 1 rad/s²), the start 7 m behind (``benchmarks/survey_frontier.py``).
+SURVEY_RATED = TRACKED.with_changes(
+    trajectory=Line(start=(0.0, 0.0, 0.0), direction_velocity=(1.0, 0.0, 0.0)),
+    obstacles=(Obstacle((40.0, 5.0, 0.0), 0.5),), epsilon=3.0, sensing_range=80.0,
+    workspace=((-100.0, -100.0, -10.0), (300.0, 100.0, 10.0)), initial_state=(-7.0, 0.0, 0.0, 0.0),
+    **{"limits.u_max": 2.0, "limits.u_min": 0.5, "limits.r_max": 0.3, "controller.backup": "none",
+       "disturbance.amplitude": (0.3, 0.3, 0.05), "region.e_d_max": 8.0, "limits.rate": (0.5, 0.5, 1.0),
+       "limits.initial": (1.0, 0.0, 0.0)})
+
+
+@pytest.fixture(scope="module")
+def rated():
+    return verify.certify(SURVEY_RATED)
+
+
+def test_under_rate_limited_plans_the_row_faces_and_the_bearing_face_hold_together(rated):
+    """Both tiers, with a terminal set that has both the row faces (step 17c) and the bearing face (step 17b), and
+    every condition of both steps holding in the certificate."""
+    law = rated.design.terminal
+    assert rated.tiers.safe and rated.tiers.tracking
+    assert law is not None and law.has_rows and law.has_bearing
+    names = {c.condition for c in rated.design.conditions}
+    assert {"terminal_rate[u]", "terminal_rate[r]", "terminal_invariant[row_r]", "terminal_invariant[bearing]",
+            "terminal_surge_floor"} <= names
+
+
+def test_the_bearing_sets_of_the_gentlest_laws_meet_their_conditions_nowhere(rated):
+    """Counterexample (what ``bearing_row_sets`` replaces): the bearing face searched on each gentlest law with
+    ``bearing_sets``' fractions of its gains and its turn taken from r_bar_bar breaks the row faces or the band's
+    invariance in every set of the grid and its refinement, so the survey was refused; the composed sets certify it."""
+    b = terminal_bounds(SURVEY_RATED, rated.design, rated.region)
+    grid = _grid(b, sorted(set(_grid_points(WIDTHS, LOWER_ENDS)) | set(_grid_points(FINE_WIDTHS, FINE_LOWER_ENDS))))
+    broken = bearing_sets(b, row_sets(b, grid))
+    assert broken and not any(all(c.ok for c in law_conditions(b, law)) for law in broken)
+    assert any(all(c.ok for c in law_conditions(b, law)) for law in bearing_row_sets(b, grid))
+
+
+@settings(max_examples=100, deadline=None, derandomize=True)
+@given(t=st.floats(0.0, 50.0), u=st.floats(0.0, 1.0), f=st.floats(-1.0, 1.0), a=st.floats(-1.0, 1.0),
+       z=st.floats(-1.0, 1.0), off=st.tuples(st.floats(-1.0, 1.0), st.floats(-1.0, 1.0), st.floats(-1.0, 1.0)),
+       dx=st.floats(-1.0, 1.0), dy=st.floats(-1.0, 1.0), dpsi=st.floats(-1.0, 1.0))
+def test_under_rate_limits_one_completion_keeps_the_jump_the_cone_and_the_faces(rated, t, u, f, a, z, off, dx, dy,
+                                                                                dpsi):
+    """Property (steps 17b and 17c together): a plan ending at x_N in X_f (bearing face included) with its last
+    row within S of the law's row there; the completion from x_N moved by the replay's deviation changes the
+    command by at most J, keeps the surge above u_min + kappa_u, and one period later along the exact arc ends in
+    X_f again, inside the cone, with its own row within S of the law's row at its end."""
+    law, dt = rated.design.terminal, SURVEY_RATED.controller.dt
+    b = terminal_bounds(SURVEY_RATED, rated.design, rated.region)
+    tr = SURVEY_RATED.trajectory
+    p, v = np.asarray(tr.position(t), float).reshape(3), np.asarray(tr.velocity(t), float).reshape(3)
+    d = law.d_lo + u * (law.d_hi - law.d_lo)
+    x_n = _state(law, b, p, v, d, f * law.bearing_max, a * law.alpha_max, z * law.z_max, (0.0, 0.0), 0.0)
+    x_n[2] -= math.copysign(b.dev_z, z)                     # x_N itself, without the replay's deviation
+    last = law.command(x_n, p, v, dt) + np.asarray(off) * np.array([law.row_u, law.row_w, law.row_r])
+    x_start = _state(law, b, p, v, d, f * law.bearing_max, a * law.alpha_max, z * law.z_max, (dx, dy), dpsi)
+    row = law.command(x_start, p, v, dt)
+    assert np.all(np.abs(row - last) <= np.asarray(b.jumps) + 1e-12), (row - last, b.jumps)
+    assert row[0] >= b.surge_floor - 1e-12
+    end = unicycle_step(x_start, row, dt)
+    p1, v1 = (np.asarray(g(t + dt), float).reshape(3) for g in (tr.position, tr.velocity))
+    assert law.contains(end, p1, v1), (line_of_sight(end, p1), bearing(end, p1, v1))
+    assert min(law.row_slacks(end, p1, v1, row, dt).values()) >= 0.0

@@ -55,8 +55,10 @@ __all__ = ["DesignInputs", "THEOREM_VERSION", "RATE_TOLERANCE", "ARC_SAMPLES", "
 #: has no set, so the same scenario may get another set; 14: a bearing face narrows the path's footprint to the sector
 #: behind the target, and "none" is a backup kind; 15: the velocity loop's bound also takes the mass mismatch into the
 #: state, so the same vehicle may get a smaller E and another backup; 16: it also splits each channel's own mass and
-#: damping coefficients into cells, each cell's centre in the loop's matrix, so E shrinks again).
-THEOREM_VERSION = "sampled-data-tube+backup+velocity-loop+terminal/16"
+#: damping coefficients into cells, each cell's centre in the loop's matrix, so E shrinks again; 17: a bearing face
+#: narrows the completion's lateral bound, and composes with the row faces under rate-limited plans, so the same
+#: scenario may get another terminal set).
+THEOREM_VERSION = "sampled-data-tube+backup+velocity-loop+terminal/17"
 #: Absolute tolerance (m/s, rad/s) of the plan check's rate rows (round-off only). The proof carries it: the
 #: dynamic plant's velocity loop is bounded for command jumps of J + RATE_TOLERANCE (``verify.vehicle.compose``).
 RATE_TOLERANCE = 1e-9

@@ -14,7 +14,7 @@ from tubekit.model.terminal_law import TerminalLaw
 from verify.kernel.intervals import lower, upper
 from verify.theorem.design import Condition
 
-__all__ = ["TerminalBounds", "CompletionArc", "completion_arc", "slack_condition", "FLOAT_SLACK"]
+__all__ = ["TerminalBounds", "CompletionArc", "completion_arc", "start_bearing", "slack_condition", "FLOAT_SLACK"]
 
 #: Every inequality of the completion holds with this slack (m or rad), so the run's float check agrees.
 FLOAT_SLACK = 1e-9
@@ -65,6 +65,21 @@ class CompletionArc:
     start_min: arb
 
 
+def start_bearing(b: TerminalBounds, law: TerminalLaw) -> arb:
+    """Φ_0 = φ_f + asin(D_xy / d_lo) (rad): the completion's start lies within the replay's deviation of X_f, so
+    its bearing is at most this (π or more without a bearing face)."""
+    return arb(law.bearing_max) + (arb(b.dev_xy) / arb(law.d_lo)).asin()
+
+
+def _lateral_share(b: TerminalBounds, law: TerminalLaw, beta: arb) -> arb:
+    """The largest |sin φ − cos φ tan β'| cos β over the start's bearings |φ| <= Φ_0 and chord angles |β'| <= β:
+    sin(Φ_0 + β) while Φ_0 + β < π/2 (``docs/verify.md`` step 17b), else 1 (Cauchy–Schwarz)."""
+    if not (law.has_bearing and b.speed_floor_xy > 0.0):
+        return arb(1)
+    top = start_bearing(b, law) + beta
+    return top.sin() if top < arb.pi() / 2 else arb(1)
+
+
 def completion_arc(b: TerminalBounds, law: TerminalLaw) -> CompletionArc | None:
     """The bounds of one completion of ``law`` from the start set about X_f (``docs/verify.md`` step 17), in Arb;
     None when a premise of the formulas fails (D_xy >= d_lo, β >= π/2)."""
@@ -80,7 +95,7 @@ def completion_arc(b: TerminalBounds, law: TerminalLaw) -> CompletionArc | None:
     spread = max(d_hi + dxy - d_star, d_star - d_lo + dxy)
     lam = arb(law.gain_d) * dt
     curve = arb(b.accel_xy) * dt * dt / 2
-    lateral = dt * arb(b.speed_xy) / beta.cos() + beta.tan() * lam * spread + curve
+    lateral = dt * arb(b.speed_xy) * _lateral_share(b, law, beta) / beta.cos() + beta.tan() * lam * spread + curve
     x_min = start_min * (1 - lam) + lam * d_star - curve
     x_max = (d_hi + dxy) * (1 - lam) + lam * d_star + curve
     return CompletionArc(a0=a0, beta=beta, spread=spread, x_min=x_min, x_max=x_max, lateral=lateral,

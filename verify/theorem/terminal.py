@@ -28,8 +28,9 @@ unicycle arc (``tubekit.model.terminal_law`` for the law), in the line-of-sight 
 
 Under a minimum surge the completion's surge must stay above u_min + κ̄_u: X_f gets a bearing face, a cone behind a
 target whose speed has a positive floor (:mod:`verify.theorem.terminal_bearing`, step 17b); a target that may stop
-is refused (``terminal_surge_floor``). Plans with a rate limit are not covered (``terminal_rate``: the completion's
-row would have to be within J of the plan's last row, which is not proved). Every inequality is evaluated in Arb
+is refused (``terminal_surge_floor``). Under rate-limited plans X_f gets row faces that keep the completion's row
+within the plans' jump (:mod:`verify.theorem.terminal_rows`, step 17c), composed with the bearing face under a
+surge floor (:func:`verify.theorem.terminal_bearing.bearing_row_sets`). Every inequality is evaluated in Arb
 and must hold with the slack :data:`FLOAT_SLACK`, so that the run's float check of the same set agrees.
 :func:`design_terminal` searches a small grid of sets, largest first, and keeps the first that meets every
 condition.
@@ -57,7 +58,7 @@ from verify.theorem.path_clearance import (PathFootprint, contains, horizon_end,
                                           path_workspace)
 from verify.theorem.completion_bounds import FLOAT_SLACK, CompletionArc, TerminalBounds, completion_arc
 from verify.theorem.completion_bounds import slack_condition as _cond  # lhs + FLOAT_SLACK <= rhs, in Arb
-from verify.theorem.terminal_bearing import bearing_conditions, bearing_sets
+from verify.theorem.terminal_bearing import bearing_conditions, bearing_row_sets, bearing_sets
 from verify.theorem.terminal_rows import row_conditions, row_sets
 
 __all__ = ["TerminalBounds", "terminal_bounds", "law_conditions", "footprint_of", "sensing_condition",
@@ -152,7 +153,7 @@ def law_conditions(b: TerminalBounds, law: TerminalLaw) -> tuple[Condition, ...]
     if arc is None:
         return (Condition("terminal_invariant[geometry]", "D_xy < d_lo and beta < pi/2", None, None, False,
                           f"the replay's deviation {b.dev_xy:.4g} m or the heading room does not fit this set"),)
-    bearing = bearing_conditions(b, law, arc) if b.surge_floor is not None else []
+    bearing = bearing_conditions(b, law, arc) if b.surge_floor is not None or law.has_bearing else []
     return tuple(_input_conditions(b, law, arc) + _invariance_conditions(b, law, arc) + _region_conditions(b, law, arc)
                  + bearing + _rate_conditions(b, law, arc))
 
@@ -208,7 +209,7 @@ def _sets(b: TerminalBounds, fine: bool = False) -> list[TerminalLaw]:
         points = _grid_points(WIDTHS, LOWER_ENDS)
     laws = _grid(b, points)
     if b.jumps is not None:
-        laws = row_sets(b, laws)
+        return bearing_row_sets(b, laws) if b.surge_floor is not None else row_sets(b, laws)
     return bearing_sets(b, laws) if b.surge_floor is not None else laws
 
 

@@ -23,7 +23,10 @@ circle), X_f gets a fourth face |φ| <= φ_f, a cone behind the target, and two 
   u >= P_min cos Φ_0 − λ (d* − d_lo + D_xy) >= u_min + κ̄_u (the plans' surge floor, ``v_bar[surge_floor]``).
 
 :func:`bearing_sets` gives each set of the grid the smallest φ_f that the float version of the first inequality
-admits, with narrower heading rooms and smaller radial gains tried too (the lateral chord grows with both).
+admits, with narrower heading rooms and smaller radial gains tried too (the lateral chord grows with both). Under
+rate-limited plans :func:`bearing_row_sets` composes the face with the row faces of step 17c, which need each set's
+gentlest gains. The face also narrows step 17's lateral bound Y to δ P sin(Φ_0 + β) / cos β + ...
+(:func:`verify.theorem.completion_bounds.completion_arc`), for every condition that reads Y.
 """
 
 from __future__ import annotations
@@ -37,16 +40,20 @@ from flint import arb
 from tubekit.model.terminal_law import TerminalLaw
 
 from verify.kernel.intervals import upper
-from verify.theorem.completion_bounds import CompletionArc, TerminalBounds, completion_arc, slack_condition
+from verify.theorem.completion_bounds import (CompletionArc, TerminalBounds, completion_arc, slack_condition,
+                                             start_bearing)
 from verify.theorem.design import Condition
+from verify.theorem.terminal_rows import GAIN_FACTORS, gentle_law, row_sets
 
-__all__ = ["bearing_conditions", "bearing_sets", "smallest_bearing", "lateral_chord", "ALPHA_FRACTIONS",
-           "GAIN_FRACTIONS", "BEARING_STEP"]
+__all__ = ["bearing_conditions", "bearing_sets", "bearing_row_sets", "GENTLE_FACTOR", "smallest_bearing", "lateral_chord",
+           "ALPHA_FRACTIONS", "GAIN_FRACTIONS", "BEARING_STEP"]
 
 #: Fractions of each grid set's heading room α_f tried under a surge floor (largest first).
 ALPHA_FRACTIONS = (1.0, 0.3, 0.1, 0.05)
 #: Fractions of each grid set's radial gain λ tried under a surge floor (largest first).
 GAIN_FRACTIONS = (1.0, 0.5, 0.2, 0.1, 0.05)
+#: The factor on the smallest gains when they are re-derived under a bearing face (:func:`bearing_row_sets`).
+GENTLE_FACTOR = GAIN_FACTORS[0]
 #: The grid on which the smallest admissible φ_f is searched (rad).
 BEARING_STEP = 0.005
 
@@ -97,14 +104,43 @@ def bearing_sets(b: TerminalBounds, laws: Iterable[TerminalLaw]) -> list[Termina
     return out
 
 
+def bearing_row_sets(b: TerminalBounds, laws: Iterable[TerminalLaw]) -> list[TerminalLaw]:
+    """Under rate-limited plans, each set of ``laws`` at each heading room of :data:`ALPHA_FRACTIONS` with its
+    gentlest invariant gains and row faces (:func:`verify.theorem.terminal_rows.row_sets`: the row faces need the
+    smallest gains, which :func:`bearing_sets`' fractions of the grid's gains would break) and its smallest bearing
+    face; then the gains re-derived with the lateral bound the face narrows (step 17b) and the face again, first
+    when it is no wider. Sets without a face are dropped."""
+    out = []
+    for law in laws:
+        for fa in ALPHA_FRACTIONS:
+            for gentle in row_sets(b, [dataclasses.replace(law, alpha_max=law.alpha_max * fa)]):
+                phi = smallest_bearing(b, gentle)
+                if phi is None:
+                    continue
+                first = dataclasses.replace(gentle, bearing_max=phi)
+                again = _regained(b, first)
+                out.extend([again, first] if again is not None else [first])
+    return out
+
+
+def _regained(b: TerminalBounds, law: TerminalLaw) -> TerminalLaw | None:
+    """``law`` (with its bearing face) with its gentlest gains and row faces re-derived under the face's lateral
+    bound, and the face re-derived for them; None when that face is wider than ``law``'s (the gains assumed it)."""
+    gentler = gentle_law(b, law, GENTLE_FACTOR)
+    phi = None if gentler is None else smallest_bearing(b, gentler)
+    if phi is None or phi > law.bearing_max:
+        return None
+    return dataclasses.replace(gentler, bearing_max=phi)
+
+
 def bearing_conditions(b: TerminalBounds, law: TerminalLaw, arc: CompletionArc) -> list[Condition]:
     """``terminal_invariant[bearing]``, ``terminal_invariant[bearing_cross]`` and ``terminal_surge_floor`` of
     ``law`` (module doc), in Arb, from its completion's bounds ``arc`` (A_0, β, Δ, x_min, x_max). Under a surge
     floor a set without the bearing face fails by name."""
     if not law.has_bearing:
-        return [Condition("terminal_surge_floor", "a bearing face |phi| <= phi_f (the target's speed along the line "
-                          "of sight keeps the law's surge above u_min + kappa_u)", None, None, False,
-                          "this set has none")]
+        return [] if b.surge_floor is None else [
+            Condition("terminal_surge_floor", "a bearing face |phi| <= phi_f (the target's speed along the line of "
+                      "sight keeps the law's surge above u_min + kappa_u)", None, None, False, "this set has none")]
     dt, dxy = arb(b.dt), arb(b.dev_xy)
     p_min, p_max = arb(b.speed_floor_xy), arb(b.speed_xy)
     lam, d_lo, d_star = arb(law.gain_d), arb(law.d_lo), arb(law.d_star)
@@ -112,7 +148,7 @@ def bearing_conditions(b: TerminalBounds, law: TerminalLaw, arc: CompletionArc) 
     curve = arb(b.accel_xy) * dt * dt / 2
     turn = arb(b.accel_xy) * dt / p_min
     phi_f = arb(law.bearing_max)
-    start = phi_f + (dxy / d_lo).asin()
+    start = start_bearing(b, law)
     lateral = dt * p_min * start.sin() - chord - curve
     valid = bool(start < arb.pi() / 2) and bool(lateral > 0) and bool(dt * p_max <= arc.x_min)
     nxt = start + turn - (lateral / arc.x_max).atan() if valid else arb("inf")
@@ -123,6 +159,8 @@ def bearing_conditions(b: TerminalBounds, law: TerminalLaw, arc: CompletionArc) 
         f"phi_f {law.bearing_max:.4g} rad, P_min {b.speed_floor_xy:.4g} m/s, chord {float(chord.upper()):.4g} m")
     crossing = slack_condition("terminal_invariant[bearing_cross]", "eta + atan((L_c + A delta^2/2) / x_min) <= phi_f",
                                turn + ((chord + curve) / arc.x_min).atan(), phi_f)
+    if b.surge_floor is None:
+        return [invariant, crossing]
     surge = slack_condition("terminal_surge_floor", "P_min cos Phi_0 - lambda (d* - d_lo + D_xy) >= u_min + kappa_u "
                             "(the law's surge never below the plans' floor)", arb(b.surge_floor), floor,
                             f"floor u_min + kappa_u = {b.surge_floor:.4g} m/s")

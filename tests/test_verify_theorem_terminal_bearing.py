@@ -14,13 +14,15 @@ from hypothesis import strategies as st
 import verify
 from tubekit import load_scenario
 from tubekit.model.kinematics import unicycle_step
-from tubekit.model.terminal_law import bearing, line_of_sight
+from tubekit.model.terminal_law import NO_BEARING, bearing, line_of_sight
 from tubekit.model.trajectory import Circle, Line, Waypoints
 from tubekit.scenario import Obstacle
+from verify.kernel.intervals import upper
+from verify.theorem.completion_bounds import completion_arc
 from verify.theorem.terminal import (FINE_LOWER_ENDS, FINE_WIDTHS, LOWER_ENDS, WIDTHS, _grid, _grid_points, law_conditions,
                                      terminal_bounds)
 from verify.theorem.terminal_bearing import BEARING_STEP, bearing_row_sets, bearing_sets, smallest_bearing
-from verify.theorem.terminal_rows import row_sets
+from verify.theorem.terminal_rows import row_changes, row_sets
 
 TRACKED = load_scenario(Path(__file__).resolve().parents[1] / "examples" / "keep_moving_tracked.toml")
 #: The same vehicle after a target on a 10 m circle at 0.4 m/s (curvature: the velocity turns 0.004 rad a period).
@@ -189,3 +191,17 @@ def test_under_rate_limits_one_completion_keeps_the_jump_the_cone_and_the_faces(
     p1, v1 = (np.asarray(g(t + dt), float).reshape(3) for g in (tr.position, tr.velocity))
     assert law.contains(end, p1, v1), (line_of_sight(end, p1), bearing(end, p1, v1))
     assert min(law.row_slacks(end, p1, v1, row, dt).values()) >= 0.0
+
+
+def test_the_bearing_face_lowers_only_the_surge_rows_change(rated):
+    """With the face, V_r = P cos(phi) moves by at most P sin(Phi_0) per radian of line-of-sight turn: the surge
+    row's change over the deviation and the arc is smaller than without the face; heave and yaw are unchanged."""
+    law = rated.design.terminal
+    b = terminal_bounds(SURVEY_RATED, rated.design, rated.region)
+    arc = completion_arc(b, law)
+    faced = row_changes(b, law, arc)
+    bare = row_changes(b, dataclasses.replace(law, bearing_max=NO_BEARING), arc)
+    for part in ("deviation", "arc"):
+        with_face, without = getattr(faced, part), getattr(bare, part)
+        assert upper(with_face[0]) < upper(without[0])
+        assert upper(with_face[1]) == upper(without[1]) and upper(with_face[2]) == upper(without[2])

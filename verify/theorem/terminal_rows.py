@@ -27,7 +27,9 @@ start set's |α| <= A_0, its distances within Δ of d* and the arc's radial boun
   |ΔN| / Den_min + (P + λ Δ) L |Δα|, with L = sup |d(1/Den)/dα| <= ((g/2)(g A_0 / 2) / 3 + (1 − g/2) sin β) /
   Den_min² (|S'(x)| <= x / 3), |ΔN| <= P asin(D_xy / d_lo) + λ D_xy (deviation: the line of sight turns, d moves)
   or A_xy δ + P τ + λ (λ δ Δ + A_xy δ² / 2 + Y² / (2 x_min)) (the arc: the target's velocity changes by A_xy δ,
-  the line of sight turns by τ, and d' = hypot(q'_x, q'_y) is within Y² / (2 x_min) of q'_x).
+  the line of sight turns by τ, and d' = hypot(q'_x, q'_y) is within Y² / (2 x_min) of q'_x). With a bearing face
+  (step 17b) V_r = P cos φ moves by at most P |Δφ| sup |sin φ| between the two bearings: the P terms take the
+  factor sin Φ_0 (deviation: both bearings within Φ_0) and sin(Φ_0 + τ) (arc), while below π/2.
 
 By induction with step 17, every candidate is rate-limited, ends in X_f with its faces, and a plan exists at every
 period. The law's gains are chosen as small as X_f's invariance allows (:func:`gentle_law`): the row's change
@@ -46,7 +48,7 @@ from tubekit.model.terminal_law import TerminalLaw
 
 from verify.kernel.intervals import lower, upper
 from verify.theorem.design import Condition
-from verify.theorem.completion_bounds import CompletionArc, TerminalBounds, completion_arc
+from verify.theorem.completion_bounds import CompletionArc, TerminalBounds, completion_arc, start_bearing
 from verify.theorem.completion_bounds import slack_condition as _cond
 
 __all__ = ["RowChanges", "row_changes", "row_conditions", "gentle_law", "row_sets", "GAIN_FACTORS"]
@@ -85,12 +87,23 @@ def row_changes(b: TerminalBounds, law: TerminalLaw, arc: CompletionArc) -> RowC
     n_max = p + lam * arc.spread
     curve = a_xy * dt * dt / 2
     radial_arc = lam * dt * arc.spread + curve + arc.lateral ** 2 / (2 * arc.x_min)
-    u_dev = (p * seen + lam * dxy) / den_min + n_max * slope * w_alpha
-    u_arc = (a_xy * dt + p * tau + lam * radial_arc) / den_min + n_max * slope * arc_alpha
+    share_dev, share_arc = _bearing_shares(b, law, tau)
+    u_dev = (p * seen * share_dev + lam * dxy) / den_min + n_max * slope * w_alpha
+    u_arc = (a_xy * dt + p * tau * share_arc + lam * radial_arc) / den_min + n_max * slope * arc_alpha
     dz, a_z, z_f = arb(b.dev_z), arb(b.accel_z), arb(law.z_max)
     w_dev = lam_z * dz
     w_arc = a_z * dt + lam_z * (lam_z * dt * (z_f + dz) + a_z * dt * dt / 2)
     return RowChanges(deviation=(u_dev, w_dev, g / dt * w_alpha), arc=(u_arc, w_arc, g / dt * arc_alpha))
+
+
+def _bearing_shares(b: TerminalBounds, law: TerminalLaw, tau: arb) -> tuple[arb, arb]:
+    """The shares of P a line-of-sight turn moves V_r = P cos φ by (module doc): |cos φ − cos φ'| <= |φ − φ'|
+    sup |sin| between them, so sin Φ_0 across the deviation (both bearings within Φ_0) and sin(Φ_0 + τ) across the
+    arc; 1 without a bearing face or past π/2."""
+    if not (law.has_bearing and b.speed_floor_xy > 0.0):
+        return arb(1), arb(1)
+    phi0, half = start_bearing(b, law), arb.pi() / 2
+    return (phi0.sin() if phi0 < half else arb(1)), ((phi0 + tau).sin() if phi0 + tau < half else arb(1))
 
 
 def row_conditions(b: TerminalBounds, law: TerminalLaw, arc: CompletionArc,

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from pathlib import Path
+
 from .scripts import load_script
 
 STUDY = load_script("benchmarks/survey_frontier.py", "bench_survey_frontier")
@@ -46,6 +48,8 @@ def test_under_rate_limited_plans_the_survey_keeps_both_tiers_with_a_rock_five_m
     import verify
     rated = {"r_max": 0.3, "backup": "none", "rate": (0.5, 0.5, 1.0), "start": 7.0}
     assert STUDY.cell(1.0, 0.3, 5.0, **rated) == {"tiers": "both", "failed": [], "loiter_radius": None}
+    shipped = tubekit.load_scenario(Path(__file__).resolve().parents[1] / "examples" / "keep_moving_survey.toml")
+    assert STUDY.survey(1.0, 0.3, 5.0, **rated).to_dict() == {**shipped.to_dict(), "name": "survey"}
     slow = STUDY.cell(1.0, 0.3, 5.0, **{**rated, "rate": (0.3, 0.3, 0.6)})
     assert slow["tiers"] == "none" and slow["failed"] == ["terminal_rate[u]"]
     toward = STUDY.survey(1.0, 0.3, 5.0, **rated).with_changes(

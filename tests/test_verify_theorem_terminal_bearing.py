@@ -15,8 +15,7 @@ import verify
 from tubekit import load_scenario
 from tubekit.model.kinematics import unicycle_step
 from tubekit.model.terminal_law import NO_BEARING, bearing, line_of_sight
-from tubekit.model.trajectory import Circle, Line, Waypoints
-from tubekit.scenario import Obstacle
+from tubekit.model.trajectory import Circle, Waypoints
 from verify.kernel.intervals import upper
 from verify.theorem.completion_bounds import completion_arc
 from verify.theorem.terminal import (FINE_LOWER_ENDS, FINE_WIDTHS, LOWER_ENDS, WIDTHS, _grid, _grid_points, law_conditions,
@@ -127,15 +126,9 @@ def test_without_a_speed_floor_no_bearing_is_admitted(certs):
     assert smallest_bearing(b, cert.design.terminal) is None
 
 
-#: The torpedo survey at 1 m/s in 0.3 m/s of current per horizontal axis, u_min 0.5 m/s, no backup, a rock 5 m off the
-#: path, plans limited to (0.5 m/s², 0.5 m/s², 1 rad/s²), the start 7 m behind (``benchmarks/survey_frontier.py``).
-SURVEY_RATED = TRACKED.with_changes(
-    trajectory=Line(start=(0.0, 0.0, 0.0), direction_velocity=(1.0, 0.0, 0.0)),
-    obstacles=(Obstacle((40.0, 5.0, 0.0), 0.5),), epsilon=3.0, sensing_range=80.0,
-    workspace=((-100.0, -100.0, -10.0), (300.0, 100.0, 10.0)), initial_state=(-7.0, 0.0, 0.0, 0.0),
-    **{"limits.u_max": 2.0, "limits.u_min": 0.5, "limits.r_max": 0.3, "controller.backup": "none",
-       "disturbance.amplitude": (0.3, 0.3, 0.05), "region.e_d_max": 8.0, "limits.rate": (0.5, 0.5, 1.0),
-       "limits.initial": (1.0, 0.0, 0.0)})
+#: The torpedo survey's kinematic half (examples/keep_moving_survey.toml): 1 m/s in 0.3 m/s of current per horizontal
+#: axis, u_min 0.5 m/s, no backup, a rock 5 m off the path, plans limited to (0.5 m/s², 0.5 m/s², 1 rad/s²).
+SURVEY_RATED = load_scenario(Path(__file__).resolve().parents[1] / "examples" / "keep_moving_survey.toml")
 
 
 @pytest.fixture(scope="module")

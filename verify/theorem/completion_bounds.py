@@ -14,7 +14,8 @@ from tubekit.model.terminal_law import TerminalLaw
 from verify.kernel.intervals import lower, upper
 from verify.theorem.design import Condition
 
-__all__ = ["TerminalBounds", "CompletionArc", "completion_arc", "start_bearing", "slack_condition", "FLOAT_SLACK"]
+__all__ = ["TerminalBounds", "CompletionArc", "completion_arc", "start_bearing", "in_cone", "slack_condition",
+           "FLOAT_SLACK"]
 
 #: Every inequality of the completion holds with this slack (m or rad), so the run's float check agrees.
 FLOAT_SLACK = 1e-9
@@ -71,10 +72,16 @@ def start_bearing(b: TerminalBounds, law: TerminalLaw) -> arb:
     return arb(law.bearing_max) + (arb(b.dev_xy) / arb(law.d_lo)).asin()
 
 
+def in_cone(b: TerminalBounds, law: TerminalLaw) -> bool:
+    """True when X_f's bearing face bounds the completion's bearings by :func:`start_bearing` (a face, and a target
+    whose horizontal speed has a positive floor, so that the bearing is defined)."""
+    return law.has_bearing and b.speed_floor_xy > 0.0
+
+
 def _lateral_share(b: TerminalBounds, law: TerminalLaw, beta: arb) -> arb:
     """The largest |sin φ − cos φ tan β'| cos β over the start's bearings |φ| <= Φ_0 and chord angles |β'| <= β:
     sin(Φ_0 + β) while Φ_0 + β < π/2 (``docs/verify.md`` step 17b), else 1 (Cauchy–Schwarz)."""
-    if not (law.has_bearing and b.speed_floor_xy > 0.0):
+    if not in_cone(b, law):
         return arb(1)
     top = start_bearing(b, law) + beta
     return top.sin() if top < arb.pi() / 2 else arb(1)

@@ -48,7 +48,7 @@ from tubekit.model.terminal_law import TerminalLaw
 
 from verify.kernel.intervals import lower, upper
 from verify.theorem.design import Condition
-from verify.theorem.completion_bounds import CompletionArc, TerminalBounds, completion_arc, start_bearing
+from verify.theorem.completion_bounds import CompletionArc, TerminalBounds, completion_arc, in_cone, start_bearing
 from verify.theorem.completion_bounds import slack_condition as _cond
 
 __all__ = ["RowChanges", "row_changes", "row_conditions", "gentle_law", "row_sets", "GAIN_FACTORS"]
@@ -100,7 +100,7 @@ def _bearing_shares(b: TerminalBounds, law: TerminalLaw, tau: arb) -> tuple[arb,
     """The shares of P a line-of-sight turn moves V_r = P cos φ by (module doc): |cos φ − cos φ'| <= |φ − φ'|
     sup |sin| between them, so sin Φ_0 across the deviation (both bearings within Φ_0) and sin(Φ_0 + τ) across the
     arc; 1 without a bearing face or past π/2."""
-    if not (law.has_bearing and b.speed_floor_xy > 0.0):
+    if not in_cone(b, law):
         return arb(1), arb(1)
     phi0, half = start_bearing(b, law), arb.pi() / 2
     return (phi0.sin() if phi0 < half else arb(1)), ((phi0 + tau).sin() if phi0 + tau < half else arb(1))

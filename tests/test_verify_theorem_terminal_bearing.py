@@ -198,3 +198,19 @@ def test_the_bearing_face_lowers_only_the_surge_rows_change(rated):
         with_face, without = getattr(faced, part), getattr(bare, part)
         assert upper(with_face[0]) < upper(without[0])
         assert upper(with_face[1]) == upper(without[1]) and upper(with_face[2]) == upper(without[2])
+
+
+def test_on_the_published_bluerov2_at_the_owners_speed_no_cone_fits_the_row_faces():
+    """Counterexample (docs/plant.md section 4, the pier): examples/bluerov2_published_brisk.toml (0.2 m/s in 0.1 m/s
+    of current, omega_bar_xy about 0.15 m/s) with the cone behind the target and the row faces composed: no set of
+    the grid or its refinement meets its own conditions, the surge or yaw row's rate failing in each, so a sector
+    narrow enough for a pier 3 m off the path is out of reach there."""
+    sc = load_scenario(Path(__file__).resolve().parents[1] / "examples" / "bluerov2_published_brisk.toml")
+    cert = verify.certify(sc)
+    b = terminal_bounds(sc, cert.design, cert.region)
+    grid = _grid(b, sorted(set(_grid_points(WIDTHS, LOWER_ENDS)) | set(_grid_points(FINE_WIDTHS, FINE_LOWER_ENDS))))
+    laws = bearing_row_sets(b, grid)
+    assert laws and b.speed_floor_xy > 0.0
+    for law in laws:
+        failed = {c.condition for c in law_conditions(b, law) if not c.ok}
+        assert failed & {"terminal_rate[u]", "terminal_rate[r]"}, (law, failed)

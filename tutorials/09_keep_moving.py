@@ -20,7 +20,8 @@
 # 3. where the theorem still says no, it names why: room beside the path for the loiter, or a target that
 #    may stop.
 #
-# The proof is `docs/verify.md`, steps 13e and 17b.
+# Last, a survey at 1 m/s with smooth (rate-limited) plans, where the cone and the terminal set's row faces hold
+# together. The proof is `docs/verify.md`, steps 13e, 17b and 17c.
 
 # %%
 import os
@@ -146,3 +147,24 @@ stopping = far.with_changes(trajectory=Waypoints(points=((0.0, 0.0, 0.0), (10.0,
 cert_stop = verify.certify(stopping)
 print("tiers:", cert_stop.tier_failures)
 print(" ", cert_stop.failures[0].condition + ":", cert_stop.failures[0].detail)
+
+# %% [markdown]
+# ## 6. At survey speed, with smooth plans and no backup
+# A vehicle whose velocity loop is part of the proof needs rate-limited plans (`limits.rate`), and the terminal
+# set then carries a fifth kind of face: the plan's last row near the terminal law's own row (step 17c). The cone
+# and these row faces hold together. `examples/keep_moving_survey.toml` is the survey a torpedo flies: a line at
+# 1 m/s in 0.3 m/s of current, u_min 0.5 m/s, plans limited to (0.5 m/s², 0.5 m/s², 1 rad/s²), a rock 5 m off the
+# path, and no backup law (the safe tier then rests on the tracking tier: a plan at every period).
+
+# %%
+survey = load_scenario(EXAMPLES / "keep_moving_survey.toml").with_changes(duration=DURATION)
+cert_survey = verify.certify(survey)
+law = cert_survey.design.terminal
+print("tiers:", cert_survey.tier_failures)
+print(f"X_f: d in [{law.d_lo:.2f}, {law.d_hi:.2f}] m, |bearing| <= {law.bearing_max:.3f} rad, "
+      f"row faces (u, w, r) = ({law.row_u:.4f}, {law.row_w:.4f}, {law.row_r:.4f})")
+run_survey = simulate(survey, cert_survey, progress=False)
+kept = [p.name for p in check_promises(run_survey) if p.given and p.ok]
+print("promises kept:", kept)
+print(f"largest command jump per period: {run_survey.metrics['command_jump_max']}; "
+      f"smallest clearance {run_survey.metrics['min_clearance']:.2f} m")

@@ -109,10 +109,31 @@ def test_on_the_dynamic_plant_the_closed_loop_attack_draws_the_water_current_wit
     """On the dynamic plant the attack's disturbance replaces the water current only (the sway and the loop's
     error are the plant's own), so it is drawn within the current's bound, the premise the certificate assumes,
     not within ω̄: on examples/bluerov2_tracked.toml (0.04 m/s per axis, ω̄_xy 0.085 m/s) no run breaks a premise and
-    the attack still pushes the tube past half its radius."""
+    the attack still pushes the tube past half its radius (from the faces of R, where the tube is not promised: the
+    certified start's own run stays well inside it)."""
     from pathlib import Path
     sc = load_scenario(Path(__file__).resolve().parents[1] / "examples" / "bluerov2_tracked.toml")
     cert = verify.certify(sc)
     res = falsify_closed_loop(sc, budget=3, seed=0, duration=3.0, certificate=cert)
     assert res.omega_bar == (0.04, 0.04) and res.omega_bar[0] < cert.disturbance.omega_xy
-    assert res.vacuous_runs == 0 and not res.found and 0.5 < res.worst.ratio < 1.0
+    assert res.vacuous_runs == 0 and not res.found and res.worst.ratio < 1.0
+    assert 0.5 < max(r.ratio for r in res.runs) < 1.0
+
+
+def test_a_run_from_a_start_with_no_tracking_tier_refutes_nothing_by_its_tube():
+    """The closed-loop attack also starts on the faces of R, and each such start is certified on its own (the start
+    is part of the design). Where that certificate gives no tracking tier the tube is not promised, so a ratio above
+    1 there is no counterexample; a broken promise still is. Counterexample to the old count: on
+    examples/keep_moving_survey.toml such runs reach ratios above 1 (they made `tubekit falsify --closed-loop` exit 3
+    on a certified design), and the attack now reports none."""
+    from verify.falsify.closed_loop import LoopRun
+    unclaimed = LoopRun("evolution", (0.0, 0.0, 0.0, 0.0), 6.0, (), False, (), claims_tube=False)
+    assert not unclaimed.counterexample and unclaimed.fitness() == 1.0
+    assert replace(unclaimed, claims_tube=True).counterexample
+    assert replace(unclaimed, broken=("clearance",)).counterexample
+    from pathlib import Path
+    sc = load_scenario(Path(__file__).resolve().parents[1] / "examples" / "keep_moving_survey.toml")
+    res = falsify_closed_loop(sc, budget=5, seed=0, duration=10.0)
+    beyond = [r for r in res.runs if not r.vacuous and not r.claims_tube and r.ratio > 1.0]
+    assert beyond and not res.found and res.worst.claims_tube
+    assert "certifies no tracking tier" in res.summary()

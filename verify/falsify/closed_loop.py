@@ -64,7 +64,9 @@ class LoopRun:
 
     ``ratio`` is max_j |e_j - ê_j| / tube_j over the run (1 = the certified tube);
     ``broken`` names the non-premise promises broken (``sway`` is NaN under an
-    override and skipped); ``vacuous`` is True when a premise failed.
+    override and skipped); ``vacuous`` is True when a premise failed; ``claims_tube`` is False when the
+    run's start is one the design's certificate for that start gives no tracking tier, so its tube is
+    not promised there and a ratio above 1 refutes nothing.
     """
 
     strategy: str
@@ -75,22 +77,26 @@ class LoopRun:
     promises: tuple[Promise, ...]
     sequence: tuple[tuple[float, float, float], ...] | None = None
     axis_ratios: tuple[float, float, float] = (math.nan, math.nan, math.nan)
+    claims_tube: bool = True
 
     @property
     def counterexample(self) -> bool:
-        """The run breaks the certificate (ratio > 1 or a promise broken, premises holding)."""
-        return not self.vacuous and (self.ratio > 1.0 or bool(self.broken))
+        """The run breaks the certificate (ratio > 1 where the tube is promised, or a promise broken, premises
+        holding)."""
+        return not self.vacuous and ((self.ratio > 1.0 and self.claims_tube) or bool(self.broken))
 
     def fitness(self) -> float:
-        """What the search maximises: the ratio, plus 10 for a broken promise."""
-        return (self.ratio if math.isfinite(self.ratio) else 1e6) + (10.0 if self.broken else 0.0) - \
+        """What the search maximises: the ratio (at most 1 where the tube is not promised), plus 10 for a broken
+        promise."""
+        ratio = self.ratio if math.isfinite(self.ratio) else 1e6
+        return (ratio if self.claims_tube else min(ratio, 1.0)) + (10.0 if self.broken else 0.0) - \
             (100.0 if self.vacuous else 0.0)
 
     def to_dict(self) -> dict:
         """JSON form."""
         return {"strategy": self.strategy, "initial_state": list(self.initial_state), "ratio": self.ratio,
                 "axis_ratios": list(self.axis_ratios),
-                "broken": list(self.broken), "vacuous": self.vacuous,
+                "broken": list(self.broken), "vacuous": self.vacuous, "claims_tube": self.claims_tube,
                 "promises": [p.to_dict() for p in self.promises],
                 "sequence": None if self.sequence is None else [list(w) for w in self.sequence]}
 
@@ -118,8 +124,9 @@ class ClosedLoopResult(SearchOutcome):
 
     @property
     def axis_ratios(self) -> tuple[float, float, float]:
-        """Largest |rho_j| / tube_j per axis over the runs whose premises held (tightness per axis)."""
-        valid = [r.axis_ratios for r in self.runs if not r.vacuous] or [self.worst.axis_ratios]
+        """Largest |rho_j| / tube_j per axis over the runs whose premises held and whose tube is promised
+        (tightness per axis)."""
+        valid = [r.axis_ratios for r in self.runs if not r.vacuous and r.claims_tube] or [self.worst.axis_ratios]
         return tuple(float(np.nanmax([a[j] for a in valid])) for j in range(3))
 
     def summary(self) -> str:
@@ -138,6 +145,10 @@ class ClosedLoopResult(SearchOutcome):
         if self.vacuous_runs:
             lines.append(f"  {self.vacuous_runs} run(s) broke a premise (disturbance or recursive feasibility) "
                          "and claim nothing")
+        unclaimed = sum(1 for r in self.runs if not r.vacuous and not r.claims_tube)
+        if unclaimed:
+            lines.append(f"  {unclaimed} run(s) started where the design certifies no tracking tier: their tube "
+                         "is not promised (only their broken promises count)")
         if not self.certified:
             lines.append("  the scenario is not certified: these figures claim nothing")
         return "\n".join(lines)
@@ -274,8 +285,9 @@ class _Attack:
             done = certified_run(sc, self.tightening_at(sc), disturbance=disturbance)
         axes = np.nanmax(np.abs(np.asarray(done.run.rho)) / np.asarray(self.tightening.tube), axis=0)
         ratio = float(np.max(axes)) if np.all(np.isfinite(axes)) else math.inf  # against the attacked tube
+        claimed = any(p.name == "tube" and p.given for p in done.promises)
         return LoopRun(strategy, tuple(float(x) for x in start), ratio, done.broken,
-                       not done.premises_held, done.promises, sequence, tuple(float(a) for a in axes))
+                       not done.premises_held, done.promises, sequence, tuple(float(a) for a in axes), claimed)
 
 
     def tightening_at(self, scenario: Scenario) -> Tightening:
@@ -347,7 +359,7 @@ def falsify_closed_loop(scenario: Scenario, law: str | None = None, *, budget: i
         runs.append(attack.run(f"greedy:{'max' if axis is None else ('e_d', 'e_z', 'e_o')[axis]}",
                                tuple(start), omega, tap=tap))
     runs.extend(_evolve(attack, scenario, rng, budget - n_greedy))
-    valid = [r for r in runs if not r.vacuous] or runs
+    valid = [r for r in runs if not r.vacuous and r.claims_tube] or [r for r in runs if not r.vacuous] or runs
     worst = max(valid, key=LoopRun.fitness)
     return ClosedLoopResult(scenario=scenario.name, law=attack.law.name, certified=bool(cert.certified),
                             tube=tuple(float(x) for x in attack.tightening.tube),

@@ -74,6 +74,24 @@ def test_no_disturbance_means_no_deviation_from_nominal():
     assert res.saturated_ticks == 0
 
 
+@pytest.mark.parametrize("sigma", [0.0, 1.0])
+def test_the_observer_is_told_the_state_the_nominal_and_the_target_at_every_tick(sigma):
+    """With or without the ancillary law (sigma = 0 does not call it), ``observer`` hears every tick a plan is
+    followed, before its command: the logged state, the nominal (rho = state - nominal) and the desired position."""
+    sc = _scenario(duration=2.0)
+    heard = []
+    res = run_closed_loop(sc, tightening=_tightening(sc, sigma), solver_factory=Pursuit, progress=False,
+                          observer=lambda x, x_hat, p_d: heard.append((x.copy(), x_hat.copy(), p_d.copy())))
+    ticks = sc.steps * res.ticks_per_step
+    assert len(heard) == ticks
+    np.testing.assert_array_equal(np.array([h[0] for h in heard]), res.states[:ticks])
+    np.testing.assert_array_equal(np.array([h[2] for h in heard]), res.desired[:ticks])
+    gap = np.array([h[0] - h[1] for h in heard])
+    at_samples = np.arange(ticks) % res.ticks_per_step == 0
+    np.testing.assert_allclose(gap[at_samples], 0.0, atol=1e-12)      # the nominal is reset onto the state
+    np.testing.assert_allclose(gap[~at_samples], (res.states[:ticks] - res.nominal[:ticks])[~at_samples], atol=1e-12)
+
+
 def test_rho_logged_and_reset_each_sample():
     sc = _scenario(duration=6.0)
     res = run_closed_loop(sc, tightening=_tightening(sc, 1.0), solver_factory=Pursuit, progress=False)
@@ -291,7 +309,7 @@ def test_signature_has_no_scenario_overrides():
     import inspect
     params = inspect.signature(run_closed_loop).parameters
     assert list(params) == ["scenario", "tightening", "tube", "progress", "label", "solver_factory", "disturbance",
-                            "plant_substeps", "remember_obstacles"]
+                            "plant_substeps", "remember_obstacles", "observer"]
     assert params["tube"].kind is inspect.Parameter.KEYWORD_ONLY
     sc = _scenario(duration=0.5)
     for override in ({"law": "paper"}, {"sigma": 1.0}, {"mode": "converged"}, {"plant": "dynamic"}):

@@ -137,3 +137,17 @@ def test_a_run_from_a_start_with_no_tracking_tier_refutes_nothing_by_its_tube():
     beyond = [r for r in res.runs if not r.vacuous and not r.claims_tube and r.ratio > 1.0]
     assert beyond and not res.found and res.worst.claims_tube
     assert "certifies no tracking tier" in res.summary()
+
+
+def test_at_sigma_zero_the_greedy_attack_reads_the_loop_and_pushes_the_tube_to_its_edge():
+    """The greedy attack reads the state, the nominal and the target from the loop's tick observer. It used to read
+    them from the ancillary law's inputs, which sigma = 0 never calls, so it applied no current at all (ratio 0 on
+    every sigma = 0 design). On examples/keep_moving_survey.toml (sigma = 0) from its certified start it now drives
+    the deviation to the tube's edge and not beyond."""
+    from pathlib import Path
+    sc = load_scenario(Path(__file__).resolve().parents[1] / "examples" / "keep_moving_survey.toml")
+    cert = verify.certify(sc)
+    res = falsify_closed_loop(sc, budget=1, seed=0, duration=5.0, certificate=cert)
+    (run,) = res.runs
+    assert cert.sigma.value == 0.0 and run.strategy == "greedy:max" and run.claims_tube
+    assert 0.9 < run.ratio <= 1.0 and not res.found

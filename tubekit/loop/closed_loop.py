@@ -58,7 +58,7 @@ import math
 import time
 import warnings
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Callable
 
 import numpy as np
 
@@ -86,7 +86,11 @@ __all__ = [
     "validate_inputs",
     "build_solver",
     "saturate",
+    "TickObserver",
 ]
+
+#: ``observer(state, nominal, p_d)``: told the state (4,), the nominal arc's point (4,) and the target (3,) at a tick.
+TickObserver = Callable[[np.ndarray, np.ndarray, np.ndarray], None]
 
 
 _ZERO_INPUT = ZERO_INPUT
@@ -157,6 +161,7 @@ class _ClosedLoop:
         self.t_h, self.v_h = 0.0, (0.0, 0.0, 0.0)  # the last hand-over to the backup: time (s), applied command
         self.sway_last = 0.0  # the last tick's sway command (m/s): a lateral backup's, else 0
         self.release = math.inf if tightening.backup is None else tightening.backup.law.sway_release
+        self.observer: TickObserver | None = None  # told (state, nominal, target) at every tick a plan is followed
 
     def sense(self, xk: np.ndarray) -> tuple[Obstacle, ...]:
         """Obstacles known after sensing at the position of ``xk``."""
@@ -336,12 +341,16 @@ class _ClosedLoop:
                 log.kappa[i] = 0.0
                 log.v_hat[i] = v
             elif self.sigma > 0.0:
+                if self.observer is not None:
+                    self.observer(xs, period.arc[j], self.desired[i])
                 a0 = time.perf_counter()
                 kap = self.ancillary(i, xs, period.arc[j])
                 law_s += time.perf_counter() - a0
                 log.kappa[i] = kap
                 v = (vh[0] + float(kap[0]), vh[1] + float(kap[1]), vh[2] + float(kap[2]))
             else:
+                if self.observer is not None:
+                    self.observer(xs, period.arc[j], self.desired[i])
                 log.kappa[i] = 0.0
                 v = vh
             v, log.saturated[i] = saturate(v, self.limits, self.lower)
@@ -397,7 +406,7 @@ class _ClosedLoop:
 def run_closed_loop(scenario: Scenario, tightening: Tightening | None = None, *, tube: bool = True,
                     progress: bool = True, label: str | None = None, solver_factory: SolverFactory | None = None,
                     disturbance: OmegaOverride | None = None, plant_substeps: int = 2,
-                    remember_obstacles: bool = True) -> SimulationResult:
+                    remember_obstacles: bool = True, observer: TickObserver | None = None) -> SimulationResult:
     """Run the closed loop on ``scenario`` for ``scenario.duration`` seconds.
 
     The ancillary law is ``scenario.controller.law``, the FHOCP the scenario's backend
@@ -428,6 +437,9 @@ def run_closed_loop(scenario: Scenario, tightening: Tightening | None = None, *,
         RK4 steps per ancillary tick (plant step = 1 / (rate * substeps) s).
     remember_obstacles : bool
         Keep obstacles in the map once detected (see :mod:`tubekit.loop.sensing`).
+    observer : callable, optional
+        ``observer(state, nominal, p_d)`` (each (4,), (4,), (3,)) at every tick a plan is followed, before its
+        command: what an adversary may read (the closed-loop falsifier's greedy attack).
 
     Returns
     -------
@@ -439,6 +451,7 @@ def run_closed_loop(scenario: Scenario, tightening: Tightening | None = None, *,
     clock = Clock.of(scenario, plant_substeps)
     loop = _ClosedLoop(scenario, tightening, clock, solver, law_obj, sig, make_plant(scenario, disturbance),
                        ObstacleMap(scenario.obstacles, scenario.sensing_range, remember=remember_obstacles))
+    loop.observer = observer
     x = tuple(float(c) for c in scenario.initial_state)
     nominal_end = np.asarray(x)
     bar = progress_bar(clock.steps, progress, label or ("tube" if tube else "baseline"))

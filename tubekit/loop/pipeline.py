@@ -14,7 +14,7 @@ import math
 from dataclasses import dataclass
 from typing import Any
 
-from tubekit.loop.closed_loop import run_closed_loop
+from tubekit.loop.closed_loop import TickObserver, run_closed_loop
 from tubekit.loop.metrics import run_metrics
 from tubekit.loop.promises import PREMISES, Promise, broken_promises, check_promises, tier_outcomes
 from tubekit.loop.result import SimulationResult
@@ -113,7 +113,7 @@ class CertifiedRun:
 
 def certified_run(scenario: Scenario, tightening: Tightening, *, tube: bool = True,
                   disturbance: OmegaOverride | None = None, solver_factory: Any = None, progress: bool = False,
-                  label: str | None = None) -> CertifiedRun:
+                  label: str | None = None, observer: TickObserver | None = None) -> CertifiedRun:
     """Simulate ``scenario`` under ``tightening``, measure it in the one convention and check its promises.
 
     Parameters
@@ -132,8 +132,10 @@ def certified_run(scenario: Scenario, tightening: Tightening, *, tube: bool = Tr
         A progress bar on a terminal.
     label : str, optional
         Progress-bar label.
+    observer : callable, optional
+        Told (state, nominal, target) at every tick a plan is followed (:func:`run_closed_loop`).
     """
     run = run_closed_loop(scenario, tightening, tube=tube, progress=progress, label=label,
-                          solver_factory=solver_factory, disturbance=disturbance)
+                          solver_factory=solver_factory, disturbance=disturbance, observer=observer)
     promises = tuple(check_promises(run, uncertified=True)) if tube else ()
     return CertifiedRun(run=run, promises=promises, metrics=run_metrics(run, promises))

@@ -12,7 +12,7 @@ the promises with :func:`tubekit.loop.promises.check_promises`:
   first arc margin, in the certified hemisphere (:func:`start_state`);
 * **greedy**: at every tick ω maximises d/dt of the tube Lyapunov function in the
   box norm, i.e. the growth of |ρ_j| on the axis with the largest |ρ_j| / tube_j
-  (or on one fixed axis), read from the loop's own state (:class:`_StateTap`);
+  (or on one fixed axis), read from the loop's own state (the loop's tick observer);
 * **evolution**: piecewise-constant sequences (one ω per FHOCP period, and the
   start) optimised by a seeded (1 + λ) evolution strategy.
 
@@ -21,15 +21,14 @@ The budget counts simulations, never seconds; the search is deterministic for a 
 
 from __future__ import annotations
 
-import contextlib
 import math
 from dataclasses import dataclass, field, replace
-from typing import TYPE_CHECKING, Callable, Iterator
+from typing import TYPE_CHECKING, Callable
 
 import numpy as np
 
 from tubekit.design_inputs import DesignInputs
-from tubekit.model.ancillary import LAWS, AncillaryLaw, get_law
+from tubekit.model.ancillary import AncillaryLaw, get_law
 from tubekit.model.errors import error_coordinates, numeric
 from tubekit.exceptions import ConfigError
 from tubekit.loop.pipeline import certified_run
@@ -198,20 +197,10 @@ def piecewise_disturbance(omega_xy: float, omega_z: float, dt: float, units: np.
     return PiecewiseOmega(tuple(_omega_from_unit(omega_xy, omega_z, u) for u in np.clip(units, 0.0, 1.0)), dt)
 
 
-@dataclass(frozen=True)
-class _StateTap(AncillaryLaw):
-    """The named law, unchanged, that also records (state, nominal, p_d) at every tick it is called."""
-
-    tap: list = field(default_factory=list, compare=False)
-
-    def __call__(self, state: np.ndarray, state_hat: np.ndarray, p_d: np.ndarray, sigma: float) -> np.ndarray:
-        self.tap[:] = [np.asarray(state, dtype=float), np.asarray(state_hat, dtype=float), np.asarray(p_d)]
-        return super().__call__(state, state_hat, p_d, sigma)
-
-
 def greedy_disturbance(tap: list, tube: np.ndarray, omega_xy: float, omega_z: float,
                        axis: int | None = None) -> Callable:
-    """``disturbance(t)`` maximising d/dt |ρ_j| / tube_j at the state last read by the law (``tap``).
+    """``disturbance(t)`` maximising d/dt |ρ_j| / tube_j at the state the loop last told its observer (``tap``:
+    state, nominal, target).
 
     ė is affine in ω (ė = J v + ζ + ξ(ω)), so ∂ė_j/∂ω = g_j and the best ω is ω̄ along s_j g_j,
     s_j = sign(ρ_j). ``axis`` None: j = argmax |ρ_j| / tube_j (right after the reset, ρ = 0: the
@@ -245,28 +234,6 @@ def greedy_disturbance(tap: list, tube: np.ndarray, omega_xy: float, omega_z: fl
 
 
 # --------------------------------------------------------------------------- one run
-@contextlib.contextmanager
-def _tapped(law: AncillaryLaw, tap: list | None) -> Iterator[None]:
-    """During the block, the law registered under ``law.name`` also records its inputs into ``tap``.
-
-    The scenario keeps naming the same law (so the certificate's design still matches); the
-    registry entry is swapped for a :class:`_StateTap` of it and restored afterwards.
-    """
-    if tap is None:
-        yield
-        return
-    previous = LAWS.get(law.name)
-    LAWS[law.name] = _StateTap(law.name, law.gain_of_jacobian, law.description, law.symbolic_gain,
-                               law.closed_form, tap=tap)
-    try:
-        yield
-    finally:
-        if previous is None:
-            LAWS.pop(law.name, None)
-        else:
-            LAWS[law.name] = previous
-
-
 @dataclass(frozen=True)
 class _Attack:
     """Fixed context of a search: the short scenario (naming the law), the certificate's Tightening and bounds."""
@@ -281,8 +248,8 @@ class _Attack:
             sequence: tuple | None = None) -> LoopRun:
         """Simulate from ``start`` under ``disturbance`` (:func:`certified_run`) and measure the promises."""
         sc = self.scenario.with_changes(initial_state=start)
-        with _tapped(self.law, tap):
-            done = certified_run(sc, self.tightening_at(sc), disturbance=disturbance)
+        observer = None if tap is None else (lambda x, x_hat, p_d: tap.__setitem__(slice(None), [x, x_hat, p_d]))
+        done = certified_run(sc, self.tightening_at(sc), disturbance=disturbance, observer=observer)
         axes = np.nanmax(np.abs(np.asarray(done.run.rho)) / np.asarray(self.tightening.tube), axis=0)
         ratio = float(np.max(axes)) if np.all(np.isfinite(axes)) else math.inf  # against the attacked tube
         claimed = any(p.name == "tube" and p.given for p in done.promises)

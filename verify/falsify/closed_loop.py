@@ -234,6 +234,13 @@ def greedy_disturbance(tap: list, tube: np.ndarray, omega_xy: float, omega_z: fl
 
 
 # --------------------------------------------------------------------------- one run
+def _recorder(tap: list) -> Callable[[np.ndarray, np.ndarray, np.ndarray], None]:
+    """The loop's tick observer that keeps only the last (state, nominal, target) in ``tap`` (the greedy reads it)."""
+    def observe(state: np.ndarray, nominal: np.ndarray, p_d: np.ndarray) -> None:
+        tap[:] = [state, nominal, p_d]
+    return observe
+
+
 @dataclass(frozen=True)
 class _Attack:
     """Fixed context of a search: the short scenario (naming the law), the certificate's Tightening and bounds."""
@@ -248,8 +255,8 @@ class _Attack:
             sequence: tuple | None = None) -> LoopRun:
         """Simulate from ``start`` under ``disturbance`` (:func:`certified_run`) and measure the promises."""
         sc = self.scenario.with_changes(initial_state=start)
-        observer = None if tap is None else (lambda x, x_hat, p_d: tap.__setitem__(slice(None), [x, x_hat, p_d]))
-        done = certified_run(sc, self.tightening_at(sc), disturbance=disturbance, observer=observer)
+        done = certified_run(sc, self.tightening_at(sc), disturbance=disturbance,
+                             observer=None if tap is None else _recorder(tap))
         axes = np.nanmax(np.abs(np.asarray(done.run.rho)) / np.asarray(self.tightening.tube), axis=0)
         ratio = float(np.max(axes)) if np.all(np.isfinite(axes)) else math.inf  # against the attacked tube
         claimed = any(p.name == "tube" and p.given for p in done.promises)

@@ -334,6 +334,8 @@ class _ClosedLoop:
             xs = np.asarray(x)
             log.states[i] = xs
             sway = 0.0
+            if self.observer is not None and period.anchor is None:  # a plan is followed: told before its command
+                self.observer(xs, period.arc[j], self.desired[i])
             if period.anchor is not None:  # the backup law; its sway command is 0 but for a lateral law
                 u_c, w_c, r_c, sway = backup.lateral_command(x, period.anchor, float(clock.t[i] - self.t_h), self.v_h)
                 v = (u_c, w_c, r_c)
@@ -341,16 +343,12 @@ class _ClosedLoop:
                 log.kappa[i] = 0.0
                 log.v_hat[i] = v
             elif self.sigma > 0.0:
-                if self.observer is not None:
-                    self.observer(xs, period.arc[j], self.desired[i])
                 a0 = time.perf_counter()
                 kap = self.ancillary(i, xs, period.arc[j])
                 law_s += time.perf_counter() - a0
                 log.kappa[i] = kap
                 v = (vh[0] + float(kap[0]), vh[1] + float(kap[1]), vh[2] + float(kap[2]))
             else:
-                if self.observer is not None:
-                    self.observer(xs, period.arc[j], self.desired[i])
                 log.kappa[i] = 0.0
                 v = vh
             v, log.saturated[i] = saturate(v, self.limits, self.lower)

@@ -79,6 +79,11 @@ class LoopRun:
     claims_tube: bool = True
 
     @property
+    def measures_tube(self) -> bool:
+        """Its premises held and its tube is promised: its ratio measures the certificate."""
+        return not self.vacuous and self.claims_tube
+
+    @property
     def counterexample(self) -> bool:
         """The run breaks the certificate (ratio > 1 where the tube is promised, or a promise broken, premises
         holding)."""
@@ -125,7 +130,7 @@ class ClosedLoopResult(SearchOutcome):
     def axis_ratios(self) -> tuple[float, float, float]:
         """Largest |rho_j| / tube_j per axis over the runs whose premises held and whose tube is promised
         (tightness per axis)."""
-        valid = [r.axis_ratios for r in self.runs if not r.vacuous and r.claims_tube] or [self.worst.axis_ratios]
+        valid = [r.axis_ratios for r in self.runs if r.measures_tube] or [self.worst.axis_ratios]
         return tuple(float(np.nanmax([a[j] for a in valid])) for j in range(3))
 
     def summary(self) -> str:
@@ -333,7 +338,7 @@ def falsify_closed_loop(scenario: Scenario, law: str | None = None, *, budget: i
         runs.append(attack.run(f"greedy:{'max' if axis is None else ('e_d', 'e_z', 'e_o')[axis]}",
                                tuple(start), omega, tap=tap))
     runs.extend(_evolve(attack, scenario, rng, budget - n_greedy))
-    valid = [r for r in runs if not r.vacuous and r.claims_tube] or [r for r in runs if not r.vacuous] or runs
+    valid = [r for r in runs if r.measures_tube] or [r for r in runs if not r.vacuous] or runs
     worst = max(valid, key=LoopRun.fitness)
     return ClosedLoopResult(scenario=scenario.name, law=attack.law.name, certified=bool(cert.certified),
                             tube=tuple(float(x) for x in attack.tightening.tube),

@@ -14,7 +14,8 @@ current, the surge command held at ū and a yaw command sweeping ±``--r-max`` a
 largest loop errors |u_c − u|, |r_c − r| and sway |v| are printed.
 
 Usage: ``python benchmarks/remus_frontier.py [--u-max 0.6 1.0 ...] [--spread 0 0.05 1] [--r-max R] [--w-max W]
-[--simulate]`` (well under a second per cell; about 20 s per simulated cell).
+[--rate RU RW RR] [--u-min U] [--simulate]`` (``--u-min``: the surge floor, default ū / 2; well under a second per
+cell, about 20 s per simulated cell).
 """
 
 from __future__ import annotations
@@ -48,20 +49,23 @@ def shrunk(params: VehicleParams, fraction: float) -> VehicleParams:
     return params.with_overrides({k: v for k, v in table.items() if k != "name"})
 
 
-def cell(params: VehicleParams, u_max: float, r_max: float, w_max: float, rate: tuple[float, float, float]) -> str:
-    """One cell of the table (module doc)."""
+def cell(params: VehicleParams, u_max: float, r_max: float, w_max: float, rate: tuple[float, float, float],
+         u_min: float | None = None) -> str:
+    """One cell of the table (module doc); ``u_min`` None: ū / 2."""
     jumps = tuple(r * PERIOD for r in rate)
+    floor = u_max / 2 if u_min is None else u_min
     bound = velocity_loop_bound(params, v_max=(u_max, w_max, r_max), tick=TICK, period=PERIOD,
-                                jump_tick=(0.0, 0.0, 0.0), jump_period=jumps, first_command=(u_max / 2 + jumps[0],
+                                jump_tick=(0.0, 0.0, 0.0), jump_period=jumps, first_command=(floor + jumps[0],
                                                                                              jumps[1], jumps[2]),
-                                surge_floor=u_max / 2)
+                                surge_floor=floor)
     by_name = {c.condition: c for c in bound.conditions}
     if not by_name["loop_fixed_point"].ok:
         growth = re.search(r"multiplied the bounds by up to ([0-9.e+]+) \((.*?)\)", by_name["loop_fixed_point"].detail)
         return "diverges" + (f" (x{growth.group(1)}, {growth.group(2)})" if growth else "")
     fins = "; ".join(f"{ch} need {by_name[f'loop_saturation[{ch}]'].lhs:.3g} vs {by_name[f'loop_saturation[{ch}]'].rhs:.3g}"
                      for ch in ("Z", "N"))
-    return f"E = ({bound.error[0]:.3f}, {bound.error[1]:.3f}, {bound.error[2]:.3f}); {fins}"
+    verdict = "**closes, fins hold**" if all(c.ok for c in bound.conditions) else "fins short"
+    return f"E = ({bound.error[0]:.3f}, {bound.error[1]:.3f}, {bound.error[2]:.3f}); {fins}; {verdict}"
 
 
 def simulated(params: VehicleParams, u_max: float, r_max: float, yaw_rate: float, seed: int | None,
@@ -103,15 +107,16 @@ def simulated_rows(u_values, spreads, r_max: float, yaw_rate: float) -> list[str
     return rows
 
 
-def table(u_values, spreads, r_max: float, w_max: float, rate) -> list[str]:
-    """The rows (module doc), one per (box, ū)."""
+def table(u_values, spreads, r_max: float, w_max: float, rate, u_min: float | None = None) -> list[str]:
+    """The rows (module doc), one per (box, ū); ``u_min`` None: ū / 2."""
     base = vehicle_params("remus100")
-    rows = [f"REMUS 100, u_min = u_max / 2, |r| <= {r_max:g} rad/s, |w| <= {w_max:g} m/s, rate {list(rate)}"]
+    floor = "u_max / 2" if u_min is None else f"{u_min:g} m/s"
+    rows = [f"REMUS 100, u_min = {floor}, |r| <= {r_max:g} rad/s, |w| <= {w_max:g} m/s, rate {list(rate)}"]
     for f in spreads:
         params = shrunk(base, f)
         label = "midpoint" if f == 0 else "published box" if f == 1 else f"box x{f:g}"
         for u in u_values:
-            rows.append(f"{label:>14} | u_max {u:4.2f} | {cell(params, u, r_max, w_max, rate)}")
+            rows.append(f"{label:>14} | u_max {u:4.2f} | {cell(params, u, r_max, w_max, rate, u_min)}")
     return rows
 
 
@@ -123,11 +128,14 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--r-max", type=float, default=0.1)
     parser.add_argument("--w-max", type=float, default=0.02)
     parser.add_argument("--rate", type=float, nargs=3, default=[0.05, 0.01, 0.02])
+    parser.add_argument("--u-min", type=float, default=None, help="the surge floor (m/s; default u_max / 2)")
     parser.add_argument("--simulate", action="store_true", help="add the simulated plant's errors (no bound)")
     args = parser.parse_args(argv)
     if not all(math.isfinite(x) and x > 0 for x in [*args.u_max, args.r_max, args.w_max, *args.rate]):
         parser.error("speeds and rates must be finite and > 0")
-    print("\n".join(table(args.u_max, args.spread, args.r_max, args.w_max, tuple(args.rate))))
+    if args.u_min is not None and not (math.isfinite(args.u_min) and 0 < args.u_min < min(args.u_max)):
+        parser.error("--u-min must be finite, > 0 and below every --u-max")
+    print("\n".join(table(args.u_max, args.spread, args.r_max, args.w_max, tuple(args.rate), args.u_min)))
     if args.simulate:
         print("\n".join(simulated_rows(args.u_max, args.spread, args.r_max, args.rate[2])))
     return 0

@@ -31,8 +31,8 @@ def test_the_midpoint_closes_at_a_crawl_and_diverges_in_yaw_at_survey_speed():
     params = mod.shrunk(vehicle_params("remus100"), 0.0)
     slow = mod.cell(params, 0.6, 0.1, 0.02, (0.05, 0.01, 0.02))
     assert slow.startswith("E = (") and "N need" in slow
-    need, floor = (float(x) for x in slow.split("N need ")[1].split(" vs "))
-    assert 0.0 < floor < need
+    need, floor = (float(x) for x in slow.split("N need ")[1].split(";")[0].split(" vs "))
+    assert 0.0 < floor < need and slow.endswith("fins short")
     assert mod.cell(params, 1.5, 0.1, 0.02, (0.05, 0.01, 0.02)).startswith("diverges (x")
     assert "channel r" in mod.cell(params, 1.5, 0.1, 0.02, (0.05, 0.01, 0.02))
 
@@ -45,3 +45,20 @@ def test_the_simulated_midpoint_follows_a_yaw_sweep_at_survey_speed_within_a_hun
     params = mod.shrunk(vehicle_params("remus100"), 0.0)
     du, dr, sway = mod.simulated(params, 1.5, 0.1, 0.02, None, seconds=6.0)
     assert 0.0 <= du < 0.01 and 0.001 < dr < 0.01 and 0.0 < sway < 0.1
+
+
+def test_at_survey_speed_with_a_high_floor_and_gentle_yaw_the_loop_closes_and_the_fins_hold_up_to_a_fifth():
+    """u_max 1.3 m/s, u_min 1.0 m/s, |r| <= 0.02 rad/s, |w| <= 0.01 m/s, plans' rate (0.02, 0.005, 0.005)
+    (docs/plant.md section 4): the loop's bound closes and every fin condition holds at the midpoint and over a
+    fifth of the published half-widths; over the published box the fixed point still diverges in yaw."""
+    mod = _module()
+    base = vehicle_params("remus100")
+    args = (1.3, 0.02, 0.01, (0.02, 0.005, 0.005), 1.0)
+    for fraction in (0.0, 0.2):
+        row = mod.cell(mod.shrunk(base, fraction), *args)
+        assert row.endswith("**closes, fins hold**"), row
+        need, floor = (float(x) for x in row.split("N need ")[1].split(";")[0].split(" vs "))
+        assert 0.0 < need < floor
+    assert "channel r" in mod.cell(mod.shrunk(base, 1.0), *args)
+    with pytest.raises(SystemExit):
+        mod.main(["--u-max", "1.0", "--u-min", "1.2"])

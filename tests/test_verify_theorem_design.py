@@ -222,3 +222,53 @@ def test_a_surge_floor_is_reserved_kappa_bar_above_u_min_and_fails_when_the_band
     assert closed.backup.law.surge == pytest.approx(1.0 - 1.5 * kappa)
     sym = {x.condition for x in verify.certify(sc.with_changes(**{"limits.u_min": None})).design.conditions}
     assert "v_bar[surge_floor]" not in sym                                        # the symmetric box: no such row
+
+
+def test_a_surge_floor_narrows_the_hulls_sway_bound_to_the_lift_it_keeps():
+    """Under u >= u_low > 0 the lift term Y_uv u damps the sway: b = −Y_v − Y_uv u_low (a point vehicle) instead of
+    −Y_v − |Y_uv| ū. At REMUS 100's midpoint the bound is the closed form, from the vehicle's numbers, and below
+    the bound over |u| <= ū; a floor at or above ū changes nothing."""
+    from tubekit.model.vehicle_sets import REMUS100
+    from verify.theorem.design import hull_sway_bound
+    p = REMUS100.nominal
+    u, r, u_low = 1.05, 0.15, 0.47
+    m11, m22, _, _, m24, _ = p.mass_entries
+    f = abs(p.Y_ur_lift - m11) * u * r + abs(p.Y_rr) * r * r
+    a, b = abs(p.Y_vv), -p.Y_v - p.Y_uv * u_low
+    expected = (-b + math.sqrt(b * b + 4 * a * f)) / (2 * a) + 2 * abs(m24) * r / m22
+    floored = float(hull_sway_bound(p, u, r, u_low).mid())
+    assert floored == pytest.approx(expected, rel=1e-9)
+    assert floored < float(hull_sway_bound(p, u, r).mid())
+    assert float(hull_sway_bound(p, u, r, u).mid()) == float(hull_sway_bound(p, u, r).mid())
+
+
+@pytest.mark.parametrize("seed", [None, 0, 1])
+def test_on_the_simulated_torpedo_the_sway_stays_within_the_floored_bound(seed):
+    """Property: REMUS 100 as simulated (its box's midpoint, and two random points of the published box), no
+    current, the surge command switching between 0.6 and 1.0 m/s and the yaw rate bang-bang between ±0.1 rad/s:
+    |v| stays within γ̄ over the run's own surge range [min u, max u] and max |r|, and the box's floored bound
+    covers the point's."""
+    from tubekit.model.vehicle_sets import REMUS100
+    from tubekit.plant.dynamic import DynamicPlant
+    from tubekit.scenario import scenario_from_dict
+    from verify.theorem.design import hull_sway_bound
+    truth = REMUS100.nominal if seed is None else REMUS100.sample(np.random.default_rng(seed))
+    scenario = scenario_from_dict({"plant": {"kind": "dynamic", "vehicle": {
+        k: v for k, v in REMUS100.to_dict().items() if k != "name"}},
+        "disturbance": {"amplitude": [0.0, 0.0, 0.0], "sway": {"gain": 0.0, "bound": 0.0}}})
+    plant = DynamicPlant(scenario, params=truth)
+    command, pose, t, body = [0.6, 0.0, 0.0], (0.0, 0.0, 0.0, 0.0), 0.0, []
+    for k in range(400):  # 40 s of 0.1 s periods
+        command[0] += max(-0.02, min(0.02, (0.6, 1.0)[(k // 90) % 2] - command[0]))
+        command[2] += max(-0.01, min(0.01, (0.1 if (k // 60) % 2 == 0 else -0.1) - command[2]))
+        for _ in range(10):
+            pose = plant.step_tuple(t, pose, tuple(command), 0.01, 1)
+            t += 0.01
+            body.append(plant.state[:4])
+    body = np.array(body)
+    u_lo, u_hi, r_hi = float(body[:, 0].min()), float(np.abs(body[:, 0]).max()), float(np.abs(body[:, 3]).max())
+    assert u_lo > 0.55 and r_hi > 0.09  # the run did what it was asked
+    point = hull_sway_bound(truth, u_hi, r_hi, u_lo)
+    sway = float(np.abs(body[:, 1]).max())
+    assert 0.0 < sway <= float(point.mid() - point.rad())
+    assert float(hull_sway_bound(REMUS100, u_hi, r_hi, u_lo).mid()) >= float(point.mid())

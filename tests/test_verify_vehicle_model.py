@@ -41,6 +41,23 @@ def test_the_arb_forces_contain_the_plants_forces_at_points(p):
             assert lower(ball) - 1e-12 <= x <= upper(ball) + 1e-12
 
 
+def test_over_a_box_the_munk_moment_is_charged_once_not_as_two_moments_that_add():
+    """Over u in [1.0, 1.3] m/s, |v| <= 0.03 m/s, w = r = 0, REMUS 100's midpoint yaw force is
+    u v (m22 - m11 - N_uv,lift) - N_vv v|v|: its enclosure is at most the hand bound
+    1.3 x 0.03 x |m22 - m11 - N_uv,lift| + |N_vv| 0.03^2 (from the vehicle's numbers), where charging m22 u v
+    and m11 u v apart would give 1.3 x 0.03 x (m22 + m11 + |N_uv,lift|); every sampled point lies inside."""
+    p = REMUS100.nominal
+    m11, m22, *_ = p.mass_entries
+    nu = (arb(1.15, 0.15), arb(0, 0.03), arb(0), arb(0))
+    n4 = arb_body_forces(nominal_balls(p), nu)[3]
+    hand = 1.3 * 0.03 * abs(m22 - m11 - p.N_uv_lift) + abs(p.N_vv) * 0.03 ** 2
+    assert upper(abs(n4)) <= hand * (1 + 1e-6)
+    assert hand < 0.5 * 1.3 * 0.03 * (m22 + m11 + abs(p.N_uv_lift))
+    rng = np.random.default_rng(5)
+    for u, v in zip(rng.uniform(1.0, 1.3, 200), rng.uniform(-0.03, 0.03, 200)):
+        assert lower(n4) <= body_forces(p, (u, v, 0.0, 0.0))[3] <= upper(n4)
+
+
 @pytest.mark.parametrize("p", POINTS)
 def test_the_hand_gradient_matches_central_differences_of_the_plant(p):
     rng = np.random.default_rng(4)

@@ -94,12 +94,15 @@ class DisturbanceBounds:
                    yaw_rate_error=bound(d, "yaw_rate_error", where))
 
 
-def hull_sway_bound(params: VehicleParams, u_bar: float, r_bar: float) -> arb:
-    """γ̄ (m/s): ISS bound of the hull's sway for |u| <= u_bar, |r| <= r_bar (body velocities), v(0) = 0.
+def hull_sway_bound(params: VehicleParams, u_bar: float, r_bar: float, u_low: float | None = None) -> arb:
+    """γ̄ (m/s): ISS bound of the hull's sway for ``u_low`` <= u <= u_bar, |r| <= r_bar (body velocities), v(0) = 0;
+    ``u_low`` None: |u| <= u_bar.
 
     Sway row of M ν̇ + C(ν)ν + D(ν)ν = τ (no sway force) for q = m22 v + m24 r:
     q̇ = (Y_ur_lift − m11) u r + Y_rr r|r| + (Y_v + Y_uv u) v + Y_vv v|v|. With
-    F = |Y_ur_lift − m11| ū r̄ + |Y_rr| r̄² and b = −Y_v − |Y_uv| ū, q q̇ < 0 whenever
+    F = |Y_ur_lift − m11| ū r̄ + |Y_rr| r̄² and b = −sup(Y_v + Y_uv u) over the surge range (−Y_v − |Y_uv| ū for
+    |u| <= ū; under a surge floor u >= u_low > 0 the lift term Y_uv u <= 0 damps: b = −Y_v − Y_uv u_low for a
+    point vehicle, ``docs/verify.md`` section 9, step 4), q q̇ < 0 whenever
     |v| > v*, the positive root of |Y_vv| v² + b v − F = 0; |v| >= v* whenever
     |q| >= q* = m22 v* + |m24| r̄. So |q| <= q* (q(0) = m24 r(0)) and
     |v| <= (q* + |m24| r̄) / m22 = v* + 2 |m24| r̄ / m22. Infinite when nothing damps sway.
@@ -117,7 +120,10 @@ def hull_sway_bound(params: VehicleParams, u_bar: float, r_bar: float) -> arb:
     ub, rb = arb(u_bar), arb(r_bar)
     force = arb(upper(abs(ball("Y_ur_lift") - m11) * ub * rb + abs(ball("Y_rr")) * rb * rb))
     a = arb(lower(abs(ball("Y_vv"))))
-    b = arb(lower(-ball("Y_v") - abs(ball("Y_uv")) * ub))
+    if u_low is None or not u_low < u_bar:
+        b = arb(lower(-ball("Y_v") - abs(ball("Y_uv")) * ub))
+    else:  # the lift term over the surge range u_low <= u <= ū
+        b = arb(lower(-ball("Y_v") - ball("Y_uv") * enclose(u_low, u_bar)))
     if a > 0:
         v_star = (-b + (b * b + 4 * a * force).sqrt()) / (2 * a)
     elif b > 0:
@@ -137,8 +143,9 @@ def disturbance_bounds(scenario: Scenario, loop_error: tuple[float, float, float
     composed by :func:`verify.vehicle.compose.solve_dynamic`): γ̄ = :func:`hull_sway_bound` over
     |u_b| <= ū + E_u, |r_b| <= r̄ + E_r and the vehicle's coefficient box,
     ω̄_xy = max(a_x, a_y) + ‖c_xy‖ + ‖(E_u, γ̄)‖, ω̄_z = a_z + |c_z| + E_w, and the yaw-rate
-    error E_r. A vehicle with lateral thrust regulates its sway to 0: γ̄ = ``loop_sway``, the sway loop's
-    error bound E_v (m/s, required then). The sway table is unused there (declared = γ̄).
+    error E_r; under a minimum surge γ̄ is taken over u >= u_min − E_u. A vehicle with lateral thrust regulates
+    its sway to 0: γ̄ = ``loop_sway``, the sway loop's error bound E_v (m/s, required then). The sway table is
+    unused there (declared = γ̄).
     """
     d, lim = scenario.disturbance, scenario.limits
     a, c = d.amplitude, d.constant
@@ -155,7 +162,9 @@ def disturbance_bounds(scenario: Scenario, loop_error: tuple[float, float, float
                                  "(loop_sway, verify.vehicle.compose.solve_dynamic composes it)")
             gamma = arb(loop_sway)
         else:
-            gamma = hull_sway_bound(scenario.plant.params, upper(arb(lim.u_max) + du), upper(arb(lim.r_max) + dr))
+            floor = lower(arb(lim.surge_floor) - du) if lim.surge_floor > 0 else None  # u >= u_min − E_u
+            gamma = hull_sway_bound(scenario.plant.params, upper(arb(lim.u_max) + du), upper(arb(lim.r_max) + dr),
+                                    floor)
         wxy = arb(max(a[0], a[1])) + cxy + (du * du + gamma * gamma).sqrt()
         return DisturbanceBounds(omega_xy=upper(wxy), omega_z=upper(wz + dw), gamma=upper(gamma),
                                  declared_sway=upper(gamma), yaw_rate_error=upper(dr))

@@ -306,11 +306,11 @@ def velocity_loop_bound(params: VehicleParams, *, v_max: Sequence[float], tick: 
     first = v if first_command is None else tuple(min(f, x) for f, x in zip(triple("first_command",
                                                                                       first_command), v))
     sway_max, sway_tick, sway_period = _sway_command(params, sway)
-    loop = loop_data_of(params, v, h, ticks, sway_max)
+    floor_u = nonnegative("surge_floor", surge_floor)
+    loop = loop_data_of(params, v, h, ticks, sway_max, floor_u)
     d_start = _start_mismatch(loop, first)  # the start transient of both decompositions
     start, start_mass = _per_mass(d_start, loop.m_true), _per_mass(d_start, loop.m_hat)
     start_cells = cell_starts(loop, first)
-    floor_u = nonnegative("surge_floor", surge_floor)
     # the sway channel's command: 0 under plans, a lateral backup's own jumps
     jt_int, jp_int = with_sway(jt, sway_tick, loop.lateral), with_sway(jp, sway_period, loop.lateral)
     n = len(loop.names)
@@ -428,7 +428,8 @@ def _result(loop: LoopData, params: VehicleParams, given: tuple, assumed: list, 
     elif lat:  # the sway loop's own error bound E_v (its command is 0)
         gamma = computed[1][0]
     else:
-        gamma = upper(hull_sway_bound(params, upper(arb(v[0]) + arb(error[0])), upper(arb(v[2]) + arb(error[2]))))
+        gamma = upper(hull_sway_bound(params, upper(arb(v[0]) + arb(error[0])), upper(arb(v[2]) + arb(error[2])),
+                                      loop.surge_low(error[0])))
     conds = [Condition(f"loop_stable[{ax}]", "||A_d^K||_inf < 1 (the sampled loop is stable; geometric tail)",
                        s.rho, 1.0, s.stable, f"K = {s.terms} ticks summed term by term, A_d = exp(A h) in Arb, "
                        f"lambda_{ax} = {lam:.4g} 1/s") for ax, s, lam in zip(loop.names, loop.sums, loop.slope)]
@@ -441,7 +442,7 @@ def _result(loop: LoopData, params: VehicleParams, given: tuple, assumed: list, 
                            + (f"; {why_open}" if why_open else "")))
     conds += saturation_conditions(loop, params, v, assumed, closed=found or not loop.stable, surge_floor=floor_u)
     how = ("E_v of the sway loop (lateral thrust regulates the sway to 0)" if lat else
-           "hull_sway_bound over |u| <= V_u + E_u, |r| <= V_r + E_r and Θ")
+           "hull_sway_bound over |u| <= V_u + E_u (u >= u_min − E_u under a surge floor), |r| <= V_r + E_r and Θ")
     conds.append(Condition("loop_sway", "gamma_bar finite (sway damped over the box)" if not lat else
                            "gamma_bar = E_v finite (the sway loop's error bound)", gamma, None, math.isfinite(gamma),
                            how if found else "not evaluated: no loop bound E (root cause: loop_fixed_point)"))

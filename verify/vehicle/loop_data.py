@@ -16,7 +16,7 @@ from typing import Sequence
 from flint import arb, ctx
 
 from tubekit.model.vehicle_params import VehicleParams
-from verify.kernel.intervals import upper
+from verify.kernel.intervals import lower, upper
 from verify.theorem.design import hull_sway_bound
 from verify.vehicle.model import (channel_gradient, channel_masses, hull_balls, nominal_balls, nominal_params,
                                   point_time_constant, velocity_box, with_sway, without_sway, CHANNELS,
@@ -43,8 +43,10 @@ class LoopData:
     """The vehicle's fixed data for the fixed point: balls, gains, slopes λ_c, the response sums per channel."""
 
     def __init__(self, params: VehicleParams, v_max: Sequence[float], tick: float, ticks: int,
-                 sway_max: float = 0.0) -> None:
+                 sway_max: float = 0.0, surge_floor: float = 0.0) -> None:
         self.params, self.v_max, self.tick, self.ticks = params, tuple(v_max), tick, int(ticks)
+        # u_min (m/s): the commanded surge never falls below it, so the relative surge stays >= u_min − E_u
+        self.surge_floor = float(surge_floor)
         # with lateral thrust a fourth channel, sway (index 1), regulated to its command: the command box is
         # |v_c| <= sway_max (0 but under a backup law that commands sway, verify.backup.hold)
         self.lateral = bool(getattr(params, "lateral", False))
@@ -84,11 +86,18 @@ class LoopData:
 
     def box(self, error: Sequence[float]) -> tuple[tuple[float, float, float], float]:
         """(ū, w̄, r̄) = V + E and the sway's bound over it (m/s, m/s, rad/s; m/s): with lateral thrust the sway
-        channel's E_v (``error`` then has the sway channel at index 1), else γ̄ of the free hull."""
+        channel's E_v (``error`` then has the sway channel at index 1), else γ̄ of the free hull (over
+        u >= :meth:`surge_low` under a surge floor)."""
         bar = tuple(upper(arb(v) + arb(e)) for v, e in zip(self.v_int, error))
         if self.lateral:
             return without_sway(bar, True), bar[1]
-        return bar, upper(hull_sway_bound(self.params, bar[0], bar[2]))
+        return bar, upper(hull_sway_bound(self.params, bar[0], bar[2], self.surge_low(error[0])))
+
+    def surge_low(self, surge_error: float) -> float | None:
+        """u_min − E_u (m/s), rounded down, the relative surge's floor; None without a surge floor."""
+        if self.surge_floor <= 0.0:
+            return None
+        return lower(arb(self.surge_floor) - arb(surge_error))
 
     def slopes(self, box: Sequence[float], gamma: float) -> list[arb]:
         """∂n̂_c/∂y_c / m̂_c over the velocity box (1/s): the drag's slope in the channel's own speed."""
@@ -98,16 +107,18 @@ class LoopData:
 
 @functools.lru_cache(maxsize=8)
 def _cached_loop(params: VehicleParams, v_max: tuple, tick: float, ticks: int, prec: int,
-                 sway_max: float = 0.0) -> LoopData:
+                 sway_max: float = 0.0, surge_floor: float = 0.0) -> LoopData:
     """:class:`LoopData` memoised on its inputs and the working precision ``prec`` (bits) it is built at."""
-    return LoopData(params, v_max, tick, ticks, sway_max)
+    return LoopData(params, v_max, tick, ticks, sway_max, surge_floor)
 
 
-def loop_data_of(params: VehicleParams, v_max: tuple, tick: float, ticks: int, sway_max: float = 0.0) -> LoopData:
-    """The :class:`LoopData` (its impulse-response sums) of a vehicle, V and h, built once per (hashable) vehicle: it
-    does not depend on the jump bounds, which the fixed point of :mod:`verify.vehicle.compose` changes each round."""
+def loop_data_of(params: VehicleParams, v_max: tuple, tick: float, ticks: int, sway_max: float = 0.0,
+                 surge_floor: float = 0.0) -> LoopData:
+    """The :class:`LoopData` (its impulse-response sums) of a vehicle, V, h and the surge floor u_min (m/s), built
+    once per (hashable) vehicle: it does not depend on the jump bounds, which the fixed point of
+    :mod:`verify.vehicle.compose` changes each round."""
     try:
         hash(params)
     except TypeError:
-        return LoopData(params, v_max, tick, ticks, sway_max)
-    return _cached_loop(params, v_max, tick, ticks, ctx.prec, sway_max)
+        return LoopData(params, v_max, tick, ticks, sway_max, surge_floor)
+    return _cached_loop(params, v_max, tick, ticks, ctx.prec, sway_max, float(surge_floor))

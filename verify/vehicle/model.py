@@ -72,16 +72,18 @@ def nominal_balls(params: VehicleParams) -> dict[str, arb]:
 def arb_body_forces(c: Mapping[str, arb], nu: Sequence[arb]) -> tuple[arb, arb, arb, arb]:
     """n(ν) = C(ν)ν + D(ν)ν (N, N, N, N m) in Arb: the mirror of ``tubekit.plant.dynamic.body_forces``.
 
-    ``c`` maps the coefficient names and m11, m22, m24 to balls; ``nu`` = (u, v, w, r) balls.
+    ``c`` maps the coefficient names and m11, m22, m24 to balls; ``nu`` = (u, v, w, r) balls. The surge's products
+    are factored (u (A v + B r), the Munk moment as (m22 − m11 − N_uv,lift) u v): the same function, but each ball
+    enters once, so over a box the enclosure does not charge m22 u v and m11 u v as if they could add.
     """
     u, v, w, r = (arb(x) for x in nu)
     au, av, aw, ar = _abs(u), _abs(v), _abs(w), _abs(r)
-    q = c["m22"] * v + c["m24"] * r
-    d1 = -(c["X_u"] + c["X_uu"] * au) * u
-    d2 = -(c["Y_v"] + c["Y_vv"] * av) * v - c["Y_rr"] * r * ar - c["Y_uv"] * u * v - c["Y_ur_lift"] * u * r
-    d3 = -(c["Z_w"] + c["Z_ww"] * aw) * w - c["Z_uw"] * u * w
-    d4 = -(c["N_r"] + c["N_rr"] * ar) * r - c["N_vv"] * v * av - c["N_uv_lift"] * u * v - c["N_ur_lift"] * u * r
-    return -q * r + d1, c["m11"] * u * r + d2, d3, q * u - c["m11"] * u * v + d4
+    n1 = -(c["m22"] * v + c["m24"] * r) * r - (c["X_u"] + c["X_uu"] * au) * u
+    n2 = u * ((c["m11"] - c["Y_ur_lift"]) * r - c["Y_uv"] * v) - (c["Y_v"] + c["Y_vv"] * av) * v - c["Y_rr"] * r * ar
+    n3 = -(c["Z_w"] + c["Z_ww"] * aw + c["Z_uw"] * u) * w
+    n4 = (u * ((c["m22"] - c["m11"] - c["N_uv_lift"]) * v + (c["m24"] - c["N_ur_lift"]) * r)
+          - (c["N_r"] + c["N_rr"] * ar) * r - c["N_vv"] * v * av)
+    return n1, n2, n3, n4
 
 
 def body_force_gradient(c: Mapping[str, arb], nu: Sequence[arb]) -> tuple[tuple[arb, ...], ...]:

@@ -339,7 +339,7 @@ def velocity_loop_bound(params: VehicleParams, *, v_max: Sequence[float], tick: 
     else:  # over |v| <= E_v with a sway loop, else the free hull's γ̄
         authority = actuator_authority(params, v, floor_u, upper(arb(sway_max) + arb(computed[1][0]))
                                        if loop.lateral else None)
-    return _result(loop, params, (v, h, d, jt, jp, first, floor_u), assumed, computed, inputs, authority,
+    return _result(loop, params, (v, h, d, jt, jp, first), assumed, computed, inputs, authority,
                    (k, max_iterations), found, rho, _why_open(loop, found, stop, growth, first_box))
 
 
@@ -420,7 +420,7 @@ def _result(loop: LoopData, params: VehicleParams, given: tuple, assumed: list, 
             authority: tuple, iterations: tuple[int, int], found: bool, rho: tuple | None,
             why_open: str = "") -> LoopBound:
     """The :class:`LoopBound` with every condition of the theorem (bounds +inf when not certified)."""
-    v, h, d, jt, jp, first, floor_u = given
+    v, h, d, jt, jp, first = given
     lat = loop.lateral
     error = without_sway(tuple(r[0] for r in computed), lat) if found else (math.inf,) * 3
     if not found:
@@ -440,7 +440,7 @@ def _result(loop: LoopData, params: VehicleParams, given: tuple, assumed: list, 
     conds.append(Condition("loop_fixed_point", "max computed/assumed of (sup|e|, sup|a|, sup|z|, sup|ydot|) < 1 "
                            "(first exit)", ratio, 1.0, found, f"{iterations[0]} iterations (at most {iterations[1]})"
                            + (f"; {why_open}" if why_open else "")))
-    conds += saturation_conditions(loop, params, v, assumed, closed=found or not loop.stable, surge_floor=floor_u)
+    conds += saturation_conditions(loop, params, v, assumed, closed=found or not loop.stable)
     how = ("E_v of the sway loop (lateral thrust regulates the sway to 0)" if lat else
            "hull_sway_bound over |u| <= V_u + E_u (u >= u_min − E_u under a surge floor), |r| <= V_r + E_r and Θ")
     conds.append(Condition("loop_sway", "gamma_bar finite (sway damped over the box)" if not lat else

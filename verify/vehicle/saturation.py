@@ -36,6 +36,8 @@ class _Loop(Protocol):
 
     def box(self, error: Sequence[float]) -> tuple[tuple[float, float, float], float]: ...
 
+    def surge_low(self, surge_error: float) -> float | None: ...
+
 __all__ = ["actuator_authority", "rate_authority_conditions", "saturation_conditions", "thrust_peaks",
            "SURGE_BANDS", "triple"]
 
@@ -109,15 +111,15 @@ def rate_authority_conditions(authority: Sequence[float], rate: Sequence[float])
 
 
 def saturation_conditions(loop: _Loop, params: VehicleParams, v: Sequence[float], assumed: list,
-                closed: bool = True, surge_floor: float = 0.0) -> list[Condition]:
+                closed: bool = True) -> list[Condition]:
     """``loop_saturation[X|Z|N]``: sup|n̂_c| + m̂_c Â_c < the smallest limit over |u| <= V_u + E_u and Θ (and
-    u >= ``surge_floor`` − E_u, the relative surge under a minimum surge command); not evaluated (no number)
-    when the fixed point did not ``closed`` (its assumed bounds mean nothing then)."""
+    u >= u_min − E_u, the relative surge under the loop's surge floor, ``loop.surge_low``); not evaluated (no
+    number) when the fixed point did not ``closed`` (its assumed bounds mean nothing then)."""
     box, sway = loop.box([r[0] for r in assumed])
     a_assumed = [r[1] for r in assumed]
     finite_box = all(math.isfinite(x) for x in (*box, sway, *a_assumed))
     u_bar = box[0] if finite_box else v[0]
-    u_low = max(0.0, lower(arb(surge_floor) - arb(assumed[0][0]))) if finite_box else 0.0
+    u_low = max(0.0, loop.surge_low(assumed[0][0]) or 0.0) if finite_box else 0.0
     if finite_box and 0.0 < u_low < u_bar:
         peaks, floor = _banded(loop, params, box, sway, a_assumed, (u_low, u_bar))
     else:

@@ -11,7 +11,8 @@ against their floor, or why the fixed point diverged (its first-round growth and
 ``--simulate`` adds what the vehicle does (no bound): the plant as simulated
 (:class:`tubekit.plant.dynamic.DynamicPlant`) at the box's midpoint and at three random points of each box, no
 current, the surge command held at ū and a yaw command sweeping ±``--r-max`` at the yaw rate limit for 60 s; the
-largest loop errors |u_c − u|, |r_c − r| and sway |v| are printed.
+largest loop errors |u_c − u|, |r_c − r|, the sway |v| and the rudder's largest share of its moment at the current
+surge are printed.
 
 Usage: ``python benchmarks/remus_frontier.py [--u-max 0.6 1.0 ...] [--spread 0 0.05 1] [--r-max R] [--w-max W]
 [--rate RU RW RR] [--u-min U] [--simulate]`` (``--u-min``: the surge floor, default ū / 2; well under a second per
@@ -69,17 +70,19 @@ def cell(params: VehicleParams, u_max: float, r_max: float, w_max: float, rate: 
 
 
 def simulated(params: VehicleParams, u_max: float, r_max: float, yaw_rate: float, seed: int | None,
-              seconds: float = 60.0) -> tuple[float, float, float]:
-    """(max |u_c − u|, max |r_c − r|, max |v|) (m/s, rad/s, m/s) of the plant at ``params``' midpoint (``seed``
-    None) or a random point of its box, surge command ``u_max``, yaw command sweeping ±``r_max`` at ``yaw_rate``
-    (rad/s²), reversing every 15 s, no current (module doc)."""
+              seconds: float = 60.0) -> tuple[float, float, float, float]:
+    """(max |u_c − u|, max |r_c − r|, max |v|, max |N| / (|N_uuδr| u² δ_max)) (m/s, rad/s, m/s, the share of the
+    rudder's moment at the current surge) of the plant at ``params``' midpoint (``seed`` None) or a random point of
+    its box, surge command ``u_max``, yaw command sweeping ±``r_max`` at ``yaw_rate`` (rad/s²), reversing every
+    15 s, no current (module doc)."""
     scenario = scenario_from_dict({"plant": {"kind": "dynamic", "vehicle": {
         k: v for k, v in params.to_dict().items() if k != "name"}},
         "disturbance": {"amplitude": [0.0, 0.0, 0.0], "sway": {"gain": 0.0, "bound": 0.0}}})
     box = scenario.plant.params
     truth = box.nominal if seed is None else box.sample(np.random.default_rng(seed))
     plant = DynamicPlant(scenario, params=truth)
-    pose, command, t, goal, worst = (0.0, 0.0, 0.0, 0.0), [u_max, 0.0, 0.0], 0.0, r_max, [0.0, 0.0, 0.0]
+    pose, command, t, goal, worst = (0.0, 0.0, 0.0, 0.0), [u_max, 0.0, 0.0], 0.0, r_max, [0.0, 0.0, 0.0, 0.0]
+    rudder = abs(truth.N_uudr) * truth.fin_max  # N m per (m/s)²
     for k in range(int(round(seconds / PERIOD))):
         if k % 150 == 0:
             goal = -goal
@@ -89,8 +92,8 @@ def simulated(params: VehicleParams, u_max: float, r_max: float, yaw_rate: float
             t += TICK
             nu = plant.state
             worst = [max(worst[0], abs(command[0] - nu[0])), max(worst[1], abs(command[2] - nu[3])),
-                     max(worst[2], abs(nu[1]))]
-    return worst[0], worst[1], worst[2]
+                     max(worst[2], abs(nu[1])), max(worst[3], abs(nu[6]) / (rudder * nu[0] ** 2))]
+    return worst[0], worst[1], worst[2], worst[3]
 
 
 def simulated_rows(u_values, spreads, r_max: float, yaw_rate: float) -> list[str]:
@@ -101,9 +104,9 @@ def simulated_rows(u_values, spreads, r_max: float, yaw_rate: float) -> list[str
         params = shrunk(base, f)
         for u in u_values:
             runs = [simulated(params, u, r_max, yaw_rate, seed) for seed in ([None] if f == 0 else [None, 0, 1, 2])]
-            worst = [max(r[i] for r in runs) for i in range(3)]
+            worst = [max(r[i] for r in runs) for i in range(4)]
             rows.append(f"{f:>14g} | u_max {u:4.2f} | |u_c - u| <= {worst[0]:.4f} m/s, |r_c - r| <= {worst[1]:.4f} "
-                        f"rad/s, |v| <= {worst[2]:.4f} m/s")
+                        f"rad/s, |v| <= {worst[2]:.4f} m/s, rudder <= {worst[3]:.2f} of its moment")
     return rows
 
 

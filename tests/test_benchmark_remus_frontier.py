@@ -43,8 +43,19 @@ def test_the_simulated_midpoint_follows_a_yaw_sweep_at_survey_speed_within_a_hun
     the hull sways a few cm/s: far inside what the bound cannot close."""
     mod = _module()
     params = mod.shrunk(vehicle_params("remus100"), 0.0)
-    du, dr, sway = mod.simulated(params, 1.5, 0.1, 0.02, None, seconds=6.0)
-    assert 0.0 <= du < 0.01 and 0.001 < dr < 0.01 and 0.0 < sway < 0.1
+    du, dr, sway, rudder = mod.simulated(params, 1.5, 0.1, 0.02, None, seconds=6.0)
+    assert 0.0 <= du < 0.01 and 0.001 < dr < 0.01 and 0.0 < sway < 0.1 and 0.0 < rudder < 1.0
+
+
+def test_the_simulated_rudder_saturates_at_half_a_metre_per_second_and_not_at_survey_speed():
+    """What the vehicle does (no bound): with the yaw command switching +-0.1 rad/s at 0.02 rad/s^2, the midpoint
+    REMUS 100's rudder reaches its whole moment at 0.5 m/s (the moment grows with u^2) and well under it at
+    1 m/s: a torpedo's command box must keep its surge up (docs/plant.md section 4)."""
+    mod = _module()
+    params = mod.shrunk(vehicle_params("remus100"), 0.0)
+    slow = mod.simulated(params, 0.5, 0.1, 0.02, None, seconds=20.0)[3]
+    brisk = mod.simulated(params, 1.0, 0.1, 0.02, None, seconds=20.0)[3]
+    assert slow >= 0.99 and brisk < 0.5
 
 
 def test_at_survey_speed_with_a_high_floor_and_gentle_yaw_the_loop_closes_and_the_fins_hold_up_to_a_fifth():

@@ -3,7 +3,9 @@
 from __future__ import annotations
 
 import dataclasses
+import math
 
+import numpy as np
 import pytest
 
 from tubekit.exceptions import ConfigError
@@ -57,3 +59,28 @@ def test_the_lateral_thrust_limit_is_the_sway_loops_saturation_condition(bluerov
     b = velocity_loop_bound(weak, v_max=V, tick=H, period=H * TICKS, jump_tick=JT, jump_period=JP)
     assert not b.certified
     assert {c.condition: c.ok for c in b.conditions}["loop_saturation[Y]"] is False
+
+
+def test_under_a_surge_floor_the_rudders_authority_is_taken_band_by_band_and_stays_below_the_sampled_one():
+    """REMUS 100's midpoint at V = (1.3 m/s, 0.01 m/s, 0.02 rad/s) under a 1 m/s surge floor: each surge band's
+    drag against its own fin force, with the hull's sway over u >= u_min, leaves the rudder a positive yaw
+    acceleration (over the whole range against the slowest force and the unfloored sway it was negative, which
+    refused every such plan); and it is a lower bound: below (|N_uudr| u^2 delta_max - |n_r|)/m_r at every sampled
+    point of the box, the plant's own forces."""
+    from tubekit.model.vehicle_sets import REMUS100
+    from verify.theorem.design import hull_sway_bound
+    p = REMUS100.nominal
+    v_box, floor = (1.3, 0.01, 0.02), 1.0
+    a_r = actuator_authority(p, v_box, floor)[2]
+    assert a_r > 0.0
+    gamma = float(hull_sway_bound(p, v_box[0], v_box[2], floor).mid())
+    m11, m22, m33, m44, m24, m42 = p.mass_entries
+    m_r = m44 - m24 * m42 / m22
+    rng = np.random.default_rng(11)
+    sampled = math.inf
+    draws = zip(rng.uniform(floor, 1.3, 400), rng.uniform(-gamma, gamma, 400), rng.uniform(-0.01, 0.01, 400),
+                rng.uniform(-0.02, 0.02, 400))
+    for u, v, w, r in draws:
+        _, n2, _, n4 = body_forces(p, (u, v, w, r))
+        sampled = min(sampled, (abs(p.N_uudr) * u * u * p.fin_max - abs(n4 - m42 / m22 * n2)) / m_r)
+    assert a_r <= sampled

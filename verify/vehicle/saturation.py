@@ -61,9 +61,12 @@ def actuator_authority(params: VehicleParams, v_max: Sequence[float], surge_floo
     """(a_u, a_w, a_r): a lower bound of the acceleration each channel delivers against drag in V.
 
     a_c = (smallest limit over ``surge_floor`` <= |u| <= V_u and Θ − sup|n_c| over V (sway |v| <= ``sway`` rounded
-    up to :data:`SWAY_GRID`, by default γ̄(V) of the free hull) and Θ) / sup m_c (m/s², m/s², rad/s²): what the thrusters deliver, in either
-    direction, anywhere in V at a commanded surge of at least ``surge_floor`` (m/s; ``limits.u_min``, 0 without
-    one; the corner of V has the largest drag). Negative when the drag (or a fin without speed) wins.
+    up to :data:`SWAY_GRID`, by default γ̄(V) of the free hull) and Θ) / sup m_c (m/s², m/s², rad/s²): what the
+    thrusters deliver, in either direction, anywhere in V at a commanded surge of at least ``surge_floor`` (m/s;
+    ``limits.u_min``, 0 without one; the corner of V has the largest drag). Under a surge floor the surge range
+    [u_min, V_u] is cut into :data:`SURGE_BANDS` bands, each band's drag against its own smallest limit (a fin's,
+    ∝ u², at the band's slow end), with γ̄ over u >= u_min; the smallest over the bands. Negative when the drag (or a
+    fin without speed) wins.
     """
     v = triple("v_max", v_max)
     key = (v, float(surge_floor), None if sway is None else _grid_up(float(sway)), ctx.prec)
@@ -91,14 +94,21 @@ def _authority(params: VehicleParams, v: tuple[float, float, float], surge_floor
                prec: int) -> tuple[float, float, float]:
     """:func:`actuator_authority` of validated inputs, memoised (the fixed point asks it once per candidate backup
     with the same vehicle and box); ``prec`` keys the working precision it is computed at."""
-    gamma = upper(hull_sway_bound(params, v[0], v[2])) if sway is None else sway
+    banded = 0.0 < surge_floor < v[0]
+    gamma = (upper(hull_sway_bound(params, v[0], v[2], surge_floor if banded else None)) if sway is None
+             else sway)
     if not math.isfinite(gamma):
         return (-math.inf,) * 3
     hull = hull_balls(params)
-    forces = channel_forces(hull, velocity_box(v[0], gamma, v[1], v[2]))
-    floor = thrust_floor(params, v[0], surge_floor)
     masses = channel_masses(hull)
-    return tuple(lower((arb(floor[c]) - abs(forces[c])) / masses[c]) for c in range(3))
+    nu = velocity_box(v[0], gamma, v[1], v[2])
+    edges = np.linspace(surge_floor, v[0], SURGE_BANDS + 1) if banded else (0.0, v[0])
+    worst = [math.inf] * 3
+    for lo, hi in zip(edges[:-1], edges[1:]):  # under a surge floor, each band against its own fin force
+        forces = channel_forces(hull, (enclose(float(lo), float(hi)), *nu[1:]) if banded else nu)
+        floor = thrust_floor(params, float(hi), float(lo) if banded else surge_floor)
+        worst = [min(w, lower((arb(floor[c]) - abs(forces[c])) / masses[c])) for c, w in enumerate(worst)]
+    return tuple(worst)
 
 
 def rate_authority_conditions(authority: Sequence[float], rate: Sequence[float]) -> list[Condition]:

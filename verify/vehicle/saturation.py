@@ -102,11 +102,10 @@ def _authority(params: VehicleParams, v: tuple[float, float, float], surge_floor
     hull = hull_balls(params)
     masses = channel_masses(hull)
     nu = velocity_box(v[0], gamma, v[1], v[2])
-    edges = np.linspace(surge_floor, v[0], SURGE_BANDS + 1) if banded else (0.0, v[0])
     worst = [math.inf] * 3
-    for lo, hi in zip(edges[:-1], edges[1:]):  # under a surge floor, each band against its own fin force
-        forces = channel_forces(hull, (enclose(float(lo), float(hi)), *nu[1:]) if banded else nu)
-        floor = thrust_floor(params, float(hi), float(lo) if banded else surge_floor)
+    for lo, hi in _surge_bands(surge_floor, v[0]) if banded else [(0.0, v[0])]:  # each band against its own force
+        forces = channel_forces(hull, (enclose(lo, hi), *nu[1:]) if banded else nu)
+        floor = thrust_floor(params, hi, lo if banded else surge_floor)
         worst = [min(w, lower((arb(floor[c]) - abs(forces[c])) / masses[c])) for c, w in enumerate(worst)]
     return tuple(worst)
 
@@ -166,17 +165,22 @@ def _banded(loop: _Loop, params: VehicleParams, box: tuple[float, float, float],
     :data:`SURGE_BANDS` bands, in each the need sup|n̂_c| + m̂_c Â_c over the band against the smallest limit over
     it (a fin's, ∝ u², at the band's slow end): the need and the force both grow with the surge, so a band is
     compared with its own force, not with the slowest band's (the condition holds iff it holds in every band)."""
-    edges = np.linspace(surge[0], surge[1], SURGE_BANDS + 1)
     worst: list[tuple[float, float, float]] = [(-math.inf, math.inf, math.inf)] * len(loop.names)
-    for a, b in zip(edges[:-1], edges[1:]):
-        need = thrust_peaks(loop, box, sway, a_assumed, surge=(float(a), float(b)))
-        limit = thrust_floor(params, float(b), float(a), loop.lateral)
+    for a, b in _surge_bands(*surge):
+        need = thrust_peaks(loop, box, sway, a_assumed, surge=(a, b))
+        limit = thrust_floor(params, b, a, loop.lateral)
         for c in range(len(loop.names)):
             ratio = need[c] / limit[c] if limit[c] > 0 else math.inf
             if ratio > worst[c][0]:
                 worst[c] = (ratio, need[c], limit[c])
     return [w[1] for w in worst], [w[2] for w in worst]
 
+
+
+def _surge_bands(lo: float, hi: float) -> list[tuple[float, float]]:
+    """[lo, hi] (m/s) cut into :data:`SURGE_BANDS` equal bands (lo, hi) of the relative surge."""
+    edges = np.linspace(lo, hi, SURGE_BANDS + 1)
+    return [(float(a), float(b)) for a, b in zip(edges[:-1], edges[1:])]
 
 
 def triple(name: str, value: Any, strict: bool = False) -> tuple[float, float, float]:

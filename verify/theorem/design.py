@@ -36,8 +36,9 @@ from verify.kernel.parts import bound, flag, item, number, text
 from verify.kernel.region import Region
 from verify.theorem.sampled import HorizonMargins, PeriodTube, TubeProblem, horizon_margins, one_period_tube
 
-__all__ = ["Condition", "Design", "DisturbanceBounds", "disturbance_bounds", "hull_sway_bound", "tube_problem",
-           "evaluate_design", "arc_rates", "sway_condition", "input_tightening", "state_conditions", "choose_design"]
+__all__ = ["Condition", "Design", "DisturbanceBounds", "disturbance_bounds", "hull_sway_bound", "relative_surge_floor",
+           "tube_problem", "evaluate_design", "arc_rates", "sway_condition", "input_tightening", "state_conditions",
+           "choose_design"]
 
 
 @dataclass(frozen=True)
@@ -133,6 +134,12 @@ def hull_sway_bound(params: VehicleParams, u_bar: float, r_bar: float, u_low: fl
     return v_star + 2 * abs(m24) * rb / m22
 
 
+def relative_surge_floor(u_min: float, surge_error: float | arb) -> float | None:
+    """u_min − E_u (m/s), rounded down: the relative surge's floor under a minimum surge command (the loop keeps
+    |u_b − u_c| <= E_u); None without one (``u_min`` <= 0). The ``u_low`` of :func:`hull_sway_bound`."""
+    return lower(arb(u_min) - arb(surge_error)) if u_min > 0 else None
+
+
 def disturbance_bounds(scenario: Scenario, loop_error: tuple[float, float, float] | None = None,
                        loop_sway: float | None = None) -> DisturbanceBounds:
     """ω̄_xy = max(a_x, a_y) + ‖c_xy‖ + γ̄, ω̄_z = a_z + |c_z|, γ̄ = gain ū r̄ + amplitude (over V).
@@ -162,9 +169,8 @@ def disturbance_bounds(scenario: Scenario, loop_error: tuple[float, float, float
                                  "(loop_sway, verify.vehicle.compose.solve_dynamic composes it)")
             gamma = arb(loop_sway)
         else:
-            floor = lower(arb(lim.surge_floor) - du) if lim.surge_floor > 0 else None  # u >= u_min − E_u
             gamma = hull_sway_bound(scenario.plant.params, upper(arb(lim.u_max) + du), upper(arb(lim.r_max) + dr),
-                                    floor)
+                                    relative_surge_floor(lim.surge_floor, du))
         wxy = arb(max(a[0], a[1])) + cxy + (du * du + gamma * gamma).sqrt()
         return DisturbanceBounds(omega_xy=upper(wxy), omega_z=upper(wz + dw), gamma=upper(gamma),
                                  declared_sway=upper(gamma), yaw_rate_error=upper(dr))

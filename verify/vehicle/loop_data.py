@@ -16,8 +16,8 @@ from typing import Sequence
 from flint import arb, ctx
 
 from tubekit.model.vehicle_params import VehicleParams
-from verify.kernel.intervals import lower, upper
-from verify.theorem.design import hull_sway_bound
+from verify.kernel.intervals import upper
+from verify.theorem.design import hull_sway_bound, relative_surge_floor
 from verify.vehicle.model import (channel_gradient, channel_masses, hull_balls, nominal_balls, nominal_params,
                                   point_time_constant, velocity_box, with_sway, without_sway, CHANNELS,
                                   LATERAL_CHANNELS)
@@ -95,9 +95,7 @@ class LoopData:
 
     def surge_low(self, surge_error: float) -> float | None:
         """u_min − E_u (m/s), rounded down, the relative surge's floor; None without a surge floor."""
-        if self.surge_floor <= 0.0:
-            return None
-        return lower(arb(self.surge_floor) - arb(surge_error))
+        return relative_surge_floor(self.surge_floor, surge_error)
 
     def slopes(self, box: Sequence[float], gamma: float) -> list[arb]:
         """∂n̂_c/∂y_c / m̂_c over the velocity box (1/s): the drag's slope in the channel's own speed."""

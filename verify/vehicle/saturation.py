@@ -103,9 +103,9 @@ def _authority(params: VehicleParams, v: tuple[float, float, float], surge_floor
     masses = channel_masses(hull)
     nu = velocity_box(v[0], gamma, v[1], v[2])
     worst = [math.inf] * 3
-    for lo, hi in _surge_bands(surge_floor, v[0]) if banded else [(0.0, v[0])]:  # each band against its own force
+    for lo, hi in _surge_bands(surge_floor, v[0]) if banded else [(surge_floor, v[0])]:  # each band, its own force
         forces = channel_forces(hull, (enclose(lo, hi), *nu[1:]) if banded else nu)
-        floor = thrust_floor(params, hi, lo if banded else surge_floor)
+        floor = thrust_floor(params, hi, lo)
         worst = [min(w, lower((arb(floor[c]) - abs(forces[c])) / masses[c])) for c, w in enumerate(worst)]
     return tuple(worst)
 

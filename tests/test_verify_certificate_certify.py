@@ -90,25 +90,33 @@ def test_shipped_scenarios_certify(pc_cert, ok_cert):
 
 
 def test_paper_scenario_is_not_certified_with_named_inequalities(paper_cert):
-    """Section VI: target speed 3 pi / 25 m/s plus omega_xy = 0.1 + 0.02 outruns u_max = 0.4; at eps = 0.1 m
-    the cross current turns the line of sight at 0.12 / 0.1 = 1.2 rad/s > r_max = 0.5."""
+    """Section VI: target speed 3 pi / 25 m/s plus omega_xy = 0.1 + 0.02 outruns u_max = 0.4, and the replayed
+    plan's e_o margin outgrows R; the yaw screen at e_d = eps is no condition where step 17 applies."""
     c = paper_cert
     assert not c.certified
     names = {f.condition for f in c.failures}
-    assert {"keep_up[u]", "yaw_budget"} <= names
+    assert {"keep_up[u]", "e_bar[e_o]"} <= names and "yaw_budget" not in names
     ku = _failure(c, "keep_up[u]")
     assert ku.lhs <= 0.4 and ku.rhs == pytest.approx(3 * math.pi / 25 + 0.12, rel=1e-9)
-    yb = _failure(c, "yaw_budget")
-    assert yb.lhs <= 0.5 and yb.rhs == pytest.approx(1.2, rel=1e-9)
     for f in c.failures:
         assert f.ok is False and f.lhs is not None and f.rhs is not None
     for f in c.to_dict()["failures"]:
         assert set(f) == {"condition", "inequality", "lhs", "rhs", "detail"}
     # the tracking tier fails on exactly these; the safe tier (its own sigma = 0 design) certifies
     assert c.tiers == Tiers(True, False)
-    assert {"keep_up[u]", "yaw_budget"} <= set(c.tier_failures["tracking"]) and c.tier_failures["safe"] == ()
+    assert {"keep_up[u]", "e_bar[e_o]"} <= set(c.tier_failures["tracking"]) and c.tier_failures["safe"] == ()
     assert c.safe_design is not None and c.safe_design.sigma == 0.0
-    assert "safe: certified; tracking: not certified (keep_up[u], yaw_budget" in c.summary()
+    assert "safe: certified; tracking: not certified (keep_up[u], e_bar[e_o])" in c.summary()
+
+
+def test_where_step_17_does_not_cover_the_design_the_yaw_screen_refuses_the_paper_scenario(paper_cert):
+    """Where no step 17 proves a plan at every period (a region heading away: the terminal law points at the
+    target) the yaw screen stays: at eps = 0.1 m the cross current turns the line of sight at
+    0.12 / 0.1 = 1.2 rad/s > r_max = 0.5."""
+    c = certify(paper_cert.inputs.scenario.with_changes(**{"region.heading": "away"}))
+    yb = _failure(c, "yaw_budget")
+    assert yb.lhs <= 0.5 and yb.rhs == pytest.approx(1.2, rel=1e-9) and "screen" in yb.detail
+    assert "yaw_budget" in c.tier_failures["tracking"] and c.tiers.safe
 
 
 @pytest.mark.parametrize("fixture", ["pc_cert", "ok_cert", "paper_cert"])
@@ -363,13 +371,17 @@ def test_paper_currents_variants_certify(kind):
 
 
 def test_beyond_the_physical_limits_paper_currents_does_not_certify():
-    """Just past keep-up (speed + 0.12 > u_max = 0.4) and past the yaw budget (0.12 / eps > r_max = 0.5)."""
+    """Just past keep-up (speed + 0.12 > u_max = 0.4); past the yaw screen (0.12 / eps > r_max = 0.5) tracking
+    fails by it where step 17 does not cover the design, and by the terminal set's own conditions where it does."""
     from dataclasses import replace as dc_replace
     sc = _paper_currents()
     fast = sc.with_changes(trajectory=dc_replace(sc.trajectory, rate=0.285 / 3.0))
     assert "keep_up[u]" in {f.condition for f in certify(fast).failures}
     close = sc.with_changes(epsilon=0.2, region=dc_replace(sc.region, e_d_max=3.0))
-    assert "yaw_budget" in {f.condition for f in certify(close).failures}
+    assert "yaw_budget" in {f.condition for f in certify(close.with_changes(**{"region.heading": "away"})).failures}
+    proved = certify(close)
+    assert not proved.tiers.tracking and "yaw_budget" not in {f.condition for f in proved.failures}
+    assert all(f.condition.startswith(("terminal_", "initial_terminal", "path_")) for f in proved.failures)
 
 
 # --------------------------------------------------------------------------- typed round trip

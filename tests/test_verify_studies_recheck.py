@@ -142,7 +142,7 @@ TAMPERING = [
     ("pc", lambda d: _set(d, ("e_bar", "e_d"), [0.5, 3.0]), "e_bar.e_d", True),
     ("pc", _scale(("arc_rates",), 0.5), "arc_rates", True),
     # conditions, verdict, premises
-    ("paper", _cond("yaw_budget", ok=True), "conditions[yaw_budget].ok", True),
+    ("paper", _cond("keep_up[u]", ok=True), "conditions[keep_up[u]].ok", True),
     ("pc", lambda d: _set(d, ("conditions",), [c for c in d["conditions"] if c["condition"] != "sensing"]),
      "conditions[sensing]", True),
     ("paper", lambda d: _set(d, ("certified",), True), "certified", True),

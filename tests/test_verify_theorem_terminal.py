@@ -14,6 +14,7 @@ import verify
 from tubekit import load_scenario
 from tubekit.model.kinematics import unicycle_step
 from tubekit.model.terminal_law import line_of_sight
+from tubekit.model.trajectory import Line
 from tubekit.scenario import Obstacle
 from verify.theorem.terminal import TERMINAL_PREFIXES, law_conditions, terminal_bounds
 
@@ -147,3 +148,19 @@ def test_the_path_shortcut_rests_on_footprints_nested_by_the_sets_reach(pc_cert)
     for near, far in zip(feet, feet[1:]):
         assert contains(far, near)
     assert not contains(feet[0], feet[-1]) or feet[0] == feet[-1]
+
+
+@pytest.mark.parametrize("edits, proved", [
+    ({}, True),
+    ({"controller.candidate": False}, True),                      # a run setting: that run rests on a premise
+    ({"region.heading": "away"}, False),                          # the terminal law points at the target
+    ({"limits.u_min": 0.05, "trajectory": Line(start=(0.0, 0.0, 0.0), direction_velocity=(0.0, 0.0, 0.0))},
+     False),                                                      # a minimum surge behind a target that stops
+    ({"limits.u_min": 0.05}, True),                               # ... behind one with a speed floor
+])
+def test_step_17_proves_a_plan_at_every_period_only_where_it_covers_the_loop(edits, proved):
+    """proves_feasibility: the terminal ingredients cover the design (module doc)."""
+    from verify.kernel.region import Region
+    from verify.theorem.terminal import proves_feasibility
+    sc = PC.with_changes(**edits)
+    assert proves_feasibility(sc, Region.from_scenario(sc)) is proved

@@ -9,6 +9,7 @@ from __future__ import annotations
 from tubekit.tiers import Tiers
 
 import math
+from pathlib import Path
 
 import pytest
 
@@ -42,7 +43,7 @@ def test_paper_currents_certifies_both_tiers_with_a_backup(pc_cert):
 def test_the_paper_scenario_certifies_the_safe_tier_only(paper_cert):
     c = paper_cert
     assert c.tiers == Tiers(True, False) and not c.certified
-    assert {"keep_up[u]", "yaw_budget"} <= set(c.tier_failures["tracking"])
+    assert set(c.tier_failures["tracking"]) == {"keep_up[u]", "e_bar[e_o]"}
     s = c.safe_design
     assert s.sigma == 0.0 and all(x.condition.startswith(SAFE_PREFIX) for x in s.conditions)
     # sigma = 0: ||dp_xy|| <= omega_xy delta = 0.012 m, |dz| <= omega_z delta = 0.01 m per period; the replay's
@@ -55,7 +56,7 @@ def test_the_paper_scenario_certifies_the_safe_tier_only(paper_cert):
     assert reach == pytest.approx(c.backup.safe_set.level - c.backup.safe_set.shape - s.margins.position[-1], rel=1e-6)
     assert (c.backup.safe_set.level, c.backup.safe_set.shape) == (0.75, 0.4) and reach == pytest.approx(0.35 - 8 * step)
     assert c.backup.certified and c.backup.handover == (s.margins.position[-1] + reach, s.margins.e_z[-1])
-    assert "safe: certified; tracking: not certified (keep_up[u], yaw_budget" in c.summary()
+    assert "safe: certified; tracking: not certified (keep_up[u], e_bar[e_o])" in c.summary()
     assert c.inputs.sigma == 0.0
 
 
@@ -158,3 +159,42 @@ def test_a_station_keeping_backup_under_a_surge_floor_leaves_no_tier(keep_moving
     cert = verify.certify(sc.with_changes(**{"controller.backup": "station_keeping"}))
     assert cert.tiers == Tiers(False, False)
     assert "backup_min_surge" in {x.condition for x in cert.tier_conditions["safe"] if x.ok is False}
+
+
+KEEP_MOVING = Path(__file__).resolve().parent.parent / "examples" / "keep_moving_tracked.toml"
+
+
+def test_the_yaw_screen_is_a_condition_only_where_no_step_17_proves_a_plan_at_every_period(paper_cert):
+    """tracking_design drops the screens of FEASIBILITY_SCREENS where proves_feasibility holds, and only there."""
+    from verify.kernel.region import Region
+    from verify.theorem.design import FEASIBILITY_SCREENS, evaluate_design
+    from verify.theorem.tiers import tracking_design
+    sc, gains, dist = paper_cert.inputs.scenario, paper_cert.gains, paper_cert.disturbance
+    for heading, screened in (("toward", False), ("away", True)):
+        s = sc.with_changes(**{"region.heading": heading})
+        region = Region.from_scenario(s)
+        names = [c.condition for c in tracking_design(s, region, gains, 0.0, dist).conditions]
+        assert ("yaw_budget" in names) is screened
+        full = [c.condition for c in evaluate_design(s, region, gains, 0.0, dist).conditions]
+        assert [n for n in full if n not in FEASIBILITY_SCREENS or screened] == names[:len(names) - 2]
+
+
+def test_the_yaw_budget_is_not_necessary_a_loop_that_turns_slower_than_the_line_of_sight_at_epsilon_tracks():
+    """Counterexample to the yaw budget read as a necessary condition (r_bar >= omega_bar_xy / epsilon): with
+    epsilon = 0.12 m the current may turn the line of sight at e_d = epsilon at 0.1 / 0.12 = 0.83 rad/s, beyond
+    r_max = 0.5 rad/s, yet both tiers are proved (the plans keep the vehicle in X_f, metres behind the target),
+    a 30 s run keeps every promise with a plan accepted at every period, and the closed-loop falsifier finds
+    nothing."""
+    import verify
+    import tubekit
+    from verify.falsify.closed_loop import falsify_closed_loop
+    sc = tubekit.load_scenario(KEEP_MOVING).with_changes(epsilon=0.12)
+    cert = verify.certify(sc)
+    assert cert.tiers == Tiers(True, True)
+    assert cert.disturbance.omega_xy / sc.epsilon > 1.6 * sc.limits.r_max
+    assert "yaw_budget" not in {c.condition for c in cert.conditions}
+    run = tubekit.simulate(sc.with_changes(duration=30.0), cert)
+    promises = {p.name: p for p in tubekit.check_promises(run)}
+    assert all(p.given and p.ok for p in promises.values()) and promises["plan_available"].ok
+    res = falsify_closed_loop(sc, budget=4, seed=0, duration=3.0, certificate=cert)
+    assert res.check() and not res.found

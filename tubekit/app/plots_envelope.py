@@ -72,7 +72,7 @@ def _own_words(result: EnvelopeResult) -> str:
 
 def _physics_note(result: EnvelopeResult) -> str:
     """``; beyond physics: ...`` when the scenario's omega_bar_xy exceeds the necessity frontier at its speed."""
-    need = min(result.limits[0] - result.own_speed, result.limits[2] * result.epsilon)
+    need = result.limits[0] - result.own_speed
     if result.own_omega <= need + 1e-9:
         return ""
     return f"; beyond physics: any controller needs {OMEGA} ≤ {max(need, 0.0):.3g} m/s here"
@@ -89,10 +89,10 @@ def _certified_curve(result: EnvelopeResult, s: np.ndarray) -> np.ndarray:
 
 def _draw_frontiers(ax: Axes, result: EnvelopeResult, s: np.ndarray, top: float) -> None:
     """Necessity (dashed, grey above), the certified region and frontier, the possible-but-not-certified rest."""
-    u_max, yaw = result.limits[0], result.limits[2] * result.epsilon
-    need = np.minimum(u_max - s, yaw)
+    u_max = result.limits[0]
+    need = u_max - s
     ax.plot(s, need, "--", color="k", lw=1.6, zorder=4,
-            label=f"necessary for any controller: min(u_max - s, r_max ε) = min({u_max:g} - s, {yaw:.3g})")
+            label=f"necessary for any controller (keep-up): u_max - s = {u_max:g} - s")
     ax.fill_between(s, need, top, color="0.85", label="physically impossible")
     cert = _certified_curve(result, s)
     if np.isfinite(result.certified_omega).any():
@@ -157,7 +157,7 @@ def _title(result: EnvelopeResult) -> str:
 
 def envelope_figure(result: EnvelopeResult) -> Figure:
     """omega_bar_xy against target speed at one epsilon: the certified region beside the physical-necessity
-    frontier min(u_max - s, r_max epsilon), the scenario's sway bound and the scenario's own point with its
+    frontier u_max - s (keep-up), the scenario's sway bound and the scenario's own point with its
     verdict (module doc: every layer is named in the legend, nothing is left unexplained).
 
     Parameters

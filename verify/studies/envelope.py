@@ -16,9 +16,12 @@ current amplitude plus constant current plus the sway the model produces over V)
   amplitude a with a fixed number of steps (a work unit: the result is the same on any
   machine). The certificate is monotone in the disturbance (every bound grows with it),
   so the bracket [certified, refuted] holds the edge;
-* **necessary** (any controller, any tube): keep-up needs u_max >= s + omega_bar_xy,
-  and holding e_o at e_d = epsilon needs the bearing rate omega_bar_xy / epsilon <= r_max,
-  so omega_bar_xy <= min(u_max - s, r_max epsilon).
+* **necessary** (any controller, any tube): keep-up needs u_max >= s + omega_bar_xy (a current that holds
+  against the target's motion outruns a slower vehicle), so omega_bar_xy <= u_max - s. The bearing rate
+  omega_bar_xy / epsilon <= r_max that earlier versions added is not necessary: no plan need go to e_d = epsilon,
+  and where step 17 covers the design the vehicle turns with the line of sight at X_f's distance
+  (``yaw_budget`` is a screen, ``docs/verify.md`` §3; a counterexample is pinned in
+  ``tests/test_verify_theorem_tiers.py``).
 
 On the dynamic plant (``[plant] kind = "dynamic"``) each point is a dynamic certificate: omega_bar_xy is its
 tracking design's (current + the sway loop's or the hull's sway + the velocity loop's error under plans alone,
@@ -94,7 +97,7 @@ class EnvelopeResult:
         The bisection bracket on the horizontal current amplitude a (m/s): certify holds at the first,
         fails at the second (NaN: none certifies / the top of the search certified).
     necessary_omega : array (k,)
-        min(u_max - s, r_max epsilon) (m/s): the physical-necessity frontier.
+        u_max - s (m/s): the physical-necessity frontier (keep-up).
     first_failure : list of str
         The first failed condition at the refuted amplitude (or at a = 0 when none certifies).
     sigma_at_edge : array (k,)
@@ -228,8 +231,7 @@ class EnvelopeResult:
                  + (f"sway + loop error (derived per certificate; {self.gamma:.4g} at zero current)"
                     if self.dynamic else f"gamma_bar {self.gamma:.4g} (sway)")
                  + f"; vertical amplitude kept at {self.amplitude_z:.4g} m/s",
-                 f"  necessary: omega_bar_xy <= min(u_max - speed, r_max epsilon) = min({self.limits[0]:g} - speed, "
-                 f"{self.limits[2] * self.epsilon:.4g})",
+                 f"  necessary: omega_bar_xy <= u_max - speed = {self.limits[0]:g} - speed (keep-up)",
                  "  speed [m/s] | certified omega_bar_xy [m/s] | necessary [m/s] | ratio | sigma [1/s] | first failure above",
                  ]
         sigmas = self.sigma_at_edge if len(self.sigma_at_edge) else np.full(len(self.speeds), np.nan)
@@ -250,9 +252,10 @@ class EnvelopeResult:
         return "\n".join(lines)
 
 
-def necessary_omega(speed: float, epsilon: float, u_max: float, r_max: float) -> float:
-    """Largest omega_bar_xy (m/s) physics admits: min(u_max - speed, r_max epsilon) (may be negative)."""
-    return min(u_max - speed, r_max * epsilon)
+def necessary_omega(speed: float, u_max: float) -> float:
+    """Largest omega_bar_xy (m/s) physics admits at target speed ``speed`` (m/s): u_max - speed, keep-up (module
+    doc; may be negative)."""
+    return u_max - speed
 
 
 def _trajectory_at_speed(trajectory: Trajectory, speed: float) -> Trajectory:
@@ -423,7 +426,7 @@ def envelope(scenario: Scenario, law: str | None = None, *, eps: float | None = 
         gamma = dist.gamma
     rows = []
     for s in grid:
-        need = necessary_omega(float(s), eps, lim.u_max, lim.r_max)
+        need = necessary_omega(float(s), lim.u_max)
         top = need - offset - (0.0 if dynamic else gamma)  # dynamic: the non-current part may grow with a
         rows.append((need, *_frontier_at(scenario, law, float(s), eps, top, steps,
                                          zero if s == grid[0] else None)))

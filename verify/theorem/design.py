@@ -38,7 +38,14 @@ from verify.theorem.sampled import HorizonMargins, PeriodTube, TubeProblem, hori
 
 __all__ = ["Condition", "Design", "DisturbanceBounds", "disturbance_bounds", "hull_sway_bound", "relative_surge_floor",
            "tube_problem", "evaluate_design", "arc_rates", "sway_condition", "input_tightening", "state_conditions",
-           "choose_design"]
+           "choose_design", "FEASIBILITY_SCREENS"]
+
+#: Conditions that screen a design for recursive feasibility without being a step of any proof: ``yaw_budget``
+#: (:func:`input_tightening`) asks the yaw to follow the line of sight at e_d = ε, where no plan need go. Where
+#: step 17 proves a plan at every period (:func:`verify.theorem.terminal.proves_feasibility`) they are dropped
+#: from the design (:func:`verify.theorem.tiers.tracking_design`): the terminal law's own yaw row
+#: (``terminal_inputs[r]``, at X_f's distance) is what the proof asks.
+FEASIBILITY_SCREENS = ("yaw_budget",)
 
 
 @dataclass(frozen=True)
@@ -252,8 +259,9 @@ def input_tightening(p: TubeProblem, tube: PeriodTube, dist: DisturbanceBounds,
                            bool(vb[1] >= need_w), "necessary: otherwise e_z leaves R"))
     conds.append(Condition("yaw_budget", "r_bar >= omega_bar_xy / epsilon (bearing rate the current causes)",
                            lower(vb[2]), upper(need_r), bool(vb[2] >= need_r),
-                           "necessary: at e_d = epsilon a cross current turns the line of sight at "
-                           "omega_bar_xy / epsilon; holding e_o needs that yaw rate"))
+                           "a screen, not a proof step: at e_d = epsilon a cross current turns the line of sight "
+                           "at omega_bar_xy / epsilon, faster than the yaw follows; dropped where the terminal "
+                           "set proves a plan at every period (docs/verify.md step 17)"))
     return conds, [lower(x) for x in vb]
 
 

@@ -62,7 +62,7 @@ from verify.theorem.terminal_bearing import bearing_conditions, bearing_row_sets
 from verify.theorem.terminal_rows import row_conditions, row_sets
 
 __all__ = ["TerminalBounds", "terminal_bounds", "law_conditions", "footprint_of", "sensing_condition",
-           "design_terminal", "with_terminal", "FLOAT_SLACK", "TERMINAL_PREFIXES"]
+           "design_terminal", "with_terminal", "proves_feasibility", "FLOAT_SLACK", "TERMINAL_PREFIXES"]
 
 #: Name prefixes of the terminal ingredients' conditions (tracking tier).
 TERMINAL_PREFIXES = ("terminal_", "path_", "initial_terminal")
@@ -277,6 +277,14 @@ def _not_covered(scenario: Scenario, region: Region) -> tuple[Condition, ...]:
         return (Condition("terminal_heading", "region.heading = toward (the terminal law points at the "
                           "target)", None, None, False, f"heading {region.heading!r}"),)
     return ()
+
+
+def proves_feasibility(scenario: Scenario, region: Region) -> bool:
+    """True when step 17 covers the design of ``scenario`` (:func:`_not_covered` names none): its terminal
+    ingredients are then the conditions under which a plan exists at every period of the loop with the candidate.
+    A run without it (``controller.candidate = false``, a run setting, not part of the design) falls back to the
+    run-time premise ``recursive_feasibility``."""
+    return not _not_covered(scenario, region)
 
 
 def design_terminal(scenario: Scenario, design: Design, region: Region, safe: SafeSet | None

@@ -31,13 +31,13 @@ from tubekit.scenario import Scenario
 from tubekit.tiers import Tiers
 
 from verify.backup import BackupCertificate, Fits, proof_for
-from verify.theorem.design import Condition, Design, DisturbanceBounds, arc_rates, choose_design, evaluate_design, \
-    input_tightening, state_conditions, sway_condition, tube_problem
+from verify.theorem.design import FEASIBILITY_SCREENS, Condition, Design, DisturbanceBounds, arc_rates, \
+    choose_design, evaluate_design, input_tightening, state_conditions, sway_condition, tube_problem
 from verify.theorem.gains import GainBounds
 from verify.kernel.intervals import lower, upper
 from verify.kernel.region import Region
 from verify.theorem.sampled import HorizonMargins, PeriodTube, _asin_ratio, horizon_margins
-from verify.theorem.terminal import with_terminal
+from verify.theorem.terminal import proves_feasibility, with_terminal
 from verify.theorem.workspace import initial_workspace, target_in_workspace
 
 __all__ = ["SAFE_CONDITIONS", "SAFE_PREFIX", "is_safe_condition", "tracking_design", "position_tube",
@@ -59,11 +59,16 @@ def is_safe_condition(name: str) -> bool:
 
 def tracking_design(scenario: Scenario, region: Region, gains: GainBounds, sigma: float,
                     dist: DisturbanceBounds) -> Design:
-    """:func:`verify.theorem.design.evaluate_design` plus ``initial_workspace`` and ``target_in_workspace``."""
+    """:func:`verify.theorem.design.evaluate_design` plus ``initial_workspace`` and ``target_in_workspace``; where
+    step 17 proves a plan at every period (:func:`verify.theorem.terminal.proves_feasibility`) without the
+    screens of :data:`verify.theorem.design.FEASIBILITY_SCREENS`, which no step of that proof uses."""
     d = evaluate_design(scenario, region, gains, sigma, dist)
     m0 = d.margins.position[0] if d.margins is not None else 0.0
     extra = (initial_workspace(scenario, m0), target_in_workspace(scenario))
-    return dataclasses.replace(d, conditions=d.conditions + extra)
+    kept = d.conditions
+    if proves_feasibility(scenario, region):
+        kept = tuple(c for c in kept if c.condition not in FEASIBILITY_SCREENS)
+    return dataclasses.replace(d, conditions=kept + extra)
 
 
 def position_tube(p) -> PeriodTube:

@@ -19,7 +19,7 @@ theorem needs them, ``docs/verify.md`` step 17c), the terminal set then with its
 together (``verify.theorem.terminal_bearing.bearing_row_sets``); ``--start``: the start's distance behind the target.
 
 Usage: ``python benchmarks/survey_frontier.py [--speed 0.6 1.0 1.5] [--current 0.1 0.2 0.3] [--offset 5 30]
-[--backup none] [--rate 0.5 0.5 1.0] [--start 7]``
+[--backup none] [--rate 0.5 0.5 1.0] [--start 7] [--e-d-max 60] [--sensing 150]``
 (about a second per cell).
 """
 
@@ -39,11 +39,13 @@ __all__ = ["survey", "cell", "main"]
 
 def survey(speed: float, current: float, offset: float, *, u_min: float = 0.5, u_max: float = 2.0,
            r_max: float = 0.2, epsilon: float = 3.0, backup: str = "loiter",
-           rate: tuple[float, float, float] | None = None, start: float | None = None):
+           rate: tuple[float, float, float] | None = None, start: float | None = None,
+           e_d_max: float | None = None, sensing: float = 80.0):
     """The survey scenario of the module doc (a :class:`tubekit.scenario.Scenario`), with ``controller.backup``
     ``backup`` (the loiter, or ``none``: the safe tier as the tracking tier's corollary). ``rate``: the plans'
     rate limit (m/s², m/s², rad/s²; ``limits.rate``), the command before t = 0 then the target's speed ahead;
-    ``start``: the start's distance behind the target (m; default ε + 2)."""
+    ``start``: the start's distance behind the target (m; default ε + 2); ``e_d_max``: ``region.e_d_max`` (m;
+    default ε + 5); ``sensing``: ``sensing_range`` (m)."""
     from tubekit import load_scenario
     from tubekit.model.trajectory import Line
     from tubekit.scenario import Obstacle
@@ -52,10 +54,11 @@ def survey(speed: float, current: float, offset: float, *, u_min: float = 0.5, u
     limits = {} if rate is None else {"limits.rate": tuple(rate), "limits.initial": (speed, 0.0, 0.0)}
     return load_scenario(SCENARIO).with_changes(
         name="survey", trajectory=Line(start=(0.0, 0.0, 0.0), direction_velocity=(speed, 0.0, 0.0)),
-        obstacles=(Obstacle((40.0, offset, 0.0), 0.5),), epsilon=epsilon, duration=60.0, sensing_range=80.0,
+        obstacles=(Obstacle((40.0, offset, 0.0), 0.5),), epsilon=epsilon, duration=60.0, sensing_range=sensing,
         workspace=((-100.0, -100.0, -10.0), (300.0, 100.0, 10.0)), initial_state=(-behind, 0.0, 0.0, 0.0),
         **{"limits.u_max": u_max, "limits.u_min": u_min, "limits.r_max": r_max, "controller.backup": backup,
-           "disturbance.amplitude": (current, current, 0.05), "region.e_d_max": epsilon + 5.0}, **limits)
+           "disturbance.amplitude": (current, current, 0.05),
+           "region.e_d_max": epsilon + 5.0 if e_d_max is None else e_d_max}, **limits)
 
 
 def cell(speed: float, current: float, offset: float, **limits: float | str | tuple[float, float, float] | None
@@ -90,13 +93,17 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--backup", default="loiter", help="controller.backup: loiter (default) or none")
     ap.add_argument("--rate", type=float, nargs=3, default=None, help="the plans' rate limit (m/s², m/s², rad/s²)")
     ap.add_argument("--start", type=float, default=None, help="the start's distance behind the target (m)")
+    ap.add_argument("--e-d-max", type=float, default=None, help="region.e_d_max (m; default epsilon + 5)")
+    ap.add_argument("--sensing", type=float, default=80.0, help="sensing_range (m)")
     args = ap.parse_args(argv)
     limits = {"u_min": args.u_min, "u_max": args.u_max, "r_max": args.r_max, "epsilon": args.epsilon,
-              "backup": args.backup, "rate": args.rate, "start": args.start}
+              "backup": args.backup, "rate": args.rate, "start": args.start, "e_d_max": args.e_d_max,
+              "sensing": args.sensing}
     for offset in args.offset:
         print(f"obstacle {offset:g} m off the path; u_min {args.u_min:g}, u_max {args.u_max:g} m/s, "
               f"r_max {args.r_max:g} rad/s, epsilon {args.epsilon:g} m, backup {args.backup}, "
-              f"plans' rate {args.rate or 'none'}, start {args.start or args.epsilon + 2.0:g} m behind")
+              f"plans' rate {args.rate or 'none'}, start {args.start or args.epsilon + 2.0:g} m behind, "
+              f"e_d_max {args.e_d_max or args.epsilon + 5.0:g} m, sensing {args.sensing:g} m")
         print("| target (m/s) \\ current (m/s) | " + " | ".join(f"{c:g}" for c in args.current) + " |")
         print("|---" * (len(args.current) + 1) + "|")
         for speed in args.speed:

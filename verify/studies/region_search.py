@@ -28,8 +28,9 @@ from verify.certificate.certify import certify, resolve_law
 __all__ = ["RegionTrial", "RegionSearchResult", "search_region", "region_independent_failures", "E_O_MAX_GRID",
            "E_D_MAX_GRID"]
 
-#: Necessary conditions whose need (rhs) no region changes, by the command limit that must meet it: they read
-#: V-bar <= V, so V below the need fails them for every region.
+#: Conditions whose need (rhs) no region changes, by the command limit that must meet it: the necessary keep-ups
+#: and, where step 17 does not cover the design, the yaw screen; they read V-bar <= V, so V below the need fails
+#: them for every region.
 _NEED_OF_LIMIT = {"keep_up[u]": "u_max", "keep_up[w]": "w_max", "yaw_budget": "r_max"}
 
 #: Default grid of region.e_o_max (dimensionless, |e_o| = |sin(psi - theta)|).

@@ -38,18 +38,6 @@ SPREADS = (0.0, 0.05, 1.0)
 TICK, PERIOD = 0.01, 0.1
 
 
-def shrunk(params: VehicleParams, fraction: float) -> VehicleParams:
-    """``params`` with every interval shrunk about its midpoint to ``fraction`` of its half-width (0: the midpoint,
-    1: the box itself)."""
-    table = {}
-    for key, value in params.to_dict().items():
-        if isinstance(value, (list, tuple)) and len(value) == 2 and all(isinstance(x, float) for x in value):
-            mid, half = (value[0] + value[1]) / 2, (value[1] - value[0]) / 2 * fraction
-            value = [mid - half, mid + half] if half > 0 else mid
-        table[key] = value
-    return params.with_overrides({k: v for k, v in table.items() if k != "name"})
-
-
 def cell(params: VehicleParams, u_max: float, r_max: float, w_max: float, rate: tuple[float, float, float],
          u_min: float | None = None) -> str:
     """One cell of the table (module doc); ``u_min`` None: ū / 2."""
@@ -101,7 +89,7 @@ def simulated_rows(u_values, spreads, r_max: float, yaw_rate: float) -> list[str
     base = vehicle_params("remus100")
     rows = [f"simulated: yaw command ±{r_max:g} rad/s at {yaw_rate:g} rad/s², 60 s, no current"]
     for f in spreads:
-        params = shrunk(base, f)
+        params = base.shrunk(f)
         for u in u_values:
             runs = [simulated(params, u, r_max, yaw_rate, seed) for seed in ([None] if f == 0 else [None, 0, 1, 2])]
             worst = [max(r[i] for r in runs) for i in range(4)]
@@ -116,7 +104,7 @@ def table(u_values, spreads, r_max: float, w_max: float, rate, u_min: float | No
     floor = "u_max / 2" if u_min is None else f"{u_min:g} m/s"
     rows = [f"REMUS 100, u_min = {floor}, |r| <= {r_max:g} rad/s, |w| <= {w_max:g} m/s, rate {list(rate)}"]
     for f in spreads:
-        params = shrunk(base, f)
+        params = base.shrunk(f)
         label = "midpoint" if f == 0 else "published box" if f == 1 else f"box x{f:g}"
         for u in u_values:
             rows.append(f"{label:>14} | u_max {u:4.2f} | {cell(params, u, r_max, w_max, rate, u_min)}")

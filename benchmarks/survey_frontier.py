@@ -18,9 +18,14 @@ sector behind the target that its bearing face allows (step 17b), with no loiter
 theorem needs them, ``docs/verify.md`` step 17c), the terminal set then with its row faces and its bearing face
 together (``verify.theorem.terminal_bearing.bearing_row_sets``); ``--start``: the start's distance behind the target.
 
+``--vehicle NAME``: the dynamic plant instead (``[plant] kind = "dynamic"``, the bundled vehicle's box shrunk about
+its midpoint to ``--spread`` of its half-widths, :meth:`tubekit.model.vehicle_params.VehicleParams.shrunk`; 0: the
+midpoint, 1: the published box), with ``--w-max`` and the vertical current ``--current-z``: the velocity loop's
+bound then enters every cell.
+
 Usage: ``python benchmarks/survey_frontier.py [--speed 0.6 1.0 1.5] [--current 0.1 0.2 0.3] [--offset 5 30]
-[--backup none] [--rate 0.5 0.5 1.0] [--start 7] [--e-d-max 60] [--sensing 150]``
-(about a second per cell).
+[--backup none] [--rate 0.5 0.5 1.0] [--start 7] [--e-d-max 60] [--sensing 150] [--vehicle remus100 --spread 0
+--w-max 0.015 --current-z 0.005]`` (about a second per cell; a few on the dynamic plant).
 """
 
 from __future__ import annotations
@@ -40,41 +45,58 @@ __all__ = ["survey", "cell", "main"]
 def survey(speed: float, current: float, offset: float, *, u_min: float = 0.5, u_max: float = 2.0,
            r_max: float = 0.2, epsilon: float = 3.0, backup: str = "loiter",
            rate: tuple[float, float, float] | None = None, start: float | None = None,
-           e_d_max: float | None = None, sensing: float = 80.0):
+           e_d_max: float | None = None, sensing: float = 80.0, vehicle: str | None = None,
+           spread: float = 0.0, w_max: float | None = None, current_z: float = 0.05):
     """The survey scenario of the module doc (a :class:`tubekit.scenario.Scenario`), with ``controller.backup``
     ``backup`` (the loiter, or ``none``: the safe tier as the tracking tier's corollary). ``rate``: the plans'
     rate limit (m/s², m/s², rad/s²; ``limits.rate``), the command before t = 0 then the target's speed ahead;
     ``start``: the start's distance behind the target (m; default ε + 2); ``e_d_max``: ``region.e_d_max`` (m;
-    default ε + 5); ``sensing``: ``sensing_range`` (m)."""
+    default ε + 5); ``sensing``: ``sensing_range`` (m); ``vehicle``: a bundled vehicle's name for the dynamic plant,
+    its box shrunk to ``spread`` (module doc); ``w_max``: ``limits.w_max`` (m/s; default the example's);
+    ``current_z``: the vertical current's amplitude (m/s)."""
     from tubekit import load_scenario
     from tubekit.model.trajectory import Line
     from tubekit.scenario import Obstacle
 
     behind = epsilon + 2.0 if start is None else start
     limits = {} if rate is None else {"limits.rate": tuple(rate), "limits.initial": (speed, 0.0, 0.0)}
-    return load_scenario(SCENARIO).with_changes(
+    if w_max is not None:
+        limits["limits.w_max"] = w_max
+    scenario = load_scenario(SCENARIO).with_changes(
         name="survey", trajectory=Line(start=(0.0, 0.0, 0.0), direction_velocity=(speed, 0.0, 0.0)),
         obstacles=(Obstacle((40.0, offset, 0.0), 0.5),), epsilon=epsilon, duration=60.0, sensing_range=sensing,
         workspace=((-100.0, -100.0, -10.0), (300.0, 100.0, 10.0)), initial_state=(-behind, 0.0, 0.0, 0.0),
         **{"limits.u_max": u_max, "limits.u_min": u_min, "limits.r_max": r_max, "controller.backup": backup,
-           "disturbance.amplitude": (current, current, 0.05),
+           "disturbance.amplitude": (current, current, current_z),
            "region.e_d_max": epsilon + 5.0 if e_d_max is None else e_d_max}, **limits)
+    if vehicle is None:
+        return scenario
+    from tubekit.model.vehicles import vehicle_params
+    from tubekit.scenario import scenario_from_dict
+
+    table = scenario.to_dict()
+    box = vehicle_params(vehicle).shrunk(spread).to_dict()
+    table["plant"] = {"kind": "dynamic", "vehicle": {k: v for k, v in box.items() if k != "name"}}
+    return scenario_from_dict(table)
 
 
 def cell(speed: float, current: float, offset: float, **limits: float | str | tuple[float, float, float] | None
          ) -> dict:
-    """The verdict of one cell: ``tiers`` (both / safe / none), the failed conditions and the loiter's radius (m)."""
+    """The verdict of one cell: ``tiers`` (both / safe / none), the failed conditions, the loiter's radius (m) and
+    the yaw-rate error the tracking design assumes (rad/s; 0 on the kinematic plant)."""
     import verify
 
     cert = verify.certify(survey(speed, current, offset, **limits))
     tiers = "both" if cert.tiers.tracking else "safe" if cert.tiers.safe else "none"
     loiter = cert.backup is not None and cert.backup.law.kind == "loiter"
     radius = cert.backup.safe_set.radius if loiter else None
-    return {"tiers": tiers, "failed": [c.condition for c in cert.failures], "loiter_radius": radius}
+    return {"tiers": tiers, "failed": [c.condition for c in cert.failures], "loiter_radius": radius,
+            "yaw_error": float(cert.design.problem.yaw_rate_error)}
 
 
 def _text(res: dict) -> str:
     radius = "" if res["loiter_radius"] is None else f" (loiter {res['loiter_radius']:.3g} m)"
+    radius += f" (E_r {res['yaw_error']:.3g} rad/s)" if res["yaw_error"] > 0 else ""
     if res["tiers"] == "both":
         return "both" + radius
     head = "safe; tracking: " if res["tiers"] == "safe" else ""
@@ -95,15 +117,22 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--start", type=float, default=None, help="the start's distance behind the target (m)")
     ap.add_argument("--e-d-max", type=float, default=None, help="region.e_d_max (m; default epsilon + 5)")
     ap.add_argument("--sensing", type=float, default=80.0, help="sensing_range (m)")
+    ap.add_argument("--vehicle", default=None, help="the dynamic plant with this bundled vehicle (e.g. remus100)")
+    ap.add_argument("--spread", type=float, default=0.0, help="its box shrunk to this fraction (0: the midpoint)")
+    ap.add_argument("--w-max", type=float, default=None, help="limits.w_max (m/s)")
+    ap.add_argument("--current-z", type=float, default=0.05, help="the vertical current's amplitude (m/s)")
     args = ap.parse_args(argv)
     limits = {"u_min": args.u_min, "u_max": args.u_max, "r_max": args.r_max, "epsilon": args.epsilon,
               "backup": args.backup, "rate": args.rate, "start": args.start, "e_d_max": args.e_d_max,
-              "sensing": args.sensing}
+              "sensing": args.sensing, "vehicle": args.vehicle, "spread": args.spread, "w_max": args.w_max,
+              "current_z": args.current_z}
     for offset in args.offset:
         print(f"obstacle {offset:g} m off the path; u_min {args.u_min:g}, u_max {args.u_max:g} m/s, "
               f"r_max {args.r_max:g} rad/s, epsilon {args.epsilon:g} m, backup {args.backup}, "
               f"plans' rate {args.rate or 'none'}, start {args.start or args.epsilon + 2.0:g} m behind, "
-              f"e_d_max {args.e_d_max or args.epsilon + 5.0:g} m, sensing {args.sensing:g} m")
+              f"e_d_max {args.e_d_max or args.epsilon + 5.0:g} m, sensing {args.sensing:g} m"
+              + ("" if args.vehicle is None else f"; dynamic plant: {args.vehicle}, box x{args.spread:g}, "
+                 f"w_max {args.w_max}, vertical current {args.current_z:g} m/s"))
         print("| target (m/s) \\ current (m/s) | " + " | ".join(f"{c:g}" for c in args.current) + " |")
         print("|---" * (len(args.current) + 1) + "|")
         for speed in args.speed:

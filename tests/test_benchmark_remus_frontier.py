@@ -13,22 +13,11 @@ def _module():
     return load_script("benchmarks/remus_frontier.py", "bench_remus_frontier")
 
 
-def test_the_box_is_shrunk_about_its_midpoint_and_points_stay_points():
-    mod = _module()
-    remus = vehicle_params("remus100")
-    lo, hi = remus.to_dict()["N_uudr"]
-    assert mod.shrunk(remus, 0.0).to_dict()["N_uudr"] == pytest.approx((lo + hi) / 2)
-    half = mod.shrunk(remus, 0.5).to_dict()["N_uudr"]
-    assert half == pytest.approx([lo + (hi - lo) / 4, hi - (hi - lo) / 4])
-    assert mod.shrunk(remus, 1.0).to_dict()["N_uudr"] == pytest.approx([lo, hi])
-    assert mod.shrunk(remus, 0.5).to_dict()["fin_max"] == remus.to_dict()["fin_max"]
-
-
 def test_the_midpoint_closes_at_a_crawl_and_diverges_in_yaw_at_survey_speed():
     """At u_max 0.6 m/s (u_min 0.3) the midpoint vehicle's loop closes, and the fins' floor is positive but far
     below what the loop commands; at 1.5 m/s the yaw channel's fixed point diverges (the sway coupling)."""
     mod = _module()
-    params = mod.shrunk(vehicle_params("remus100"), 0.0)
+    params = vehicle_params("remus100").shrunk(0.0)
     slow = mod.cell(params, 0.6, 0.1, 0.02, (0.05, 0.01, 0.02))
     assert slow.startswith("E = (") and "N need" in slow
     need, floor = (float(x) for x in slow.split("N need ")[1].split(";")[0].split(" vs "))
@@ -42,7 +31,7 @@ def test_the_simulated_midpoint_follows_a_yaw_sweep_at_survey_speed_within_a_hun
     0.02 rad/s^2 with a lag error of about T_lag x rate (0.1 s x 0.02 = 0.002 rad/s) plus the loop's own, and
     the hull sways a few cm/s: far inside what the bound cannot close."""
     mod = _module()
-    params = mod.shrunk(vehicle_params("remus100"), 0.0)
+    params = vehicle_params("remus100").shrunk(0.0)
     du, dr, sway, rudder = mod.simulated(params, 1.5, 0.1, 0.02, None, seconds=6.0)
     assert 0.0 <= du < 0.01 and 0.001 < dr < 0.01 and 0.0 < sway < 0.1 and 0.0 < rudder < 1.0
 
@@ -52,7 +41,7 @@ def test_the_simulated_rudder_saturates_at_half_a_metre_per_second_and_not_at_su
     REMUS 100's rudder reaches its whole moment at 0.5 m/s (the moment grows with u^2) and well under it at
     1 m/s: a torpedo's command box must keep its surge up (docs/plant.md section 4)."""
     mod = _module()
-    params = mod.shrunk(vehicle_params("remus100"), 0.0)
+    params = vehicle_params("remus100").shrunk(0.0)
     slow = mod.simulated(params, 0.5, 0.1, 0.02, None, seconds=20.0)[3]
     brisk = mod.simulated(params, 1.0, 0.1, 0.02, None, seconds=20.0)[3]
     assert slow >= 0.99 and brisk < 0.5
@@ -66,10 +55,10 @@ def test_at_survey_speed_with_a_high_floor_and_gentle_yaw_the_loop_closes_and_th
     base = vehicle_params("remus100")
     args = (1.3, 0.02, 0.01, (0.02, 0.005, 0.005), 1.0)
     for fraction in (0.0, 0.2):
-        row = mod.cell(mod.shrunk(base, fraction), *args)
+        row = mod.cell(base.shrunk(fraction), *args)
         assert row.endswith("**closes, fins hold**"), row
         need, floor = (float(x) for x in row.split("N need ")[1].split(";")[0].split(" vs "))
         assert 0.0 < need < floor
-    assert "channel r" in mod.cell(mod.shrunk(base, 1.0), *args)
+    assert "channel r" in mod.cell(base.shrunk(1.0), *args)
     with pytest.raises(SystemExit):
         mod.main(["--u-max", "1.0", "--u-min", "1.2"])

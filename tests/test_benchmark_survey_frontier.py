@@ -47,7 +47,8 @@ def test_under_rate_limited_plans_the_survey_keeps_both_tiers_with_a_rock_five_m
     import tubekit
     import verify
     rated = {"r_max": 0.3, "backup": "none", "rate": (0.5, 0.5, 1.0), "start": 7.0}
-    assert STUDY.cell(1.0, 0.3, 5.0, **rated) == {"tiers": "both", "failed": [], "loiter_radius": None}
+    assert STUDY.cell(1.0, 0.3, 5.0, **rated) == {"tiers": "both", "failed": [], "loiter_radius": None,
+                                                  "yaw_error": 0.0}       # the kinematic plant: no loop error
     shipped = tubekit.load_scenario(Path(__file__).resolve().parents[1] / "examples" / "keep_moving_survey.toml")
     assert STUDY.survey(1.0, 0.3, 5.0, **rated).to_dict() == {**shipped.to_dict(), "name": "survey"}
     slow = STUDY.cell(1.0, 0.3, 5.0, **{**rated, "rate": (0.3, 0.3, 0.6)})
@@ -71,3 +72,15 @@ def test_at_the_yaw_rate_the_torpedos_rudder_holds_only_the_terminal_rows_and_th
     brisk = STUDY.cell(1.4, 0.3, 5.0, rate=(0.05, 0.01, 0.02), **kw)
     assert set(slow["failed"]) == {"terminal_rate[u]", "terminal_rate[r]"}
     assert set(brisk["failed"]) == {"initial_terminal", "path_clearance[0]"}
+
+
+def test_on_the_dynamic_plant_the_midpoint_torpedo_is_refused_by_the_terminal_yaw_row_alone():
+    """REMUS 100 at its box's midpoint, 1.25 m/s in 0.15 m/s of current, u in [1.0, 1.5] m/s, |r| <= 0.02 rad/s,
+    the plans' yaw rate 0.004 rad/s²: the velocity loop's bound closes and every fin condition holds; what fails is
+    the terminal law's yaw row alone, because the yaw loop's error E_r the tracking design carries is more than half
+    of r_max (the sway's rate drives it, docs/plant.md section 4)."""
+    res = STUDY.cell(1.25, 0.15, 40.0, u_min=1.0, u_max=1.5, r_max=0.02, backup="none", rate=(0.05, 0.01, 0.004),
+                     start=80.0, e_d_max=100.0, sensing=300.0, vehicle="remus100", spread=0.0, w_max=0.015,
+                     current_z=0.005)
+    assert res["failed"] == ["terminal_rate[r]"]
+    assert 0.5 * 0.02 < res["yaw_error"] < 0.02

@@ -155,3 +155,22 @@ def test_sample_stays_in_the_box(seed):
     m11, m22, m33, m44, m24, m42 = s.mass_entries
     assert m24 == m42
     assert np.all(np.linalg.eigvalsh(np.array([[m22, m24], [m42, m44]])) > 0) and min(m11, m33) > 0
+
+
+def test_a_box_is_shrunk_about_its_midpoint_and_points_stay_points():
+    """shrunk(f): each interval about its midpoint to f of its half-width; 0 is the nominal point, 1 the box."""
+    from tubekit.model.vehicles import vehicle_params
+    remus = vehicle_params("remus100")
+    lo, hi = remus.interval("N_uudr")
+    assert remus.shrunk(0.0).to_dict()["N_uudr"] == pytest.approx((lo + hi) / 2) and remus.shrunk(0.0).is_point
+    assert remus.shrunk(0.5).interval("N_uudr") == pytest.approx((lo + (hi - lo) / 4, hi - (hi - lo) / 4))
+    assert remus.shrunk(1.0).interval("N_uudr") == pytest.approx((lo, hi))
+    assert remus.shrunk(0.5).to_dict()["fin_max"] == remus.to_dict()["fin_max"]       # a number stays a number
+    assert remus.shrunk(0.5).interval("Y_rdot") == remus.shrunk(0.5).interval("N_vdot")  # M stays symmetric
+
+
+@pytest.mark.parametrize("fraction", [-0.1, 1.5, float("nan"), "half", True])
+def test_a_box_is_shrunk_only_by_a_fraction_of_its_half_width(fraction):
+    from tubekit.model.vehicles import vehicle_params
+    with pytest.raises(ConfigError, match=r"fraction: expected a number in \[0, 1\]"):
+        vehicle_params("remus100").shrunk(fraction)

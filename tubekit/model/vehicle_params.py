@@ -194,6 +194,20 @@ class VehicleParams:
         mid = {n: 0.5 * (self.interval(n)[0] + self.interval(n)[1]) for n in self.interval_fields}
         return replace(self, **mid) if mid else self
 
+    def shrunk(self, fraction: float) -> VehicleParams:
+        """Every interval shrunk about its midpoint to ``fraction`` of its half-width: 0 gives the midpoint (a point
+        vehicle, :attr:`nominal`), 1 the box itself. Raises ConfigError outside [0, 1]."""
+        if not is_number(fraction) or not 0.0 <= float(fraction) <= 1.0:
+            raise ConfigError("fraction", "a number in [0, 1] (of each interval's half-width)", fraction)
+        if float(fraction) == 0.0:
+            return self.nominal
+        box = {}
+        for name in self.interval_fields:
+            lo, hi = self.interval(name)
+            mid, half = 0.5 * (lo + hi), 0.5 * (hi - lo) * float(fraction)
+            box[name] = (mid - half, mid + half)
+        return replace(self, **box) if box else self
+
     def sample(self, rng: np.random.Generator) -> VehicleParams:
         """A point drawn uniformly in the box (N_vdot tied to Y_rdot, M stays symmetric)."""
         point = {n: float(rng.uniform(*self.interval(n))) for n in self.interval_fields}

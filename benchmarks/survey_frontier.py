@@ -95,12 +95,12 @@ def cell(speed: float, current: float, offset: float, **limits: float | str | tu
 
 
 def _text(res: dict) -> str:
-    radius = "" if res["loiter_radius"] is None else f" (loiter {res['loiter_radius']:.3g} m)"
-    radius += f" (E_r {res['yaw_error']:.3g} rad/s)" if res["yaw_error"] > 0 else ""
+    notes = "" if res["loiter_radius"] is None else f" (loiter {res['loiter_radius']:.3g} m)"
+    notes += f" (E_r {res['yaw_error']:.3g} rad/s)" if res["yaw_error"] > 0 else ""
     if res["tiers"] == "both":
-        return "both" + radius
+        return "both" + notes
     head = "safe; tracking: " if res["tiers"] == "safe" else ""
-    return head + ", ".join(res["failed"][:3]) + radius
+    return head + ", ".join(res["failed"][:3]) + notes
 
 
 def main(argv: list[str] | None = None) -> int:

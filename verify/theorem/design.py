@@ -42,9 +42,9 @@ __all__ = ["Condition", "Design", "DisturbanceBounds", "disturbance_bounds", "hu
 
 #: Conditions that screen a design for recursive feasibility without being a step of any proof: ``yaw_budget``
 #: (:func:`input_tightening`) asks the yaw to follow the line of sight at e_d = ε, where no plan need go. Where
-#: step 17 proves a plan at every period (:func:`verify.theorem.terminal.proves_feasibility`) they are dropped
-#: from the design (:func:`verify.theorem.tiers.tracking_design`): the terminal law's own yaw row
-#: (``terminal_inputs[r]``, at X_f's distance) is what the proof asks.
+#: step 17 proves a plan at every period (:func:`verify.theorem.terminal.proves_feasibility`) the design is
+#: evaluated without them (``screens=False``, :func:`verify.theorem.tiers.tracking_design`): the terminal law's own
+#: yaw row (``terminal_inputs[r]``, at X_f's distance) is what the proof asks.
 FEASIBILITY_SCREENS = ("yaw_budget",)
 
 
@@ -233,8 +233,9 @@ class Design:
 
 
 def input_tightening(p: TubeProblem, tube: PeriodTube, dist: DisturbanceBounds,
-                     u_min: float | None = None) -> tuple[list[Condition], list]:
-    """V̄ = V - κ̄ (so v̂ + κ never saturates) and the necessary conditions for recursive feasibility.
+                     u_min: float | None = None, screens: bool = True) -> tuple[list[Condition], list]:
+    """V̄ = V - κ̄ (so v̂ + κ never saturates) and the necessary conditions for recursive feasibility, with the
+    screens of :data:`FEASIBILITY_SCREENS` when ``screens``.
 
     With a minimum surge ``u_min`` (m/s; ``limits.u_min``) the nominal surge lies in [u_min + κ̄_u, u_max − κ̄_u],
     so v = v̂ + κ never commands less than u_min: condition ``v_bar[surge_floor]`` (that band non-empty)."""
@@ -251,12 +252,14 @@ def input_tightening(p: TubeProblem, tube: PeriodTube, dist: DisturbanceBounds,
                                f"u_min = {u_min:g} m/s, sup|kappa_u| <= {tube.kappa[0]:.6g} m/s"))
     need_u = arb(p.pd_xy) + arb(dist.omega_xy)
     need_w = arb(p.pd_z) + arb(dist.omega_z)
-    need_r = arb(dist.omega_xy) / arb(p.eps)
     conds.append(Condition("keep_up[u]", "u_bar >= horizontal target speed + omega_bar_xy", lower(vb[0]),
                            upper(need_u), bool(vb[0] >= need_u),
                            "necessary: otherwise target and current outrun the vehicle, e_d leaves R"))
     conds.append(Condition("keep_up[w]", "w_bar >= |zdot_d| + omega_bar_z", lower(vb[1]), upper(need_w),
                            bool(vb[1] >= need_w), "necessary: otherwise e_z leaves R"))
+    if not screens:
+        return conds, [lower(x) for x in vb]
+    need_r = arb(dist.omega_xy) / arb(p.eps)
     conds.append(Condition("yaw_budget", "r_bar >= omega_bar_xy / epsilon (bearing rate the current causes)",
                            lower(vb[2]), upper(need_r), bool(vb[2] >= need_r),
                            "a screen, not a proof step: at e_d = epsilon a cross current turns the line of sight "
@@ -331,8 +334,8 @@ def _score(p: TubeProblem, region: Region, m: HorizonMargins | None, v_bar: list
 
 
 def evaluate_design(scenario: Scenario, region: Region, gains: GainBounds, sigma: float,
-                    dist: DisturbanceBounds) -> Design:
-    """Steps 2-5 of the module doc for one σ (1/s)."""
+                    dist: DisturbanceBounds, screens: bool = True) -> Design:
+    """Steps 2-5 of the module doc for one σ (1/s); ``screens``: with :data:`FEASIBILITY_SCREENS`."""
     p = tube_problem(scenario, region, gains, sigma, dist)
     tube = one_period_tube(p)
     conds = [sway_condition(dist),
@@ -343,7 +346,7 @@ def evaluate_design(scenario: Scenario, region: Region, gains: GainBounds, sigma
         return Design(sigma=sigma, problem=p, tube=tube, margins=None, v_bar=None, conditions=tuple(conds),
                       score=-math.inf)
     m = horizon_margins(p, tube, scenario.controller.horizon_steps)
-    inp, v_bar = input_tightening(p, tube, dist, scenario.limits.u_min)
+    inp, v_bar = input_tightening(p, tube, dist, scenario.limits.u_min, screens)
     conds += inp
     conds += state_conditions(scenario, region, p, m, v_bar)
     return Design(sigma=sigma, problem=p, tube=tube, margins=m, v_bar=tuple(v_bar), conditions=tuple(conds),

@@ -31,8 +31,8 @@ from tubekit.scenario import Scenario
 from tubekit.tiers import Tiers
 
 from verify.backup import BackupCertificate, Fits, proof_for
-from verify.theorem.design import FEASIBILITY_SCREENS, Condition, Design, DisturbanceBounds, arc_rates, \
-    choose_design, evaluate_design, input_tightening, state_conditions, sway_condition, tube_problem
+from verify.theorem.design import Condition, Design, DisturbanceBounds, arc_rates, choose_design, evaluate_design, \
+    input_tightening, state_conditions, sway_condition, tube_problem
 from verify.theorem.gains import GainBounds
 from verify.kernel.intervals import lower, upper
 from verify.kernel.region import Region
@@ -62,13 +62,10 @@ def tracking_design(scenario: Scenario, region: Region, gains: GainBounds, sigma
     """:func:`verify.theorem.design.evaluate_design` plus ``initial_workspace`` and ``target_in_workspace``; where
     step 17 proves a plan at every period (:func:`verify.theorem.terminal.proves_feasibility`) without the
     screens of :data:`verify.theorem.design.FEASIBILITY_SCREENS`, which no step of that proof uses."""
-    d = evaluate_design(scenario, region, gains, sigma, dist)
+    d = evaluate_design(scenario, region, gains, sigma, dist, screens=not proves_feasibility(scenario, region))
     m0 = d.margins.position[0] if d.margins is not None else 0.0
     extra = (initial_workspace(scenario, m0), target_in_workspace(scenario))
-    kept = d.conditions
-    if proves_feasibility(scenario, region):
-        kept = tuple(c for c in kept if c.condition not in FEASIBILITY_SCREENS)
-    return dataclasses.replace(d, conditions=kept + extra)
+    return dataclasses.replace(d, conditions=d.conditions + extra)
 
 
 def position_tube(p) -> PeriodTube:

@@ -43,7 +43,9 @@ def test_under_rate_limited_plans_the_survey_keeps_both_tiers_with_a_rock_five_m
     """1 m/s in 0.3 m/s of current, no backup, plans limited to (0.5, 0.5, 1.0) per second, the start 7 m behind:
     both tiers with the rock 5 m off (the row faces and the bearing face together, docs/verify.md step 17b), and
     60 s flown in a steady 0.3 m/s current toward the rock keep every promise with the solver's plan at every
-    period and the surge never below u_min; with rates of 0.3 m/s² in surge the row face fails by name."""
+    period and the surge never below u_min. At (0.3, 0.3, 0.6) both tiers hold only with the line-of-sight
+    feedforward (docs/verify.md step 17e; theorem terminal/18 refused it by terminal_rate[u]); at 0.2 m/s² in surge
+    the row face fails by name."""
     import tubekit
     import verify
     rated = {"r_max": 0.3, "backup": "none", "rate": (0.5, 0.5, 1.0), "start": 7.0}
@@ -51,7 +53,8 @@ def test_under_rate_limited_plans_the_survey_keeps_both_tiers_with_a_rock_five_m
                                                   "yaw_error": 0.0}       # the kinematic plant: no loop error
     shipped = tubekit.load_scenario(Path(__file__).resolve().parents[1] / "examples" / "keep_moving_survey.toml")
     assert STUDY.survey(1.0, 0.3, 5.0, **rated).to_dict() == {**shipped.to_dict(), "name": "survey"}
-    slow = STUDY.cell(1.0, 0.3, 5.0, **{**rated, "rate": (0.3, 0.3, 0.6)})
+    assert STUDY.cell(1.0, 0.3, 5.0, **{**rated, "rate": (0.3, 0.3, 0.6)})["tiers"] == "both"
+    slow = STUDY.cell(1.0, 0.3, 5.0, **{**rated, "rate": (0.2, 0.2, 0.4)})
     assert slow["tiers"] == "none" and slow["failed"] == ["terminal_rate[u]"]
     toward = STUDY.survey(1.0, 0.3, 5.0, **rated).with_changes(
         **{"disturbance.amplitude": (0.0, 0.0, 0.0), "disturbance.constant": (0.0, 0.3, 0.0)})
@@ -65,12 +68,13 @@ def test_under_rate_limited_plans_the_survey_keeps_both_tiers_with_a_rock_five_m
 def test_at_the_yaw_rate_the_torpedos_rudder_holds_only_the_terminal_rows_and_the_missions_geometry_are_left():
     """REMUS 100's certified rudder holds |r| <= 0.02 rad/s; the yaw screen asked 0.3 / 3 = 0.1 rad/s at epsilon
     3 m in 0.3 m/s of current. Without it (docs/verify.md section 3) a 1.4 m/s survey over u in [1.0, 1.8] m/s is
-    refused at the rates the loop bound takes, (0.02, 0.006, 0.005), by the row faces alone, and at
-    (0.05, 0.01, 0.02) by the rock 5 m off the path and the start alone: X_f lies tens of metres behind."""
+    refused at the rates the loop bound takes, (0.02, 0.006, 0.005), by the surge row alone (the yaw row holds with
+    the line-of-sight feedforward, step 17e), and at (0.05, 0.01, 0.02) by the rock 5 m off the path and the start
+    alone: X_f lies tens of metres behind."""
     kw = dict(u_min=1.0, u_max=1.8, r_max=0.02, backup="none", start=20.0, e_d_max=60.0, sensing=150.0)
     slow = STUDY.cell(1.4, 0.3, 5.0, rate=(0.02, 0.006, 0.005), **kw)
     brisk = STUDY.cell(1.4, 0.3, 5.0, rate=(0.05, 0.01, 0.02), **kw)
-    assert set(slow["failed"]) == {"terminal_rate[u]", "terminal_rate[r]"}
+    assert slow["failed"] == ["terminal_rate[u]"]
     assert set(brisk["failed"]) == {"initial_terminal", "path_clearance[0]"}
 
 
@@ -84,3 +88,25 @@ def test_on_the_dynamic_plant_the_midpoint_torpedo_is_refused_by_the_terminal_ya
                      current_z=0.005)
     assert res["failed"] == ["terminal_rate[r]"]
     assert 0.5 * 0.02 < res["yaw_error"] < 0.02
+
+
+def test_with_its_yaw_loop_at_ten_rad_s_the_midpoint_torpedo_keeps_both_tiers_on_the_dynamic_plant():
+    """The same cell with REMUS 100's yaw loop at 10 rad/s (``yaw_loop_bandwidth``; surge and heave keep the
+    vehicle's 5 rad/s: at 10 rad/s in every channel the stern planes saturate, ``loop_saturation[Z]``): the yaw loop's
+    error falls to about half and both tiers hold. Flown 60 s in a steady 0.15 m/s current across the path, every
+    promise is kept, the solver's plan at every period, the surge never below u_min."""
+    import numpy as np
+
+    import tubekit
+    import verify
+
+    kw = dict(u_min=1.0, u_max=1.5, r_max=0.02, backup="none", rate=(0.05, 0.01, 0.004), start=80.0, e_d_max=100.0,
+              sensing=300.0, vehicle="remus100", spread=0.0, w_max=0.015, current_z=0.005)
+    res = STUDY.cell(1.25, 0.15, 40.0, yaw_bandwidth=10.0, **kw)
+    assert res["tiers"] == "both" and res["yaw_error"] < 0.6 * STUDY.cell(1.25, 0.15, 40.0, **kw)["yaw_error"]
+    across = STUDY.survey(1.25, 0.15, 40.0, yaw_bandwidth=10.0, **kw).with_changes(
+        **{"disturbance.amplitude": (0.0, 0.0, 0.0), "disturbance.constant": (0.0, 0.15, 0.0)})
+    cert = verify.certify(across)
+    run = tubekit.simulate(across, cert, progress=False)
+    assert cert.tiers.tracking and [p.name for p in tubekit.check_promises(run) if p.given and not p.ok] == []
+    assert run.metrics["replaced_steps"] == 0 and float(np.min(run.inputs[:-1, 0])) >= 1.0

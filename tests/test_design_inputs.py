@@ -107,7 +107,7 @@ def test_the_dict_round_trip_is_exact_and_another_theorem_version_is_refused():
     back = DesignInputs.from_dict(json.loads(json.dumps(d.to_dict())))
     assert back == d and back.key() == d.key()
     old = dict(d.to_dict(), theorem_version="sampled-data-tube+backup+velocity-loop/6")
-    with pytest.raises(ConfigError, match=r"design\.theorem_version: expected sampled-data-tube.*terminal/18"):
+    with pytest.raises(ConfigError, match=r"design\.theorem_version: expected sampled-data-tube.*terminal/19"):
         DesignInputs.from_dict(old)
 
 

@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 import verify
-from tubekit import load_scenario, paper_scenario
+from tubekit import SolverError, load_scenario, paper_scenario
 from tubekit.loop.candidate import SETTLE_MARGIN, candidate_plan, pursuit_input, settle_last_row
 from tubekit.fhocp.registry import make_solver
 from tubekit.loop.pipeline import certified_run
@@ -211,3 +211,39 @@ def test_a_run_under_way_starts_its_first_plan_within_the_jump_of_the_initial_co
     first = done.run.v_hat[0]
     assert np.all(np.abs(first - np.array([0.2, 0.0, 0.0])) <= jump + 1e-9) and first[0] > jump[0]
     assert done.broken == () and done.metrics["outcome"] == {"safe": "certified, kept", "tracking": "certified, kept"}
+
+
+class _OnceThenNothing:
+    """The solver answers at t = 0 and never again: every later plan is the candidate."""
+
+    def __init__(self, scenario, tightening):
+        self.solver, self.calls = make_solver(scenario, tightening), 0
+
+    def solve(self, t, state, obstacles, v_last=None):
+        self.calls += 1
+        if self.calls > 1:
+            raise SolverError("refused on purpose")
+        return self.solver.solve(t, state, obstacles, v_last=v_last)
+
+
+@pytest.mark.parametrize("current", [None, (0.0, 0.3, 0.0)])
+def test_the_feedforward_law_alone_carries_a_survey_with_the_plans_rate_and_surge_floor(current):
+    """``examples/keep_moving_survey.toml`` with plans limited to (0.3, 0.3, 0.6) certifies both tiers only with
+    the line-of-sight feedforward (``docs/verify.md`` step 17e). With the solver answering once, every later plan
+    is the shifted candidate completed by that law: for 60 s (in the file's current, and in a steady 0.3 m/s
+    current toward the rock) each passes the exact check, no backup runs, the surge stays above u_min and
+    every promise holds."""
+    from pathlib import Path
+
+    import tubekit
+    from tubekit.loop.closed_loop import run_closed_loop
+    survey = Path(__file__).resolve().parents[1] / "examples" / "keep_moving_survey.toml"
+    sc = load_scenario(survey).with_changes(**{"limits.rate": (0.3, 0.3, 0.6)})
+    if current is not None:
+        sc = sc.with_changes(**{"disturbance.amplitude": (0.0, 0.0, 0.0), "disturbance.constant": current})
+    cert = verify.certify(sc)
+    assert cert.tiers.tracking and cert.design.terminal.los_feedforward
+    res = run_closed_loop(sc, cert.tightening, solver_factory=_OnceThenNothing, progress=False)
+    assert np.all(res.candidate[1:]) and not np.any(res.backup_active) and np.all(res.plan_age == 0)
+    assert np.min(res.inputs[:-1, 0]) >= sc.limits.u_min
+    assert [p.name for p in tubekit.check_promises(res) if p.given and not p.ok] == []

@@ -69,6 +69,8 @@ def test_interval_of_an_unknown_or_non_numeric_name_is_a_value_error():
     ({"N_r": [-1.0, 0.5]}, "plant.vehicle.N_r", "damping removes energy"),
     ({"m": [0.0, 10.0]}, "plant.vehicle.m", "> 0 at every point"),
     ({"loop_bandwidth": [-1.0, 5.0]}, "plant.vehicle.loop_bandwidth", "> 0"),
+    ({"yaw_loop_bandwidth": -1.0}, "plant.vehicle.yaw_loop_bandwidth", "0 \\(the loop_bandwidth\\) or a number > 0"),
+    ({"sway_loop_bandwidth": [0.0, 5.0]}, "plant.vehicle.sway_loop_bandwidth", "at every point of the box"),
     ({"Z_max": 0.0}, "plant.vehicle.Z_max", "> 0"),                              # thrusters need it
     ({"fin_max": 0.2}, "plant.vehicle.fin_max", "unused with actuation = 'thrusters'"),
     ({"actuation": "oars"}, "plant.vehicle.actuation", "thrusters"),
@@ -174,3 +176,12 @@ def test_a_box_is_shrunk_only_by_a_fraction_of_its_half_width(fraction):
     from tubekit.model.vehicles import vehicle_params
     with pytest.raises(ConfigError, match=r"fraction: expected a number in \[0, 1\]"):
         vehicle_params("remus100").shrunk(fraction)
+
+
+def test_each_channel_runs_at_its_own_bandwidth_or_the_loop_bandwidth():
+    """PI gains by hand, per body velocity (u, v, w, r): loop_bandwidth 8 gives k_p = 8, k_i = 16 wherever a channel
+    has no bandwidth of its own; a yaw loop at 12 rad/s gives k_p = 12, k_i = 36; a box's gains are its midpoint's."""
+    assert VehicleParams(**POINT).loop_gains == ((8.0, 16.0),) * 4
+    own = VehicleParams(**{**POINT, "yaw_loop_bandwidth": 12.0, "heave_loop_bandwidth": [2.0, 6.0]})
+    assert own.loop_gains == ((8.0, 16.0), (8.0, 16.0), (4.0, 4.0), (12.0, 36.0))
+    assert VehicleParams(**{**POINT, "yaw_loop_bandwidth": 12.0}).to_dict()["yaw_loop_bandwidth"] == 12.0

@@ -43,7 +43,7 @@ CASES = [
                                                      {"center": [1.6, 0.0, 0.0], "radius": 0.4}]},
      "safe_only.obstacles[0,1]", ["vehicle_radius"]),
     ("rate beyond the rudder's authority", REMUS, {}, "rate_authority[u]", ["limits.rate[0]"]),
-    ("plans too slow for the yaw row's face", CURRENTS, {"limits.rate": [0.1, 0.1, 0.1]}, "terminal_rate[r]",
+    ("plans too slow for the yaw row's face", CURRENTS, {"limits.rate": [0.5, 0.5, 0.05]}, "terminal_rate[r]",
      ["limits.rate[2]"]),
 ]
 

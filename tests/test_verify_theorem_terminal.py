@@ -45,7 +45,7 @@ def test_the_papers_obstacles_on_the_circle_refuse_tracking_by_name():
 
 
 @pytest.mark.parametrize("change, name", [
-    ({"limits.rate": (0.1, 0.1, 0.1)}, "terminal_rate[r]"),
+    ({"limits.rate": (0.1, 0.1, 0.1)}, "terminal_rate[u]"),
     ({"region.heading": "both"}, "terminal_heading"),
 ])
 def test_designs_outside_the_theorem_are_named(change, name):

@@ -39,3 +39,15 @@ def test_the_jump_sum_bounds_the_sampled_response_of_the_matrix():
             x = ad @ x
         assert total <= loop.sums[c].tick[0][0]
         assert total > 0.5 * loop.sums[c].tick[0][0]  # and the sum is not loose: the sup over a tick is near it
+
+
+def test_a_channel_with_a_bandwidth_of_its_own_gets_its_own_gains_and_sums():
+    """REMUS 100 (no lateral thrust: channels u, w, r) with its yaw loop at 10 rad/s against the loop_bandwidth's 5:
+    the yaw channel's gains are (10, 25), the others' (5, 6.25), and only the yaw channel's response sums change."""
+    from tubekit.model.vehicle_sets import REMUS100
+
+    base = loop_data_of(REMUS100.nominal, (1.5, 0.015, 0.02), H, TICKS)
+    own = loop_data_of(REMUS100.nominal.with_overrides({"yaw_loop_bandwidth": 10.0}), (1.5, 0.015, 0.02), H, TICKS)
+    assert base.gains == ((5.0, 6.25),) * 3 and own.gains == ((5.0, 6.25), (5.0, 6.25), (10.0, 25.0))
+    assert own.sums[:2] == base.sums[:2] and own.sums[2] != base.sums[2]
+    assert own.sums[2].tick[0][0] < base.sums[2].tick[0][0]   # a faster loop: less error per unit jump

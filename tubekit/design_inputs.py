@@ -58,8 +58,9 @@ __all__ = ["DesignInputs", "THEOREM_VERSION", "RATE_TOLERANCE", "ARC_SAMPLES", "
 #: damping coefficients into cells, each cell's centre in the loop's matrix, so E shrinks again; 17: a bearing face
 #: narrows the completion's lateral bound, and composes with the row faces under rate-limited plans, so the same
 #: scenario may get another terminal set; 18: the yaw screen r_bar >= omega_bar_xy / epsilon is no condition where
-#: step 17 covers the design, so a design it refused may certify).
-THEOREM_VERSION = "sampled-data-tube+backup+velocity-loop+terminal/18"
+#: step 17 covers the design, so a design it refused may certify; 19: under rate-limited plans the terminal law may
+#: feed the line of sight's turn forward into its yaw row, a field of the terminal law).
+THEOREM_VERSION = "sampled-data-tube+backup+velocity-loop+terminal/19"
 #: Absolute tolerance (m/s, rad/s) of the plan check's rate rows (round-off only). The proof carries it: the
 #: dynamic plant's velocity loop is bounded for command jumps of J + RATE_TOLERANCE (``verify.vehicle.compose``).
 RATE_TOLERANCE = 1e-9

@@ -14,10 +14,15 @@ step 17b). The *row faces* |v_{N−1} − κ_f(x_N)| <= S = (S_u, S_w, S_r), the
 row at the plan's end, are used only for rate-limited plans (S = 0 otherwise: no face); there they keep the
 completion's row within the plans' jump J of the row before it (step 17c). The law, held over one period δ (a plan's row) from the state at time t, is
 
-* r = −g α / δ (turn the fraction g of the way onto the line of sight);
-* u = (V_r + λ (d − d*)) / (S(g α / 2) cos(α (1 − g / 2))), V_r = ṗ_d(t) · (p_d − p) / d the target's
+* r = T / δ with the turn T = −g α (turn the fraction g of the way onto the line of sight) or, with the
+  *line-of-sight feedforward* (``los_feedforward``), T = −g α + δ ω̂, ω̂ = (P_⊥ − N tan α) / d the rate at which
+  the line of sight turns at the row's start (P_⊥ = ṗ_d(t) · n the target's speed across it, n the line of sight
+  turned by +90°, N tan α the vehicle's own speed across it): the heading then follows the line of sight's turn
+  instead of catching it up one period late (step 17e);
+* u = N / (S(T / 2) cos(α + T / 2)), N = V_r + λ (d − d*), V_r = ṗ_d(t) · (p_d − p) / d the target's
   speed away from the vehicle along the line of sight, S(x) = sin x / x: the exact unicycle arc then closes
-  the radial gap by the fraction λ δ of d − d* (the target's own curvature aside);
+  the radial gap by the fraction λ δ of d − d* (the target's own curvature aside); with T = −g α this is
+  N / (S(g α / 2) cos(α (1 − g / 2)));
 * w = ż_d(t) − λ_z e_z.
 
 ``verify.theorem.terminal`` proves, for the target's path and the certified disturbance, that the law from
@@ -80,10 +85,15 @@ class TerminalLaw:
     row_u: float = NO_ROWS
     row_w: float = NO_ROWS
     row_r: float = NO_ROWS
+    los_feedforward: bool = False
 
     def __post_init__(self) -> None:
+        if not isinstance(self.los_feedforward, bool):
+            raise ConfigError("terminal.los_feedforward", "a bool (True: the yaw row follows the line of sight's "
+                              "turn)", self.los_feedforward)
         for f in fields(self):
-            finite(f"terminal.{f.name}", getattr(self, f.name))
+            if f.name != "los_feedforward":
+                finite(f"terminal.{f.name}", getattr(self, f.name))
         positive("terminal.d_lo", self.d_lo)
         if not self.d_lo <= self.d_star <= self.d_hi:
             raise ConfigError("terminal.d_star", f"within [d_lo, d_hi] = [{self.d_lo}, {self.d_hi}] m", self.d_star)
@@ -149,13 +159,20 @@ class TerminalLaw:
         p = np.asarray(p_d, dtype=float)
         v = np.asarray(pd_dot, dtype=float)
         d, alpha, e_z = line_of_sight(x, p)
-        radial = (v[0] * (p[0] - x[0]) + v[1] * (p[1] - x[1])) / d if d > 0.0 else 0.0
+        dx, dy = p[0] - x[0], p[1] - x[1]
+        radial = (v[0] * dx + v[1] * dy) / d if d > 0.0 else 0.0
+        closing = radial + self.gain_d * (d - self.d_star)
         g = self.turn
-        u = (radial + self.gain_d * (d - self.d_star)) / (float(sinc(0.5 * g * alpha)) * math.cos(alpha * (1 - g / 2)))
+        if self.los_feedforward and d > 0.0:
+            across = (v[1] * dx - v[0] * dy) / d
+            turn = -g * alpha + dt * (across - closing * math.tan(alpha)) / d
+            u = closing / (float(sinc(0.5 * turn)) * math.cos(alpha + 0.5 * turn))
+            return np.array([u, v[2] - self.gain_z * e_z, turn / dt])
+        u = closing / (float(sinc(0.5 * g * alpha)) * math.cos(alpha * (1 - g / 2)))
         return np.array([u, v[2] - self.gain_z * e_z, -g * alpha / dt])
 
     def to_dict(self) -> dict[str, float]:
-        """The twelve numbers by name."""
+        """The thirteen numbers by name (``los_feedforward`` as 1.0 or 0.0)."""
         return {k: float(v) for k, v in asdict(self).items()}
 
     @classmethod
@@ -165,4 +182,7 @@ class TerminalLaw:
         if not isinstance(d, dict) or set(d) != set(names):
             raise ConfigError(where, f"an object with exactly the keys {names}",
                               sorted(d) if isinstance(d, dict) else type(d).__name__)
-        return cls(**{k: float(d[k]) for k in names})
+        values = {k: float(d[k]) for k in names}
+        if values["los_feedforward"] not in (0.0, 1.0):
+            raise ConfigError(f"{where}.los_feedforward", "1.0 or 0.0", d["los_feedforward"])
+        return cls(**{**values, "los_feedforward": values["los_feedforward"] == 1.0})

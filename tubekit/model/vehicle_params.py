@@ -25,7 +25,7 @@ import numpy as np
 from tubekit.exceptions import ConfigError
 from tubekit.validation import is_number
 
-__all__ = ["VehicleParams", "Coefficient", "ACTUATIONS"]
+__all__ = ["VehicleParams", "Coefficient", "ACTUATIONS", "CHANNEL_BANDWIDTHS"]
 
 #: A coefficient: a number, or the interval (lo, hi) with lo < hi.
 Coefficient = Union[float, tuple[float, float]]
@@ -33,6 +33,8 @@ Coefficient = Union[float, tuple[float, float]]
 #: Actuation models: constant limits, or a propeller plus fins whose authority is ∝ u².
 ACTUATIONS = ("thrusters", "fins")
 
+#: The per-channel bandwidths of the velocity loop, in the order of ν = (u, v, w, r) (0: ``loop_bandwidth``).
+CHANNEL_BANDWIDTHS = ("surge_loop_bandwidth", "sway_loop_bandwidth", "heave_loop_bandwidth", "yaw_loop_bandwidth")
 #: Coefficients that must be <= 0 over the whole box (damping: they remove energy).
 _NONPOSITIVE = ("X_u", "Y_v", "Z_w", "N_r", "X_uu", "Y_vv", "Z_ww", "N_rr")
 _POSITIVE = ("m", "I_zz", "X_max", "thruster_time_constant", "loop_bandwidth")
@@ -109,6 +111,10 @@ class VehicleParams:
     fin_max: Coefficient = 0.349                 # rad, largest fin angle (Fossen: 20 deg)
     thruster_time_constant: Coefficient = 0.1    # s, every channel (assumption)
     loop_bandwidth: Coefficient = 5.0            # rad/s, velocity loop (PI: k_p = ω_b, k_i = ω_b²/4)
+    surge_loop_bandwidth: Coefficient = 0.0      # rad/s, the surge loop's own ω_b (0: loop_bandwidth)
+    sway_loop_bandwidth: Coefficient = 0.0       # rad/s, the sway loop's (lateral thrust only; 0: loop_bandwidth)
+    heave_loop_bandwidth: Coefficient = 0.0      # rad/s, the heave loop's (0: loop_bandwidth)
+    yaw_loop_bandwidth: Coefficient = 0.0        # rad/s, the yaw loop's (0: loop_bandwidth)
     actuation: str = "fins"                      # "thrusters" or "fins"
 
     def __post_init__(self) -> None:
@@ -128,6 +134,10 @@ class VehicleParams:
             for name in ("Z_uuds", "N_uudr"):
                 lo, hi = self.interval(name)
                 self._require(name, lo > 0.0 or hi < 0.0, "a nonzero fin coefficient (an interval not containing 0)")
+        for name in CHANNEL_BANDWIDTHS:
+            lo, hi = self.interval(name)
+            self._require(name, lo >= 0.0 and (hi == 0.0 or lo > 0.0), "0 (the loop_bandwidth) or a number > 0 "
+                          "at every point of the box")
         self._check_lateral()
         self._require("N_vdot", self.interval("N_vdot") == self.interval("Y_rdot"),
                       f"the value of Y_rdot, {self.Y_rdot!r} (M symmetric at every point of the box)")
@@ -149,6 +159,21 @@ class VehicleParams:
                 self._require(name, self.interval(name) == (0.0, 0.0), "0 when Y_max > 0: the sway loop regulates "
                               "sway and yaw as separate channels, which needs m x_g - Y_rdot = 0 (M diagonal in sway "
                               "and yaw); give Y_max = 0 to keep the hull's free sway")
+
+    @property
+    def loop_gains(self) -> tuple[tuple[float, float], tuple[float, float], tuple[float, float], tuple[float, float]]:
+        """The velocity loop's PI gains (k_p (1/s), k_i (1/s²)) of the controller's model (:attr:`nominal`) per
+        body velocity u, v, w, r: k_p = ω_c, k_i = ω_c²/4 with ω_c the channel's own bandwidth
+        (``surge_loop_bandwidth``, ``sway_loop_bandwidth``, ``heave_loop_bandwidth``, ``yaw_loop_bandwidth``), or
+        ``loop_bandwidth`` where that is 0."""
+        nom = self.nominal
+        base = float(nom.loop_bandwidth)
+        out = []
+        for name in CHANNEL_BANDWIDTHS:
+            own = float(getattr(nom, name))
+            w = own if own > 0.0 else base
+            out.append((w, 0.25 * w ** 2))
+        return out[0], out[1], out[2], out[3]
 
     @property
     def lateral(self) -> bool:

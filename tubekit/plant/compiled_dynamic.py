@@ -69,9 +69,9 @@ def _saturate(c: float, lim: float) -> float:
 @routine
 def _rhs(t: float, y: np.ndarray, command: np.ndarray, truth: np.ndarray, model: np.ndarray, control: np.ndarray,
          limits: np.ndarray, current: np.ndarray, lateral: bool, out: np.ndarray, peak: np.ndarray) -> None:
-    """d/dt of ``y`` into ``out`` (``DynamicPlant._rhs``); ``control`` = (k_p, k_i, 1/T_thr), ``command`` =
-    (u_c, w_c, r_c[, v_c]) (v_c = 0 when absent)."""
-    kp, ki, tau_inv = control[0], control[1], control[2]
+    """d/dt of ``y`` into ``out`` (``DynamicPlant._rhs``); ``control`` = (k_p of u, v, w, r, k_i of u, v, w, r,
+    1/T_thr), ``command`` = (u_c, w_c, r_c[, v_c]) (v_c = 0 when absent)."""
+    tau_inv = control[8]
     vc = command[3] if command.shape[0] > 3 else 0.0
     c1, c2, c3 = current_at(current, t)
     psi, u, v, w, r = y[3], y[4], y[5], y[6], y[7]
@@ -85,7 +85,8 @@ def _rhs(t: float, y: np.ndarray, command: np.ndarray, truth: np.ndarray, model:
     # the loop (model): τ_cmd = n̂(ν) + M̂ (k_p e + k_i ∫e), saturated
     f1, f2, f3, f4 = _forces(model, u, v, w, r)
     e0, e1, e2 = command[0] - u, command[1] - w, command[2] - r
-    a0, a1, a2 = kp * e0 + ki * y[11], kp * e1 + ki * y[12], kp * e2 + ki * y[13]
+    a0, a1, a2 = control[0] * e0 + control[4] * y[11], control[2] * e1 + control[6] * y[12], \
+        control[3] * e2 + control[7] * y[13]
     raw0 = f1 + model[_M11] * a0
     raw1 = f3 + model[_M33] * a1
     raw2 = f4 - model[_M42] * f2 / model[_M22] + (model[_M44] - model[_M42] * model[_M24] / model[_M22]) * a2
@@ -106,7 +107,7 @@ def _rhs(t: float, y: np.ndarray, command: np.ndarray, truth: np.ndarray, model:
     out[13] = 0.0 if s2 != raw2 and s2 * e2 > 0.0 else e2
     if lateral:
         # Y_cmd = n̂_2 + m̂_22 (k_p e_v + k_i ∫e_v), e_v = v_c − v = −dv (exactly −v at v_c = 0)
-        raw = f2 + model[_M22] * (-kp * dv + ki * y[15])
+        raw = f2 + model[_M22] * (-control[1] * dv + control[5] * y[15])
         sat = _saturate(raw, limits[7])
         out[14] = (sat - y[14]) * tau_inv
         ev = -dv
@@ -141,8 +142,8 @@ def rk4_dynamic(t: float, y0: np.ndarray, command: np.ndarray, h: float, n: int,
         velocity, tracked by the sway loop with ``lateral`` (0 when absent; without ``lateral`` it must be 0).
     truth, model : array (21,)
         :func:`coefficients` of the vehicle as simulated and of the controller's model.
-    control : array (3,)
-        (k_p (1/s), k_i (1/s²), 1 / T_thr (1/s)).
+    control : array (9,)
+        (k_p (1/s) of u, v, w, r, k_i (1/s²) of u, v, w, r, 1 / T_thr (1/s)).
     limits : array (8,)
         :func:`actuator_limits` of the vehicle as simulated.
     current : array (7,)

@@ -45,6 +45,9 @@ from tubekit.plant.kinematic import Plant, rk4_tuple
 from tubekit.scenario import Scenario
 from tubekit.model.vehicles import VehicleParams
 
+#: Indices of u, w, r in ν = (u, v, w, r): the commanded channels.
+_SURGE_HEAVE_YAW = (0, 2, 3)
+
 __all__ = ["DynamicPlant", "body_forces", "body_acceleration", "kinetic_energy"]
 
 Floats4 = tuple[float, float, float, float]
@@ -119,7 +122,9 @@ class DynamicPlant:
         self.override = override
         self._current_model = Plant(scenario.disturbance)
         self._mass = self.model.mass_entries
-        self._kp, self._ki = self.model.loop_bandwidth, 0.25 * self.model.loop_bandwidth ** 2
+        # per body velocity (u, v, w, r): the PI gains k_p = ω_c, k_i = ω_c²/4 of each channel's loop
+        gains = self.model.loop_gains
+        self._kp, self._ki = tuple(g[0] for g in gains), tuple(g[1] for g in gains)
         self._tau_inv = 1.0 / self.params.thruster_time_constant
         # thrusters' limits are constant: read once, not at every integrator stage (fins: per stage)
         self._limits = self.params.thrust_limits if self.params.actuation == "thrusters" else None
@@ -149,7 +154,7 @@ class DynamicPlant:
         m11, m22, m33, m44, m24, m42 = self._mass
         n1, n2, n3, n4 = forces if forces is not None else body_forces(self.model, nu)
         e = (command[0] - nu[0], command[1] - nu[2], command[2] - nu[3])
-        a = [self._kp * ei + self._ki * ii for ei, ii in zip(e, integral)]
+        a = [self._kp[c] * ei + self._ki[c] * ii for c, ei, ii in zip(_SURGE_HEAVE_YAW, e, integral)]
         raw = (n1 + m11 * a[0], n3 + m33 * a[1], n4 - m42 * n2 / m22 + (m44 - m42 * m24 / m22) * a[2])
         sat = tuple(min(max(c, -lim), lim) for c, lim in zip(raw, self._limits or self.params.thrust_limits_at(nu[0])))
         return sat, tuple(s != c for s, c in zip(sat, raw))
@@ -172,7 +177,7 @@ class DynamicPlant:
         """
         n2 = (forces if forces is not None else body_forces(self.model, nu))[1]
         # −k_p (v − v_c): at v_c = 0 the very floats of −k_p v (signed zeros too)
-        raw = n2 + self._mass[1] * (-self._kp * (nu[1] - sway) + self._ki * integral)
+        raw = n2 + self._mass[1] * (-self._kp[1] * (nu[1] - sway) + self._ki[1] * integral)
         sat = min(max(raw, -self._sway_limit), self._sway_limit)
         return sat, sat != raw
 
@@ -288,13 +293,14 @@ class DynamicPlant:
         return values[0], values[1], values[2], values[3]
 
     def _packed(self) -> tuple[np.ndarray, ...]:
-        """The compiled routines' arrays, packed once: the truth's and the model's coefficients, (k_p, k_i, 1/T),
+        """The compiled routines' arrays, packed once: the truth's and the model's coefficients, (k_p per channel u,
+        v, w, r, then k_i, then 1/T),
         the actuator limits and the current."""
         if self._compiled is None:
             from tubekit.plant import compiled_dynamic
 
             self._compiled = (compiled_dynamic.coefficients(self.params), compiled_dynamic.coefficients(self.model),
-                              np.array([self._kp, self._ki, self._tau_inv]),
+                              np.array([*self._kp, *self._ki, self._tau_inv]),
                               compiled_dynamic.actuator_limits(self.params, self._sway_limit),
                               np.array(self._current_model.current_parameters))
         return self._compiled

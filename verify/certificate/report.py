@@ -199,6 +199,23 @@ def _short_tube_lines(cert: CertificateRecord) -> list[str]:
     return out
 
 
+def _terminal_lines(cert: CertificateRecord) -> list[str]:
+    """The certified terminal set and law in one line (none when tracking has none): X_f's faces, its gains and
+    whether its yaw row feeds the line of sight's turn forward (``docs/verify.md`` step 17e)."""
+    law = cert.design.terminal
+    if law is None:
+        return []
+    faces = [f"d in [{_f(law.d_lo, 4)}, {_f(law.d_hi, 4)}] m", f"|alpha| <= {_f(law.alpha_max, 3)} rad",
+             f"|e_z| <= {_f(law.z_max, 3)} m"]
+    if law.has_bearing:
+        faces.append(f"|bearing| <= {_f(law.bearing_max, 3)} rad")
+    if law.has_rows:
+        faces.append(f"row faces {_vec((law.row_u, law.row_w, law.row_r))}")
+    fed = " and the line of sight's turn fed forward" if law.los_feedforward else ""
+    return [f"Terminal set X_f: {', '.join(faces)}; law: turn g = {_f(law.turn, 3)}{fed}, lambda = "
+            f"{_f(law.gain_d, 3)} 1/s, lambda_z = {_f(law.gain_z, 3)} 1/s"]
+
+
 def _short_backup_lines(cert: CertificateRecord) -> list[str]:
     """The backup (its verdict, safe set and hand-over) and, on the dynamic plant, the velocity loop: a line each."""
     out: list[str] = []
@@ -235,7 +252,7 @@ def summary_text(cert: CertificateRecord) -> str:
     lines.append(f"Disturbance: ||omega_xy|| <= {_f(dist.omega_xy)} m/s, |omega_z| <= {_f(dist.omega_z)} m/s "
                  f"(sway gamma_bar = {_f(dist.gamma)} m/s)")
     lines += _tracking_bound_lines(cert)
-    lines += _short_tube_lines(cert) + _short_backup_lines(cert)
+    lines += _short_tube_lines(cert) + _terminal_lines(cert) + _short_backup_lines(cert)
     lines.append(f"Design key: {cert.design_key} (theorem {THEOREM_VERSION})")
     lines.append("Full text (every number, condition, premise and assumption): tubekit certify -v, "
                  "Certificate.summary(verbose=True)")

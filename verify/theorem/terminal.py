@@ -30,7 +30,11 @@ Under a minimum surge the completion's surge must stay above u_min + κ̄_u: X_f
 target whose speed has a positive floor (:mod:`verify.theorem.terminal_bearing`, step 17b); a target that may stop
 is refused (``terminal_surge_floor``). Under rate-limited plans X_f gets row faces that keep the completion's row
 within the plans' jump (:mod:`verify.theorem.terminal_rows`, step 17c), composed with the bearing face under a
-surge floor (:func:`verify.theorem.terminal_bearing.bearing_row_sets`). Every inequality is evaluated in Arb
+surge floor (:func:`verify.theorem.terminal_bearing.bearing_row_sets`). Where no set of the grid fits the row faces,
+the same grid is tried with the line-of-sight feedforward in the yaw row (step 17e): the turn then follows the line
+of sight's turn at the completion's start, so atan(Y / x_min) above becomes the residual E of
+:func:`verify.theorem.completion_bounds.feedforward_residual`, β and the turn's bound grow by δΩ / 2 and δΩ, and the
+feedforward's own change enters the rows. Every inequality is evaluated in Arb
 and must hold with the slack :data:`FLOAT_SLACK`, so that the run's float check of the same set agrees.
 :func:`design_terminal` searches a small grid of sets, largest first, and keeps the first that meets every
 condition.
@@ -102,13 +106,13 @@ def terminal_bounds(scenario: Scenario, design: Design, region: Region) -> Termi
 
 
 def _input_conditions(b: TerminalBounds, law: TerminalLaw, arc: CompletionArc) -> list[Condition]:
-    dt, g = arb(b.dt), arb(law.turn)
+    dt = arb(b.dt)
     ub, wb, rb = (arb(v) for v in b.v_bar)
-    u_peak = (arb(b.speed_xy) + arb(law.gain_d) * arc.spread) / ((g * arc.a0 / 2).sinc() * arc.beta.cos())
+    u_peak = (arb(b.speed_xy) + arb(law.gain_d) * arc.spread) / ((arc.turn_max / 2).sinc() * arc.beta.cos())
     w_peak = arb(b.speed_z) + arb(law.gain_z) * (arb(law.z_max) + arb(b.dev_z))
-    return [_cond("terminal_inputs[u]", "(P + lambda Delta) / (S(g A_0/2) cos beta) <= u_bar_bar", u_peak, ub),
+    return [_cond("terminal_inputs[u]", "(P + lambda Delta) / (S(T_max/2) cos beta) <= u_bar_bar", u_peak, ub),
             _cond("terminal_inputs[w]", "W + lambda_z (z_f + D_z) <= w_bar_bar", w_peak, wb),
-            _cond("terminal_inputs[r]", "g A_0 / delta <= r_bar_bar", g * arc.a0 / dt, rb),
+            _cond("terminal_inputs[r]", "T_max / delta = g A_0 / delta (+ Omega) <= r_bar_bar", arc.turn_max / dt, rb),
             _cond("terminal_gains", "lambda delta <= 1 and lambda_z delta <= 1 (no overshoot past d*, z_d)",
                   max(arb(law.gain_d), arb(law.gain_z)) * dt, arb(1))]
 
@@ -116,14 +120,15 @@ def _input_conditions(b: TerminalBounds, law: TerminalLaw, arc: CompletionArc) -
 def _invariance_conditions(b: TerminalBounds, law: TerminalLaw, arc: CompletionArc) -> list[Condition]:
     dt, g = arb(b.dt), arb(law.turn)
     d_hi, alpha_f, z_f = arb(law.d_hi), arb(law.alpha_max), arb(law.z_max)
-    alpha_next = (1 - g) * arc.a0 + (arc.lateral / arc.x_min).atan() if arc.x_min > 0 else arb("inf")
+    alpha_next = (1 - g) * arc.a0 + arc.residual if arc.x_min > 0 else arb("inf")
     lam_z = arb(law.gain_z) * dt
     z_next = (1 - lam_z) * (z_f + arb(b.dev_z)) + arb(b.accel_z) * dt * dt / 2
     return [_cond("terminal_invariant[d_lo]", "d_lo <= x_min (the completion ends no nearer than d_lo)",
                   arb(law.d_lo), arc.x_min),
             _cond("terminal_invariant[d_hi]", "hypot(x_max, Y) <= d_hi", (arc.x_max ** 2 + arc.lateral ** 2).sqrt(),
                   d_hi),
-            _cond("terminal_invariant[alpha]", "(1 - g) A_0 + atan(Y / x_min) <= alpha_f", alpha_next, alpha_f),
+            _cond("terminal_invariant[alpha]", "(1 - g) A_0 + atan(Y / x_min) (with the feedforward: + E) <= alpha_f",
+                  alpha_next, alpha_f),
             _cond("terminal_invariant[e_z]", "(1 - lambda_z delta)(z_f + D_z) + A_z delta^2 / 2 <= z_f", z_next, z_f)]
 
 
@@ -134,7 +139,7 @@ def _region_conditions(b: TerminalBounds, law: TerminalLaw, arc: CompletionArc) 
     d_in_lo = arc.start_min - run / 2
     d_in_hi = arb(law.d_hi) + dxy + run / 2
     turn = (run / arc.start_min).asin() if run < arc.start_min else arb("inf")
-    alpha_in = arc.a0 + turn
+    alpha_in = arc.a0 + dt * arc.omega + turn  # the feedforward may turn the heading past the line of sight by δΩ
     e_o_in = alpha_in.sin() if alpha_in < arb.pi() / 2 else arb("inf")
     z_in = arb(law.z_max) + arb(b.dev_z) + (wb + arb(b.speed_z)) * dt / 2
     return [_cond("terminal_in_region[e_d_lo]", "epsilon + M_d + pad <= d_lo - D_xy - L delta / 2",
@@ -198,16 +203,19 @@ def sensing_condition(scenario: Scenario, b: TerminalBounds, safe: SafeSet) -> C
                  spread, arb(scenario.sensing_range) - arb(scenario.vehicle_radius))
 
 
-def _sets(b: TerminalBounds, fine: bool = False) -> list[TerminalLaw]:
+def _sets(b: TerminalBounds, fine: bool = False, feedforward: bool = False) -> list[TerminalLaw]:
     """The grid of terminal sets and their gains, largest first (module doc); under a surge floor each with its
     bearing face (:func:`verify.theorem.terminal_bearing.bearing_sets`). ``fine``: the refinement's sets that the
-    coarse grid does not have (:data:`FINE_LOWER_ENDS`, :data:`FINE_WIDTHS`)."""
+    coarse grid does not have (:data:`FINE_LOWER_ENDS`, :data:`FINE_WIDTHS`); ``feedforward``: the laws with the
+    line-of-sight feedforward (step 17e)."""
     if fine:
         coarse = set(_grid_points(WIDTHS, LOWER_ENDS))
         points = [p for p in _grid_points(FINE_WIDTHS, FINE_LOWER_ENDS) if p not in coarse]
     else:
         points = _grid_points(WIDTHS, LOWER_ENDS)
     laws = _grid(b, points)
+    if feedforward:
+        laws = [dataclasses.replace(law, los_feedforward=True) for law in laws]
     if b.jumps is not None:
         return bearing_row_sets(b, laws) if b.surge_floor is not None else row_sets(b, laws)
     return bearing_sets(b, laws) if b.surge_floor is not None else laws
@@ -215,9 +223,13 @@ def _sets(b: TerminalBounds, fine: bool = False) -> list[TerminalLaw]:
 
 def _refined(b: TerminalBounds) -> Iterator[TerminalLaw]:
     """The refinement's sets under rate-limited plans (the row faces: their gains must be the gentlest a set
-    allows), built only when the loop asks for them (the coarse grid found none); none without rate limits."""
+    allows), built only when the loop asks for them (the coarse grid found none), then the same grid's laws with the
+    line-of-sight feedforward, coarse and fine (step 17e: the yaw row follows the line of sight's turn instead of
+    catching it up); none without rate limits."""
     if b.jumps is not None:
         yield from _sets(b, fine=True)
+        yield from _sets(b, feedforward=True)
+        yield from _sets(b, fine=True, feedforward=True)
 
 
 def _grid_points(widths: tuple[float, ...], lower_ends: tuple[float, ...]) -> list[tuple[float, float]]:

@@ -31,6 +31,11 @@ start set's |α| <= A_0, its distances within Δ of d* and the arc's radial boun
   (step 17b) V_r = P cos φ moves by at most P |Δφ| sup |sin φ| between the two bearings: the P terms take the
   factor sin Φ_0 (deviation: both bearings within Φ_0) and sin(Φ_0 + τ) (arc), while below π/2.
 
+With the line-of-sight feedforward (step 17e, r = (−g α + δ ω̂) / δ, ω̂ = (P_⊥ − N tan α) / d) the heading's change
+over the arc is g A_0 + E (E the residual, not the line of sight's whole turn), K_r adds the feedforward's own change
+|Δω̂| (:func:`feedforward_change`), and the surge's denominator S(T/2) cos(α + T/2) moves also with the turn T:
+by at most δ |Δω̂| (T_max / 12 + sin β / 2) more.
+
 By induction with step 17, every candidate is rate-limited, ends in X_f with its faces, and a plan exists at every
 period. The law's gains are chosen as small as X_f's invariance allows (:func:`gentle_law`): the row's change
 grows with them. Each face is as wide as the jump leaves, S = J − K(deviation) less a thousandth of J, never
@@ -51,7 +56,8 @@ from verify.theorem.design import Condition
 from verify.theorem.completion_bounds import CompletionArc, TerminalBounds, completion_arc, in_cone, start_bearing
 from verify.theorem.completion_bounds import slack_condition as _cond
 
-__all__ = ["RowChanges", "row_changes", "row_conditions", "gentle_law", "row_sets", "GAIN_FACTORS"]
+__all__ = ["RowChanges", "row_changes", "feedforward_change", "row_conditions", "gentle_law", "row_sets",
+           "GAIN_FACTORS"]
 
 #: The smallest invariant gains are tried times these factors (the Arb conditions need a little room).
 GAIN_FACTORS = (1.02, 1.1, 1.3)
@@ -80,20 +86,42 @@ def row_changes(b: TerminalBounds, law: TerminalLaw, arc: CompletionArc) -> RowC
     seen = (dxy / arb(law.d_lo)).asin()
     w_alpha = arb(b.dev_psi) + seen
     tau = (arc.lateral / arc.x_min).atan()
-    arc_alpha = g * arc.a0 + tau
-    den_min = (g * arc.a0 / 2).sinc() * arc.beta.cos()
-    den_slope = (g / 2) * (g * arc.a0 / 2) / 3 + (1 - g / 2) * arc.beta.sin()
-    slope = den_slope / (den_min * den_min)
+    arc_alpha = g * arc.a0 + arc.residual
+    den_min = (arc.turn_max / 2).sinc() * arc.beta.cos()
+    slope = ((g / 2) * (arc.turn_max / 2) / 3 + (1 - g / 2) * arc.beta.sin()) / (den_min * den_min)
+    slope_ff = (arc.turn_max / 12 + arc.beta.sin() / 2) / (den_min * den_min)  # per unit of δ |Δω̂|
     n_max = p + lam * arc.spread
     curve = a_xy * dt * dt / 2
     radial_arc = lam * dt * arc.spread + curve + arc.lateral ** 2 / (2 * arc.x_min)
     share_dev, share_arc = _bearing_shares(b, law, tau)
-    u_dev = (p * seen * share_dev + lam * dxy) / den_min + n_max * slope * w_alpha
-    u_arc = (a_xy * dt + p * tau * share_arc + lam * radial_arc) / den_min + n_max * slope * arc_alpha
+    n_dev = p * seen * share_dev + lam * dxy
+    n_arc = a_xy * dt + p * tau * share_arc + lam * radial_arc
+    ff_dev = ff_arc = arb(0)
+    if law.los_feedforward:
+        ff_dev = feedforward_change(b, law, arc, across=p * seen, closing=n_dev, alpha=w_alpha, distance=dxy,
+                                    nearest=arc.start_min)
+        ff_arc = feedforward_change(b, law, arc, across=a_xy * dt + p * tau, closing=n_arc, alpha=arc_alpha,
+                                    distance=radial_arc, nearest=arb(min(lower(arc.start_min), lower(arc.x_min))))
+    u_dev = n_dev / den_min + n_max * slope * w_alpha + n_max * slope_ff * dt * ff_dev
+    u_arc = n_arc / den_min + n_max * slope * arc_alpha + n_max * slope_ff * dt * ff_arc
     dz, a_z, z_f = arb(b.dev_z), arb(b.accel_z), arb(law.z_max)
     w_dev = lam_z * dz
     w_arc = a_z * dt + lam_z * (lam_z * dt * (z_f + dz) + a_z * dt * dt / 2)
-    return RowChanges(deviation=(u_dev, w_dev, g / dt * w_alpha), arc=(u_arc, w_arc, g / dt * arc_alpha))
+    return RowChanges(deviation=(u_dev, w_dev, g / dt * w_alpha + ff_dev),
+                      arc=(u_arc, w_arc, g / dt * arc_alpha + ff_arc))
+
+
+def feedforward_change(b: TerminalBounds, law: TerminalLaw, arc: CompletionArc, *, across: arb, closing: arb,
+                       alpha: arb, distance: arb, nearest: arb) -> arb:
+    """The largest change of the feedforward ω̂ = (P_⊥ − N tan α) / d (rad/s, step 17e) between two states whose
+    P_⊥ differ by at most ``across``, N by ``closing``, α by ``alpha``, d by ``distance``, both at least ``nearest``
+    from the target, with |P_⊥| <= P, |N| <= N_max = P + λ Δ and |α| <= A_0:
+
+        |Δω̂| <= (ΔP_⊥ + ΔN tan A_0 + N_max sec²(A_0) Δα) / d_min + (P + N_max tan A_0) Δd / d_min²."""
+    p, a0 = arb(b.speed_xy), arc.a0
+    n_max = p + arb(law.gain_d) * arc.spread
+    tan, sec2 = a0.tan(), 1 / a0.cos() ** 2
+    return (across + closing * tan + n_max * sec2 * alpha) / nearest + (p + n_max * tan) * distance / nearest ** 2
 
 
 def _bearing_shares(b: TerminalBounds, law: TerminalLaw, tau: arb) -> tuple[arb, arb]:
@@ -134,11 +162,12 @@ def _smallest_gains(b: TerminalBounds, law: TerminalLaw) -> tuple[float, float, 
         if arc is None or not arc.x_min > 0:
             return None
         a0, lateral, x_min, x_max = (float(x.mid()) for x in (arc.a0, arc.lateral, arc.x_min, arc.x_max))
+        residual = float(arc.residual.mid()) if law.los_feedforward else math.atan(lateral / x_min)
         overshoot = math.hypot(x_max, lateral) - x_max
         lam_lo = (dxy + curve + GAIN_SLACK) / (dt * below)
         lam_hi = (dxy + curve + overshoot + GAIN_SLACK) / (dt * (law.d_hi + dxy - law.d_star))
         lam = max(lam_lo, lam_hi)
-        g = (a0 - law.alpha_max + math.atan(lateral / x_min) + GAIN_SLACK) / a0
+        g = (a0 - law.alpha_max + residual + GAIN_SLACK) / a0
         if not (0.0 < g <= 1.0 and lam * dt <= 1.0):
             return None
     lam_z = (b.dev_z + b.accel_z * dt * dt / 2 + GAIN_SLACK) / (dt * (law.z_max + b.dev_z))

@@ -61,8 +61,6 @@ class LoopFacts(Protocol):
     hull: Mapping[str, arb]
     nominal: Mapping[str, arb]
     m_hat: tuple[arb, ...]
-    k_p: float
-    k_i: float
     slope: tuple[float, ...]
     tick: float
     ticks: int
@@ -71,6 +69,8 @@ class LoopFacts(Protocol):
     mass_gain_balls: tuple[tuple[arb, ...], ...]
 
     def box(self, error: Sequence[float]) -> tuple[tuple[float, float, float], float]: ...
+
+    def channel_gains(self, c: int) -> tuple[arb, arb]: ...
 
 
 @dataclass(frozen=True)
@@ -178,7 +178,7 @@ def channel_cells(loop: LoopFacts, c: int, base: Sequence[Sequence[arb]],
     box, gamma = loop.box((0.0,) * len(loop.names))
     nu = velocity_box(box[0], gamma, box[1], box[2])
     with ctx.workprec(RESPONSE_PREC):
-        k_p, k_i, lam = arb(loop.k_p), arb(loop.k_i), arb(loop.slope[c])
+        (k_p, k_i), lam = loop.channel_gains(c), arb(loop.slope[c])
         out = []
         for combo in itertools.product(*pieces):
             hull = {**loop.hull, **dict(zip(names, combo))}

@@ -56,18 +56,20 @@ class LoopData:
         self.v_int = with_sway(self.v_max, float(sway_max), self.lateral)
         self.nominal, self.hull = nominal_balls(params), hull_balls(params)
         nom = nominal_params(params)
+        # loop_bandwidth's gains (what the LDI studies of benchmarks/ read); the bound reads each channel's own:
         self.k_p, self.k_i = float(nom.loop_bandwidth), 0.25 * float(nom.loop_bandwidth) ** 2
+        # per channel (in the order of ``names``): its own PI gains (k_p, k_i), the loop_bandwidth's where the vehicle
+        # gives the channel no bandwidth of its own (VehicleParams.loop_gains)
+        self.gains: tuple[tuple[float, float], ...] = tuple(params.loop_gains[i] for i in self.own)
         self.lag = point_time_constant(params)
         self.m_hat = channel_masses(self.nominal, self.lateral)
         self.m_true = channel_masses(self.hull, self.lateral)
         box, gamma = self.box((0.0,) * len(self.names))
         self.slope = tuple(float(x.mid()) for x in self.slopes(box, gamma)) if math.isfinite(gamma) \
             else (0.0,) * len(self.names)
-        kp, ki = arb(self.k_p), arb(self.k_i)
-        bases = tuple(loop_matrix(self.k_p, self.k_i, self.lag, lam) for lam in self.slope)  # A(λ_c) per channel
-        self.sums: tuple[ResponseSums, ...] = tuple(impulse_sums(
-            a, [[0, 1, -kp], [1 / ki, 0, 0], [0, 0, -1]], [[0, 1, 0], [ki, kp, 0], [0, 0, 1], [ki, kp, 1]],
-            tick=tick, ticks_per_period=ticks) for a in bases)
+        bases = tuple(loop_matrix(kp, ki, self.lag, lam) for lam, (kp, ki) in zip(self.slope, self.gains))  # A(λ_c)
+        self.sums: tuple[ResponseSums, ...] = tuple(_channel_sums(a, kp, ki, tick, ticks)
+                                                    for a, (kp, ki) in zip(bases, self.gains))
         h = arb(tick)
         # the sums as balls, per channel and output row: (jump per tick, jump per period, h Ẇ, h w_n, start peak)
         self.gain_balls = tuple(gain_balls(s, tick) for s in self.sums)
@@ -78,6 +80,11 @@ class LoopData:
         # step 5c: per channel, its own constant coefficients split into cells (verify.vehicle.cells)
         self.cells: tuple[tuple[Cell, ...], ...] = tuple(channel_cells(self, c, a) for c, a in enumerate(bases)) \
             if self.stable else tuple(() for _ in self.names)
+
+    def channel_gains(self, c: int) -> tuple[arb, arb]:
+        """(k_p, k_i) of channel ``c`` (an index into ``names``) as balls."""
+        kp, ki = self.gains[c]
+        return arb(kp), arb(ki)
 
     @property
     def stable(self) -> bool:
@@ -101,6 +108,14 @@ class LoopData:
         """∂n̂_c/∂y_c / m̂_c over the velocity box (1/s): the drag's slope in the channel's own speed."""
         grads = channel_gradient(self.nominal, velocity_box(box[0], gamma, box[1], box[2]), self.lateral)
         return [grads[c][self.own[c]] / self.m_hat[c] for c in range(len(self.names))]
+
+
+def _channel_sums(a: list, k_p: float, k_i: float, tick: float, ticks: int) -> ResponseSums:
+    """The impulse-response sums of one channel's loop matrix ``a`` with its gains: the inputs (jump, Ẇ, w_n)
+    and the outputs (e, a, z, ẏ) of :mod:`verify.vehicle.bound`."""
+    kp, ki = arb(k_p), arb(k_i)
+    return impulse_sums(a, [[0, 1, -kp], [1 / ki, 0, 0], [0, 0, -1]], [[0, 1, 0], [ki, kp, 0], [0, 0, 1], [ki, kp, 1]],
+                        tick=tick, ticks_per_period=ticks)
 
 
 @functools.lru_cache(maxsize=8)

@@ -129,7 +129,7 @@ def test_where_no_coarse_set_fits_the_rows_the_refinement_finds_one_that_meets_e
     b = terminal_bounds(sc, cert.design, cert.region)
     coarse_lows = {round(s.d_lo, 9) for s in terminal._sets(b)}
     assert round(law.d_lo, 9) not in coarse_lows
-    monkeypatch.setattr(terminal, "_refined", lambda bounds: iter(()))
+    monkeypatch.setattr(terminal, "_refined", lambda bounds, wanted: iter(()))
     found, conds = terminal.design_terminal(sc, cert.design, cert.region, cert.backup.safe_set)
     assert found is None and {c.condition for c in conds if not c.ok} == {"initial_terminal"}
 
@@ -164,3 +164,27 @@ def test_step_17_proves_a_plan_at_every_period_only_where_it_covers_the_loop(edi
     from verify.theorem.terminal import proves_feasibility
     sc = PC.with_changes(**edits)
     assert proves_feasibility(sc, Region.from_scenario(sc)) is proved
+
+
+@pytest.mark.parametrize("rate, searched", [
+    ((0.5, 0.5, 0.05), True),     # the yaw row fails: the feedforward may lower it
+    ((0.5, 0.002, 1.0), False),   # the heave row fails: nothing the feedforward changes
+])
+def test_the_feedforwards_laws_are_searched_only_where_they_could_lower_what_fails(monkeypatch, rate, searched):
+    """paper_currents with rate-limited plans: where the best memoryless set fails its yaw row, the search goes on
+    to the line-of-sight feedforward's laws (step 17e); where it fails its heave row (a member of
+    FEEDFORWARD_CANNOT_LOWER), their grid is never built, and the verdict names the heave row."""
+    import verify.theorem.terminal as terminal
+
+    built = []
+    sets = terminal._sets
+
+    def spy(b, fine=False, feedforward=False):
+        built.append(feedforward)
+        return sets(b, fine, feedforward)
+    monkeypatch.setattr(terminal, "_sets", spy)
+    cert = verify.certify(PC.with_changes(**{"limits.rate": rate}))
+    assert not cert.tiers.tracking and any(built) is searched
+    if not searched:
+        assert "terminal_rate[w]" in {c.condition for c in cert.failures}
+        assert "terminal_rate[w]" in terminal.FEEDFORWARD_CANNOT_LOWER

@@ -43,9 +43,10 @@ condition.
 from __future__ import annotations
 
 import dataclasses
+import functools
 import itertools
 import math
-from typing import Iterator
+from typing import Callable, Iterator
 
 from flint import arb
 
@@ -66,10 +67,19 @@ from verify.theorem.terminal_bearing import bearing_conditions, bearing_row_sets
 from verify.theorem.terminal_rows import row_conditions, row_sets
 
 __all__ = ["TerminalBounds", "terminal_bounds", "law_conditions", "footprint_of", "sensing_condition",
-           "design_terminal", "with_terminal", "proves_feasibility", "FLOAT_SLACK", "TERMINAL_PREFIXES"]
+           "design_terminal", "with_terminal", "proves_feasibility", "FLOAT_SLACK", "TERMINAL_PREFIXES",
+           "FEEDFORWARD_CANNOT_LOWER"]
 
 #: Name prefixes of the terminal ingredients' conditions (tracking tier).
 TERMINAL_PREFIXES = ("terminal_", "path_", "initial_terminal")
+#: Conditions the line-of-sight feedforward (step 17e) cannot lower: the e_d and depth rooms, the radial and depth
+#: invariance, the heave row, the surge floor and the sensed region. Where the best memoryless set fails one of them,
+#: its laws are not searched (a search effort, not a proof step).
+FEEDFORWARD_CANNOT_LOWER = frozenset((
+    "terminal_in_region[e_d_lo]", "terminal_in_region[e_d_hi]", "terminal_in_region[e_z]", "terminal_in_region[room]",
+    "terminal_invariant[e_z]", "terminal_invariant[d_lo]", "terminal_invariant[d_hi]", "terminal_inputs[w]",
+    "terminal_rate[w]", "terminal_invariant[row_w]", "terminal_gains", "terminal_surge_floor", "terminal_sensing",
+    "terminal_backup"))
 #: Fractions of the free e_d band X_f's width is tried at, largest first.
 WIDTHS = (1.0, 0.6, 0.35, 0.2, 0.1)
 #: Where X_f's lower end d_lo is tried, as fractions of the free e_d band above its least value (a larger d_lo
@@ -152,6 +162,7 @@ def _region_conditions(b: TerminalBounds, law: TerminalLaw, arc: CompletionArc) 
                   arb(b.room_z))]
 
 
+@functools.lru_cache(maxsize=1 << 15)
 def law_conditions(b: TerminalBounds, law: TerminalLaw) -> tuple[Condition, ...]:
     """The completion's conditions for ``law`` (module doc): inputs, invariance and the region along the arc."""
     arc = completion_arc(b, law)
@@ -203,33 +214,42 @@ def sensing_condition(scenario: Scenario, b: TerminalBounds, safe: SafeSet) -> C
                  spread, arb(scenario.sensing_range) - arb(scenario.vehicle_radius))
 
 
-def _sets(b: TerminalBounds, fine: bool = False, feedforward: bool = False) -> list[TerminalLaw]:
+def _sets(b: TerminalBounds, fine: bool = False, feedforward: bool = False) -> tuple[TerminalLaw, ...]:
     """The grid of terminal sets and their gains, largest first (module doc); under a surge floor each with its
     bearing face (:func:`verify.theorem.terminal_bearing.bearing_sets`). ``fine``: the refinement's sets that the
     coarse grid does not have (:data:`FINE_LOWER_ENDS`, :data:`FINE_WIDTHS`); ``feedforward``: the laws with the
-    line-of-sight feedforward (step 17e)."""
+    line-of-sight feedforward (step 17e). Memoized on the bounds and the grid as it stands (the dynamic plant's fixed
+    point derives the same bounds in each of its rounds; a study may replace the grid)."""
     if fine:
         coarse = set(_grid_points(WIDTHS, LOWER_ENDS))
-        points = [p for p in _grid_points(FINE_WIDTHS, FINE_LOWER_ENDS) if p not in coarse]
+        points = tuple(p for p in _grid_points(FINE_WIDTHS, FINE_LOWER_ENDS) if p not in coarse)
     else:
-        points = _grid_points(WIDTHS, LOWER_ENDS)
-    laws = _grid(b, points)
+        points = tuple(_grid_points(WIDTHS, LOWER_ENDS))
+    return _built_sets(b, points, tuple(ANGLES), feedforward)
+
+
+@functools.lru_cache(maxsize=64)
+def _built_sets(b: TerminalBounds, points: tuple[tuple[float, float], ...], angles: tuple[float, ...],
+                feedforward: bool) -> tuple[TerminalLaw, ...]:
+    """:func:`_sets` for the grid ``points`` and heading fractions ``angles``."""
+    laws = _grid(b, list(points), angles)
     if feedforward:
         laws = [dataclasses.replace(law, los_feedforward=True) for law in laws]
     if b.jumps is not None:
-        return bearing_row_sets(b, laws) if b.surge_floor is not None else row_sets(b, laws)
-    return bearing_sets(b, laws) if b.surge_floor is not None else laws
+        return tuple(bearing_row_sets(b, laws) if b.surge_floor is not None else row_sets(b, laws))
+    return tuple(bearing_sets(b, laws) if b.surge_floor is not None else laws)
 
 
-def _refined(b: TerminalBounds) -> Iterator[TerminalLaw]:
+def _refined(b: TerminalBounds, wanted: Callable[[], bool]) -> Iterator[TerminalLaw]:
     """The refinement's sets under rate-limited plans (the row faces: their gains must be the gentlest a set
-    allows), built only when the loop asks for them (the coarse grid found none), then the same grid's laws with the
-    line-of-sight feedforward, coarse and fine (step 17e: the yaw row follows the line of sight's turn instead of
-    catching it up); none without rate limits."""
+    allows), built only when the loop asks for them (the coarse grid found none), then, when ``wanted()`` says so
+    once the memoryless sets are spent, the same grid's laws with the line-of-sight feedforward, coarse and fine
+    (step 17e: the yaw row follows the line of sight's turn instead of catching it up); none without rate limits."""
     if b.jumps is not None:
         yield from _sets(b, fine=True)
-        yield from _sets(b, feedforward=True)
-        yield from _sets(b, fine=True, feedforward=True)
+        if wanted():
+            yield from _sets(b, feedforward=True)
+            yield from _sets(b, fine=True, feedforward=True)
 
 
 def _grid_points(widths: tuple[float, ...], lower_ends: tuple[float, ...]) -> list[tuple[float, float]]:
@@ -237,8 +257,10 @@ def _grid_points(widths: tuple[float, ...], lower_ends: tuple[float, ...]) -> li
     return [(w, f) for w in widths for f in lower_ends]
 
 
-def _grid(b: TerminalBounds, points: list[tuple[float, float]]) -> list[TerminalLaw]:
-    """The grid of terminal sets without the bearing face at the (width, lower end) fractions ``points``."""
+def _grid(b: TerminalBounds, points: list[tuple[float, float]], angles: tuple[float, ...] = ANGLES
+          ) -> list[TerminalLaw]:
+    """The grid of terminal sets without the bearing face at the (width, lower end) fractions ``points`` and the
+    fractions ``angles`` of the free heading room."""
     dt, (ub, wb, rb) = b.dt, b.v_bar
     half_run = (ub + b.speed_xy) * dt / 2
     lo_min = b.room_d[0] + b.dev_xy + half_run + 1e-6
@@ -253,7 +275,7 @@ def _grid(b: TerminalBounds, points: list[tuple[float, float]]) -> list[Terminal
         seen = b.dev_psi + math.asin(min(1.0, b.dev_xy / d_lo))
         turn = math.asin(min(1.0, 2 * half_run / (d_lo - b.dev_xy)))
         room = math.asin(min(b.room_o, 0.999)) - seen - turn if b.room_o > 0 else -1.0
-        for frac in ANGLES:
+        for frac in angles:
             alpha_f = min(frac * room, 1.2)
             if alpha_f <= 0.0:
                 continue
@@ -319,7 +341,15 @@ def design_terminal(scenario: Scenario, design: Design, region: Region, safe: Sa
     closest: tuple[tuple[int, float], tuple[Condition, ...]] | None = None
     narrowest: tuple[float, TerminalLaw, tuple[Condition, ...]] | None = None
     blocked: list[PathFootprint] = []  # footprints whose path failed: one that contains any of them fails too
-    for law in itertools.chain(_sets(b), _refined(b)):
+
+    def fed() -> bool:
+        """Whether the feedforward's laws are worth a search (the proof does not depend on it): the rest of the
+        design holds, and the best memoryless set fails nothing the feedforward cannot lower."""
+        best = narrowest[2] if narrowest is not None else closest[1] if closest is not None else ()
+        return all(c.ok for c in design.conditions) and not any(
+            not c.ok and c.condition in FEEDFORWARD_CANNOT_LOWER for c in best)
+
+    for law in itertools.chain(_sets(b), _refined(b, fed)):
         own = law_conditions(b, law)
         if not all(c.ok for c in own):
             miss = _shortfall(own)

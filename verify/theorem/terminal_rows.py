@@ -44,6 +44,7 @@ narrower than K(arc): the plans meet a wide face more easily, and the completion
 
 from __future__ import annotations
 
+import copy
 import dataclasses
 import math
 
@@ -64,6 +65,8 @@ GAIN_FACTORS = (1.02, 1.1, 1.3)
 #: Each smallest gain closes its face by this much more (m or rad) than the deviation needs: the Arb conditions
 #: ask a slack of FLOAT_SLACK, and a channel without deviation (no vertical current) would otherwise get gain 0.
 GAIN_SLACK = 1e-8
+#: The fixed-point rounds of the smallest gains stop once neither gain moves by more than this share of itself.
+SETTLED = 1e-12
 #: The narrowest face S is the arc's bound times (1 + this) plus twice FLOAT_SLACK.
 FACE_INFLATION = 1e-6
 #: The widest face leaves this share of J to the rate condition's slack.
@@ -158,7 +161,8 @@ def _smallest_gains(b: TerminalBounds, law: TerminalLaw) -> tuple[float, float, 
     below = law.d_star - law.d_lo + dxy
     g, lam = 0.01, 0.0
     for _ in range(12):
-        arc = completion_arc(b, dataclasses.replace(law, turn=g, gain_d=lam))
+        before = (g, lam)
+        arc = completion_arc(b, _sized(law, g, lam))
         if arc is None or not arc.x_min > 0:
             return None
         a0, lateral, x_min, x_max = (float(x.mid()) for x in (arc.a0, arc.lateral, arc.x_min, arc.x_max))
@@ -170,8 +174,19 @@ def _smallest_gains(b: TerminalBounds, law: TerminalLaw) -> tuple[float, float, 
         g = (a0 - law.alpha_max + residual + GAIN_SLACK) / a0
         if not (0.0 < g <= 1.0 and lam * dt <= 1.0):
             return None
+        if abs(g - before[0]) <= SETTLED * g and abs(lam - before[1]) <= SETTLED * lam:
+            break  # settled: the rounds left would move the gains by less than the float slack matters
     lam_z = (b.dev_z + b.accel_z * dt * dt / 2 + GAIN_SLACK) / (dt * (law.z_max + b.dev_z))
     return g, lam, lam_z
+
+
+def _sized(law: TerminalLaw, turn: float, gain_d: float) -> TerminalLaw:
+    """``law`` with the trial ``turn`` and ``gain_d`` of a sizing round, not validated again (the rounds build
+    thousands; every law the search returns is built by :func:`dataclasses.replace`, which validates it)."""
+    trial = copy.copy(law)
+    object.__setattr__(trial, "turn", turn)
+    object.__setattr__(trial, "gain_d", gain_d)
+    return trial
 
 
 def gentle_law(b: TerminalBounds, law: TerminalLaw, factor: float) -> TerminalLaw | None:

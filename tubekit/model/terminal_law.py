@@ -168,6 +168,7 @@ class TerminalLaw:
             turn = -g * alpha + dt * (across - closing * math.tan(alpha)) / d
             u = closing / (float(sinc(0.5 * turn)) * math.cos(alpha + 0.5 * turn))
             return np.array([u, v[2] - self.gain_z * e_z, turn / dt])
+        # T = −g α: the memoryless law, written as it was so that its floats stay the certified runs' own
         u = closing / (float(sinc(0.5 * g * alpha)) * math.cos(alpha * (1 - g / 2)))
         return np.array([u, v[2] - self.gain_z * e_z, -g * alpha / dt])
 

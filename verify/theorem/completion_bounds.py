@@ -120,8 +120,7 @@ def completion_arc(b: TerminalBounds, law: TerminalLaw) -> CompletionArc | None:
     turn_max = arb(law.turn) * a0 + dt * omega
     residual = (lateral / x_min).atan() if x_min > 0 else arb("inf")
     if law.los_feedforward and x_min > 0:
-        residual = feedforward_residual(b, a0, beta, spread, lam, closing, omega, turn_max, x_min, lateral,
-                                        start_min)
+        residual = feedforward_residual(b, a0, spread, lam, closing, omega, turn_max, x_min, lateral, start_min)
     return CompletionArc(a0=a0, beta=beta, spread=spread, x_min=x_min, x_max=x_max, lateral=lateral,
                          start_min=start_min, omega=omega, turn_max=turn_max, residual=residual)
 
@@ -134,8 +133,8 @@ def _across_share(b: TerminalBounds, law: TerminalLaw) -> arb:
     return phi0.sin() if phi0 < arb.pi() / 2 else arb(1)
 
 
-def feedforward_residual(b: TerminalBounds, a0: arb, beta: arb, spread: arb, lam: arb, closing: arb, omega: arb,
-                         turn_max: arb, x_min: arb, lateral: arb, start_min: arb) -> arb:
+def feedforward_residual(b: TerminalBounds, a0: arb, spread: arb, lam: arb, closing: arb, omega: arb, turn_max: arb,
+                         x_min: arb, lateral: arb, start_min: arb) -> arb:
     """E (rad): |δ ω̂ − θ| over the completion, θ = atan(q'_y / q'_x) the line of sight's turn (step 17e). With
     y_0 = δ (P_⊥ − N tan α̃) = δ d̃ ω̂, the chord's lateral δ N tan(α̃ + T/2) = δ N tan α̃ − y_1 and the target's
     curvature ρ (|ρ| <= A δ²/2): q'_y = y_0 + y_1 + ρ_y and q'_x − d̃ = −λ δ (d̃ − d*) + ρ_x, so

@@ -22,7 +22,7 @@ together (``verify.theorem.terminal_bearing.bearing_row_sets``); ``--start``: th
 its midpoint to ``--spread`` of its half-widths, :meth:`tubekit.model.vehicle_params.VehicleParams.shrunk`; 0: the
 midpoint, 1: the published box), with ``--w-max`` and the vertical current ``--current-z``: the velocity loop's
 bound then enters every cell. ``--yaw-bandwidth W``: its yaw loop at W rad/s (``yaw_loop_bandwidth``; the other
-channels keep the vehicle's ``loop_bandwidth``).
+channels keep the vehicle's ``loop_bandwidth``); ``--heave-bandwidth W``: its heave loop likewise.
 
 Usage: ``python benchmarks/survey_frontier.py [--speed 0.6 1.0 1.5] [--current 0.1 0.2 0.3] [--offset 5 30]
 [--backup none] [--rate 0.5 0.5 1.0] [--start 7] [--e-d-max 60] [--sensing 150] [--vehicle remus100 --spread 0
@@ -47,15 +47,16 @@ def survey(speed: float, current: float, offset: float, *, u_min: float = 0.5, u
            r_max: float = 0.2, epsilon: float = 3.0, backup: str = "loiter",
            rate: tuple[float, float, float] | None = None, start: float | None = None,
            e_d_max: float | None = None, sensing: float = 80.0, vehicle: str | None = None,
-           spread: float = 0.0, w_max: float | None = None, current_z: float = 0.05, yaw_bandwidth: float = 0.0):
+           spread: float = 0.0, w_max: float | None = None, current_z: float = 0.05, yaw_bandwidth: float = 0.0,
+           heave_bandwidth: float = 0.0):
     """The survey scenario of the module doc (a :class:`tubekit.scenario.Scenario`), with ``controller.backup``
     ``backup`` (the loiter, or ``none``: the safe tier as the tracking tier's corollary). ``rate``: the plans'
     rate limit (m/s², m/s², rad/s²; ``limits.rate``), the command before t = 0 then the target's speed ahead;
     ``start``: the start's distance behind the target (m; default ε + 2); ``e_d_max``: ``region.e_d_max`` (m;
     default ε + 5); ``sensing``: ``sensing_range`` (m); ``vehicle``: a bundled vehicle's name for the dynamic plant,
     its box shrunk to ``spread`` (module doc); ``w_max``: ``limits.w_max`` (m/s; default the example's);
-    ``current_z``: the vertical current's amplitude (m/s); ``yaw_bandwidth``: the vehicle's
-    ``yaw_loop_bandwidth`` (rad/s; 0: its ``loop_bandwidth``)."""
+    ``current_z``: the vertical current's amplitude (m/s); ``yaw_bandwidth``, ``heave_bandwidth``: the vehicle's
+    ``yaw_loop_bandwidth``, ``heave_loop_bandwidth`` (rad/s; 0: its ``loop_bandwidth``)."""
     from tubekit import load_scenario
     from tubekit.model.trajectory import Line
     from tubekit.scenario import Obstacle
@@ -78,7 +79,7 @@ def survey(speed: float, current: float, offset: float, *, u_min: float = 0.5, u
 
     table = scenario.to_dict()
     box = vehicle_params(vehicle).shrunk(spread).to_dict()
-    box["yaw_loop_bandwidth"] = yaw_bandwidth
+    box["yaw_loop_bandwidth"], box["heave_loop_bandwidth"] = yaw_bandwidth, heave_bandwidth
     table["plant"] = {"kind": "dynamic", "vehicle": {k: v for k, v in box.items() if k != "name"}}
     return scenario_from_dict(table)
 
@@ -126,11 +127,14 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--current-z", type=float, default=0.05, help="the vertical current's amplitude (m/s)")
     ap.add_argument("--yaw-bandwidth", type=float, default=0.0,
                     help="plant.vehicle.yaw_loop_bandwidth (rad/s; 0: the vehicle's loop_bandwidth)")
+    ap.add_argument("--heave-bandwidth", type=float, default=0.0,
+                    help="plant.vehicle.heave_loop_bandwidth (rad/s; 0: the vehicle's loop_bandwidth)")
     args = ap.parse_args(argv)
     limits = {"u_min": args.u_min, "u_max": args.u_max, "r_max": args.r_max, "epsilon": args.epsilon,
               "backup": args.backup, "rate": args.rate, "start": args.start, "e_d_max": args.e_d_max,
               "sensing": args.sensing, "vehicle": args.vehicle, "spread": args.spread, "w_max": args.w_max,
-              "current_z": args.current_z, "yaw_bandwidth": args.yaw_bandwidth}
+              "current_z": args.current_z, "yaw_bandwidth": args.yaw_bandwidth,
+              "heave_bandwidth": args.heave_bandwidth}
     for offset in args.offset:
         print(f"obstacle {offset:g} m off the path; u_min {args.u_min:g}, u_max {args.u_max:g} m/s, "
               f"r_max {args.r_max:g} rad/s, epsilon {args.epsilon:g} m, backup {args.backup}, "

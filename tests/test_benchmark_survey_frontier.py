@@ -110,3 +110,12 @@ def test_with_its_yaw_loop_at_ten_rad_s_the_midpoint_torpedo_keeps_both_tiers_on
     run = tubekit.simulate(across, cert, progress=False)
     assert cert.tiers.tracking and [p.name for p in tubekit.check_promises(run) if p.given and not p.ok] == []
     assert run.metrics["replaced_steps"] == 0 and float(np.min(run.inputs[:-1, 0])) >= 1.0
+
+
+def test_with_its_heave_loop_at_four_rad_s_a_five_percent_box_keeps_both_tiers():
+    """The yaw loop at 10 rad/s and the heave loop at 4 rad/s (``heave_loop_bandwidth``): ±5 % of REMUS 100's
+    published half-widths, 1.25 m/s in 0.1 m/s of current, keeps both tiers: a coefficient box, not a point."""
+    kw = dict(u_min=1.0, u_max=1.5, r_max=0.02, backup="none", rate=(0.05, 0.01, 0.004), start=80.0, e_d_max=100.0,
+              sensing=300.0, vehicle="remus100", spread=0.05, w_max=0.015, current_z=0.005, yaw_bandwidth=10.0)
+    res = STUDY.cell(1.25, 0.1, 40.0, heave_bandwidth=4.0, **kw)
+    assert res["tiers"] == "both" and res["failed"] == []

@@ -7,7 +7,9 @@ paper's model, no velocity loop): the minimum-surge tube, the loiter's certified
 through the terminal set's bearing face (``docs/verify.md`` steps 13e, 17b). For each target speed P and current
 amplitude c (per horizontal axis; 0.05 m/s in depth) ``examples/keep_moving_tracked.toml`` is re-set to a survey:
 a line at P along x, u_min ``--u-min``, u_max ``--u-max``, r_max ``--r-max``, ε ``--epsilon``, e_d <= ε + 5 m, the start
-2 m behind the target's ε, and one obstacle (radius 0.5 m) whose centre is ``--offset`` m off the path, 40 m ahead.
+2 m behind the target's ε, and one obstacle (radius 0.5 m) whose centre is ``--offset`` m off the path, at
+x = ``--rock-x`` m (default 40 m ahead of the target's start; with a start far behind, put it where the vehicle
+passes within the run's 60 s, or it never stands in the vehicle's way).
 Each cell prints the tiers (``both``, ``safe``, or the first failed conditions) and the loiter's certified radius.
 Nothing is timed.
 
@@ -48,7 +50,7 @@ def survey(speed: float, current: float, offset: float, *, u_min: float = 0.5, u
            rate: tuple[float, float, float] | None = None, start: float | None = None,
            e_d_max: float | None = None, sensing: float = 80.0, vehicle: str | None = None,
            spread: float = 0.0, w_max: float | None = None, current_z: float = 0.05, yaw_bandwidth: float = 0.0,
-           heave_bandwidth: float = 0.0):
+           heave_bandwidth: float = 0.0, rock_x: float = 40.0):
     """The survey scenario of the module doc (a :class:`tubekit.scenario.Scenario`), with ``controller.backup``
     ``backup`` (the loiter, or ``none``: the safe tier as the tracking tier's corollary). ``rate``: the plans'
     rate limit (m/s², m/s², rad/s²; ``limits.rate``), the command before t = 0 then the target's speed ahead;
@@ -56,7 +58,9 @@ def survey(speed: float, current: float, offset: float, *, u_min: float = 0.5, u
     default ε + 5); ``sensing``: ``sensing_range`` (m); ``vehicle``: a bundled vehicle's name for the dynamic plant,
     its box shrunk to ``spread`` (module doc); ``w_max``: ``limits.w_max`` (m/s; default the example's);
     ``current_z``: the vertical current's amplitude (m/s); ``yaw_bandwidth``, ``heave_bandwidth``: the vehicle's
-    ``yaw_loop_bandwidth``, ``heave_loop_bandwidth`` (rad/s; 0: its ``loop_bandwidth``)."""
+    ``yaw_loop_bandwidth``, ``heave_loop_bandwidth`` (rad/s; 0: its ``loop_bandwidth``); ``rock_x``: the obstacle's
+    position along the path (m; the target starts at 0, the vehicle ``start`` behind it: a rock must lie where the
+    vehicle passes within the run's 60 s to stand in its way)."""
     from tubekit import load_scenario
     from tubekit.model.trajectory import Line
     from tubekit.scenario import Obstacle
@@ -67,7 +71,7 @@ def survey(speed: float, current: float, offset: float, *, u_min: float = 0.5, u
         limits["limits.w_max"] = w_max
     scenario = load_scenario(SCENARIO).with_changes(
         name="survey", trajectory=Line(start=(0.0, 0.0, 0.0), direction_velocity=(speed, 0.0, 0.0)),
-        obstacles=(Obstacle((40.0, offset, 0.0), 0.5),), epsilon=epsilon, duration=60.0, sensing_range=sensing,
+        obstacles=(Obstacle((rock_x, offset, 0.0), 0.5),), epsilon=epsilon, duration=60.0, sensing_range=sensing,
         workspace=((-100.0, -100.0, -10.0), (300.0, 100.0, 10.0)), initial_state=(-behind, 0.0, 0.0, 0.0),
         **{"limits.u_max": u_max, "limits.u_min": u_min, "limits.r_max": r_max, "controller.backup": backup,
            "disturbance.amplitude": (current, current, current_z),
@@ -129,14 +133,17 @@ def main(argv: list[str] | None = None) -> int:
                     help="plant.vehicle.yaw_loop_bandwidth (rad/s; 0: the vehicle's loop_bandwidth)")
     ap.add_argument("--heave-bandwidth", type=float, default=0.0,
                     help="plant.vehicle.heave_loop_bandwidth (rad/s; 0: the vehicle's loop_bandwidth)")
+    ap.add_argument("--rock-x", type=float, default=40.0,
+                    help="the obstacle's position along the path (m; the target starts at 0)")
     args = ap.parse_args(argv)
     limits = {"u_min": args.u_min, "u_max": args.u_max, "r_max": args.r_max, "epsilon": args.epsilon,
               "backup": args.backup, "rate": args.rate, "start": args.start, "e_d_max": args.e_d_max,
               "sensing": args.sensing, "vehicle": args.vehicle, "spread": args.spread, "w_max": args.w_max,
               "current_z": args.current_z, "yaw_bandwidth": args.yaw_bandwidth,
-              "heave_bandwidth": args.heave_bandwidth}
+              "heave_bandwidth": args.heave_bandwidth, "rock_x": args.rock_x}
     for offset in args.offset:
-        print(f"obstacle {offset:g} m off the path; u_min {args.u_min:g}, u_max {args.u_max:g} m/s, "
+        print(f"obstacle {offset:g} m off the path at x = {args.rock_x:g} m; u_min {args.u_min:g}, "
+              f"u_max {args.u_max:g} m/s, "
               f"r_max {args.r_max:g} rad/s, epsilon {args.epsilon:g} m, backup {args.backup}, "
               f"plans' rate {args.rate or 'none'}, start {args.start or args.epsilon + 2.0:g} m behind, "
               f"e_d_max {args.e_d_max or args.epsilon + 5.0:g} m, sensing {args.sensing:g} m"

@@ -224,22 +224,50 @@ def test_a_surge_floor_is_reserved_kappa_bar_above_u_min_and_fails_when_the_band
     assert "v_bar[surge_floor]" not in sym                                        # the symmetric box: no such row
 
 
+def _positive_root(a: float, b: float, force: float) -> float:
+    """The positive root of a v² + b v = force (a > 0)."""
+    return (-b + math.sqrt(b * b + 4 * a * force)) / (2 * a)
+
+
 def test_a_surge_floor_narrows_the_hulls_sway_bound_to_the_lift_it_keeps():
-    """Under u >= u_low > 0 the lift term Y_uv u damps the sway: b = −Y_v − Y_uv u_low (a point vehicle) instead of
-    −Y_v − |Y_uv| ū. At REMUS 100's midpoint the bound is the closed form, from the vehicle's numbers, and below
-    the bound over |u| <= ū; a floor at or above ū changes nothing."""
+    """Under u >= u_low > 0 the lift term Y_uv u damps the sway and the surge factors out of the two u-terms: beyond
+    the turn's steady sway v_c = |Y_ur_lift − m11| r / |Y_uv| the worst surge is u_low, below it ū, so
+    v* = max(v_low, min(v_c, v_high)). At REMUS 100's midpoint the bound is that closed form, from the vehicle's
+    numbers, below the earlier floored form (F at ū over b at u_low) and the bound over |u| <= ū; a floor at or
+    above ū changes nothing."""
     from tubekit.model.vehicle_sets import REMUS100
     from verify.theorem.design import hull_sway_bound
     p = REMUS100.nominal
     u, r, u_low = 1.05, 0.15, 0.47
     m11, m22, _, _, m24, _ = p.mass_entries
-    f = abs(p.Y_ur_lift - m11) * u * r + abs(p.Y_rr) * r * r
-    a, b = abs(p.Y_vv), -p.Y_v - p.Y_uv * u_low
-    expected = (-b + math.sqrt(b * b + 4 * a * f)) / (2 * a) + 2 * abs(m24) * r / m22
+    turn, a = abs(p.Y_ur_lift - m11), abs(p.Y_vv)
+    low = _positive_root(a, -p.Y_v - p.Y_uv * u_low, turn * u_low * r + abs(p.Y_rr) * r * r)
+    high = _positive_root(a, -p.Y_v - p.Y_uv * u, turn * u * r + abs(p.Y_rr) * r * r)
+    earlier = _positive_root(a, -p.Y_v - p.Y_uv * u_low, turn * u * r + abs(p.Y_rr) * r * r)
+    v_c = turn * r / abs(p.Y_uv)
+    expected = max(low, min(v_c, high)) + 2 * abs(m24) * r / m22
     floored = float(hull_sway_bound(p, u, r, u_low).mid())
     assert floored == pytest.approx(expected, rel=1e-9)
+    assert floored < earlier + 2 * abs(m24) * r / m22
     assert floored < float(hull_sway_bound(p, u, r).mid())
     assert float(hull_sway_bound(p, u, r, u).mid()) == float(hull_sway_bound(p, u, r).mid())
+
+
+def test_under_a_surge_floor_the_hulls_sway_bound_is_capped_by_the_turns_steady_sway():
+    """A turn's steady sway (m11 − Y_ur_lift) r / |Y_uv| does not depend on the surge: under a floor of 0.9 m/s,
+    REMUS 100's midpoint gets a bound that grows with the top speed ū only up to that steady sway (plus the
+    r-coupling 2|m24| r / m22), at r = 0.05 rad/s, from ū = 0.95 to 10 m/s; at 10 m/s the earlier form (F at ū
+    over b at u_low) is more than twice as large."""
+    from tubekit.model.vehicle_sets import REMUS100
+    from verify.theorem.design import hull_sway_bound
+    p = REMUS100.nominal
+    m11, m22, _, _, m24, _ = p.mass_entries
+    cap = abs(p.Y_ur_lift - m11) * 0.05 / abs(p.Y_uv) + 2 * abs(m24) * 0.05 / m22
+    bounds = [float(hull_sway_bound(p, u_bar, 0.05, 0.9).mid()) for u_bar in (0.95, 1.0, 1.5, 2.5, 10.0)]
+    assert bounds == sorted(bounds) and bounds[0] < bounds[-1] <= cap * (1 + 1e-12)
+    turn, a, b = abs(p.Y_ur_lift - m11), abs(p.Y_vv), -p.Y_v - p.Y_uv * 0.9
+    earlier = _positive_root(a, b, turn * 10.0 * 0.05 + abs(p.Y_rr) * 0.05 ** 2)  # F at ū = 10 over b at u_low
+    assert bounds[-1] < 0.5 * earlier
 
 
 @pytest.mark.parametrize("seed", [None, 0, 1])

@@ -104,7 +104,7 @@ def test_with_its_yaw_loop_at_ten_rad_s_the_midpoint_torpedo_keeps_both_tiers_on
 
 def test_the_shipped_survey_keeps_both_tiers_over_a_fifth_of_the_published_box_with_the_rock_in_its_way():
     """examples/remus100_survey.toml: REMUS 100 over ±20 % of the published half-widths (every interval contains
-    that box: checked against the bundled vehicle), yaw loop 10 rad/s, heave 4 rad/s, 1.25 m/s in 0.1 m/s of
+    that box: checked against the bundled vehicle), yaw loop 10 rad/s, heave 4 rad/s, 1.25 m/s in 0.15 m/s of
     current: both tiers. Flown 60 s, every promise is kept, the solver's plan at every period, the surge never below
     u_min, and the rock stands in the vehicle's way: it passes it within 21 m (the rock 20 m off the line)."""
     import numpy as np
@@ -122,5 +122,5 @@ def test_the_shipped_survey_keeps_both_tiers_over_a_fifth_of_the_published_box_w
     assert cert.tiers.safe and cert.tiers.tracking
     run = tubekit.simulate(scenario, cert, progress=False)
     assert [p.name for p in tubekit.check_promises(run) if p.given and not p.ok] == []
-    assert run.metrics["replaced_steps"] == 0 and float(np.min(run.inputs[:-1, 0])) >= 1.0
+    assert run.metrics["replaced_steps"] == 0 and float(np.min(run.inputs[:-1, 0])) >= scenario.limits.u_min > 0.5
     assert run.metrics["min_clearance"] < 21.0

@@ -29,7 +29,6 @@ def test_quick_benchmark_writes_all_keys(tmp_path):
         assert key in res, key
         assert isinstance(res[key], (int, float)) and math.isfinite(res[key]), (key, res[key])
     assert res["n_states"] >= 100
-    assert res["clarabel_ms_median"] <= res["rt_step_ms_median"]
     assert res["details"]["rt_fallbacks"] == 0
     assert res["details"]["rate_penalty"] == 0.0
     assert set(PEERS) <= set(res["peers"])

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -130,8 +131,25 @@ def test_where_no_coarse_set_fits_the_rows_the_refinement_finds_one_that_meets_e
     coarse_lows = {round(s.d_lo, 9) for s in terminal._sets(b)}
     assert round(law.d_lo, 9) not in coarse_lows
     monkeypatch.setattr(terminal, "_refined", lambda bounds, wanted: iter(()))
+    monkeypatch.setattr(terminal, "_started", lambda bounds, distance, wanted: iter(()))  # the coarse grid alone
     found, conds = terminal.design_terminal(sc, cert.design, cert.region, cert.backup.safe_set)
     assert found is None and {c.condition for c in conds if not c.ok} == {"initial_terminal"}
+
+
+def test_where_every_set_of_the_grid_misses_the_start_a_set_centred_on_it_keeps_both_tiers(monkeypatch):
+    """``examples/remus100_survey.toml`` with its rock 18.5 m off the line (20 m in the file): the grid's sets that
+    clear the rock lie beyond the start, 60 m behind the target, so without the sets centred on the start the search
+    ends at ``initial_terminal``; with them both tiers hold and X_f's centre is the start's distance."""
+    import verify.theorem.terminal as terminal
+    sc = load_scenario(Path(__file__).resolve().parents[1] / "examples" / "remus100_survey.toml").with_changes(
+        obstacles=(Obstacle((-40.0, 18.5, 0.0), 0.5),))
+    cert = verify.certify(sc)
+    law = cert.design.terminal
+    assert cert.tiers.safe and cert.tiers.tracking and law is not None
+    assert law.d_lo < 60.0 < law.d_hi and (law.d_lo + law.d_hi) / 2 == pytest.approx(60.0, rel=1e-9)
+    monkeypatch.setattr(terminal, "_started", lambda bounds, distance, wanted: iter(()))
+    found, conds = terminal.design_terminal(sc, cert.design, cert.region, cert.backup.safe_set)
+    assert found is None and "initial_terminal" in {c.condition for c in conds if not c.ok}
 
 
 def test_the_path_shortcut_rests_on_footprints_nested_by_the_sets_reach(pc_cert):

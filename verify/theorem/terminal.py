@@ -48,6 +48,7 @@ import itertools
 import math
 from typing import Callable, Iterator
 
+import numpy as np
 from flint import arb
 
 from tubekit.design_inputs import ARC_SAMPLES
@@ -252,6 +253,37 @@ def _refined(b: TerminalBounds, wanted: Callable[[], bool]) -> Iterator[Terminal
             yield from _sets(b, fine=True, feedforward=True)
 
 
+def _started(b: TerminalBounds, distance: float, wanted: Callable[[], bool]) -> Iterator[TerminalLaw]:
+    """The sets centred on the start's distance from the target (m; d* = ``distance``, each width of
+    :data:`FINE_WIDTHS` whose lower end lies in the free band), tried after every set of the grid: the grid's sets
+    may all miss the start (``initial_terminal``) where one about it fits. The same laws with the line-of-sight
+    feedforward follow when ``wanted()`` says so; a search effort only, as the grid (the proof does not depend on
+    which sets are tried)."""
+    band = _free_band(b)
+    if band is None:
+        return
+    lo_min, hi_max = band
+    points = []
+    for width in FINE_WIDTHS:
+        d_lo = (distance - width * hi_max / 2) / (1 - width / 2)  # d* = d_lo + width (hi_max − d_lo) / 2
+        lower_end = (d_lo - lo_min) / (hi_max - lo_min)
+        if 0.0 <= lower_end < 1.0:
+            points.append((width, lower_end))
+    if points:
+        yield from _built_sets(b, tuple(points), tuple(ANGLES), False)
+        if b.jumps is not None and wanted():
+            yield from _built_sets(b, tuple(points), tuple(ANGLES), True)
+
+
+def _free_band(b: TerminalBounds) -> tuple[float, float] | None:
+    """(least d_lo, largest d_hi) (m) a set may take: R's e_d room less the replay's deviation and half a run; None
+    when nothing is left (the same band :func:`_grid` places its sets in)."""
+    half_run = (b.v_bar[0] + b.speed_xy) * b.dt / 2
+    lo_min = b.room_d[0] + b.dev_xy + half_run + 1e-6
+    hi_max = b.room_d[1] - b.dev_xy - half_run - 1e-6
+    return (lo_min, hi_max) if hi_max > lo_min else None
+
+
 def _grid_points(widths: tuple[float, ...], lower_ends: tuple[float, ...]) -> list[tuple[float, float]]:
     """(width, lower end) fractions in the grid's order: widest first, then the lower end upward."""
     return [(w, f) for w in widths for f in lower_ends]
@@ -263,11 +295,11 @@ def _grid(b: TerminalBounds, points: list[tuple[float, float]], angles: tuple[fl
     fractions ``angles`` of the free heading room."""
     dt, (ub, wb, rb) = b.dt, b.v_bar
     half_run = (ub + b.speed_xy) * dt / 2
-    lo_min = b.room_d[0] + b.dev_xy + half_run + 1e-6
-    hi_max = b.room_d[1] - b.dev_xy - half_run - 1e-6
+    band = _free_band(b)
     z_f = b.room_z - b.dev_z - (wb + b.speed_z) * dt / 2 - 1e-6
-    if hi_max <= lo_min or z_f <= 0.0 or lo_min <= b.dev_xy:
+    if band is None or z_f <= 0.0 or band[0] <= b.dev_xy:
         return []
+    lo_min, hi_max = band
     out = []
     for width, lower_end in points:
         d_lo = lo_min + lower_end * (hi_max - lo_min)
@@ -349,7 +381,9 @@ def design_terminal(scenario: Scenario, design: Design, region: Region, safe: Sa
         return all(c.ok for c in design.conditions) and not any(
             not c.ok and c.condition in FEEDFORWARD_CANNOT_LOWER for c in best)
 
-    for law in itertools.chain(_sets(b), _refined(b, fed)):
+    start, at = scenario.initial_state, np.asarray(scenario.trajectory.position(0.0), dtype=float).reshape(3)
+    for law in itertools.chain(_sets(b), _refined(b, fed),
+                               _started(b, math.hypot(start[0] - at[0], start[1] - at[1]), fed)):
         own = law_conditions(b, law)
         if not all(c.ok for c in own):
             miss = _shortfall(own)

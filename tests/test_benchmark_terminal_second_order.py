@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import functools
 import math
 
 import numpy as np
@@ -11,6 +12,12 @@ from .scripts import load_script
 
 STUDY = load_script("benchmarks/terminal_second_order.py", "bench_terminal_second_order")
 DT = 0.1
+
+
+@functools.lru_cache(maxsize=None)
+def _study(rate_scale: float = 1.0) -> dict:
+    """The study at the shipped plans' rates times ``rate_scale``, once per worker (two tests read the shipped one)."""
+    return STUDY.study(rate_scale=rate_scale)
 
 
 @pytest.mark.parametrize("w, m", [(0.01, 0.0), (0.0, 0.002), (0.0118, 0.0021)])
@@ -46,7 +53,7 @@ def test_at_the_tracking_tiers_own_loop_bound_every_channel_fits_on_the_slow_sce
     """On examples/bluerov2_slow.toml as shipped, read at the tracking design's plans-only loop bound (docs/verify.md
     step 17d: smaller deviations than the fixed point's E gave), every channel's band fits its room with its
     command changes within J, whichever surge law: the memoryless law's row faces (step 17c) fit there too."""
-    res = STUDY.study()
+    res = _study()
     ch = res["channels"]
     assert res["failed"] == ""
     for key in ("heading", "radial", "radial_plain", "depth"):
@@ -57,7 +64,7 @@ def test_at_the_tracking_tiers_own_loop_bound_every_channel_fits_on_the_slow_sce
 def test_with_the_rates_doubled_the_bands_narrow():
     """Plans' rates x2 (the safe tier still certified): every band fits and the heading's and the radial one's are
     narrower than at the shipped rates (a larger J lets the command absorb the deviation faster)."""
-    shipped, doubled = STUDY.study()["channels"], STUDY.study(rate_scale=2.0)["channels"]
+    shipped, doubled = _study()["channels"], _study(2.0)["channels"]
     assert all(doubled[k]["fits"] for k in ("heading", "radial", "radial_plain", "depth"))
     assert doubled["heading"]["band"]["x"] < shipped["heading"]["band"]["x"]
     assert doubled["radial"]["band"]["x"] < shipped["radial"]["band"]["x"]

@@ -8,7 +8,7 @@ import pytest
 import verify
 from tubekit import load_scenario
 from tubekit.loop.plan_check import check_plan
-from verify.theorem.initial_plan import initial_plan_condition, law_plan
+from verify.theorem.initial_plan import initial_plan_condition, law_plan, start_distance
 
 PC = load_scenario(verify.SCENARIOS_DIR / "paper_currents.toml")
 
@@ -53,3 +53,13 @@ def test_under_rate_limited_plans_the_plan_leaves_rest_by_the_jump_and_is_the_lo
     cond = initial_plan_condition(sc, cert.design, cert.region, cert.design.terminal, cert.backup.safe_set)
     check = check_plan(sc, tight, 0.0, x0, loop_rows, sc.obstacles, -1, v_last=np.zeros(3))
     assert cond.ok and check.ok and cond.lhs == pytest.approx(check.slack, abs=1e-9)
+
+
+def test_the_start_distance_is_horizontal_and_taken_from_the_target_at_t0():
+    """A line target from the origin, the start 3 m behind, 4 m beside and 7 m below it: 5 m (depth not counted)."""
+    from pathlib import Path
+    sc = load_scenario(Path(__file__).resolve().parents[1] / "examples" / "line.toml")
+    p0 = np.asarray(sc.trajectory.position(0.0), dtype=float).reshape(3)
+    moved = sc.with_changes(initial_state=(p0[0] - 3.0, p0[1] + 4.0, p0[2] - 7.0, 0.0))
+    assert start_distance(moved) == pytest.approx(5.0, rel=1e-12)
+

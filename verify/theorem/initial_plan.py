@@ -30,7 +30,7 @@ from tubekit.scenario import Scenario
 from verify.kernel.region import Region
 from verify.theorem.design import Condition, Design
 
-__all__ = ["law_plan", "initial_plan_condition"]
+__all__ = ["law_plan", "initial_plan_condition", "start_distance"]
 
 
 def law_plan(scenario: Scenario, law: TerminalLaw, v_bar: np.ndarray, v_low: np.ndarray | None = None
@@ -129,11 +129,16 @@ def initial_plan_condition(scenario: Scenario, design: Design, region: Region, l
     slacks.update(law.slacks(end, end_target, end_velocity))
     slacks.update(law.row_slacks(end, end_target, end_velocity, rows[-1], float(scenario.controller.dt)))
     where, worst = min(slacks.items(), key=lambda kv: kv[1])
-    start = np.asarray(scenario.initial_state, dtype=float)
-    p0 = np.asarray(scenario.trajectory.position(0.0), dtype=float).reshape(3)
-    d0 = math.hypot(p0[0] - start[0], p0[1] - start[1])
+    d0 = start_distance(scenario)
     ok = bool(math.isfinite(worst) and worst > 0.0 and worst - 1e-9 > 0.0)
     return Condition("initial_terminal", "the terminal law's plan from the start (rows clipped to V_bar) passes the "
                      "exact check at t = 0: smallest slack > 0", worst, 1e-9, ok,
                      f"tightest: {where}; start {d0:.4g} m from the target; X_f d in [{law.d_lo:.4g}, "
                      f"{law.d_hi:.4g}] m, |alpha| <= {law.alpha_max:.4g} rad after {len(rows)} rows")
+
+
+def start_distance(scenario: Scenario) -> float:
+    """The start's horizontal distance from the target at t = 0 (m)."""
+    start = scenario.initial_state
+    p0 = np.asarray(scenario.trajectory.position(0.0), dtype=float).reshape(3)
+    return math.hypot(p0[0] - start[0], p0[1] - start[1])

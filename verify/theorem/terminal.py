@@ -48,7 +48,6 @@ import itertools
 import math
 from typing import Callable, Iterator
 
-import numpy as np
 from flint import arb
 
 from tubekit.design_inputs import ARC_SAMPLES
@@ -59,7 +58,7 @@ from tubekit.scenario import Scenario
 from verify.kernel.intervals import lower, upper
 from verify.kernel.region import Region
 from verify.theorem.design import Condition, Design
-from verify.theorem.initial_plan import initial_plan_condition
+from verify.theorem.initial_plan import initial_plan_condition, start_distance
 from verify.theorem.path_clearance import (PathFootprint, contains, horizon_end, path_clearance, path_samples,
                                           path_workspace)
 from verify.theorem.completion_bounds import FLOAT_SLACK, CompletionArc, TerminalBounds, completion_arc
@@ -270,9 +269,10 @@ def _started(b: TerminalBounds, distance: float, wanted: Callable[[], bool]) -> 
         if 0.0 <= lower_end < 1.0:
             points.append((width, lower_end))
     if points:
-        yield from _built_sets(b, tuple(points), tuple(ANGLES), False)
+        grid, angles = tuple(points), tuple(ANGLES)  # hashable for the memo, whatever a study put there
+        yield from _built_sets(b, grid, angles, False)
         if b.jumps is not None and wanted():
-            yield from _built_sets(b, tuple(points), tuple(ANGLES), True)
+            yield from _built_sets(b, grid, angles, True)
 
 
 def _free_band(b: TerminalBounds) -> tuple[float, float] | None:
@@ -381,9 +381,7 @@ def design_terminal(scenario: Scenario, design: Design, region: Region, safe: Sa
         return all(c.ok for c in design.conditions) and not any(
             not c.ok and c.condition in FEEDFORWARD_CANNOT_LOWER for c in best)
 
-    start, at = scenario.initial_state, np.asarray(scenario.trajectory.position(0.0), dtype=float).reshape(3)
-    for law in itertools.chain(_sets(b), _refined(b, fed),
-                               _started(b, math.hypot(start[0] - at[0], start[1] - at[1]), fed)):
+    for law in itertools.chain(_sets(b), _refined(b, fed), _started(b, start_distance(scenario), fed)):
         own = law_conditions(b, law)
         if not all(c.ok for c in own):
             miss = _shortfall(own)

@@ -30,6 +30,17 @@ settings.load_profile(os.environ.get("HYPOTHESIS_PROFILE", "ci"))
 os.environ.setdefault("TUBEKIT_QUICK", "1")
 
 
+def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:
+    """Tests marked ``slow`` run first, the longest first (``@pytest.mark.slow(seconds)``: a rough length, only an
+    ordering hint; otherwise the collection's order, the sort being stable): with pytest-xdist's work stealing the
+    long ones then start while every worker still has a queue, and the run does not end on one worker finishing a
+    long test while the other idles. The order is deterministic, as every worker must see the same one."""
+    def key(item: pytest.Item) -> tuple[bool, float]:
+        slow = item.get_closest_marker("slow")
+        return slow is None, -float(slow.args[0]) if slow is not None and slow.args else 0.0
+    items.sort(key=key)
+
+
 # ---- certificates shared by several test modules (computed once per session) -------------------------------
 @pytest.fixture(scope="session")
 def pc_cert():

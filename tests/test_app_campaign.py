@@ -212,6 +212,7 @@ def _start_worker(address: str) -> subprocess.Popen:
                             stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
 
 
+@pytest.mark.slow
 def test_a_campaign_on_an_existing_scheduler_survives_a_killed_worker(serial, tmp_path):
     runs = 14
     procs: list[subprocess.Popen] = []
@@ -271,6 +272,7 @@ def test_a_cluster_campaign_reports_safety_backup_and_tracking(tmp_path):
 
 # ---- issue 35: the paper's own scenario (safe tier only, σ = 0: no tube) ------------------------------------
 
+@pytest.mark.slow
 def test_a_campaign_on_the_papers_scenario_exits_0_with_its_figures_and_runs_per_tier(tmp_path):
     """``scenario = "paper"`` certifies the safe tier only, at σ = 0 (no tube: every ratio is null). The CLI
     exits 0, draws both figures and counts the runs per tier; no run is called certified."""

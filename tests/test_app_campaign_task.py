@@ -44,6 +44,7 @@ def test_the_disturbance_sequences_are_drawn_from_the_seed_within_the_bounds(tas
         assert math.hypot(wx, wy) <= bound.omega_xy * (1 + 1e-12) and abs(wz) <= bound.omega_z * (1 + 1e-12)
 
 
+@pytest.mark.slow
 def test_on_the_dynamic_plant_the_sequences_replace_the_current_within_its_own_bound():
     """The dynamic plant's override replaces the water current only (the sway and the loop error are the plant's), so
     the sequences stay within the current's bound, the premise the certificate assumes (0.1 m/s per axis here), not

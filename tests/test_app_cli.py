@@ -88,6 +88,7 @@ def _fake_certify(scenario, law=None):
 
 
 @pytest.mark.parametrize("flag, shown", [(None, True), ("-q", False), ("-v", True)])
+@pytest.mark.slow
 def test_diagnostics_are_logged_on_stderr_results_on_stdout(flag, shown, tmp_path, monkeypatch, capsys):
     pytest.importorskip("tubekit.fhocp")
     import verify

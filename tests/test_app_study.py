@@ -307,6 +307,7 @@ def real_reproduce(tmp_path_factory):
     return rc, out
 
 
+@pytest.mark.slow
 def test_reproduce_with_real_certificate(real_reproduce):
     rc, out = real_reproduce
     assert rc == 0

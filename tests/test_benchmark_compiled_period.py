@@ -4,6 +4,7 @@ alternation reports both sides with the same plans (timings not asserted)."""
 from __future__ import annotations
 
 import numpy as np
+import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 from hypothesis.extra import numpy as hnp
@@ -30,6 +31,7 @@ def test_the_numpy_side_computes_the_compiled_sides_floats(s0, inputs, dt):
                                   compiled_arcs.eo_linearisation(states, ref, 1e-9))
 
 
+@pytest.mark.slow
 def test_a_short_alternation_reports_both_sides_and_restores_the_routines():
     before = compiled_arcs.rollout
     out = BENCH.measure(duration=1.0, rounds=1)

@@ -3,6 +3,8 @@ back; the numpy side's tube runs log the very floats of the compiled side's (tim
 
 from __future__ import annotations
 
+import pytest
+
 from tubekit.fhocp import compiled_rows
 
 from .scripts import load_script
@@ -10,6 +12,7 @@ from .scripts import load_script
 BENCH = load_script("benchmarks/compiled_step.py", "bench_compiled_step")
 
 
+@pytest.mark.slow
 def test_a_short_alternation_reports_both_sides_and_restores_the_routines():
     before = {name: getattr(compiled_rows, name) for name in BENCH.NUMPY}
     out = BENCH.measure(duration=1.0, rounds=1, backends=("clarabel",))

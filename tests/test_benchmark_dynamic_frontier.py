@@ -11,6 +11,7 @@ def _module():
     return load_script("benchmarks/dynamic_frontier.py", "bench_dynamic_frontier")
 
 
+@pytest.mark.slow
 def test_the_shipped_point_certifies_and_the_paper_current_does_not():
     """u_max 0.3 m/s with 0.04 m/s of current is the shipped scenario (the safe tier; tracking refused only at the
     start: the row-faced set the refinement finds begins beyond 2 m, the start is 1 m from the target); at the
@@ -32,6 +33,7 @@ def test_the_spread_option_widens_von_benzons_values_or_takes_the_published_box(
     assert set(box) == set(mod.VON_BENZON)
 
 
+@pytest.mark.slow
 def test_over_the_published_box_the_shipped_point_does_not_certify():
     """The published spread (von Benzon ↔ Einarsson): the velocity loop's small-gain fixed point diverges, so the
     shipped point certifies neither tier there (docs/plant.md section 4)."""
@@ -50,6 +52,7 @@ def test_over_the_published_box_the_shipped_point_does_not_certify():
 @pytest.mark.parametrize("spread, bandwidth, verdict", [("0.2", 20.0, "safe"), ("0.2", 10.0, "safe"),
                                                         ("published", 20.0, "safe"),
                                                         ("published", 10.0, "loop_fixed_point")])
+@pytest.mark.slow(40)
 def test_with_the_cells_twenty_percent_certifies_at_ten_rad_per_second_and_the_published_box_at_twenty(
         spread, bandwidth, verdict):
     """``--spread S --bandwidth W``: over von Benzon's values ±20 % the safe tier holds with the loop at 20 rad/s

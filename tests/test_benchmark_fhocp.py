@@ -16,6 +16,7 @@ PEERS = ("scp_realtime", "scp_converged", "ipopt", "sqpmethod_qrqp")
 PEER_KEYS = ("median_ms", "p90_ms", "p99_ms", "failures", "cost_gap_max", "converged")
 
 
+@pytest.mark.slow
 def test_quick_benchmark_writes_all_keys(tmp_path):
     pytest.importorskip("casadi")
     out = tmp_path / "fhocp.json"

@@ -4,11 +4,14 @@ from __future__ import annotations
 
 import math
 
+import pytest
+
 from .scripts import load_script
 
 HOLD = load_script("benchmarks/hold_backup.py", "hold_backup_benchmark")
 
 
+@pytest.mark.slow
 def test_near_the_pier_only_the_hold_certifies_and_its_disc_is_a_third_of_station_keepings():
     """The pier example: the hold backup certifies the safe tier with a disc below 4 m; station keeping, whose safe
     set at the start reaches the pier, is refused by name (``backup_initial``). On the same scenario without the

@@ -29,6 +29,7 @@ def scenario():
     return load_scenario(verify.SCENARIOS_DIR / "paper_currents.toml")
 
 
+@pytest.mark.slow
 def test_the_generated_solver_answers_the_recorded_subproblems_as_clarabel_does(scenario):
     """Every subproblem of 1 s of the certified run (its periods' solves), solved by each backend: no failure, the
     plan's inputs within 1e-3 of Clarabel's and the objective within 1e-5 relative (QOCO's defaults, 1e-7, against
@@ -42,6 +43,7 @@ def test_the_generated_solver_answers_the_recorded_subproblems_as_clarabel_does(
     assert gen["max_input_diff"] < 1e-3 and gen["max_objective_gap"] < 1e-5
 
 
+@pytest.mark.slow
 def test_the_certified_run_on_the_generated_solver_keeps_its_promises(scenario):
     rows = STUDY.closed_loop(scenario, 2.0, ("clarabel", "qocogen"))
     assert rows["qocogen"]["broken"] == [] == rows["clarabel"]["broken"]

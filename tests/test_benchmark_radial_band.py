@@ -16,6 +16,7 @@ def _module():
 
 
 @pytest.mark.parametrize("rate", [0.05, 0.1])
+@pytest.mark.slow
 def test_the_smallest_band_is_the_continuous_time_argument_plus_a_sampling_margin(rate):
     """The adversary that reverses the disturbance once the command has matched it moves the distance by
     (2 omega)^2 / (2 rho) while the command catches up: a half-width of omega^2 / rho (docs/plant.md section 4).
@@ -27,6 +28,7 @@ def test_the_smallest_band_is_the_continuous_time_argument_plus_a_sampling_margi
     assert closed_form <= x <= closed_form + 3 * OMEGA * DT
 
 
+@pytest.mark.slow
 def test_every_corner_of_the_invariant_set_has_a_command_step_that_keeps_it_in_the_set():
     """Property: the computed set is robustly control-invariant. The successor is affine in (the step, the
     disturbance) and the set convex, so it suffices that each corner has one step |Delta| <= J whose successors

@@ -4,6 +4,8 @@ from __future__ import annotations
 
 from pathlib import Path
 
+import pytest
+
 from .scripts import load_script
 
 STUDY = load_script("benchmarks/survey_frontier.py", "bench_survey_frontier")
@@ -39,6 +41,7 @@ def test_without_a_backup_the_sector_behind_the_target_passes_a_rock_three_metre
     assert set(loiter["failed"]) <= {"path_clearance[0]", "initial_terminal"}
 
 
+@pytest.mark.slow
 def test_under_rate_limited_plans_the_survey_keeps_both_tiers_with_a_rock_five_metres_off_in_a_current_toward_it():
     """1 m/s in 0.3 m/s of current, no backup, plans limited to (0.5, 0.5, 1.0) per second, the start 7 m behind:
     both tiers with the rock 5 m off (the row faces and the bearing face together, docs/verify.md step 17b), and
@@ -65,6 +68,7 @@ def test_under_rate_limited_plans_the_survey_keeps_both_tiers_with_a_rock_five_m
     assert float(run.metrics["min_clearance"]) > 0.0
 
 
+@pytest.mark.slow
 def test_at_the_yaw_rate_the_torpedos_rudder_holds_only_the_terminal_rows_and_the_missions_geometry_are_left():
     """REMUS 100's certified rudder holds |r| <= 0.02 rad/s; the yaw screen asked 0.3 / 3 = 0.1 rad/s at epsilon
     3 m in 0.3 m/s of current. Without it (docs/verify.md section 3) a 1.4 m/s survey over u in [1.0, 1.8] m/s is
@@ -78,6 +82,7 @@ def test_at_the_yaw_rate_the_torpedos_rudder_holds_only_the_terminal_rows_and_th
     assert set(brisk["failed"]) == {"initial_terminal", "path_clearance[0]"}
 
 
+@pytest.mark.slow
 def test_the_midpoint_torpedo_is_refused_only_by_where_its_terminal_set_lies_and_a_faster_yaw_loop_certifies_it():
     """REMUS 100 at its box's midpoint, 1.25 m/s in 0.15 m/s of current, u in [1.0, 1.5] m/s, |r| <= 0.02 rad/s,
     the plans' yaw rate 0.004 rad/s², on the dynamic plant. With the vehicle's own 5 rad/s loop the velocity loop's
@@ -96,6 +101,7 @@ def test_the_midpoint_torpedo_is_refused_only_by_where_its_terminal_set_lies_and
     assert fast["tiers"] == "both" and fast["yaw_error"] < 0.6 * own["yaw_error"]
 
 
+@pytest.mark.slow
 def test_the_shipped_survey_keeps_both_tiers_over_a_fifth_of_the_published_box_with_the_rock_in_its_way():
     """examples/remus100_survey.toml: REMUS 100 over ±20 % of the published half-widths (every interval contains
     that box: checked against the bundled vehicle), yaw loop 10 rad/s, heave 4 rad/s, 1.25 m/s in 0.15 m/s of

@@ -43,12 +43,14 @@ def test_the_narrowest_band_keeps_its_command_change_within_j_and_none_without_r
     assert STUDY.smallest_band(DT, 0.0065, 0.0, 1e-6) is None
 
 
+@pytest.mark.slow
 def test_a_narrower_rate_limit_never_narrows_the_band():
     """Property: the set that fits J fits any larger J, so the narrowest band is monotone in J."""
     widths = [STUDY.smallest_band(DT, 0.0065, 0.0005, j).x for j in (0.003, 0.006, 0.012)]
     assert widths[0] >= widths[1] >= widths[2]
 
 
+@pytest.mark.slow
 def test_at_the_tracking_tiers_own_loop_bound_every_channel_fits_on_the_slow_scenario():
     """On examples/bluerov2_slow.toml as shipped, read at the tracking design's plans-only loop bound (docs/verify.md
     step 17d: smaller deviations than the fixed point's E gave), every channel's band fits its room with its
@@ -61,6 +63,7 @@ def test_at_the_tracking_tiers_own_loop_bound_every_channel_fits_on_the_slow_sce
     assert math.isclose(ch["radial"]["J"], 0.03 * DT)
 
 
+@pytest.mark.slow
 def test_with_the_rates_doubled_the_bands_narrow():
     """Plans' rates x2 (the safe tier still certified): every band fits and the heading's and the radial one's are
     narrower than at the shipped rates (a larger J lets the command absorb the deviation faster)."""

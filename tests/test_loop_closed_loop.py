@@ -621,6 +621,7 @@ def test_a_loiter_backup_keeps_its_surge_and_the_vehicle_clear_in_the_loop():
     assert safety["clearance"] and safety["inputs"] and safety["workspace"]
 
 
+@pytest.mark.slow
 def test_a_hold_backup_keeps_its_disc_and_hands_back_to_a_plan_in_the_loop():
     """examples/bluerov2_pier.toml with the FHOCP failing for 15 s (periods 100..249, the candidate off): the hold law
     takes over from the moving vehicle without a jump (its sway command starts at 0), commands sway to hold the

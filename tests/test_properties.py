@@ -50,6 +50,7 @@ def _xi_matrix(state):
     return np.stack([numeric().xi(state[0], state[1], state[3], *e) for e in np.eye(3)], axis=-1)
 
 
+@pytest.mark.slow
 @settings(max_examples=max(10, settings.default.max_examples // 4))  # scales with the profile
 @given(region=vs.regions(max_e_o=0.9), law=st.sampled_from(sorted(LAWS)), data=st.data())
 def test_certificate_soundness(region, law, data):

@@ -77,7 +77,7 @@ def test_the_dynamic_vehicles_section_is_reserved():
     assert "## Dynamic vehicles" in README
 
 
-@pytest.mark.slow
+@pytest.mark.slow(80)
 def test_every_readme_command_runs_and_exits_as_stated(tmp_path):
     """Each command line, two at a time: the exit code its comment states, no traceback."""
     for name in ("verify", "examples"):

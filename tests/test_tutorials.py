@@ -37,7 +37,7 @@ def _build_notebooks():
     return build_notebooks
 
 
-@pytest.mark.slow
+@pytest.mark.slow(30)
 @pytest.mark.parametrize("path", FILES, ids=lambda p: p.stem)
 def test_tutorial_runs_as_an_executed_notebook(path, tmp_path, monkeypatch):
     """Each tutorial, converted with jupytext and executed with nbclient (quick sizes): no error, its prose,

@@ -142,6 +142,7 @@ def test_the_proof_refuses_another_kind_and_a_shaped_set(designed):
                                                     limits=LIMITS, loop_error=(0, 0, 0), tick=TICK) == 0.0
 
 
+@pytest.mark.slow
 def test_with_the_bundled_thrust_shares_the_hold_is_refused_by_the_lateral_thrust_and_says_which_knob():
     """The bundled BlueROV2 Heavy keeps 10 % of its horizontal thrust for sway (Y_max 11.37 N): enough to regulate the
     sway to 0, not to push sideways against 0.1 m/s of current. The hold is then refused by ``loop_saturation[Y]``

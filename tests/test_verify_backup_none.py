@@ -63,6 +63,7 @@ def test_the_safe_tier_is_given_only_with_the_tracking_tier():
     assert free.tiers == Tiers(True, True) and free.backup.law == NoBackup()
 
 
+@pytest.mark.slow
 def test_without_a_backup_the_rocks_may_come_to_x_f_s_reach_and_the_box_widen(no_backup_cert):
     """examples/bluerov2_no_backup.toml (±15 % of every coefficient, rocks 10 m beside the path): both tiers, the
     completion's footprint being X_f's reach; with station keeping the same scenario keeps only the safe tier (the

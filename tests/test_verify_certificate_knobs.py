@@ -188,6 +188,7 @@ def _plant_condition(cert: verify.Certificate, name: str) -> verify.Condition:
     return {c.condition: c for c in (*cert.conditions, *cert.plant_conditions)}[name]
 
 
+@pytest.mark.slow
 def test_without_a_backup_a_diverging_loop_gets_the_surge_limit_at_which_it_closes():
     """The published-spread example with u_max 0.6 m/s: the loop's bound diverges (no numbers on the condition);
     the knob names the largest surge limit a bisection finds, and re-certified there the loop closes. With a backup

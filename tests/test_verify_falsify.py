@@ -120,6 +120,7 @@ def test_on_the_dynamic_plant_the_closed_loop_attack_draws_the_water_current_wit
     assert 0.5 < max(r.ratio for r in res.runs) < 1.0
 
 
+@pytest.mark.slow
 def test_a_run_from_a_start_with_no_tracking_tier_refutes_nothing_by_its_tube():
     """The closed-loop attack also starts on the faces of R, and each such start is certified on its own (the start
     is part of the design). Where that certificate gives no tracking tier the tube is not promised, so a ratio above

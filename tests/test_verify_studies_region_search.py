@@ -55,6 +55,7 @@ def test_bad_grids(kwargs, field):
         search_region(paper_scenario(), **kwargs)
 
 
+@pytest.mark.slow
 def test_cli_search_region_exit_codes(capsys):
     assert main(["certify", PAPER_CURRENTS, "--search-region"]) == 0
     assert "best: e_o_max = 0.9" in capsys.readouterr().out

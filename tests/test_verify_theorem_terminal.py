@@ -136,6 +136,7 @@ def test_where_no_coarse_set_fits_the_rows_the_refinement_finds_one_that_meets_e
     assert found is None and {c.condition for c in conds if not c.ok} == {"initial_terminal"}
 
 
+@pytest.mark.slow
 def test_where_every_set_of_the_grid_misses_the_start_a_set_centred_on_it_keeps_both_tiers(monkeypatch):
     """``examples/remus100_survey.toml`` with its rock 18.5 m off the line (20 m in the file): the grid's sets that
     clear the rock lie beyond the start, 60 m behind the target, so without the sets centred on the start the search

@@ -147,6 +147,7 @@ def test_under_rate_limited_plans_the_row_faces_and_the_bearing_face_hold_togeth
             "terminal_surge_floor"} <= names
 
 
+@pytest.mark.slow
 def test_the_bearing_sets_of_the_gentlest_laws_meet_their_conditions_nowhere(rated):
     """Counterexample (what ``bearing_row_sets`` replaces): the bearing face searched on each gentlest law with
     ``bearing_sets``' fractions of its gains and its turn taken from r_bar_bar breaks the row faces or the band's

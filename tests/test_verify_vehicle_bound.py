@@ -178,6 +178,7 @@ def test_a_vehicle_that_is_not_one_is_refused():
         velocity_loop_bound({"m": 1.0}, **PAPER)
 
 
+@pytest.mark.slow
 def test_a_diverging_fixed_point_is_one_root_cause_and_no_astronomical_number():
     """Issue 32: over the published spread the small-gain fixed point diverges; the certificate used to print
     loop_saturation[X] = 1.5e+267 from the last assumed bounds. Now the fixed point names the channel that cannot

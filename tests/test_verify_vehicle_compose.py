@@ -239,6 +239,7 @@ def _widened(sc, fraction: float):
     return sc.with_changes(plant=dataclasses.replace(sc.plant, overrides=over))
 
 
+@pytest.mark.slow
 def test_a_start_that_does_not_close_is_followed_by_the_next_start(monkeypatch):
     """bluerov2_slow over von Benzon's values ±15 %, the loop bound without its cells (step 5c, which closes this case
     from the first start): from the first start (1.25 × the plans-only bound) the fixed point ends 0.04 % above its
@@ -306,6 +307,7 @@ def test_the_hand_over_to_a_law_that_does_not_blend_is_charged_its_jump():
     assert all(j >= x for j, x in zip(handover_jump(loiter, plans), plans))    # never below the plans' own jumps
 
 
+@pytest.mark.slow
 def test_the_sway_loop_is_what_certifies_the_papers_current():
     """examples/bluerov2_current.toml (the paper's 0.1 m/s per axis) certifies the safe tier with the Heavy's lateral
     thrust (γ̄ = the sway loop's E_v, assumed and checked like E: ``loop_consistent`` names it); the same vehicle
@@ -323,6 +325,7 @@ def test_the_sway_loop_is_what_certifies_the_papers_current():
     assert without.disturbance.gamma > 10 * cert.disturbance.gamma
 
 
+@pytest.mark.slow
 def test_a_target_at_two_tenths_of_a_metre_per_second_certifies_the_safe_tier_on_the_heavy():
     """examples/bluerov2_brisk.toml: a 0.2 m/s target (2.5x bluerov2_slow's) in 0.05 m/s of current per axis; the
     safe tier holds, tracking refused only by the row faces; the same scenario in 0.15 m/s fails ``keep_up[u]``

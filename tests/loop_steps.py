@@ -11,8 +11,11 @@ from verify.certificate.certify import Certificate, certify
 
 __all__ = ["fresh_solutions", "certified_with_steps_off", "STEP_5B", "STEP_5C"]
 
-#: The functions of ``verify.vehicle.bound`` that give the second (step 5b) and third (step 5c) decompositions.
+#: The functions of ``verify.vehicle.bound`` that give the second (step 5b: one output) and third (step 5c: a
+#: channel's four outputs) decompositions.
 STEP_5B, STEP_5C = "_mass_in_state", "_in_cells"
+#: What each gives when switched off: no bound.
+_OFF = {STEP_5B: math.inf, STEP_5C: (math.inf,) * 4}
 
 
 @contextlib.contextmanager
@@ -32,6 +35,6 @@ def certified_with_steps_off(monkeypatch, scenario: Scenario, steps: tuple[str, 
     :data:`STEP_5C`) giving no bound, inside :func:`fresh_solutions`."""
     import verify.vehicle.bound as bound
     for step in steps:
-        monkeypatch.setattr(bound, step, lambda *args: math.inf)
+        monkeypatch.setattr(bound, step, lambda *args, _off=_OFF[step]: _off)
     with fresh_solutions():
         return certify(scenario)

@@ -464,7 +464,7 @@ def test_with_the_mass_in_the_state_twenty_percent_closes_where_the_first_decomp
                   first_command=_NO_BACKUP_FIRST)
     both = velocity_loop_bound(box, **kwargs)
     assert both.certified, both.reason
-    monkeypatch.setattr(bound, "_in_cells", lambda *args: math.inf)  # step 5c off: the second decomposition's case
+    monkeypatch.setattr(bound, "_in_cells", lambda *args: (math.inf,) * 4)  # step 5c off: the second decomposition's case
     assert velocity_loop_bound(box, **kwargs).certified
     monkeypatch.setattr(bound, "_mass_in_state", lambda *args: math.inf)
     first = velocity_loop_bound(box, **kwargs)

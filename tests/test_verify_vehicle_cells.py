@@ -95,7 +95,7 @@ def test_over_the_published_spread_the_cells_close_the_loop_where_the_other_two_
     with_cells = velocity_loop_bound(_published(), **kwargs)
     assert with_cells.certified, with_cells.reason
     assert with_cells.error[0] < 0.1 and with_cells.error[2] < 0.06
-    monkeypatch.setattr(bound, STEP_5C, lambda *args: math.inf)
+    monkeypatch.setattr(bound, STEP_5C, lambda *args: (math.inf,) * 4)
     without = velocity_loop_bound(_published(), **kwargs)
     assert not without.certified and "diverged" in next(c for c in without.conditions
                                                         if c.condition == "loop_fixed_point").detail

@@ -247,7 +247,7 @@ def test_a_start_that_does_not_close_is_followed_by_the_next_start(monkeypatch):
     ``certify`` returns, and ``recheck`` (under the same switch) agrees with it number for number."""
     import verify.vehicle.bound as bound
     import verify.vehicle.compose as compose
-    monkeypatch.setattr(bound, STEP_5C, lambda *args: math.inf)
+    monkeypatch.setattr(bound, STEP_5C, lambda *args: (math.inf,) * 4)
     sc = _widened(load_scenario(SLOW), 0.15)
     starts: list[tuple[float, object]] = []
     solve_from = compose._solve_from

@@ -66,7 +66,7 @@ from tubekit.model.vehicle_params import VehicleParams
 from verify.vehicle.model import (arb_body_forces, channel_gradient, channel_mismatch, channel_mismatch_gradient,
                                   point_time_constant, velocity_box, with_sway, without_sway)
 from verify.vehicle.loop_data import LoopData, loop_data_of, loop_matrix
-from verify.vehicle.cells import CellInputs, cell_bound, cell_inputs, cell_own_gains, cell_starts
+from verify.vehicle.cells import CellInputs, cell_inputs, cell_own_gains, cell_starts, channel_bounds
 from verify.vehicle.saturation import (SURGE_BANDS, actuator_authority, rate_authority_conditions,
                                        saturation_conditions, triple)
 
@@ -212,6 +212,7 @@ def computed_bounds(loop: LoopData, jump_tick: Sequence[float], jump_period: Seq
     out = []
     for c in range(len(loop.names)):
         jt, jp = arb(jump_tick[c]), arb(jump_period[c])
+        in_cells = _in_cells(loop, c, jt, jp, inputs) if inputs is not None else ()
         row = []
         for o, (g_tick, g_period, h_rate, h_drag, peak) in enumerate(loop.gain_balls[c]):
             x = jt * g_tick + (jp - jt) * g_period
@@ -220,19 +221,18 @@ def computed_bounds(loop: LoopData, jump_tick: Sequence[float], jump_period: Seq
                 continue
             first = x + h_rate * arb(inputs.rate[c]) + h_drag * arb(inputs.drag[c]) + peak * arb(inputs.start[c])
             first += arb(inputs.mismatch[c]) if o == 1 else 0
-            row.append(min(upper(first), _mass_in_state(loop, c, o, x, inputs), _in_cells(loop, c, o, jt, jp, inputs)))
+            row.append(min(upper(first), _mass_in_state(loop, c, o, x, inputs), in_cells[o]))
         out.append(row)
     return out
 
 
-def _in_cells(loop: LoopData, c: int, o: int, jump_tick: arb, jump_period: arb, inputs: Inputs) -> float:
-    """Output ``o`` of channel ``c`` in the third decomposition (:mod:`verify.vehicle.cells`): the largest over the
-    channel's cells; +inf where the step is not used."""
+def _in_cells(loop: LoopData, c: int, jump_tick: arb, jump_period: arb, inputs: Inputs) -> tuple[float, ...]:
+    """The four outputs of channel ``c`` in the third decomposition (:mod:`verify.vehicle.cells`): each the largest
+    over the channel's cells; +inf where the step is not used."""
     cells = loop.cells[c] if inputs.cells else ()
     if not cells:
-        return math.inf
-    return max(cell_bound(cell, o, jump_tick, jump_period, inputs.drag[c], ins)
-               for cell, ins in zip(cells, inputs.cells[c]))
+        return (math.inf,) * 4
+    return channel_bounds(cells, jump_tick, jump_period, inputs.drag[c], inputs.cells[c])
 
 
 def _mass_in_state(loop: LoopData, c: int, o: int, jumps: arb, inputs: Inputs) -> float:

@@ -48,7 +48,8 @@ class Mission:
     along the path (m; the target starts at 0); e_d_max, start : X_f's room and the start's distance behind the
     target (m); r_max : rad/s; u_max : m/s (None: the file's); current : the file's horizontal current per axis
     (m/s, the what-if's floor); rates : the plans' rates with ``None`` where ``--rate`` goes (m/s², m/s², rad/s²);
-    spreads : the loop's boxes the table shows (fractions of the bundled box; None: the file's own box)."""
+    sweep : the rates ``--rate`` defaults to; omegas : the what-if's ω̄_xy (m/s); spreads : the loop's boxes the
+    table shows (fractions of the bundled box; None: the file's own box)."""
 
     scenario: Path
     surface: float

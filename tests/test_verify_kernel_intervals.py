@@ -12,8 +12,8 @@ from flint import arb
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from verify.kernel.intervals import (Case, compile_arb, compile_numpy, enclose, lower, maximise, sym_eig_bounds,
-                              upper)
+from verify.kernel.intervals import (Case, compile_arb, compile_numpy, enclose, lower, maximise, raise_upper,
+                                     sym_eig_bounds, upper)
 
 X, Y = sp.symbols("x y", real=True)
 
@@ -162,3 +162,20 @@ def test_vectorised_broadcasts_every_entry_to_float():
     assert out.dtype == float and out.shape == (2, 3)
     np.testing.assert_array_equal(out, [[4.0, 0.0, 6.0], [5.0, 0.0, 6.0]])
     assert vectorised(lambda x: [x])(2.0).shape == (1,)
+
+
+@settings(deadline=None)
+@given(mid=st.floats(0.0, 1e6), rad=st.floats(0.0, 1e3), best=st.floats(-1e6, 2e6), exponent=st.integers(-300, 300))
+def test_raise_upper_is_the_running_maximum_of_the_exact_upper_bounds(mid, rad, best, exponent):
+    """Property: for a ball x >= 0 (any scale) raise_upper(best, x) == max(best, upper(x)): skipping the exact upper
+    bound below best never changes the maximum."""
+    scale = 2.0 ** exponent
+    x = abs(arb(mid * scale, rad * scale))
+    assert raise_upper(best * scale, x) == max(best * scale, upper(x))
+
+
+def test_raise_upper_at_the_edge_takes_the_exact_bound():
+    """A ball whose float top is within 1e-12 of best, or not finite, is compared exactly."""
+    x = arb(1.0, 1e-20)
+    assert raise_upper(1.0, x) == max(1.0, upper(x)) > 1.0
+    assert raise_upper(5.0, arb("inf")) == math.inf

@@ -33,6 +33,7 @@ if TYPE_CHECKING:  # sympy is imported on first compilation: the precompiled obj
 
 __all__ = [
     "bisect_sup",
+    "raise_upper",
     "enclose",
     "point",
     "upper",
@@ -77,6 +78,17 @@ def upper(x: arb) -> float:
     while not (arb(f) >= u):
         f = math.nextafter(f, math.inf)
     return f
+
+
+def raise_upper(best: float, x: arb) -> float:
+    """max(``best``, :func:`upper` of ``x``) for a ball ``x`` >= 0 (an absolute value, a norm): the exact upper bound
+    is taken only where the ball's float top, mid + rad, comes within a relative 1e-12 of ``best`` or is not finite;
+    below that its upper bound, at most a few ulps above mid + rad, cannot reach ``best``. A running maximum over
+    many balls then costs about one float conversion a ball."""
+    top = float(x.mid()) + float(x.rad())
+    if top < best * (1.0 - 1e-12):
+        return best
+    return max(best, upper(x))
 
 
 def lower(x: arb) -> float:

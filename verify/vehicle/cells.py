@@ -34,7 +34,7 @@ from typing import Mapping, Protocol, Sequence
 
 from flint import arb, ctx
 
-from verify.kernel.intervals import _abs, enclose, lower, upper
+from verify.kernel.intervals import _abs, enclose, lower, raise_upper, upper
 from verify.vehicle.model import channel_masses, channel_mismatch, channel_mismatch_gradient, velocity_box
 from verify.vehicle.response import RESPONSE_PREC, gain_balls, impulse_sums
 
@@ -277,9 +277,8 @@ def cell_bound(cell: Cell, o: int, jump_tick: arb, jump_period: arb, w_n: float,
 def channel_bounds(cells: Sequence[Cell], jump_tick: arb, jump_period: arb, w_n: float,
                    inputs: Sequence[CellInputs], outputs: Sequence[int] = (0, 1, 2, 3)) -> tuple[float, ...]:
     """Per output of ``outputs``, the largest over ``cells`` of :func:`cell_bound`: every cell's residuals converted
-    once for its four outputs, each output's ball formed in the same order as one cell at a time; -inf without
-    cells. A cell's exact upper bound is taken only where its ball's float top, mid + rad, comes within a relative
-    1e-12 of the largest so far (below that its upper bound, a few ulps above mid + rad at most, cannot reach it)."""
+    once for its four outputs, each output's ball formed in the same order as one cell at a time, the running
+    largest kept by :func:`verify.kernel.intervals.raise_upper`; -inf without cells."""
     jump_rest, drag = jump_period - jump_tick, arb(w_n)
     best = [-math.inf] * len(outputs)
     for cell, ins in zip(cells, inputs):
@@ -292,8 +291,5 @@ def channel_bounds(cells: Sequence[Cell], jump_tick: arb, jump_period: arb, w_n:
                 x += arb(ins.mismatch)
             if o == 3:
                 x *= cell.mu
-            x = abs(x)
-            top = float(x.mid()) + float(x.rad())
-            if not (top < best[i] * (1.0 - 1e-12)):
-                best[i] = max(best[i], upper(x))
+            best[i] = raise_upper(best[i], abs(x))
     return tuple(best)

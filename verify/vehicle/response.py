@@ -26,7 +26,7 @@ from typing import Sequence
 
 from flint import arb, arb_mat, ctx
 
-from verify.kernel.intervals import upper
+from verify.kernel.intervals import raise_upper, upper
 
 __all__ = ["ResponseSums", "impulse_sums", "gain_balls", "RESPONSE_PREC", "INTRA_TICK_PIECES"]
 
@@ -109,16 +109,6 @@ def _tick_maxima(stacked: arb_mat, x: arb_mat, pieces: int) -> list[arb]:
     return out
 
 
-def _raise_peaks(peak: list[float], g: list[arb]) -> None:
-    """peak[i] = max(peak[i], upper(g[i])) for balls g[i] >= 0; the exact upper bound is taken only where the
-    ball's float top, mid + rad, comes within a relative 1e-12 of the peak (below that its upper bound, at most a
-    few ulps above mid + rad, cannot reach it)."""
-    for i, x in enumerate(g):
-        top = float(x.mid()) + float(x.rad())
-        if top >= peak[i] * (1.0 - 1e-12) or not math.isfinite(top):
-            peak[i] = max(peak[i], upper(x))
-
-
 def impulse_sums(a: Sequence[Sequence[arb | float]], inputs: Sequence[Sequence[arb | float]],
                  outputs: Sequence[Sequence[arb | float]], *, tick: float, ticks_per_period: int,
                  tol: float = 1e-8, max_terms: int = 20000) -> ResponseSums:
@@ -159,7 +149,7 @@ def impulse_sums(a: Sequence[Sequence[arb | float]], inputs: Sequence[Sequence[a
             g_m = arb_mat(n_out, n_in, g)
             total_m = total_m + g_m
             phase_m[i % ticks_per_period] = phase_m[i % ticks_per_period] + g_m
-            _raise_peaks(peak_flat, g)
+            peak_flat = [raise_upper(p, x) for p, x in zip(peak_flat, g)]
             norm_sum += norm
             power = power * ad
             norm = _norm_inf(power)

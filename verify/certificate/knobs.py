@@ -222,7 +222,8 @@ def _sway_bound(c: _Failed, ctx: _Context) -> list[Knob]:
     return [] if ctx.dynamic else c.knob("disturbance.sway.bound", ">=", c.rhs, "m/s")
 
 
-#: Bisection steps of the ``loop_fixed_point`` knob (each one plans-only loop bound, about 0.05 s).
+#: Bisection steps of the ``loop_fixed_point`` knob (each one plans-only loop bound: 1.2-1.5 s over the published
+#: BlueROV2 box with its cells, so the knob costs about 20 s there).
 LOOP_BISECTION_STEPS = 12
 
 

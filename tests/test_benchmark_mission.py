@@ -5,9 +5,6 @@ from __future__ import annotations
 import math
 import re
 
-import numpy as np
-import pytest
-
 import verify
 from tubekit.loop.pipeline import certified_run
 

@@ -139,7 +139,7 @@ def runaway():
         duration=20.0, trajectory=Line(start=(1.0, 3.0, 0.2), direction_velocity=(0.6, 0.0, 0.0)),
         obstacles=(Obstacle((2.0, 3.7, 0.2), 0.4), Obstacle((2.0, 2.3, 0.2), 0.4), Obstacle((3.0, 3.0, 0.2), 0.3)),
         **{"controller.recovery": False})  # the backup is what this fixture exercises
-    n, reg = sc.controller.horizon_steps, sc.region
+    n = sc.controller.horizon_steps
     tight = dataclasses.replace(
         Tightening.untightened(sc), e_d_min=sc.epsilon + 0.05, obstacle_margin=0.05, margins=np.full((n, 4), 0.02),
         tube=np.full(3, 0.05), disturbance=DisturbanceBound(0.12, 0.1, 0.02),

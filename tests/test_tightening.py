@@ -47,7 +47,6 @@ def test_horizon_arcs_is_the_number_of_margin_rows():
 
 def test_certified_tightening_is_the_pontryagin_difference():
     """V_bar = V - kappa_bar and the per-axis tube of the sampled-data certificate."""
-    from dataclasses import replace
     free = load_scenario(verify.SCENARIOS_DIR / "paper_currents.toml")
     assert np.array_equal(verify.certify(free).tightening.v_max, free.limits.vector)  # sigma = 0: no kappa
     sc = load_scenario(verify.SCENARIOS_DIR / "certifiable.toml")    # sigma = 100 declared, both tiers

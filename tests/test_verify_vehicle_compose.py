@@ -530,9 +530,9 @@ def test_a_pier_within_three_metres_of_the_path_keeps_both_tiers_and_is_passed()
 PIER_BRISK = "examples/bluerov2_pier_brisk.toml"
 
 
-def test_at_the_owners_speed_a_pier_three_metres_from_the_path_keeps_both_tiers_over_a_tenth_of_the_spread():
+def test_at_the_owners_speed_a_pier_three_metres_from_the_path_keeps_both_tiers_over_fifteen_percent_of_the_spread():
     """examples/bluerov2_pier_brisk.toml: a 0.2 m/s target whose path passes within 3 m of a pier's surface (at
-    t = 25 s, the vehicle about 9 s later), in 0.05 m/s of current per axis, over a box that contains a tenth of the
+    t = 25 s, the vehicle about 9 s later), in 0.05 m/s of current per axis, over a box that contains 15 % of the
     published spread about its midpoints and lies inside the published box; both tiers with no backup; flown the
     whole 60 s with the hull at the box's lower corner: every promise kept, a plan at every period, the pier
     cleared."""
@@ -542,9 +542,9 @@ def test_at_the_owners_speed_a_pier_three_metres_from_the_path_keeps_both_tiers_
     speed = sc.trajectory.direction_velocity[0]
     assert speed >= 0.2 and max(sc.disturbance.amplitude[:2]) >= 0.05
     assert abs(pier.center[1]) - pier.radius <= 3.0 and 0.0 < pier.center[0] / speed < sc.duration - 20.0
-    tenth, published, own = (vehicle_params("bluerov2_heavy").shrunk(0.1).to_dict(),
+    fifteen, published, own = (vehicle_params("bluerov2_heavy").shrunk(0.15).to_dict(),
                              vehicle_params("bluerov2_heavy").to_dict(), sc.plant.params.to_dict())
-    for key, (lo, hi) in ((k, v) for k, v in tenth.items() if isinstance(v, (list, tuple))):
+    for key, (lo, hi) in ((k, v) for k, v in fifteen.items() if isinstance(v, (list, tuple))):
         assert own[key][0] <= lo and hi <= own[key][1], key
         assert published[key][0] <= own[key][0] and own[key][1] <= published[key][1], key
     cert = certify(sc)

@@ -30,9 +30,9 @@ rudder (REMUS 100) is what those rates cost.
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import math
 import sys
-from dataclasses import dataclass
 from pathlib import Path
 
 EXAMPLES = Path(__file__).resolve().parent.parent / "examples"
@@ -40,7 +40,7 @@ EXAMPLES = Path(__file__).resolve().parent.parent / "examples"
 __all__ = ["Mission", "MISSIONS", "cell", "what_if", "dynamic", "main"]
 
 
-@dataclass(frozen=True)
+@dataclasses.dataclass(frozen=True)
 class Mission:
     """An obstacle near a shipped file's path, and the limits the cell changes.
 
@@ -116,15 +116,12 @@ def dynamic(mission: Mission, rate: float, spread: float | None = None) -> dict:
     ω̄_xy (m/s; None then) and the yaw channel's need and limit (N m)."""
     import verify
     from tubekit.model.vehicles import vehicle_params
-    from tubekit.scenario import scenario_from_dict
 
     scenario = cell(mission, rate)
     if spread is not None:
-        table = scenario.to_dict()
-        box = vehicle_params(scenario.plant.vehicle).shrunk(spread).to_dict()
-        box["loop_bandwidth"] = 20.0
-        table["plant"] = {"kind": "dynamic", "vehicle": {k: v for k, v in box.items() if k != "name"}}
-        scenario = scenario_from_dict(table)
+        box = {k: v for k, v in vehicle_params(scenario.plant.vehicle).shrunk(spread).to_dict().items() if k != "name"}
+        overrides = tuple({**box, "loop_bandwidth": 20.0}.items())
+        scenario = scenario.with_changes(plant=dataclasses.replace(scenario.plant, overrides=overrides))
     cert = verify.certify(scenario)
     loop = cert.velocity_loop
     closed = loop is not None and all(math.isfinite(x) for x in loop.error)

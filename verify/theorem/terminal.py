@@ -278,10 +278,15 @@ def _started(b: TerminalBounds, distance: float, wanted: Callable[[], bool]) -> 
 def _free_band(b: TerminalBounds) -> tuple[float, float] | None:
     """(least d_lo, largest d_hi) (m) a set may take: R's e_d room less the replay's deviation and half a run; None
     when nothing is left (the same band :func:`_grid` places its sets in)."""
-    half_run = (b.v_bar[0] + b.speed_xy) * b.dt / 2
+    half_run = _half_run(b)
     lo_min = b.room_d[0] + b.dev_xy + half_run + 1e-6
     hi_max = b.room_d[1] - b.dev_xy - half_run - 1e-6
     return (lo_min, hi_max) if hi_max > lo_min else None
+
+
+def _half_run(b: TerminalBounds) -> float:
+    """Half of one period's relative run at the top surge and the target's speed, (ū + P) δ / 2 (m)."""
+    return (b.v_bar[0] + b.speed_xy) * b.dt / 2
 
 
 def _grid_points(widths: tuple[float, ...], lower_ends: tuple[float, ...]) -> list[tuple[float, float]]:
@@ -294,7 +299,7 @@ def _grid(b: TerminalBounds, points: list[tuple[float, float]], angles: tuple[fl
     """The grid of terminal sets without the bearing face at the (width, lower end) fractions ``points`` and the
     fractions ``angles`` of the free heading room."""
     dt, (ub, wb, rb) = b.dt, b.v_bar
-    half_run = (ub + b.speed_xy) * dt / 2
+    half_run = _half_run(b)
     band = _free_band(b)
     z_f = b.room_z - b.dev_z - (wb + b.speed_z) * dt / 2 - 1e-6
     if band is None or z_f <= 0.0 or band[0] <= b.dev_xy:

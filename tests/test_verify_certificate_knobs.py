@@ -12,6 +12,7 @@ import pytest
 
 import verify
 from tubekit.scenario import paper_scenario, read_toml, scenario_from_dict
+import verify.certificate.knobs as knobs_module
 from verify.certificate.knobs import KNOB_TABLE, Knob, failure_knobs, knobs_for
 from verify.theorem.tiers import SAFE_PREFIX
 
@@ -189,15 +190,19 @@ def _plant_condition(cert: verify.Certificate, name: str) -> verify.Condition:
 
 
 @pytest.mark.slow
-def test_without_a_backup_a_diverging_loop_gets_the_surge_limit_at_which_it_closes():
+def test_without_a_backup_a_diverging_loop_gets_the_surge_limit_at_which_it_closes(monkeypatch):
     """The published-spread example with u_max 0.6 m/s: the loop's bound diverges (no numbers on the condition);
-    the knob names the largest surge limit a bisection finds, and re-certified there the loop closes. With a backup
-    (station keeping) the plans' bound is only necessary, so no knob is given."""
+    the knob names the largest surge limit a bisection finds, and re-certified there the loop closes; asked again
+    (a summary after a report) it is not bisected again. With a backup (station keeping) the plans' bound is only
+    necessary, so no knob is given."""
     table, cert = _certify(PUBLISHED, {"limits.u_max": 0.6})
     cond = _plant_condition(cert, "loop_fixed_point")
     assert cond.ok is False and cond.lhs is None
     (knob,) = knobs_for(cert, cond)
     assert knob.field == "limits.u_max" and knob.relation == "<=" and 0.3 <= knob.value < 0.6
+    with monkeypatch.context() as patched:
+        patched.setattr(knobs_module, "_loop_closes", lambda *_: pytest.fail("the knob was bisected again"))
+        assert knobs_for(cert, cond) == (knob,)
     fixed = verify.certify(scenario_from_dict(_with_knob(table, knob)))
     assert _plant_condition(fixed, "loop_fixed_point").ok is True
     _, kept = _certify(PUBLISHED, {"limits.u_max": 0.6, "controller.backup": "station_keeping"})

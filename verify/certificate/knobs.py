@@ -45,6 +45,7 @@ re-certifies with each value and checks the condition.
 
 from __future__ import annotations
 
+import functools
 import math
 import re
 from dataclasses import dataclass
@@ -223,7 +224,7 @@ def _sway_bound(c: _Failed, ctx: _Context) -> list[Knob]:
 
 
 #: Bisection steps of the ``loop_fixed_point`` knob (each one plans-only loop bound: 1.2-1.5 s over the published
-#: BlueROV2 box with its cells, so the knob costs about 20 s there).
+#: BlueROV2 box with its cells, so the knob costs about 20 s there, once per scenario: it is memoised).
 LOOP_BISECTION_STEPS = 12
 
 
@@ -244,14 +245,22 @@ def _loop_fixed_point(c: _Failed, ctx: _Context) -> list[Knob]:
     sc = ctx.scenario
     if not ctx.dynamic or sc.controller.backup != "none":
         return []
-    lo, hi = 0.0, float(sc.limits.u_max)
+    value = _largest_closing_u_max(sc)
+    return [] if value is None else [Knob(c.name, "limits.u_max", "<=", value, "m/s")]
+
+
+@functools.lru_cache(maxsize=8)
+def _largest_closing_u_max(scenario: Scenario) -> float | None:
+    """The bisection of :func:`_loop_fixed_point` (m/s), rounded down and checked again; None when that value does
+    not close. Memoised per scenario (frozen, hashable): a certificate's summary and report ask it again."""
+    lo, hi = 0.0, float(scenario.limits.u_max)
     for _ in range(LOOP_BISECTION_STEPS):
         mid = 0.5 * (lo + hi)
-        lo, hi = (mid, hi) if _loop_closes(sc, mid) else (lo, mid)
+        lo, hi = (mid, hi) if _loop_closes(scenario, mid) else (lo, mid)
     value = _rounded(lo, up=False)
-    if value is None or not _loop_closes(sc, value):
-        return []
-    return [Knob(c.name, "limits.u_max", "<=", value, "m/s")]
+    if value is None or not _loop_closes(scenario, value):
+        return None
+    return value
 
 
 def _rate_authority(c: _Failed, ctx: _Context) -> list[Knob]:

@@ -18,6 +18,7 @@ Usage: ``python benchmarks/brisk_tracked.py [--scenario FILE] [--duration 60] [-
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import sys
 from pathlib import Path
 
@@ -43,9 +44,7 @@ def _corner(scenario, end: int):
     """``scenario`` with its simulated hull at the lower (0) or upper (1) end of every coefficient interval."""
     params = scenario.plant.params
     corner = {k: v[end] for k, v in vars(params).items() if not k.startswith("_") and isinstance(v, tuple)}
-    return scenario.with_changes(plant=scenario.plant.__class__(kind="dynamic", vehicle=scenario.plant.vehicle,
-                                                                overrides=scenario.plant.overrides,
-                                                                truth=tuple(corner.items())))
+    return scenario.with_changes(plant=dataclasses.replace(scenario.plant, truth=tuple(corner.items())))
 
 
 def variants(path: Path = SCENARIO) -> dict:
@@ -101,8 +100,7 @@ def _widened(scenario, spread: float):
             mid = (value[0] + value[1]) / 2
             value = tuple(sorted((mid * (1 - spread), mid * (1 + spread))))
         overrides.append((key, value))
-    return scenario.with_changes(plant=scenario.plant.__class__(kind="dynamic", vehicle=scenario.plant.vehicle,
-                                                                overrides=tuple(overrides)))
+    return scenario.with_changes(plant=dataclasses.replace(scenario.plant, overrides=tuple(overrides), truth=()))
 
 
 def _verdict(cert) -> str:

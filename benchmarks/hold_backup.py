@@ -25,6 +25,7 @@ Everything is measured on the certificate or the run; nothing here is timed.
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import json
 import math
 import sys
@@ -140,9 +141,7 @@ def corners(scenario: Scenario) -> dict[str, Scenario]:
     for label, end in (("lower_corner", 0), ("upper_corner", 1)):
         corner = {k: v[end] for k, v in vars(params).items() if not k.startswith("_") and isinstance(v, tuple)
                   and len(v) == 2}
-        out[label] = scenario.with_changes(plant=scenario.plant.__class__(
-            kind="dynamic", vehicle=scenario.plant.vehicle, overrides=scenario.plant.overrides,
-            truth=tuple(corner.items())))
+        out[label] = scenario.with_changes(plant=dataclasses.replace(scenario.plant, truth=tuple(corner.items())))
     return out
 
 

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import dataclasses
+
 from tubekit.scenario import Scenario
 
 __all__ = ["at_corner", "flown_at_corner"]
@@ -12,9 +14,7 @@ def at_corner(scenario: Scenario, end: int) -> Scenario:
     interval of its vehicle's coefficient box; the certificate's box is unchanged."""
     params = scenario.plant.params
     corner = {k: v[end] for k, v in vars(params).items() if not k.startswith("_") and isinstance(v, tuple)}
-    return scenario.with_changes(plant=scenario.plant.__class__(kind="dynamic", vehicle=scenario.plant.vehicle,
-                                                                overrides=scenario.plant.overrides,
-                                                                truth=tuple(corner.items())))
+    return scenario.with_changes(plant=dataclasses.replace(scenario.plant, truth=tuple(corner.items())))
 
 
 def flown_at_corner(scenario: Scenario, end: int, cert, duration: float | None = 20.0) -> tuple[dict, object]:

@@ -7,6 +7,8 @@ import math
 
 import numpy as np
 import pytest
+from hypothesis import given
+from hypothesis import strategies as st
 
 from tubekit import paper_scenario
 from tubekit.plant.factory import make_plant
@@ -353,3 +355,64 @@ def test_a_yaw_loop_of_its_own_bandwidth_turns_faster_and_leaves_the_other_chann
     assert np.sum(np.abs(0.1 - fast[11:, 3])) < 0.8 * np.sum(np.abs(0.1 - slow[11:, 3]))
     np.testing.assert_array_equal(fast[:, 2], slow[:, 2])
     assert np.max(np.abs(fast[:, 0] - slow[:, 0])) < 1e-5
+
+
+# ---- [plant] start = "settled": the loop's equilibrium at limits.initial ------------------------------------------
+
+def _settled(vehicle: str, surge: float, u_max: float = 2.5):
+    plant = PlantSettings("dynamic", vehicle=vehicle, start="settled")
+    return paper_scenario().with_changes(disturbance=CALM, plant=plant, **{
+        "limits.u_max": u_max, "limits.rate": (0.5, 0.5, 1.0), "limits.initial": (surge, 0.0, 0.0)})
+
+
+@st.composite
+def _settled_runs(draw):
+    """A vehicle, a truth anywhere in its box and a straight-run surge it can hold at every point of that box."""
+    vehicle = draw(st.sampled_from(["bluerov2_heavy", "remus100"]))
+    box = PlantSettings("dynamic", vehicle=vehicle).params
+    fractions = draw(st.lists(st.floats(0.0, 1.0), min_size=len(box.interval_fields),
+                              max_size=len(box.interval_fields)))
+    truth = {k: box.interval(k)[0] + f * (box.interval(k)[1] - box.interval(k)[0])
+             for k, f in zip(box.interval_fields, fractions)}
+    surge = draw(st.floats(0.0, 0.7 if vehicle == "bluerov2_heavy" else 1.2))  # below either top speed at any corner
+    return vehicle, box.with_point(truth), surge
+
+
+@given(_settled_runs())
+def test_a_settled_start_is_the_loops_equilibrium_wherever_the_truth_lies_in_the_box(run):
+    """Property: started settled at u_0 and commanded u_0, the vehicle (any point of its box) stays at ν = (u_0, 0,
+    0, 0) with its thrust and integrators unchanged for 1 s: no start transient, though the controller's model is the
+    box's midpoint and the truth is not."""
+    vehicle, truth, surge = run
+    plant = DynamicPlant(_settled(vehicle, surge), params=truth)
+    x = (0.0, 0.0, 0.0, 0.0)
+    for k in range(100):
+        x = plant.step_tuple(0.01 * k, x, (surge, 0.0, 0.0), 0.005, 2)
+        if k == 0:
+            first = plant.state
+    assert np.allclose(plant.state, first, rtol=0.0, atol=1e-9)
+    assert np.allclose(plant.state[:4], (surge, 0.0, 0.0, 0.0), rtol=0.0, atol=1e-9)
+    assert x[0] == pytest.approx(surge, abs=1e-8)  # 1 s at u_0 along x, no current
+
+
+def test_a_settled_start_the_vehicle_cannot_hold_names_the_field():
+    """The BlueROV2 Heavy's eight T200 do not hold 2.4 m/s against its drag: no equilibrium there."""
+    with pytest.raises(ConfigError, match=r"^plant\.start: expected 'trimmed': the vehicle cannot hold 2\.4 m/s"):
+        DynamicPlant(_settled("bluerov2_heavy", 2.4)).step_tuple(0.0, (0.0,) * 4, (2.4, 0.0, 0.0), 0.01, 1)
+
+
+def test_a_trimmed_start_moves_where_a_settled_one_does_not():
+    """At a corner of the BlueROV2's box the trimmed start at 0.3 m/s (integrators 0, τ = n̂) has a transient that a
+    settled one lacks: the counterexample the settled start removes."""
+    box = BLUEROV2_HEAVY
+    truth = box.with_point({k: box.interval(k)[0] for k in box.interval_fields})
+    worst = []
+    for start in ("trimmed", "settled"):
+        sc = _settled("bluerov2_heavy", 0.3).with_changes(**{"plant.start": start})
+        plant, x = DynamicPlant(sc, params=truth), (0.0,) * 4
+        errors = []
+        for k in range(100):
+            x = plant.step_tuple(0.01 * k, x, (0.3, 0.0, 0.0), 0.01, 1)
+            errors.append(abs(plant.state[0] - 0.3))
+        worst.append(max(errors))
+    assert worst[0] > 1e-3 and worst[1] < 1e-9

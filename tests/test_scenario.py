@@ -10,6 +10,7 @@ import pytest
 
 from tubekit import ConfigError, TubekitError, load_scenario, paper_scenario, scenario_from_dict
 from tubekit.model.trajectory import Circle, Helix, Line, Waypoints
+from tubekit.model.vehicles import PlantSettings
 
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
 
@@ -366,3 +367,31 @@ def test_an_initial_command_is_off_by_default_in_the_dict_only_when_set_and_roun
 def test_initial_command_errors_name_the_field(table, match):
     with pytest.raises(ConfigError, match=match):
         scenario_from_dict({"limits": table})
+
+
+# ---- [plant] start: a velocity loop settled before t = 0 ---------------------------------------------------------
+
+def test_a_settled_start_is_written_only_when_set_and_round_trips(tmp_path):
+    """``[plant] start = "settled"`` lands in the dict (a trimmed start leaves it as it was) and through TOML."""
+    base = paper_scenario().with_changes(**{"limits.rate": (0.5, 0.5, 1.0), "limits.initial": (0.2, 0.0, 0.0),
+                                            "plant": PlantSettings("dynamic", "bluerov2_heavy")})
+    assert not base.plant.settled and "start" not in base.to_dict()["plant"]
+    sc = base.with_changes(**{"plant.start": "settled"})
+    assert sc.plant.settled and sc.to_dict()["plant"]["start"] == "settled"
+    path = tmp_path / "settled.toml"
+    path.write_text(_to_toml(sc.to_dict()))
+    assert load_scenario(path) == sc
+
+
+@pytest.mark.parametrize("table, match", [
+    ({"plant": {"kind": "dynamic", "start": "warm"}}, r"^plant\.start: expected one of \('trimmed', 'settled'\)"),
+    ({"plant": {"start": "settled"}}, r"^plant\.start: expected 'trimmed' on the kinematic plant"),
+    ({"plant": {"kind": "dynamic", "start": "settled"}}, r"^plant\.start: expected 'trimmed' without limits\.rate"),
+    ({"plant": {"kind": "dynamic", "start": "settled"},
+      "limits": {"rate": [0.5, 0.5, 1.0], "initial": [0.2, 0.0, 0.1]}}, r"^limits\.initial: expected w = r = 0"),
+    ({"plant": {"kind": "dynamic", "start": "settled"},
+      "limits": {"rate": [0.5, 0.5, 1.0], "initial": [0.2, 0.1, 0.0]}}, r"^limits\.initial: expected w = r = 0"),
+])
+def test_settled_start_errors_name_the_field(table, match):
+    with pytest.raises(ConfigError, match=match):
+        scenario_from_dict(table)

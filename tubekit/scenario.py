@@ -135,6 +135,21 @@ class Scenario:
             object.__setattr__(self, "workspace", (tuple(float(x) for x in lo), tuple(float(x) for x in hi)))
         period_count("duration", self.duration, self.controller.dt)
         self._check_lateral_backup()
+        self._check_settled_start()
+
+    def _check_settled_start(self) -> None:
+        """A settled start (``[plant] start = "settled"``) needs a rate limit, so that the first command lies within
+        J of ``limits.initial`` (a jump the loop's bound counts), and a straight run there (w = r = 0: heave and
+        yaw at rest, so the hull's sway is at rest too and the loop's equilibrium exists)."""
+        if not self.plant.settled:
+            return
+        if self.limits.rate is None:
+            raise ConfigError("plant.start", "'trimmed' without limits.rate (a settled start needs the first command "
+                              "within the plans' jump of limits.initial)", self.plant.start)
+        start = self.limits.start_command
+        if start[1] != 0.0 or start[2] != 0.0:
+            raise ConfigError("limits.initial", "w = r = 0 under a settled start (the loop settles on a straight "
+                              "run)", [float(x) for x in start])
 
     def _check_lateral_backup(self) -> None:
         """A backup law that commands sway (``controller.backup = "hold"``) needs a dynamic plant whose vehicle has

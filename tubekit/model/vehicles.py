@@ -24,9 +24,13 @@ from tubekit.model.vehicle_sets import BLUEROV2_HEAVY, REMUS100, VEHICLES
 from tubekit.validation import read_toml
 
 __all__ = ["VehicleParams", "VEHICLES", "PlantSettings", "PLANT_KINDS", "vehicle_params", "read_vehicle_file",
-           "CUSTOM", "REMUS100", "BLUEROV2_HEAVY", "ACTUATIONS", "ThrusterGeometry"]
+           "CUSTOM", "REMUS100", "BLUEROV2_HEAVY", "ACTUATIONS", "ThrusterGeometry", "PLANT_STARTS"]
 
 PLANT_KINDS = ("kinematic", "dynamic")
+#: How the dynamic plant's velocity loop starts at t = 0 (``[plant] start``): ``"trimmed"`` at the first command
+#: (ν = the command, τ = n̂(ν), integrators 0) or ``"settled"`` at ``limits.initial`` (ν = that command, τ = n(ν) of
+#: the vehicle as simulated, the integrators holding the model's mismatch: the loop's equilibrium, no transient).
+PLANT_STARTS = ("trimmed", "settled")
 
 
 #: The name of a vehicle given whole (every parameter in ``[plant.vehicle]`` or a vehicle file, no shipped set).
@@ -68,6 +72,12 @@ class PlantSettings:
     truth : mapping or pairs
         ``[plant.truth]``: the value of interval coefficients in the plant as simulated (each
         inside its interval; the others take the midpoint). Default: the nominal vehicle.
+    start : str
+        How the velocity loop starts (:data:`PLANT_STARTS`; dynamic plant only): ``"trimmed"`` (default) at the
+        first command with the integrators at 0, or ``"settled"``: the vehicle has run straight at
+        ``limits.initial`` under its loop long enough before t = 0 for the loop to be at its equilibrium (the
+        integrators carry the mismatch between the model and the vehicle), so the loop bound has no start
+        transient (``docs/plant.md`` section 2; the scenario checks ``limits``).
 
     Attributes
     ----------
@@ -83,11 +93,17 @@ class PlantSettings:
     vehicle: str = "remus100"
     overrides: tuple[tuple[str, Any], ...] = ()
     truth: tuple[tuple[str, float], ...] = ()
+    start: str = "trimmed"
     thrusters: ThrusterGeometry | None = field(default=None, init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
         if self.kind not in PLANT_KINDS:
             raise ConfigError("plant.kind", f"one of {PLANT_KINDS}", self.kind)
+        if self.start not in PLANT_STARTS:
+            raise ConfigError("plant.start", f"one of {PLANT_STARTS}", self.start)
+        if self.start == "settled" and self.kind != "dynamic":
+            raise ConfigError("plant.start", "'trimmed' on the kinematic plant (it has no velocity loop to settle)",
+                              self.start)
         over = _pairs("plant.vehicle", self.overrides)
         thrusters = over.pop("thrusters", None)
         if thrusters is not None:
@@ -119,6 +135,11 @@ class PlantSettings:
         """True for the 4-DOF plant."""
         return self.kind == "dynamic"
 
+    @property
+    def settled(self) -> bool:
+        """True when the velocity loop starts at its equilibrium at ``limits.initial`` (``start = "settled"``)."""
+        return self.start == "settled"
+
     def to_dict(self) -> dict[str, Any]:
         """The ``[plant]`` table (vehicle overrides under ``vehicle``, with ``name``; ``thrusters`` inside it)."""
         over = {k: (list(v) if isinstance(v, tuple) else v) for k, v in self.overrides if k != "thrusters"}
@@ -127,6 +148,8 @@ class PlantSettings:
             out["vehicle"]["thrusters"] = self.thrusters.to_dict()
         if self.truth:
             out["truth"] = dict(self.truth)
+        if self.settled:  # written only when set: a trimmed start keeps its dict
+            out["start"] = self.start
         return out
 
     @classmethod
@@ -137,9 +160,9 @@ class PlantSettings:
         if "tracking_bound" in d:
             raise ConfigError("plant.tracking_bound", "absent: the velocity loop's error bound is derived from the "
                               "vehicle by the certificate (verify.vehicle.bound), never assumed", d["tracking_bound"])
-        unknown = set(d) - {"kind", "vehicle", "vehicle_file", "truth"}
+        unknown = set(d) - {"kind", "vehicle", "vehicle_file", "truth", "start"}
         if unknown:
-            raise ConfigError(f"plant.{sorted(unknown)[0]}", "one of the keys ['kind', 'truth', 'vehicle', "
+            raise ConfigError(f"plant.{sorted(unknown)[0]}", "one of the keys ['kind', 'start', 'truth', 'vehicle', "
                               "'vehicle_file']", sorted(unknown)[0])
         if "vehicle_file" in d:
             if "vehicle" in d:
@@ -147,7 +170,7 @@ class PlantSettings:
                                   d["vehicle_file"])
             d = {**{k: v for k, v in d.items() if k != "vehicle_file"},
                  "vehicle": read_vehicle_file(d["vehicle_file"])}
-        kw: dict[str, Any] = {k: d[k] for k in ("kind",) if k in d}
+        kw: dict[str, Any] = {k: d[k] for k in ("kind", "start") if k in d}
         if "truth" in d:
             if not isinstance(d["truth"], dict):
                 raise ConfigError("plant.truth", "a table of coefficient values", d["truth"])

@@ -90,7 +90,10 @@ class DynamicPlant:
     and integrators are internal state, initialised on the first step to the
     trimmed start ν = (u_c, 0, w_c, r_c), τ = sat(n̂(ν)) (the vehicle already
     moving at the first command, as the kinematic plant assumes); with lateral thrust the sway force Y and its
-    integrator follow them in the state (Y starts trimmed too, at sat(n̂_2(ν))). Each call of
+    integrator follow them in the state (Y starts trimmed too, at sat(n̂_2(ν))). Under ``[plant] start =
+    "settled"`` the loop starts instead at its equilibrium at ``limits.initial`` = (u_0, 0, 0):
+    ν = (u_0, 0, 0, 0), τ = n(ν) of the truth and the surge integrator holding the model's mismatch
+    (:meth:`settled_state`); the first command is then a jump from u_0. Each call of
     :meth:`step_tuple` (one tick) logs ν and τ at its start (:meth:`history`). The water current it
     applies is reported apart from the total ω = current + hull sway + loop error (:meth:`omega_series`,
     :meth:`omega_peak`): :meth:`current_series` at the ticks and :meth:`current_peak` over every stage.
@@ -132,6 +135,7 @@ class DynamicPlant:
         self.lateral = self.model.lateral
         self._sway_limit = float(self.params.Y_max) if self.lateral else 0.0
         self.state: tuple[float, ...] | None = None  # (u, v, w, r, X, Z, N, I_u, I_w, I_r[, Y, I_v])
+        self._settled_at = float(scenario.limits.start_command[0]) if scenario.plant.settled else None
         self._log: list[tuple[float, ...]] = []
         # largest ||omega_xy||, |omega_z|, then ||delta_xy||, |delta_z| of the current, over every evaluation (m/s)
         self._peak = [0.0, 0.0, 0.0, 0.0]
@@ -235,6 +239,29 @@ class DynamicPlant:
             return (*nu, *tau, 0.0, 0.0, 0.0, self.sway_command(nu, 0.0)[0], 0.0)
         return (*nu, *tau, 0.0, 0.0, 0.0)
 
+    def settled_state(self, surge: float) -> tuple[float, ...]:
+        """The loop's equilibrium on a straight run at ``surge`` u_0 (m/s), the state's layout of :attr:`state`.
+
+        ν = (u_0, 0, 0, 0) makes every body force but the truth's surge drag n_1(ν) vanish, so the thrust is
+        τ = (n_1, 0, 0) (and Y = 0) and the surge integrator I_u = (n_1 − n̂_1)/(m̂_11 k_i) makes τ_cmd = τ with
+        e = 0; every other integrator is 0.
+
+        Raises
+        ------
+        ConfigError
+            ``plant.start``: n_1 exceeds the truth's surge thrust at u_0 (no equilibrium there).
+        """
+        nu = (float(surge), 0.0, 0.0, 0.0)
+        drag, nominal = body_forces(self.params, nu)[0], body_forces(self.model, nu)[0]
+        limit = (self._limits or self.params.thrust_limits_at(nu[0]))[0]
+        if abs(drag) > limit:
+            raise ConfigError("plant.start", f"'trimmed': the vehicle cannot hold {surge:g} m/s (its drag "
+                              f"{abs(drag):.4g} N exceeds its surge thrust {limit:.4g} N)", "settled")
+        integral = (drag - nominal) / (self._mass[0] * self._ki[0])
+        if self.lateral:
+            return (*nu, drag, 0.0, 0.0, integral, 0.0, 0.0, 0.0, 0.0)
+        return (*nu, drag, 0.0, 0.0, integral, 0.0, 0.0)
+
     # ---- the closed loop's interface ----------------------------------------------------
     def step_tuple(self, t: float, x: Sequence[float], v: Sequence[float], h: float, n: int,
                    sway: float = 0.0) -> Floats4:
@@ -268,7 +295,7 @@ class DynamicPlant:
         if sway != 0.0 and not self.lateral:
             raise ConfigError("sway", "0 on a vehicle without lateral thrust (Y_max = 0)", sway)
         if self.state is None:
-            self.state = self._start(v)
+            self.state = self._start(v) if self._settled_at is None else self.settled_state(self._settled_at)
         self._log.append(self.state[:7])
         command = (v[0], v[1], v[2], float(sway))
         if self.override is not None:

@@ -229,7 +229,9 @@ def _short_backup_lines(cert: CertificateRecord) -> list[str]:
     if loop is not None:
         e = loop.error
         out.append(f"velocity loop (derived bound): {'certified' if loop.certified else 'NOT certified'}; "
-                   f"loop error E = ({_f(e[0])} m/s, {_f(e[1])} m/s, {_f(e[2])} rad/s)")
+                   f"loop error E = ({_f(e[0])} m/s, {_f(e[1])} m/s, {_f(e[2])} rad/s)"
+                   + ("; the loop starts settled at limits.initial (no start transient: [plant] start)"
+                      if cert.inputs.scenario.plant.settled else ""))
     return out
 
 

@@ -17,7 +17,8 @@ trimmed start (e = I = z = 0, τ = n̂(ν(0)), ν(0) = (u_c, 0, w_c, r_c) of the
 x(0) = (W(0)/k_i, 0, 0) with W(0) = d(ν(0))/m_c, so |W(0)| <= sup|d|/m_c over the first command's box
 |y_c(0)| <= F_c, v(0) = 0 (``first_command``; where it is not given, F = V). d vanishes at rest, so a loop
 that starts from rest and whose first command moves by at most J (the plans' rate limit) starts with almost no
-transient.
+transient. A *settled* start (``settled``: the loop at its equilibrium at ν(0), the integrators holding the
+mismatch, ``[plant] start = "settled"``) has x(0) = 0 exactly; its first command is a jump the sums count.
 :func:`verify.vehicle.response.impulse_sums` bounds every output by the sums of its sampled
 response: jumps (J_tick at every tick, J_period − J_tick more at period boundaries, worst phase),
 the inputs Ẇ and w_n (L1), and the free response from x(0) (peak).
@@ -71,8 +72,8 @@ from verify.vehicle.saturation import (SURGE_BANDS, actuator_authority, rate_aut
                                        saturation_conditions, triple)
 
 __all__ = ["LoopBound", "velocity_loop_bound", "actuator_authority", "loop_matrix", "computed_bounds",
-           "input_bounds", "start_bounds", "start_bounds_nominal", "own_gains", "Inputs", "rate_authority_conditions",
-           "LOOP_MAX_ITERATIONS", "LOOP_INFLATION", "SURGE_BANDS"]
+           "input_bounds", "start_bounds", "start_bounds_nominal", "start_terms", "own_gains", "Inputs",
+           "rate_authority_conditions", "LOOP_MAX_ITERATIONS", "LOOP_INFLATION", "SURGE_BANDS"]
 
 #: Default bound on the fixed-point iterations (a count, not seconds).
 LOOP_MAX_ITERATIONS = 60
@@ -145,6 +146,17 @@ def start_bounds_nominal(loop: LoopData, first_command: Sequence[float]) -> tupl
     """sup|d_c|/m̂_c over the same box (m/s², m/s², rad/s²): the start transient of the second decomposition (its
     Ĩ(0) = d/(m̂ k_i); module doc)."""
     return _per_mass(_start_mismatch(loop, first_command), loop.m_hat)
+
+
+def start_terms(loop: LoopData, first_command: Sequence[float], settled: bool = False) -> tuple:
+    """The start transient of the three decompositions: :func:`start_bounds`, :func:`start_bounds_nominal` and
+    :func:`verify.vehicle.cells.cell_starts` (m/s², m/s², rad/s²); zeros for a settled start (x(0) = 0: at the
+    equilibrium e = 0, z = 0 and Ĩ = I + D/k_i = 0 because the integrators hold −D/k_i)."""
+    if settled:
+        zeros = (0.0,) * len(loop.names)
+        return zeros, zeros, tuple((0.0,) * len(cells) for cells in loop.cells)
+    d_start = _start_mismatch(loop, first_command)
+    return _per_mass(d_start, loop.m_true), _per_mass(d_start, loop.m_hat), cell_starts(loop, first_command)
 
 
 def _per_mass(d: Sequence[arb], masses: Sequence[arb]) -> tuple[float, ...]:
@@ -272,7 +284,7 @@ def velocity_loop_bound(params: VehicleParams, *, v_max: Sequence[float], tick: 
                         jump_tick: Sequence[float], jump_period: Sequence[float],
                         rate: Sequence[float] | None = None, first_command: Sequence[float] | None = None,
                         surge_floor: float = 0.0, max_iterations: int = LOOP_MAX_ITERATIONS,
-                        sway: tuple[float, float, float] = (0.0, 0.0, 0.0)) -> LoopBound:
+                        sway: tuple[float, float, float] = (0.0, 0.0, 0.0), settled: bool = False) -> LoopBound:
     """The velocity loop's error bound over the command box ``v_max`` (m/s, m/s, rad/s) and Θ.
 
     Parameters
@@ -300,6 +312,11 @@ def velocity_loop_bound(params: VehicleParams, *, v_max: Sequence[float], tick: 
         With lateral thrust, the sway command's bound |v_c| <= V_v (m/s), its change per tick and at a period
         boundary (m/s): (0, 0, 0) while only plans run (the sway loop regulates to 0); a backup law that commands
         sway (``verify.backup.hold``) gives its own. Refused other than 0 without lateral thrust.
+    settled : bool
+        The run starts at the loop's equilibrium (``[plant] start = "settled"``): e = 0, τ = n(ν(0)) and the
+        integrators holding the mismatch, so x(0) = 0 in every decomposition (Ĩ = I + D/k_i = 0) and there is no
+        start transient (:func:`start_terms`); the first command's change from ν(0) must be within
+        ``jump_period`` (the sums count a jump at t = 0). ``first_command`` is then not read.
     """
     v, h, d, ticks, jt, jp, rho = _validate(params, v_max, tick, period, jump_tick, jump_period, rate,
                                             max_iterations)
@@ -308,9 +325,7 @@ def velocity_loop_bound(params: VehicleParams, *, v_max: Sequence[float], tick: 
     sway_max, sway_tick, sway_period = _sway_command(params, sway)
     floor_u = nonnegative("surge_floor", surge_floor)
     loop = loop_data_of(params, v, h, ticks, sway_max, floor_u)
-    d_start = _start_mismatch(loop, first)  # the start transient of both decompositions
-    start, start_mass = _per_mass(d_start, loop.m_true), _per_mass(d_start, loop.m_hat)
-    start_cells = cell_starts(loop, first)
+    start, start_mass, start_cells = start_terms(loop, first, settled)
     # the sway channel's command: 0 under plans, a lateral backup's own jumps
     jt_int, jp_int = with_sway(jt, sway_tick, loop.lateral), with_sway(jp, sway_period, loop.lateral)
     n = len(loop.names)

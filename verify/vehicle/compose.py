@@ -21,6 +21,9 @@ plan check compares a plan's first node with the last applied command, initially
 blending backup starts from that command. The start is then bounded over |ν(0)| <= |c_0| + J per channel, c_0 the
 command before t = 0 (``limits.initial``, else (u_min, 0, 0): so (u_min + J_u, J_w, J_r))
 (``first_command`` of the loop bound, u_min = 0 without a minimum surge); for a law that does not blend, over V.
+Under ``[plant] start = "settled"`` the run starts at the loop's equilibrium at c_0 (``settled`` of the loop bound:
+no start transient), and the first command is a jump from c_0: within J for a plan or a blending backup (the
+plan check, the ramp); for a law that does not blend the period's jump also covers :func:`start_jump`.
 Under a minimum surge the fins' authority is taken over u >= u_min − E_u (``surge_floor``, :func:`surge_floor_of`).
 
 A vehicle with lateral thrust regulates its sway by a loop of its own (command 0, never jumping): its error bound
@@ -50,6 +53,7 @@ from __future__ import annotations
 import json
 import math
 from dataclasses import dataclass
+from typing import Sequence
 
 from flint import arb
 
@@ -68,7 +72,7 @@ from verify.theorem.tiers import solve_tiers
 from verify.vehicle.bound import LoopBound, rate_authority_conditions, velocity_loop_bound
 
 __all__ = ["DynamicSolution", "LawLoop", "solve_dynamic", "loop_for_law", "tracking_disturbance", "plan_jumps",
-           "handover_jump", "surge_floor_of", "plans_only_bound", "FIXED_POINT_ROUNDS", "FIXED_POINT_RESTARTS", "PLAN_CHECK_TOLERANCE"]
+           "handover_jump", "start_jump", "surge_floor_of", "plans_only_bound", "FIXED_POINT_ROUNDS", "FIXED_POINT_RESTARTS", "PLAN_CHECK_TOLERANCE"]
 
 #: The plan check's rate tolerance, carried by the proof (one number: :data:`tubekit.design_inputs.RATE_TOLERANCE`).
 PLAN_CHECK_TOLERANCE = RATE_TOLERANCE
@@ -204,13 +208,14 @@ class _LoopInputs:
     plans: tuple[float, float, float]
     surge_floor: float = 0.0
     initial: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    settled: bool = False
 
     @classmethod
     def of(cls, scenario: Scenario) -> "_LoopInputs":
         return cls(params=scenario.plant.params, v_max=tuple(float(x) for x in scenario.limits.vector),
                    tick=1.0 / float(scenario.controller.ancillary_rate_hz), period=float(scenario.controller.dt),
                    plans=plan_jumps(scenario), surge_floor=surge_floor_of(scenario),
-                   initial=tuple(float(x) for x in scenario.limits.start_command))
+                   initial=tuple(float(x) for x in scenario.limits.start_command), settled=scenario.plant.settled)
 
     @property
     def start(self) -> tuple[float, float, float]:
@@ -230,6 +235,8 @@ class _LoopInputs:
         per_period = tuple(max(j, t) for j, t in zip(self.plans, per_tick))
         if not law.blends:
             per_period = tuple(max(p, h) for p, h in zip(per_period, handover_jump(law, self.plans)))
+            if self.settled:
+                per_period = tuple(max(p, s) for p, s in zip(per_period, start_jump(law, self.initial)))
         sway = (0.0, 0.0, 0.0)
         if law.lateral:  # the sway command: the law's per-tick change; a plan takes over within its release of 0
             sway_tick = proof.sway_change(law, safe, omega_xy=dist.omega_xy, omega_z=dist.omega_z,
@@ -238,7 +245,7 @@ class _LoopInputs:
         return velocity_loop_bound(self.params, v_max=self.v_max, tick=self.tick, period=self.period,
                                    jump_tick=per_tick, jump_period=per_period,
                                    first_command=self.start if law.blends else None, surge_floor=self.surge_floor,
-                                   sway=sway)
+                                   sway=sway, settled=self.settled)
 
 
 def surge_floor_of(scenario: Scenario) -> float:
@@ -251,9 +258,23 @@ def handover_jump(law: BackupLaw, plans: tuple[float, float, float]) -> tuple[fl
     within J of the law's ``handover_command`` h (``Tightening.terminal_rest``) and the law's first command c has
     min_surge <= c_u <= u_b, |c_w| <= w_b, |c_r| <= k, so |c − v̂_{N−1}| <= J + (max(u_b − h_u, h_u − min_surge),
     w_b + |h_w|, k + |h_r|) (the loiter: J_u in surge, its surge being h_u)."""
-    h, b = law.handover_command, law.bounds
-    dev = (max(b[0] - h[0], h[0] - law.min_surge), b[1] + abs(h[1]), b[2] + abs(h[2]))
-    return tuple(upper(arb(j) + arb(x)) for j, x in zip(plans, dev))
+    return tuple(upper(arb(j) + arb(x)) for j, x in zip(plans, _reach(law, law.handover_command)))
+
+
+def _reach(law: BackupLaw, command: Sequence[float]) -> tuple[float, float, float]:
+    """How far the law's first command c (min_surge <= c_u <= u_b, |c_w| <= w_b, |c_r| <= k) can be from
+    ``command`` per channel (m/s, m/s, rad/s; each difference rounded up)."""
+    b, c = [arb(x) for x in law.bounds], [arb(float(x)) for x in command]
+    return (max(upper(b[0] - c[0]), upper(c[0] - arb(law.min_surge))), upper(b[1] + abs(c[1])),
+            upper(b[2] + abs(c[2])))
+
+
+def start_jump(law: BackupLaw, initial: tuple[float, float, float]) -> tuple[float, float, float]:
+    """The jump at t = 0 from a settled start at c_0 = ``initial`` to the first command of a law that does not
+    blend (m/s, m/s, rad/s): that command c has min_surge <= c_u <= u_b, |c_w| <= w_b, |c_r| <= k, so
+    |c − c_0| <= (max(u_b − c_0u, c_0u − min_surge), w_b + |c_0w|, k + |c_0r|) (:func:`handover_jump` with c_0 in
+    place of the hand-over command and no plan row between)."""
+    return _reach(law, initial)
 
 
 def _loop_at(scenario: Scenario, law: BackupLaw, safe: SafeSet, dist: DisturbanceBounds,
@@ -279,7 +300,7 @@ def plans_only_bound(scenario: Scenario) -> LoopBound:
     inputs = _LoopInputs.of(scenario)
     return velocity_loop_bound(inputs.params, v_max=inputs.v_max, tick=inputs.tick, period=inputs.period,
                                jump_tick=(0.0, 0.0, 0.0), jump_period=inputs.plans, first_command=inputs.start,
-                               surge_floor=inputs.surge_floor)
+                               surge_floor=inputs.surge_floor, settled=inputs.settled)
 
 
 def _first_assumption(first: LoopBound, start: float = _INFLATE) -> tuple[float, float, float] | None:

@@ -509,6 +509,14 @@ def test_over_the_published_spread_a_hull_without_linear_yaw_damping_keeps_every
 
 # ---- a pier within 3 m of the path, both tiers (no backup: the footprint is X_f's reach) ---------------------
 
+def _kept_with_a_plan_throughout(scenario, end: int, cert) -> None:
+    """``scenario`` flown its whole duration with the hull at corner ``end`` of its box: every given promise kept, a
+    plan at every period, clear of every obstacle, no backup."""
+    promises, run = flown_at_corner(scenario, end, cert, duration=None)
+    assert all(p.ok for p in promises.values() if p.given), [p for p in promises.values() if p.given and not p.ok]
+    assert promises["plan_available"].ok and promises["clearance"].ok and not run.backup_active.any()
+
+
 PIER_SLOW = "examples/bluerov2_pier_slow.toml"
 
 
@@ -522,9 +530,7 @@ def test_a_pier_within_three_metres_of_the_path_keeps_both_tiers_and_is_passed()
     assert abs(pier.center[1]) - pier.radius < 3.0 and 0.0 < pier.center[0] / speed < sc.duration
     cert = certify(sc)
     assert cert.tiers == Tiers(True, True)
-    promises, run = flown_at_corner(sc, 1, cert, duration=None)
-    assert all(p.ok for p in promises.values() if p.given), [p for p in promises.values() if p.given and not p.ok]
-    assert promises["plan_available"].ok and promises["clearance"].ok and not run.backup_active.any()
+    _kept_with_a_plan_throughout(sc, 1, cert)
 
 
 PIER_BRISK = "examples/bluerov2_pier_brisk.toml"
@@ -549,9 +555,7 @@ def test_at_the_owners_speed_a_pier_three_metres_from_the_path_keeps_both_tiers_
         assert published[key][0] <= own[key][0] and own[key][1] <= published[key][1], key
     cert = certify(sc)
     assert cert.tiers == Tiers(True, True)
-    promises, run = flown_at_corner(sc, 0, cert, duration=None)
-    assert all(p.ok for p in promises.values() if p.given), [p for p in promises.values() if p.given and not p.ok]
-    assert promises["plan_available"].ok and promises["clearance"].ok and not run.backup_active.any()
+    _kept_with_a_plan_throughout(sc, 0, cert)
 
 
 PUBLISHED_BRISK = "examples/bluerov2_published_brisk.toml"
@@ -587,9 +591,7 @@ def test_a_settled_start_lets_the_published_box_start_at_the_targets_speed_and_k
     assert cert.tiers == Tiers(True, True)
     assert cert.velocity_loop.error[0] < 0.75 * crawl.error[0]
     for end in (0, 1):
-        promises, run = flown_at_corner(sc, end, cert, duration=None)
-        assert all(p.ok for p in promises.values() if p.given), [p for p in promises.values() if p.given and not p.ok]
-        assert promises["plan_available"].ok and not run.backup_active.any()
+        _kept_with_a_plan_throughout(sc, end, cert)
 
 
 @pytest.mark.slow(8)

@@ -109,3 +109,14 @@ def test_the_warm_up_copy_of_a_lateral_backup_campaign_is_a_valid_kinematic_scen
     warm = warm_scenario(pier)
     assert pier.controller.backup == "hold" and warm.controller.backup == "station_keeping"
     assert warm.plant.kind == "kinematic" and warm.duration == 1.0
+
+
+def test_the_warm_up_copy_of_a_settled_start_campaign_is_a_valid_kinematic_scenario():
+    """A campaign whose loop starts settled (``[plant] start = "settled"``, which only the dynamic plant takes): the
+    kinematic warm-up copy starts trimmed instead of being refused (it was: 'plant.start: expected 'trimmed' on the
+    kinematic plant')."""
+    from tubekit.app.campaign_cluster import warm_scenario
+    from tubekit.scenario import load_scenario
+    underway = load_scenario(Path(__file__).resolve().parents[1] / "examples" / "bluerov2_published_underway.toml")
+    warm = warm_scenario(underway)
+    assert underway.plant.settled and warm.plant.kind == "kinematic" and not warm.plant.settled

@@ -372,8 +372,8 @@ def _settled_runs(draw):
     box = PlantSettings("dynamic", vehicle=vehicle).params
     fractions = draw(st.lists(st.floats(0.0, 1.0), min_size=len(box.interval_fields),
                               max_size=len(box.interval_fields)))
-    truth = {k: box.interval(k)[0] + f * (box.interval(k)[1] - box.interval(k)[0])
-             for k, f in zip(box.interval_fields, fractions)}
+    truth = {k: min(max(lo + f * (hi - lo), lo), hi)  # inside the interval despite rounding
+             for k, f in zip(box.interval_fields, fractions) for lo, hi in [box.interval(k)]}
     surge = draw(st.floats(0.0, 0.7 if vehicle == "bluerov2_heavy" else 1.2))  # below either top speed at any corner
     return vehicle, box.with_point(truth), surge
 

@@ -48,7 +48,7 @@ def warm_scenario(scenario: Scenario) -> Scenario:
     station keeping, which the kinematic plant takes) imports and runs the same ``verify``, cvxpy and loop code."""
     warm = scenario.with_changes(duration=WARM_DURATION_S)
     if warm.plant.dynamic:  # a backup law that commands sway needs the dynamic plant: the default law's copy
-        warm = warm.with_changes(plant=dataclasses.replace(warm.plant, kind="kinematic"),
+        warm = warm.with_changes(plant=dataclasses.replace(warm.plant, kind="kinematic", start="trimmed"),
                                  **{"controller.backup": "station_keeping"})
     return warm
 

@@ -72,7 +72,8 @@ from verify.theorem.tiers import solve_tiers
 from verify.vehicle.bound import LoopBound, rate_authority_conditions, velocity_loop_bound
 
 __all__ = ["DynamicSolution", "LawLoop", "solve_dynamic", "loop_for_law", "tracking_disturbance", "plan_jumps",
-           "handover_jump", "start_jump", "surge_floor_of", "plans_only_bound", "FIXED_POINT_ROUNDS", "FIXED_POINT_RESTARTS", "PLAN_CHECK_TOLERANCE"]
+           "handover_jump", "start_jump", "surge_floor_of", "plans_only_bound", "FIXED_POINT_ROUNDS",
+           "FIXED_POINT_RESTARTS", "PLAN_CHECK_TOLERANCE"]
 
 #: The plan check's rate tolerance, carried by the proof (one number: :data:`tubekit.design_inputs.RATE_TOLERANCE`).
 PLAN_CHECK_TOLERANCE = RATE_TOLERANCE
@@ -258,23 +259,17 @@ def handover_jump(law: BackupLaw, plans: tuple[float, float, float]) -> tuple[fl
     within J of the law's ``handover_command`` h (``Tightening.terminal_rest``) and the law's first command c has
     min_surge <= c_u <= u_b, |c_w| <= w_b, |c_r| <= k, so |c − v̂_{N−1}| <= J + (max(u_b − h_u, h_u − min_surge),
     w_b + |h_w|, k + |h_r|) (the loiter: J_u in surge, its surge being h_u)."""
-    return tuple(upper(arb(j) + arb(x)) for j, x in zip(plans, _reach(law, law.handover_command)))
+    return tuple(upper(arb(j) + arb(x)) for j, x in zip(plans, start_jump(law, law.handover_command)))
 
 
-def _reach(law: BackupLaw, command: Sequence[float]) -> tuple[float, float, float]:
-    """How far the law's first command c (min_surge <= c_u <= u_b, |c_w| <= w_b, |c_r| <= k) can be from
-    ``command`` per channel (m/s, m/s, rad/s; each difference rounded up)."""
-    b, c = [arb(x) for x in law.bounds], [arb(float(x)) for x in command]
+def start_jump(law: BackupLaw, initial: Sequence[float]) -> tuple[float, float, float]:
+    """How far the first command c of a law that does not blend can be from the command ``initial`` c_0 (m/s, m/s,
+    rad/s; each difference rounded up): c has min_surge <= c_u <= u_b, |c_w| <= w_b, |c_r| <= k, so
+    |c − c_0| <= (max(u_b − c_0u, c_0u − min_surge), w_b + |c_0w|, k + |c_0r|). With c_0 the settled start's
+    command it is the jump at t = 0; with the hand-over command, :func:`handover_jump` less the plans' J."""
+    b, c = [arb(x) for x in law.bounds], [arb(float(x)) for x in initial]
     return (max(upper(b[0] - c[0]), upper(c[0] - arb(law.min_surge))), upper(b[1] + abs(c[1])),
             upper(b[2] + abs(c[2])))
-
-
-def start_jump(law: BackupLaw, initial: tuple[float, float, float]) -> tuple[float, float, float]:
-    """The jump at t = 0 from a settled start at c_0 = ``initial`` to the first command of a law that does not
-    blend (m/s, m/s, rad/s): that command c has min_surge <= c_u <= u_b, |c_w| <= w_b, |c_r| <= k, so
-    |c − c_0| <= (max(u_b − c_0u, c_0u − min_surge), w_b + |c_0w|, k + |c_0r|) (:func:`handover_jump` with c_0 in
-    place of the hand-over command and no plan row between)."""
-    return _reach(law, initial)
 
 
 def _loop_at(scenario: Scenario, law: BackupLaw, safe: SafeSet, dist: DisturbanceBounds,

@@ -124,3 +124,33 @@ def test_the_shipped_survey_keeps_both_tiers_over_a_fifth_of_the_published_box_w
     assert [p.name for p in tubekit.check_promises(run) if p.given and not p.ok] == []
     assert run.metrics["replaced_steps"] == 0 and float(np.min(run.inputs[:-1, 0])) >= scenario.limits.u_min > 0.5
     assert run.metrics["min_clearance"] < 21.0
+
+
+@pytest.mark.slow
+def test_started_settled_the_survey_keeps_both_tiers_in_twice_the_current_and_started_trimmed_it_does_not():
+    """examples/remus100_tidal.toml: the survey's box (every interval contains ±20 % of the published half-widths)
+    in 0.3 m/s of horizontal current at 1.25 m/s, the loop settled at the survey speed: both tiers; flown 30 s,
+    every promise kept, the solver's plan at every period and the surge never below u_min. The same file started
+    trimmed is refused: the start transient widens E_u and the terminal law's surge then needs less than u_min."""
+    import dataclasses
+
+    import numpy as np
+
+    import tubekit
+    import verify
+    from tubekit.model.vehicles import vehicle_params
+
+    scenario = tubekit.load_scenario(Path(__file__).resolve().parents[1] / "examples" / "remus100_tidal.toml")
+    fifth = vehicle_params("remus100").shrunk(0.2)
+    for name in fifth.interval_fields:
+        (lo, hi), (a, b) = scenario.plant.params.interval(name), fifth.interval(name)
+        assert lo <= a and b <= hi, name
+    assert min(scenario.disturbance.amplitude[:2]) >= 0.3 and scenario.trajectory.direction_velocity[0] >= 1.0
+    cert = verify.certify(scenario)
+    assert cert.tiers.safe and cert.tiers.tracking
+    run = tubekit.simulate(scenario.with_changes(duration=30.0), cert, progress=False)
+    assert [p.name for p in tubekit.check_promises(run) if p.given and not p.ok] == []
+    assert run.metrics["replaced_steps"] == 0 and float(np.min(run.inputs[:-1, 0])) >= scenario.limits.u_min > 0.5
+    trimmed = verify.certify(scenario.with_changes(plant=dataclasses.replace(scenario.plant, start="trimmed")))
+    assert [f.condition for f in trimmed.failures] == ["terminal_surge_floor"]
+    assert trimmed.velocity_loop.error[0] > cert.velocity_loop.error[0]

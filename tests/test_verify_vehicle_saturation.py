@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import re
 
 import numpy as np
 import pytest
@@ -12,7 +13,7 @@ from tubekit.exceptions import ConfigError
 from tubekit.model.vehicle_sets import BLUEROV2_HEAVY
 from tubekit.plant.dynamic import body_forces
 from verify.vehicle.bound import velocity_loop_bound
-from verify.vehicle.saturation import actuator_authority, triple
+from verify.vehicle.saturation import actuator_authority, straight_top_speed, triple
 
 V, H, TICKS = (0.4, 0.3, 0.5), 0.01, 10
 JT, JP = (0.002, 0.002, 0.002), (0.02, 0.02, 0.02)
@@ -84,3 +85,33 @@ def test_under_a_surge_floor_the_rudders_authority_is_taken_band_by_band_and_sta
         _, n2, _, n4 = body_forces(p, (u, v, w, r))
         sampled = min(sampled, (abs(p.N_uudr) * u * u * p.fin_max - abs(n4 - m42 / m22 * n2)) / m_r)
     assert a_r <= sampled
+
+
+def test_the_weakest_hulls_top_speed_is_the_smallest_thrust_against_the_largest_drag():
+    """REMUS 100's bundled box pairs Prestero's propeller thrust (10.1 N, his drag at 2.5 m/s) with Fossen's drag
+    (X_u|u| = -6.23 kg/m, docs/plant.md section 3.1): that hull tops out at sqrt(10.1 / 6.23) m/s; a box with a
+    linear drag too solves the quadratic; a box without drag has none."""
+    from tubekit.model.vehicles import vehicle_params
+    assert straight_top_speed(vehicle_params("remus100")) == pytest.approx(math.sqrt(10.1 / 6.23), rel=1e-9)
+    nominal = vehicle_params("remus100").nominal
+    linear = dataclasses.replace(nominal, X_u=-2.0, X_uu=-4.0, X_max=10.0)
+    assert straight_top_speed(linear) == pytest.approx(1.350781059358212, rel=1e-9)  # 4 u^2 + 2 u = 10
+    assert straight_top_speed(dataclasses.replace(nominal, X_u=0.0, X_uu=0.0)) == math.inf
+
+
+def test_a_loop_that_does_not_close_names_the_top_speed_it_asks_for_and_no_overflowed_number():
+    """Over REMUS 100's published box with V_u = 1.7 m/s beyond its weakest hull's top speed (1.27 m/s) under a
+    0.78 m/s surge floor, the fixed point diverges: loop_saturation[X] says by how much V_u exceeds the top speed,
+    the fins' conditions are taken over the design's surge band (no 'at u = 0' while u_min holds the vehicle off
+    it) and no failure prints the diverged bounds (no number of 1e+100 or more)."""
+    from tubekit.model.vehicles import vehicle_params
+    bound = velocity_loop_bound(vehicle_params("remus100"), v_max=(1.7, 0.01, 0.013), tick=0.01, period=0.1,
+                                jump_tick=(0.0003, 0.00005, 0.00002), jump_period=(0.003, 0.0005, 0.0002),
+                                rate=(0.03, 0.005, 0.002), surge_floor=0.78)
+    failed = {c.condition: c for c in bound.conditions if c.ok is not True}
+    assert "loop_fixed_point" in failed
+    x = failed["loop_saturation[X]"]
+    assert x.lhs is None and "top speed, about 1.273 m/s" in x.detail and "at least 0.427 m/s" in x.detail
+    assert all("at u = 0" not in c.detail for c in failed.values())
+    numbers = [float(t) for c in failed.values() for t in re.findall(r"\d+(?:\.\d+)?e\+\d+", c.detail)]
+    assert not [n for n in numbers if n >= 1e100]

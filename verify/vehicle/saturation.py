@@ -38,8 +38,8 @@ class _Loop(Protocol):
 
     def surge_low(self, surge_error: float) -> float | None: ...
 
-__all__ = ["actuator_authority", "rate_authority_conditions", "saturation_conditions", "thrust_peaks",
-           "SURGE_BANDS", "triple"]
+__all__ = ["actuator_authority", "rate_authority_conditions", "saturation_conditions", "straight_top_speed",
+           "thrust_peaks", "SURGE_BANDS", "triple"]
 
 _ACTUATOR = {"X": "the surge thrust", "Y": "the lateral thrust", "Z": "the heave force (stern planes on a finned "
              "vehicle)", "N": "the yaw moment (the rudder on a finned vehicle)"}
@@ -126,9 +126,9 @@ def saturation_conditions(loop: _Loop, params: VehicleParams, v: Sequence[float]
     number) when the fixed point did not ``closed`` (its assumed bounds mean nothing then)."""
     box, sway = loop.box([r[0] for r in assumed])
     a_assumed = [r[1] for r in assumed]
-    finite_box = all(math.isfinite(x) for x in (*box, sway, *a_assumed))
-    u_bar = box[0] if finite_box else v[0]
-    u_low = max(0.0, loop.surge_low(assumed[0][0]) or 0.0) if finite_box else 0.0
+    finite_box = closed and all(math.isfinite(x) for x in (*box, sway, *a_assumed))
+    u_bar = box[0] if finite_box else v[0]  # a fixed point that did not close: the design's box, not its bounds
+    u_low = max(0.0, loop.surge_low(assumed[0][0] if finite_box else 0.0) or 0.0)
     if finite_box and 0.0 < u_low < u_bar:
         peaks, floor = _banded(loop, params, box, sway, a_assumed, (u_low, u_bar))
     else:
@@ -146,13 +146,33 @@ def saturation_conditions(loop: _Loop, params: VehicleParams, v: Sequence[float]
         if ch == "Y" and loop.v_int[1] > 0.0:  # a backup that commands sway (the hold) pushes sideways
             why += (f"; the backup commands sway up to {loop.v_int[1]:.4g} m/s: a larger sway share of the "
                     "thrusters ([plant.vehicle.thrusters] shares) raises Y_max")
+        top_note = ""
+        if ch == "X" and v[0] > (top := straight_top_speed(params)):
+            top_note = (f"; V_u = {v[0]:.4g} m/s is beyond the weakest hull's top speed, about {top:.4g} m/s running "
+                    "straight (the smallest surge thrust against the largest drag of the box): that hull's surge "
+                    f"error at the command V_u is at least {v[0] - top:.3g} m/s; a lower limits.u_max (the target and "
+                    "the current must fit under it: keep_up[u]) or a box whose thrust and drag belong together")
         peak = peaks[c]
         if not closed:  # the assumed bounds of a fixed point that did not close mean nothing: no number
             peak, why = None, "not evaluated: the loop bound did not close (root cause: loop_fixed_point)" + (
                 "" if floor[c] > 0 else f"; and {why}")
+        why += top_note
         conds.append(Condition(f"loop_saturation[{ch}]", f"sup|tau_cmd_{ch}| < smallest {ch} limit over the box",
                                peak, floor[c], bool(peak is not None and peak < floor[c]), why))
     return conds
+
+
+def straight_top_speed(params: VehicleParams) -> float:
+    """The weakest hull's top speed running straight in still water (m/s): the positive root of
+    |X_u| u + |X_u|u|| u² = X_min, the largest drag of the box (each coefficient's most negative end) against the
+    smallest surge thrust over |u| <= 10 m/s; +inf when the box has no drag. A diagnostic (plain floats), not a
+    proof step: a hull of the box cannot hold a surge above it, so a loop commanding one has at least the
+    difference as its error."""
+    linear, quadratic = -float(params.interval("X_u")[0]), -float(params.interval("X_uu")[0])
+    thrust = float(thrust_floor(params, 10.0)[0])
+    if quadratic <= 0.0:
+        return thrust / linear if linear > 0.0 else math.inf
+    return (-linear + math.sqrt(linear * linear + 4.0 * quadratic * thrust)) / (2.0 * quadratic)
 
 
 #: Surge bands of the fins' condition under a minimum surge (:func:`_banded`).

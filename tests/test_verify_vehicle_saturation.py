@@ -11,6 +11,7 @@ import pytest
 
 from tubekit.exceptions import ConfigError
 from tubekit.model.vehicle_sets import BLUEROV2_HEAVY
+from tubekit.model.vehicles import vehicle_params
 from tubekit.plant.dynamic import body_forces
 from verify.vehicle.bound import velocity_loop_bound
 from verify.vehicle.saturation import actuator_authority, straight_top_speed, triple
@@ -91,7 +92,6 @@ def test_the_weakest_hulls_top_speed_is_the_smallest_thrust_against_the_largest_
     """REMUS 100's bundled box pairs Prestero's propeller thrust (10.1 N, his drag at 2.5 m/s) with Fossen's drag
     (X_u|u| = -6.23 kg/m, docs/plant.md section 3.1): that hull tops out at sqrt(10.1 / 6.23) m/s; a box with a
     linear drag too solves the quadratic; a box without drag has none."""
-    from tubekit.model.vehicles import vehicle_params
     assert straight_top_speed(vehicle_params("remus100")) == pytest.approx(math.sqrt(10.1 / 6.23), rel=1e-9)
     nominal = vehicle_params("remus100").nominal
     linear = dataclasses.replace(nominal, X_u=-2.0, X_uu=-4.0, X_max=10.0)
@@ -104,7 +104,6 @@ def test_a_loop_that_does_not_close_names_the_top_speed_it_asks_for_and_no_overf
     0.78 m/s surge floor, the fixed point diverges: loop_saturation[X] says by how much V_u exceeds the top speed,
     the fins' conditions are taken over the design's surge band (no 'at u = 0' while u_min holds the vehicle off
     it) and no failure prints the diverged bounds (no number of 1e+100 or more)."""
-    from tubekit.model.vehicles import vehicle_params
     bound = velocity_loop_bound(vehicle_params("remus100"), v_max=(1.7, 0.01, 0.013), tick=0.01, period=0.1,
                                 jump_tick=(0.0003, 0.00005, 0.00002), jump_period=(0.003, 0.0005, 0.0002),
                                 rate=(0.03, 0.005, 0.002), surge_floor=0.78)

@@ -148,10 +148,11 @@ def saturation_conditions(loop: _Loop, params: VehicleParams, v: Sequence[float]
                     "thrusters ([plant.vehicle.thrusters] shares) raises Y_max")
         top_note = ""
         if ch == "X" and v[0] > (top := straight_top_speed(params)):
-            top_note = (f"; V_u = {v[0]:.4g} m/s is beyond the weakest hull's top speed, about {top:.4g} m/s running "
-                    "straight (the smallest surge thrust against the largest drag of the box): that hull's surge "
-                    f"error at the command V_u is at least {v[0] - top:.3g} m/s; a lower limits.u_max (the target and "
-                    "the current must fit under it: keep_up[u]) or a box whose thrust and drag belong together")
+            top_note = (f"; V_u = {v[0]:.4g} m/s is beyond the weakest hull's top speed, about {top:.4g} m/s "
+                        "running straight (the smallest surge thrust against the largest drag of the box): that "
+                        f"hull's surge error at the command V_u is at least {v[0] - top:.3g} m/s; a lower "
+                        "limits.u_max (the target and the current must fit under it: keep_up[u]) or a box whose "
+                        "thrust and drag belong together")
         peak = peaks[c]
         if not closed:  # the assumed bounds of a fixed point that did not close mean nothing: no number
             peak, why = None, "not evaluated: the loop bound did not close (root cause: loop_fixed_point)" + (

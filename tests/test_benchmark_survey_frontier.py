@@ -101,6 +101,18 @@ def test_the_midpoint_torpedo_is_refused_only_by_where_its_terminal_set_lies_and
     assert fast["tiers"] == "both" and fast["yaw_error"] < 0.6 * own["yaw_error"]
 
 
+def _survey_box_example(name: str):
+    """The shipped REMUS example ``name``, checked to hold ±20 % of the published half-widths in every interval."""
+    import tubekit
+    from tubekit.model.vehicles import vehicle_params
+    scenario = tubekit.load_scenario(Path(__file__).resolve().parents[1] / "examples" / name)
+    fifth = vehicle_params("remus100").shrunk(0.2)
+    for field in fifth.interval_fields:
+        (lo, hi), (a, b) = scenario.plant.params.interval(field), fifth.interval(field)
+        assert lo <= a and b <= hi, field
+    return scenario
+
+
 @pytest.mark.slow
 def test_the_shipped_survey_keeps_both_tiers_over_a_fifth_of_the_published_box_with_the_rock_in_its_way():
     """examples/remus100_survey.toml: REMUS 100 over ±20 % of the published half-widths (every interval contains
@@ -111,13 +123,8 @@ def test_the_shipped_survey_keeps_both_tiers_over_a_fifth_of_the_published_box_w
 
     import tubekit
     import verify
-    from tubekit.model.vehicles import vehicle_params
 
-    scenario = tubekit.load_scenario(Path(__file__).resolve().parents[1] / "examples" / "remus100_survey.toml")
-    fifth = vehicle_params("remus100").shrunk(0.2)
-    for name in fifth.interval_fields:
-        (lo, hi), (a, b) = scenario.plant.params.interval(name), fifth.interval(name)
-        assert lo <= a and b <= hi, name
+    scenario = _survey_box_example("remus100_survey.toml")
     cert = verify.certify(scenario)
     assert cert.tiers.safe and cert.tiers.tracking
     run = tubekit.simulate(scenario, cert, progress=False)
@@ -138,13 +145,8 @@ def test_started_settled_the_survey_keeps_both_tiers_in_twice_the_current_and_st
 
     import tubekit
     import verify
-    from tubekit.model.vehicles import vehicle_params
 
-    scenario = tubekit.load_scenario(Path(__file__).resolve().parents[1] / "examples" / "remus100_tidal.toml")
-    fifth = vehicle_params("remus100").shrunk(0.2)
-    for name in fifth.interval_fields:
-        (lo, hi), (a, b) = scenario.plant.params.interval(name), fifth.interval(name)
-        assert lo <= a and b <= hi, name
+    scenario = _survey_box_example("remus100_tidal.toml")
     assert min(scenario.disturbance.amplitude[:2]) >= 0.3 and scenario.trajectory.direction_velocity[0] >= 1.0
     cert = verify.certify(scenario)
     assert cert.tiers.safe and cert.tiers.tracking

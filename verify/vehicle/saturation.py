@@ -146,21 +146,26 @@ def saturation_conditions(loop: _Loop, params: VehicleParams, v: Sequence[float]
         if ch == "Y" and loop.v_int[1] > 0.0:  # a backup that commands sway (the hold) pushes sideways
             why += (f"; the backup commands sway up to {loop.v_int[1]:.4g} m/s: a larger sway share of the "
                     "thrusters ([plant.vehicle.thrusters] shares) raises Y_max")
-        top_note = ""
-        if ch == "X" and v[0] > (top := straight_top_speed(params)):
-            top_note = (f"; V_u = {v[0]:.4g} m/s is beyond the weakest hull's top speed, about {top:.4g} m/s "
-                        "running straight (the smallest surge thrust against the largest drag of the box): that "
-                        f"hull's surge error at the command V_u is at least {v[0] - top:.3g} m/s; a lower "
-                        "limits.u_max (the target and the current must fit under it: keep_up[u]) or a box whose "
-                        "thrust and drag belong together")
         peak = peaks[c]
         if not closed:  # the assumed bounds of a fixed point that did not close mean nothing: no number
             peak, why = None, "not evaluated: the loop bound did not close (root cause: loop_fixed_point)" + (
                 "" if floor[c] > 0 else f"; and {why}")
-        why += top_note
+        if ch == "X":
+            why += _top_speed_note(params, v[0])
         conds.append(Condition(f"loop_saturation[{ch}]", f"sup|tau_cmd_{ch}| < smallest {ch} limit over the box",
                                peak, floor[c], bool(peak is not None and peak < floor[c]), why))
     return conds
+
+
+def _top_speed_note(params: VehicleParams, v_u: float) -> str:
+    """The surge condition's note when V_u = ``v_u`` (m/s) lies beyond :func:`straight_top_speed`, else ''."""
+    top = straight_top_speed(params)
+    if v_u <= top:
+        return ""
+    return (f"; V_u = {v_u:.4g} m/s is beyond the weakest hull's top speed, about {top:.4g} m/s running straight "
+            "(the smallest surge thrust against the largest drag of the box): that hull's surge error at the "
+            f"command V_u is at least {v_u - top:.3g} m/s; a lower limits.u_max (the target and the current must "
+            "fit under it: keep_up[u]) or a box whose thrust and drag belong together")
 
 
 def straight_top_speed(params: VehicleParams) -> float:

@@ -39,6 +39,18 @@ def test_best_is_widest_certified():
     assert (res.best.e_o_max, res.best.e_d_max) == max((t.e_o_max, t.e_d_max) for t in res.certified)
 
 
+def test_the_table_names_each_failure_whole_and_counts_them():
+    """A failed condition's name is printed whole (``path_clearance[0]`` is wider than the table's 14 characters,
+    and it was cut to ``path_clearance``), and the failures are counted under the table with the skips' reason."""
+    res = search_region(load_scenario(PAPER_CURRENTS), e_o_max=(0.3, 0.5), e_d_max=(0.4, 2.0))
+    verdicts = {(t.e_o_max, t.e_d_max): t.first_failure for t in res.tried}
+    assert verdicts[(0.3, 2.0)] == "path_clearance[0]" and verdicts[(0.5, 2.0)] == ""
+    rows = res.summary().splitlines()
+    row_03 = next(r for r in rows if r.strip().startswith("0.3 |"))
+    assert row_03.split("|")[1:] == [f" {'skipped':>17s} ", f" {'path_clearance[0]':>17s}"]
+    assert "  first failures: skipped: e_d_max <= epsilon = 0.5 (2), path_clearance[0] (1)" in rows
+
+
 def test_small_e_d_max_is_skipped():
     res = search_region(load_scenario(PAPER_CURRENTS), e_o_max=(0.5,), e_d_max=(0.4, 3.0))
     assert res.tried[0].first_failure.startswith("skipped")

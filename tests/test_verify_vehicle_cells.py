@@ -17,7 +17,9 @@ from verify.certificate.certify import certify
 from verify.studies.recheck import recheck
 from verify.kernel.intervals import enclose, lower, upper
 from verify.vehicle.bound import velocity_loop_bound
-from verify.vehicle.cells import CELL_BUDGET, _cell_matrix, own_splits, split_ball
+from verify.vehicle.cells import (CELL_BUDGET, CellInputs, _cell_matrix, _rest, cell_inputs, channel_bounds,
+                                  own_splits, split_ball)
+from verify.vehicle.model import velocity_box
 from verify.vehicle.loop_data import loop_data_of, loop_matrix
 
 from .corners import flown_at_corner
@@ -83,6 +85,59 @@ def test_the_cell_matrix_has_the_eigenvalues_of_the_loop_in_its_plain_coordinate
 
 #: the published box's command box at the owners' speed, the plans' jumps (rate (0.03, 0.03, 0.06) m/s², rad/s² over
 #: 0.1 s) and the first command within J of 0.2 m/s
+_SIZES = st.one_of(st.just(0.0), st.floats(1e-9, 1e3), st.just(math.inf))
+
+
+@settings(derandomize=True, max_examples=40, deadline=None)
+@given(jumps=st.tuples(st.floats(0.0, 0.5), st.floats(0.0, 0.5)), w_n=st.floats(0.0, 50.0), seed=st.integers(0, 2**16),
+       sizes=st.lists(st.tuples(_SIZES, _SIZES, _SIZES, _SIZES), min_size=1, max_size=4))
+def test_a_channels_bound_is_every_cells_own_bound_at_its_largest(jumps, w_n, seed, sizes):
+    """Property: over the published box's yaw cells (36 of them) and any residual inputs (zero, tiny, large or
+    infinite, drawn per cell), each output of ``channel_bounds`` (which forms a cell's ball only where a float
+    screen cannot rule it out) equals the largest over the cells of that cell's ball, formed here term by term from
+    the module doc's row o and rounded up, to the last bit."""
+    cells = loop_data_of(_published(), (0.35, 0.15, 0.2), H, TICKS).cells[3]
+    rng = np.random.default_rng(seed)
+    pick = rng.integers(len(sizes), size=len(cells))
+    inputs = [CellInputs(*(x * (1 + rng.random()) for x in sizes[i])) for i in pick]
+    j_tick, j_period = arb(min(jumps)), arb(max(jumps))
+    expected = []
+    for o in range(4):
+        best = -math.inf
+        for cell, ins in zip(cells, inputs):
+            g = cell.gains[o]
+            x = (j_tick * g[0] + (j_period - j_tick) * g[1] + g[2] * arb(ins.rate) + g[3] * arb(w_n)
+                 + g[5] * arb(ins.mass) + g[4] * arb(ins.start))
+            x = x + arb(ins.mismatch) if o == 1 else x
+            best = max(best, upper(abs(x * cell.mu if o == 3 else x)))
+        expected.append(best)
+    assert len(cells) > 10 and channel_bounds(cells, j_tick, j_period, w_n, inputs) == tuple(expected)
+
+
+@pytest.mark.parametrize("channel", [0, 3])
+def test_each_cells_residuals_are_its_own_damping_and_mass_residual_over_the_box(channel):
+    """Cells that share their damping's pieces share the residuals formed for them: every cell's inputs equal the
+    module doc's, formed here for that cell alone (its Δa, Δb, δ_k and μ), to the last bit (surge: 32 cells over 4
+    mass pieces; yaw: 36 over 3)."""
+    loop = loop_data_of(_published(), (0.35, 0.15, 0.2), H, TICKS)
+    nu, rates, accel = velocity_box(0.4, 0.05, 0.2, 0.3), (arb(0.3), arb(0.1), arb(0.2), arb(0.5)), 0.7
+    cells, own, m_hat = loop.cells[channel], loop.own[channel], loop.m_hat[channel]
+    d_rest, g_rest = _rest(loop, channel, nu)
+    cross = sum((abs(g) * x for j, (g, x) in enumerate(zip(g_rest, rates)) if j != own), arb(0)) / m_hat
+    speed = nu[own]
+    size = arb.union(speed.abs_lower(), speed.abs_upper())
+    expected = []
+    for cell in cells:
+        d_a, d_b = cell.damping
+        d_own, g_own = -(d_a + d_b * size) * speed, -(d_a + 2 * d_b * size)
+        mismatch = upper(abs(d_rest + d_own) / m_hat)
+        rate = abs((g_rest[own] + g_own) / m_hat - arb(cell.slope)) * arb(accel) + cross
+        expected.append(CellInputs(rate=upper(rate), mass=upper(cell.mass_residual * arb(accel)), mismatch=mismatch,
+                                   start=mismatch))
+    assert len({c.pieces[0] for c in cells}) > 1 and len(cells) > 30
+    assert cell_inputs(loop, channel, nu, rates, accel, None) == tuple(expected)
+
+
 _V, _PLANS, _FIRST = (0.35, 0.15, 0.2), (0.003, 0.003, 0.006), (0.203, 0.003, 0.006)
 
 

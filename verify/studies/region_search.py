@@ -13,6 +13,7 @@ certificates, never seconds.
 
 from __future__ import annotations
 
+import collections
 import dataclasses
 import math
 from dataclasses import dataclass
@@ -89,18 +90,28 @@ class RegionSearchResult:
             return "\n".join([head, "  no region can help, nothing searched (none certifies):",
                               *(f"    {b}" for b in self.blocked_by)])
         eds = sorted({t.e_d_max for t in self.tried})
-        lines = [head,
-                 "  e_o_max \\ e_d_max [m] | " + " | ".join(f"{e:>14g}" for e in eds)]
-        for eo in sorted({t.e_o_max for t in self.tried}):
-            row = {t.e_d_max: t for t in self.tried if t.e_o_max == eo}
-            cells = [("certified" if row[e].certified else row[e].first_failure)[:14] if e in row else "-"
-                     for e in eds]
-            lines.append(f"  {eo:21g} | " + " | ".join(f"{c:>14s}" for c in cells))
+        rows = {eo: {t.e_d_max: _verdict(t) for t in self.tried if t.e_o_max == eo}
+                for eo in sorted({t.e_o_max for t in self.tried})}
+        width = max(14, *(len(v) for row in rows.values() for v in row.values()))
+        lines = [head, "  e_o_max \\ e_d_max [m] | " + " | ".join(f"{e:>{width}g}" for e in eds)]
+        for eo, row in rows.items():
+            lines.append(f"  {eo:21g} | " + " | ".join(f"{row.get(e, '-'):>{width}s}" for e in eds))
+        counts = collections.Counter(t.first_failure for t in self.tried if not t.certified)
+        if counts:
+            lines.append("  first failures: " + ", ".join(f"{name} ({n})" for name, n in counts.most_common()))
         best = self.best
         lines.append(f"  tried {len(self.tried)}, certified {len(self.certified)}")
         lines.append("  best: " + ("none certifies" if best is None else
                                    f"e_o_max = {best.e_o_max:g}, e_d_max = {best.e_d_max:g} m"))
         return "\n".join(lines)
+
+
+def _verdict(trial: RegionTrial) -> str:
+    """A grid cell's text: ``certified``, the first failed condition, or ``skipped`` (its reason: the failures'
+    line)."""
+    if trial.certified:
+        return "certified"
+    return "skipped" if trial.first_failure.startswith("skipped") else trial.first_failure
 
 
 def _grid(field: str, values, upper: float | None) -> tuple[float, ...]:

@@ -30,8 +30,10 @@ from __future__ import annotations
 import itertools
 import math
 from dataclasses import dataclass
+from functools import cached_property
 from typing import Mapping, Protocol, Sequence
 
+import numpy as np
 from flint import arb, ctx
 
 from verify.kernel.intervals import _abs, enclose, lower, raise_upper, upper
@@ -93,6 +95,10 @@ class Cell:
     gains : tuple
         Per output row (e, a + D, z, q x): (Σ g_J per tick, max-phase Σ g_J per period, h Σ g_r, h Σ g_n,
         peak g_r, h Σ g_v) as balls (s or dimensionless, as the rows of :class:`verify.vehicle.loop_data.LoopData`).
+    pieces : (3,) ints
+        Which sub-interval of the mass entry, the linear and the quadratic damping coefficient the cell is: cells
+        with the same damping pieces share their damping's residuals, cells with the same mass piece their μ
+        (:func:`cell_inputs` forms each once).
     """
 
     damping: tuple[arb, arb]
@@ -101,6 +107,14 @@ class Cell:
     mu_centre: float
     slope: float
     gains: tuple[tuple[arb, ...], ...]
+    pieces: tuple[int, int, int]
+
+    @cached_property
+    def gain_tops(self) -> np.ndarray:
+        """(4, 7) floats: per row of :attr:`gains`, sup|g| of its six balls (rounded up), then sup|μ| (the ẏ row's
+        factor); what :func:`channel_bounds` screens with."""
+        tops = [[upper(_abs(g)) for g in row] for row in self.gains]
+        return np.array([[*row, upper(_abs(self.mu))] for row in tops], dtype=float)
 
 
 @dataclass(frozen=True)
@@ -182,7 +196,8 @@ def channel_cells(loop: LoopFacts, c: int, base: Sequence[Sequence[arb]],
     with ctx.workprec(RESPONSE_PREC):
         (k_p, k_i), lam = loop.channel_gains(c), arb(loop.slope[c])
         out = []
-        for combo in itertools.product(*pieces):
+        for index in itertools.product(*(range(len(p)) for p in pieces)):
+            combo = [p[i] for p, i in zip(pieces, index)]
             hull = {**loop.hull, **dict(zip(names, combo))}
             mu = loop.m_hat[c] / channel_masses(hull, loop.lateral)[c]
             own = channel_mismatch_gradient(loop.nominal, hull, nu, loop.lateral)[c][loop.own[c]] / loop.m_hat[c]
@@ -195,16 +210,16 @@ def channel_cells(loop: LoopFacts, c: int, base: Sequence[Sequence[arb]],
                 return ()
             damping = (loop.nominal[names[1]] - combo[1], loop.nominal[names[2]] - combo[2])
             out.append(Cell(damping=damping, mu=mu, mass_residual=abs(1 - arb(mu_k) / mu), mu_centre=mu_k,
-                            slope=delta_k, gains=gain_balls(sums, loop.tick)))
+                            slope=delta_k, gains=gain_balls(sums, loop.tick), pieces=index))
         return tuple(out)
 
 
-def _own_damping(cell: Cell, speed: arb) -> tuple[arb, arb]:
+def _own_damping(cell: Cell, speed: arb, size: arb | None = None) -> tuple[arb, arb]:
     """The own damping's part of d_c and of ∂d_c/∂y_c in ``cell``: −(Δa + Δb |y|) y and −(Δa + 2 Δb |y|) (Δ: the
     cell's :attr:`Cell.damping`), y over the ball ``speed`` (as :func:`verify.vehicle.model.arb_body_forces` writes
-    every channel's own damping)."""
+    every channel's own damping); ``size`` |y| when the caller has it."""
     d_a, d_b = cell.damping
-    size = _abs(speed)
+    size = _abs(speed) if size is None else size
     return -(d_a + d_b * size) * speed, -(d_a + 2 * d_b * size)
 
 
@@ -240,13 +255,18 @@ def cell_inputs(loop: LoopFacts, c: int, nu: Sequence[arb], rates: Sequence[arb]
     own, m_hat, y_dot = loop.own[c], loop.m_hat[c], arb(accel)
     d_rest, g_rest = _rest(loop, c, nu)
     cross = sum((abs(g) * x for j, (g, x) in enumerate(zip(g_rest, rates)) if j != own), arb(0)) / m_hat
+    size, damped, massed = _abs(nu[own]), {}, {}
     out = []
     for k, cell in enumerate(cells):
-        d_own, g_own = _own_damping(cell, nu[own])
-        rate = abs((g_rest[own] + g_own) / m_hat - arb(cell.slope)) * y_dot + cross
-        mass = cell.mass_residual * y_dot
-        mismatch = upper(abs(d_rest + d_own) / m_hat)
-        out.append(CellInputs(rate=upper(rate), mass=upper(mass), mismatch=mismatch,
+        key = (cell.pieces[1:], cell.slope)  # the damping's pieces fix Δa, Δb and δ_k: the same balls below
+        if key not in damped:
+            d_own, g_own = _own_damping(cell, nu[own], size)
+            damped[key] = (upper(abs((g_rest[own] + g_own) / m_hat - arb(cell.slope)) * y_dot + cross),
+                           upper(abs(d_rest + d_own) / m_hat))
+        if (cell.pieces[0], cell.mu_centre) not in massed:
+            massed[(cell.pieces[0], cell.mu_centre)] = upper(cell.mass_residual * y_dot)
+        rate, mismatch = damped[key]
+        out.append(CellInputs(rate=rate, mass=massed[(cell.pieces[0], cell.mu_centre)], mismatch=mismatch,
                               start=mismatch if starts is None else starts[k]))
     return tuple(out)
 
@@ -276,20 +296,46 @@ def cell_bound(cell: Cell, o: int, jump_tick: arb, jump_period: arb, w_n: float,
 
 def channel_bounds(cells: Sequence[Cell], jump_tick: arb, jump_period: arb, w_n: float,
                    inputs: Sequence[CellInputs], outputs: Sequence[int] = (0, 1, 2, 3)) -> tuple[float, ...]:
-    """Per output of ``outputs``, the largest over ``cells`` of :func:`cell_bound`: every cell's residuals converted
-    once for its four outputs, each output's ball formed in the same order as one cell at a time, the running
-    largest kept by :func:`verify.kernel.intervals.raise_upper`; -inf without cells."""
+    """Per output of ``outputs``, the largest over ``cells`` of :func:`cell_bound`, the same floats as one cell at a
+    time: each output's ball is formed in Arb, in the same order, only for the cells a float screen cannot rule out.
+
+    The screen (:func:`_screen_tops`) sums sup|g| × sup|input| over a cell's terms, every factor rounded up, which
+    is >= sup|x| of the cell's ball up to the floats' and Arb's rounding (a relative 1e-14 for these few terms).
+    Cells are visited from the largest screen down, and a cell whose screen × (1 + 1e-9) is below the running
+    largest :func:`verify.kernel.intervals.upper` is skipped: its ball cannot raise it. -inf without cells."""
     jump_rest, drag = jump_period - jump_tick, arb(w_n)
-    best = [-math.inf] * len(outputs)
-    for cell, ins in zip(cells, inputs):
-        rate, mass, start = arb(ins.rate), arb(ins.mass), arb(ins.start)
-        for i, o in enumerate(outputs):
-            g_tick, g_period, h_rate, h_drag, peak, h_mass = cell.gains[o]
-            x = (jump_tick * g_tick + jump_rest * g_period + h_rate * rate + h_drag * drag + h_mass * mass
-                 + peak * start)
-            if o == 1:
-                x += arb(ins.mismatch)
-            if o == 3:
-                x *= cell.mu
-            best[i] = raise_upper(best[i], abs(x))
+    tops = _screen_tops(cells, upper(_abs(jump_tick)), upper(_abs(jump_rest)), float(w_n), inputs)
+    best = []
+    for o in outputs:
+        out = -math.inf
+        for k in np.argsort(-tops[:, o], kind="stable"):
+            if tops[k, o] * (1.0 + 1e-9) < out:
+                break
+            out = raise_upper(out, abs(_cell_ball(cells[k], o, jump_tick, jump_rest, drag, inputs[k])))
+        best.append(out)
     return tuple(best)
+
+
+def _cell_ball(cell: Cell, o: int, jump_tick: arb, jump_rest: arb, drag: arb, ins: CellInputs) -> arb:
+    """Output ``o``'s ball in ``cell`` (before |.|), the module doc's row o for the cell's residuals ``ins``."""
+    g_tick, g_period, h_rate, h_drag, peak, h_mass = cell.gains[o]
+    x = (jump_tick * g_tick + jump_rest * g_period + h_rate * arb(ins.rate) + h_drag * drag
+         + h_mass * arb(ins.mass) + peak * arb(ins.start))
+    if o == 1:
+        x += arb(ins.mismatch)
+    if o == 3:
+        x *= cell.mu
+    return x
+
+
+def _screen_tops(cells: Sequence[Cell], jump_tick: float, jump_rest: float, w_n: float,
+                 inputs: Sequence[CellInputs]) -> np.ndarray:
+    """(cells, 4) floats: per cell and output, Σ sup|g| × sup|input| (+ sup|D| in row 1, × sup|μ| in row 3); +inf
+    where a product is not a number (an infinite input against a zero gain), so that such a cell is formed."""
+    tops = np.array([cell.gain_tops for cell in cells])                       # (cells, 4, 7)
+    ins = np.array([[jump_tick, jump_rest, i.rate, w_n, i.start, i.mass] for i in inputs], dtype=float)
+    with np.errstate(invalid="ignore", over="ignore"):
+        x = np.einsum("kog,kg->ko", tops[:, :, :6], ins)
+        x[:, 1] += np.array([i.mismatch for i in inputs], dtype=float)
+        x[:, 3] *= tops[:, 3, 6]
+    return np.where(np.isnan(x), np.inf, x)

@@ -111,10 +111,14 @@ class Cell:
 
     @cached_property
     def gain_tops(self) -> np.ndarray:
-        """(4, 7) floats: per row of :attr:`gains`, sup|g| of its six balls (rounded up), then sup|μ| (the ẏ row's
-        factor); what :func:`channel_bounds` screens with."""
-        tops = [[upper(_abs(g)) for g in row] for row in self.gains]
-        return np.array([[*row, upper(_abs(self.mu))] for row in tops], dtype=float)
+        """(4, 6) floats: sup|g| of each ball of :attr:`gains` (rounded up); what :func:`channel_bounds` screens
+        with."""
+        return np.array([[upper(_abs(g)) for g in row] for row in self.gains], dtype=float)
+
+    @cached_property
+    def mu_top(self) -> float:
+        """sup|μ| (rounded up): the ẏ row's factor in :func:`channel_bounds`' screen."""
+        return upper(_abs(self.mu))
 
 
 @dataclass(frozen=True)
@@ -263,10 +267,11 @@ def cell_inputs(loop: LoopFacts, c: int, nu: Sequence[arb], rates: Sequence[arb]
             d_own, g_own = _own_damping(cell, nu[own], size)
             damped[key] = (upper(abs((g_rest[own] + g_own) / m_hat - arb(cell.slope)) * y_dot + cross),
                            upper(abs(d_rest + d_own) / m_hat))
-        if (cell.pieces[0], cell.mu_centre) not in massed:
-            massed[(cell.pieces[0], cell.mu_centre)] = upper(cell.mass_residual * y_dot)
+        mass_key = (cell.pieces[0], cell.mu_centre)  # the mass piece fixes μ and μ_k
+        if mass_key not in massed:
+            massed[mass_key] = upper(cell.mass_residual * y_dot)
         rate, mismatch = damped[key]
-        out.append(CellInputs(rate=rate, mass=massed[(cell.pieces[0], cell.mu_centre)], mismatch=mismatch,
+        out.append(CellInputs(rate=rate, mass=massed[mass_key], mismatch=mismatch,
                               start=mismatch if starts is None else starts[k]))
     return tuple(out)
 
@@ -332,10 +337,10 @@ def _screen_tops(cells: Sequence[Cell], jump_tick: float, jump_rest: float, w_n:
                  inputs: Sequence[CellInputs]) -> np.ndarray:
     """(cells, 4) floats: per cell and output, Σ sup|g| × sup|input| (+ sup|D| in row 1, × sup|μ| in row 3); +inf
     where a product is not a number (an infinite input against a zero gain), so that such a cell is formed."""
-    tops = np.array([cell.gain_tops for cell in cells])                       # (cells, 4, 7)
+    tops = np.array([cell.gain_tops for cell in cells])                       # (cells, 4, 6)
     ins = np.array([[jump_tick, jump_rest, i.rate, w_n, i.start, i.mass] for i in inputs], dtype=float)
     with np.errstate(invalid="ignore", over="ignore"):
-        x = np.einsum("kog,kg->ko", tops[:, :, :6], ins)
+        x = np.einsum("kog,kg->ko", tops, ins)
         x[:, 1] += np.array([i.mismatch for i in inputs], dtype=float)
-        x[:, 3] *= tops[:, 3, 6]
+        x[:, 3] *= np.array([cell.mu_top for cell in cells], dtype=float)
     return np.where(np.isnan(x), np.inf, x)

@@ -6,6 +6,7 @@ from pathlib import Path
 
 import pytest
 
+from .corners import assert_holds_share
 from .scripts import load_script
 
 STUDY = load_script("benchmarks/survey_frontier.py", "bench_survey_frontier")
@@ -104,12 +105,8 @@ def test_the_midpoint_torpedo_is_refused_only_by_where_its_terminal_set_lies_and
 def _survey_box_example(name: str):
     """The shipped REMUS example ``name``, checked to hold ±20 % of the published half-widths in every interval."""
     import tubekit
-    from tubekit.model.vehicles import vehicle_params
     scenario = tubekit.load_scenario(Path(__file__).resolve().parents[1] / "examples" / name)
-    fifth = vehicle_params("remus100").shrunk(0.2)
-    for field in fifth.interval_fields:
-        (lo, hi), (a, b) = scenario.plant.params.interval(field), fifth.interval(field)
-        assert lo <= a and b <= hi, field
+    assert_holds_share(scenario, "remus100", 0.2)
     return scenario
 
 

@@ -83,8 +83,6 @@ def test_the_cell_matrix_has_the_eigenvalues_of_the_loop_in_its_plain_coordinate
                            rtol=1e-3)
 
 
-#: the published box's command box at the owners' speed, the plans' jumps (rate (0.03, 0.03, 0.06) m/s², rad/s² over
-#: 0.1 s) and the first command within J of 0.2 m/s
 _SIZES = st.one_of(st.just(0.0), st.floats(1e-9, 1e3), st.just(math.inf))
 
 
@@ -138,6 +136,8 @@ def test_each_cells_residuals_are_its_own_damping_and_mass_residual_over_the_box
     assert cell_inputs(loop, channel, nu, rates, accel, None) == tuple(expected)
 
 
+#: the published box's command box at the owners' speed, the plans' jumps (rate (0.03, 0.03, 0.06) m/s², rad/s² over
+#: 0.1 s) and the first command within J of 0.2 m/s
 _V, _PLANS, _FIRST = (0.35, 0.15, 0.2), (0.003, 0.003, 0.006), (0.203, 0.003, 0.006)
 
 

@@ -15,7 +15,7 @@ from verify.certificate.certify import Certificate, certify
 from verify.vehicle.compose import PLAN_CHECK_TOLERANCE, plan_jumps
 from verify.studies.recheck import recheck
 from verify.theorem.terminal import TERMINAL_PREFIXES
-from .corners import flown_at_corner
+from .corners import assert_holds_share, flown_at_corner
 from .loop_steps import STEP_5B, STEP_5C, certified_with_steps_off, fresh_solutions
 from .tier_checks import refused_only_by_the_row_faces
 
@@ -540,17 +540,12 @@ def _pier_example(path: str, share: float, current: float):
     """The scenario at ``path``, checked: a 0.2 m/s target passing within 3 m of the pier's surface inside the run,
     ``current`` (m/s per horizontal axis), a box that contains ``share`` of the published spread about its midpoints
     and lies inside the published box."""
-    from tubekit.model.vehicles import vehicle_params
     sc = load_scenario(path)
     (pier,) = sc.obstacles
     speed = sc.trajectory.direction_velocity[0]
     assert speed >= 0.2 and max(sc.disturbance.amplitude[:2]) >= current
     assert abs(pier.center[1]) - pier.radius <= 3.0 and 0.0 < pier.center[0] / speed < sc.duration - 20.0
-    inner, published, own = (vehicle_params("bluerov2_heavy").shrunk(share).to_dict(),
-                             vehicle_params("bluerov2_heavy").to_dict(), sc.plant.params.to_dict())
-    for key, (lo, hi) in ((k, v) for k, v in inner.items() if isinstance(v, (list, tuple))):
-        assert own[key][0] <= lo and hi <= own[key][1], key
-        assert published[key][0] <= own[key][0] and own[key][1] <= published[key][1], key
+    assert_holds_share(sc, "bluerov2_heavy", share, inside=True)
     return sc
 
 

@@ -43,6 +43,28 @@ def test_plan_jumps_are_the_rate_times_the_period_or_twice_v():
     assert plan_jumps(_dynamic()) == pytest.approx((0.8, 0.6, 1.0))  # V = (0.4, 0.3, 0.5)
 
 
+def test_a_backup_laws_loop_ratio_is_bounded_once_per_law_and_safe_set(monkeypatch):
+    """fits(law, safe) (what the backup's design asks of the loop bound) bounds each (law, safe set) once: the tracking
+    design's backup and the safe tier's ask for the same laws; a different safe set is bounded again."""
+    import verify.vehicle.compose as compose
+    from types import SimpleNamespace
+
+    from tubekit.model.backup import SafeSet
+    from verify.theorem.design import disturbance_bounds
+    sc = load_scenario("examples/bluerov2_pier.toml")
+    assumed = (0.05, 0.01, 0.05)
+    asked: list[tuple[object, object]] = []
+
+    def loop(self, law, safe, dist, e_a):
+        asked.append((law, safe))
+        return SimpleNamespace(certified=False)   # a loop bound that fails: the ratio is inf
+    monkeypatch.setattr(compose._LoopInputs, "loop", loop)
+    fits = compose._fits(sc, disturbance_bounds(sc, loop_error=assumed, loop_sway=0.01), assumed, 0.01)
+    law, near, far = "a law", SafeSet(level=1.0, shape=0.0, depth=0.5), SafeSet(level=2.0, shape=0.0, depth=0.5)
+    assert [fits(law, near), fits(law, near), fits(law, far), fits(law, near)] == [math.inf] * 4
+    assert asked == [(law, near), (law, far)]
+
+
 def test_the_tolerance_is_the_plan_checks():
     from tubekit.loop.plan_check import RATE_TOLERANCE
     assert PLAN_CHECK_TOLERANCE == RATE_TOLERANCE

@@ -50,3 +50,34 @@ def test_the_worst_phase_is_at_least_every_phase_and_at_most_the_full_sum():
 def test_an_unstable_system_gives_infinite_sums():
     s = impulse_sums([[0.5]], [[1.0]], [[1.0]], tick=0.1, ticks_per_period=2, max_terms=200)
     assert not s.stable and s.tick[0][0] == math.inf and s.period[0][0] == math.inf
+
+
+def test_equal_balls_get_the_sums_formed_for_them_and_different_balls_their_own(monkeypatch):
+    """The memo of impulse_sums keys on the exact balls: a repeated call returns the sums formed for it without
+    summing again; A one ulp away, or the same midpoint with a radius, is summed afresh and gets what a cold call
+    gives."""
+    from flint import arb
+
+    import verify.vehicle.response as response
+    monkeypatch.setattr(response, "_MEMO", {})
+    a = [[0.0, 1.0], [-4.0, -1.0]]
+    kwargs = dict(tick=0.05, ticks_per_period=7)
+    first = impulse_sums(a, [[0.0, 1.0]], [[1.0, 0.0]], **kwargs)
+    monkeypatch.setattr(response, "_sums", lambda *args: pytest.fail("summed again for the same balls"))
+    assert impulse_sums([[0, 1], [-4, -1]], [[0, 1]], [[1, 0]], **kwargs) is first
+    monkeypatch.undo()
+    nudged = [[0.0, 1.0], [-4.0, math.nextafter(-1.0, 0.0)]]
+    widened = [[0.0, 1.0], [-4.0, arb(-1.0, 1e-3)]]
+    for other in (nudged, widened):
+        warm = impulse_sums(other, [[0.0, 1.0]], [[1.0, 0.0]], **kwargs)
+        monkeypatch.setattr(response, "_MEMO", {})
+        assert warm == impulse_sums(other, [[0.0, 1.0]], [[1.0, 0.0]], **kwargs) != first
+
+
+def test_the_memo_keeps_at_most_its_size(monkeypatch):
+    import verify.vehicle.response as response
+    monkeypatch.setattr(response, "_MEMO", {})
+    monkeypatch.setattr(response, "MEMO_SIZE", 3)
+    for k in (1.0, 2.0, 3.0, 4.0, 5.0):
+        impulse_sums([[-k]], [[1.0]], [[1.0]], tick=0.1, ticks_per_period=2)
+    assert len(response._MEMO) == 3

@@ -189,12 +189,16 @@ def _loop_ratio(loop: LoopBound, assumed: tuple[float, float, float], sway: floa
 def _fits(scenario: Scenario, dist: DisturbanceBounds, assumed: tuple[float, float, float],
           sway: float | None = None) -> Fits:
     """``fits(law, safe)`` for :func:`verify.backup.design_backup`: E / E_a of the loop bound the candidate's
-    command rate gives (inf when the loop bound fails). The scenario's part is read once, not per candidate."""
+    command rate gives (inf when the loop bound fails). The scenario's part is read once, not per candidate, and
+    each (law, safe set) is bounded once: the tracking design's backup and the safe tier's try the same laws."""
     fixed = _LoopInputs.of(scenario)
+    rated: dict[tuple[BackupLaw, SafeSet], float] = {}
 
     def ratio(law: BackupLaw, safe: SafeSet) -> float:
-        loop = fixed.loop(law, safe, dist, assumed)
-        return _loop_ratio(loop, assumed, sway) if loop.certified else math.inf
+        if (law, safe) not in rated:
+            loop = fixed.loop(law, safe, dist, assumed)
+            rated[law, safe] = _loop_ratio(loop, assumed, sway) if loop.certified else math.inf
+        return rated[law, safe]
     return ratio
 
 

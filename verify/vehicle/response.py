@@ -28,12 +28,16 @@ from flint import arb, arb_mat, ctx
 
 from verify.kernel.intervals import raise_upper, upper
 
-__all__ = ["ResponseSums", "impulse_sums", "gain_balls", "RESPONSE_PREC", "INTRA_TICK_PIECES"]
+__all__ = ["ResponseSums", "impulse_sums", "gain_balls", "RESPONSE_PREC", "INTRA_TICK_PIECES", "MEMO_SIZE"]
 
 #: Working precision (bits) of the response sums: the ball radii of A_d^i grow like ρ(|A_d|)^i.
 RESPONSE_PREC = 128
 #: Sub-intervals Q of [0, h] for the intra-tick enclosure of exp(A θ).
 INTRA_TICK_PIECES = 4
+#: Sums kept by :func:`impulse_sums` for calls with the same balls (a few kilobytes each).
+MEMO_SIZE = 4096
+
+_MEMO: dict[tuple, "ResponseSums"] = {}
 
 
 @dataclass(frozen=True)
@@ -128,49 +132,78 @@ def impulse_sums(a: Sequence[Sequence[arb | float]], inputs: Sequence[Sequence[a
         Stop summing term by term once ‖A_d^i‖_∞ < ``tol``.
     max_terms : int
         Largest K; if ρ = ‖A_d^K‖_∞ is still >= 1 there the sums are +inf (not stable).
+
+    Notes
+    -----
+    The sums are a function of the exact balls of A, b, c, h, N, ``tol`` and K alone (formed at
+    :data:`RESPONSE_PREC`): a call with the same balls returns the sums already formed (at most
+    :data:`MEMO_SIZE` kept; a fixed point's rounds and a knob's bisection meet the same channels again).
     """
     with ctx.workprec(RESPONSE_PREC):
         n = len(a)
         A = arb_mat([[arb(x) for x in row] for row in a])
         B = arb_mat([[arb(inputs[j][i]) for j in range(len(inputs))] for i in range(n)])
         C = arb_mat([[arb(x) for x in row] for row in outputs])
-        h = arb(tick)
-        ad = (A * h).exp()
-        rows = _intra_tick_rows(A, C, h, INTRA_TICK_PIECES)
-        stacked = _stacked(rows)
-        n_out, n_in = len(outputs), len(inputs)
-        total_m = arb_mat(n_out, n_in)
-        phase_m = [arb_mat(n_out, n_in) for _ in range(ticks_per_period)]
-        peak_flat = [0.0] * (n_out * n_in)
-        power, norm_sum, i = arb_mat(n, n, [arb(int(r == c)) for r in range(n) for c in range(n)]), arb(0), 0
+        key = (_exact_entries(A), _exact_entries(B), _exact_entries(C), _exact(arb(tick)), int(ticks_per_period),
+               float(tol), int(max_terms))
+        found = _MEMO.get(key)
+        if found is None:
+            found = _sums(A, B, C, arb(tick), int(ticks_per_period), tol, max_terms)
+            if len(_MEMO) >= MEMO_SIZE:
+                del _MEMO[next(iter(_MEMO))]
+            _MEMO[key] = found
+        return found
+
+
+def _exact(ball: arb) -> tuple[tuple[int, int], tuple[int, int]]:
+    """A ball's midpoint and radius, each as the exact (mantissa, exponent) pair: equal keys, equal balls."""
+    return ball.mid().man_exp(), ball.rad().man_exp()
+
+
+def _exact_entries(m: arb_mat) -> tuple[int, int, tuple[tuple[tuple[int, int], tuple[int, int]], ...]]:
+    """The shape and every entry of ``m``, exactly (:func:`_exact`)."""
+    return m.nrows(), m.ncols(), tuple(_exact(x) for x in m.entries())
+
+
+def _sums(A: arb_mat, B: arb_mat, C: arb_mat, h: arb, ticks_per_period: int, tol: float,
+          max_terms: int) -> ResponseSums:
+    """:func:`impulse_sums` of the balls A (n x n), B (n x n_in), C (n_out x n), formed at the working precision."""
+    n, n_in, n_out = A.nrows(), B.ncols(), C.nrows()
+    ad = (A * h).exp()
+    rows = _intra_tick_rows(A, C, h, INTRA_TICK_PIECES)
+    stacked = _stacked(rows)
+    total_m = arb_mat(n_out, n_in)
+    phase_m = [arb_mat(n_out, n_in) for _ in range(ticks_per_period)]
+    peak_flat = [0.0] * (n_out * n_in)
+    power, norm_sum, i = arb_mat(n, n, [arb(int(r == c)) for r in range(n) for c in range(n)]), arb(0), 0
+    norm = _norm_inf(power)
+    while i < max_terms and not (i >= ticks_per_period and _done(norm, tol)):
+        g = _tick_maxima(stacked, power * B, INTRA_TICK_PIECES)
+        g_m = arb_mat(n_out, n_in, g)
+        total_m = total_m + g_m
+        phase_m[i % ticks_per_period] = phase_m[i % ticks_per_period] + g_m
+        peak_flat = [raise_upper(p, x) for p, x in zip(peak_flat, g)]
+        norm_sum += norm
+        power = power * ad
         norm = _norm_inf(power)
-        while i < max_terms and not (i >= ticks_per_period and _done(norm, tol)):
-            g = _tick_maxima(stacked, power * B, INTRA_TICK_PIECES)
-            g_m = arb_mat(n_out, n_in, g)
-            total_m = total_m + g_m
-            phase_m[i % ticks_per_period] = phase_m[i % ticks_per_period] + g_m
-            peak_flat = [raise_upper(p, x) for p, x in zip(peak_flat, g)]
-            norm_sum += norm
-            power = power * ad
-            norm = _norm_inf(power)
-            i += 1
-        total = [[total_m[o, j] for j in range(n_in)] for o in range(n_out)]
-        phase = [[[m[o, j] for j in range(n_in)] for o in range(n_out)] for m in phase_m]
-        peak = [peak_flat[o * n_in:(o + 1) * n_in] for o in range(n_out)]
-        rho = upper(norm)
-        if not rho < 1.0:
-            inf = tuple(tuple(math.inf for _ in range(n_in)) for _ in range(n_out))
-            return ResponseSums(tick=inf, period=inf, peak=inf, rho=rho, terms=i)
-        xk = power * B
-        row_norm = [max(upper(_norm_inf(_row(r, o))) for r in rows) for o in range(n_out)]
-        tails = [[arb(row_norm[o]) * norm_sum * _col_norm(xk, j) / (1 - arb(rho)) for j in range(n_in)]
-                 for o in range(n_out)]
-        tick_sums = tuple(tuple(upper(total[o][j] + tails[o][j]) for j in range(n_in)) for o in range(n_out))
-        period_sums = tuple(tuple(max(upper(phase[p][o][j] + tails[o][j]) for p in range(ticks_per_period))
-                                  for j in range(n_in)) for o in range(n_out))
-        # a single term of the tail is at most the whole tail
-        peaks = tuple(tuple(max(peak[o][j], upper(tails[o][j])) for j in range(n_in)) for o in range(n_out))
-        return ResponseSums(tick=tick_sums, period=period_sums, peak=peaks, rho=rho, terms=i)
+        i += 1
+    total = [[total_m[o, j] for j in range(n_in)] for o in range(n_out)]
+    phase = [[[m[o, j] for j in range(n_in)] for o in range(n_out)] for m in phase_m]
+    peak = [peak_flat[o * n_in:(o + 1) * n_in] for o in range(n_out)]
+    rho = upper(norm)
+    if not rho < 1.0:
+        inf = tuple(tuple(math.inf for _ in range(n_in)) for _ in range(n_out))
+        return ResponseSums(tick=inf, period=inf, peak=inf, rho=rho, terms=i)
+    xk = power * B
+    row_norm = [max(upper(_norm_inf(_row(r, o))) for r in rows) for o in range(n_out)]
+    tails = [[arb(row_norm[o]) * norm_sum * _col_norm(xk, j) / (1 - arb(rho)) for j in range(n_in)]
+             for o in range(n_out)]
+    tick_sums = tuple(tuple(upper(total[o][j] + tails[o][j]) for j in range(n_in)) for o in range(n_out))
+    period_sums = tuple(tuple(max(upper(phase[p][o][j] + tails[o][j]) for p in range(ticks_per_period))
+                              for j in range(n_in)) for o in range(n_out))
+    # a single term of the tail is at most the whole tail
+    peaks = tuple(tuple(max(peak[o][j], upper(tails[o][j])) for j in range(n_in)) for o in range(n_out))
+    return ResponseSums(tick=tick_sums, period=period_sums, peak=peaks, rho=rho, terms=i)
 
 
 def gain_balls(sums: ResponseSums, tick: float) -> tuple[tuple[arb, ...], ...]:

@@ -220,3 +220,23 @@ def test_the_smooth_law_resists_the_adversary_from_the_hand_over(start):
             state = max(nxt, key=lambda x: _lyapunov(x, s, law.unstable))
             worst, worst_z = max(worst, _lyapunov(state, s, law.unstable)), max(worst_z, abs(state[2]))
         assert worst <= s.level and worst_z <= s.depth
+
+
+def test_the_sampled_rate_of_many_shapes_at_once_is_each_shapes_own_to_the_bit():
+    """rates_sampled (the shape search's screen, every shape in one array) gives, per shape, exactly the float of
+    V̇ sampled at 721 χ in [0, π/2] for that shape alone (written out here, one shape at a time), on a grid of shapes
+    up to the level and a few currents; and rate_sampled is its entry."""
+    from verify.backup.proof import rate_sampled, rates_sampled
+
+    def alone(beta: float, omega: float, e_r: float) -> float:
+        chi = np.linspace(0.0, math.pi / 2, 721)
+        gp, d = beta * np.sin(chi), 1.5 - beta * (1 - np.cos(chi))
+        r = -LAW.yaw_rate * np.clip(chi / LAW.yaw_band, -1.0, 1.0)
+        u = LAW.surge * np.cos(chi)
+        return float((-u * np.cos(chi) + omega * np.sqrt(1 + (gp / d) ** 2)
+                      + gp * (r + e_r + u * np.sin(chi) / d)).max())
+    shapes = np.round(np.arange(0.05, 1.5, 0.05), 6)
+    for omega in (0.0, 0.05, 0.3):
+        together = rates_sampled(LAW, 1.5, shapes, omega, yaw_err=0.01)
+        assert together.tolist() == [alone(float(b), omega, 0.01) for b in shapes]
+        assert rate_sampled(LAW, SafeSet(level=1.5, shape=0.5, depth=1.0), omega, yaw_err=0.01) == together[9]

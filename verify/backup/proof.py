@@ -61,7 +61,7 @@ from verify.backup.protocol import BackupCertificate
 from verify.backup.rate import backup_command_rate, backup_tick_change
 
 __all__ = ["BackupCertificate", "planar_rate_bound", "certify_backup", "ramp_window", "tick_distance", "rate_sampled",
-           "ridge_rate", "hold_conditions", "angle_step", "checked_bounds",
+           "rates_sampled", "ridge_rate", "hold_conditions", "angle_step", "checked_bounds",
            "backup_command_rate", "backup_tick_change", "BACKUP_MAX_BOXES"]
 
 #: Bisection budget of :func:`planar_rate_bound` (intervals of χ examined): a work unit, not seconds.
@@ -101,13 +101,21 @@ def rate_sampled(law: StationKeeping, safe: SafeSet, omega_xy: float, n: int = 7
     """The largest V̇ (m/s) at sampled χ with the input of the same instant (no hold) and the worst ω."""
     if law.yaw_law == "continuous":
         return continuous_rate_sampled(law, safe, omega_xy, 2 * n - 1, yaw_err)
+    return float(rates_sampled(law, safe.level, np.array([float(safe.shape)]), omega_xy, n, yaw_err)[0])
+
+
+def rates_sampled(law: StationKeeping, level: float, shapes: np.ndarray, omega_xy: float, n: int = 721,
+                  yaw_err: float = 0.0) -> np.ndarray:
+    """:func:`rate_sampled` (m/s) of the switched law on the level ``level`` (m) for each shape β of ``shapes`` (m) at
+    once: the same samples, the same float operations per element (a row per shape)."""
     chi = np.linspace(0.0, math.pi / 2, n)
-    gp = safe.shape * np.sin(chi)
-    d = safe.level - safe.shape * (1 - np.cos(chi))
+    beta = np.asarray(shapes, dtype=float)[:, None]
+    gp = beta * np.sin(chi)
+    d = level - beta * (1 - np.cos(chi))
     r = -law.yaw_rate * np.clip(chi / law.yaw_band, -1.0, 1.0)
     u = law.surge * np.cos(chi)
     rate = -u * np.cos(chi) + omega_xy * np.sqrt(1 + (gp / d) ** 2) + gp * (r + yaw_err + u * np.sin(chi) / d)
-    return float(rate.max())
+    return rate.max(axis=1)
 
 
 def planar_rate_bound(law: StationKeeping, safe: SafeSet, omega_xy: float, tick: float,

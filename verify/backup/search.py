@@ -36,7 +36,7 @@ from flint import arb
 from tubekit.model.backup import SafeSet, StationKeeping
 from tubekit.validation import nonnegative, positive
 from verify.backup.continuous import cone_angle, continuous_best_shape
-from verify.backup.proof import BACKUP_MAX_BOXES, certify_backup, ramp_window, rate_sampled, tick_distance
+from verify.backup.proof import BACKUP_MAX_BOXES, certify_backup, ramp_window, rates_sampled, tick_distance
 from verify.backup.protocol import BackupCertificate, Fits
 from verify.kernel.intervals import lower, upper
 
@@ -272,9 +272,9 @@ def _best_shape(law: StationKeeping, level: float, omega_xy: float, handover: fl
             return None
         i, rate = continuous_best_shape(law, level, shapes, omega_xy, yaw_err=yaw_err)
         return float(shapes[i]) if rate < 0.0 else None
-    best, value = None, 0.0
-    for shape in shapes:
-        rate = rate_sampled(law, SafeSet(level=level, shape=float(shape), depth=1.0), omega_xy, yaw_err=yaw_err)
-        if rate < value:
-            best, value = float(shape), rate
-    return best
+    if shapes.size == 0:
+        return None
+    rates = rates_sampled(law, level, shapes, omega_xy, yaw_err=yaw_err)
+    rates = np.where(np.isnan(rates), np.inf, rates)
+    i = int(np.argmin(rates))   # the first of the most negative
+    return float(shapes[i]) if rates[i] < 0.0 else None

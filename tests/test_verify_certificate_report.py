@@ -11,8 +11,8 @@ import pytest
 from verify.certificate.certify import assumptions_of
 from verify.certificate.knobs import failure_knobs
 from verify.certificate.record import ASSUMPTIONS
-from verify.certificate.report import (FAILURE_LINES, certificate_text, compare, knob_text, summary_text, tiers_line,
-                                       tried_lines, verdict_line)
+from verify.certificate.report import (FAILURE_LINES, LOOP_NOT_CLOSED, certificate_text, compare, knob_text,
+                                       summary_text, tiers_line, tried_lines, verdict_line)
 
 EXAMPLES = Path(__file__).resolve().parent.parent / "examples"
 
@@ -170,3 +170,16 @@ def test_a_path_clearance_failure_says_where_when_and_how_much():
     found = re.search(r"needs (\d\.\d+) m, has (\d(?:\.\d+)?) m at t = (\d+\.\d) s", line)
     assert found and float(found[2]) < float(found[1]) and 0.0 < float(found[3]) <= 40.0, line
     assert "tracking: not certified (path_clearance[0])" in text.splitlines()[0]
+
+
+def test_where_the_loop_bound_did_not_close_the_summary_names_it_as_the_root_cause_first(remus_cert, pc_cert):
+    """examples/remus100_currents.toml: the loop's fixed point does not close, so ω̄ (and every condition reading it)
+    rests on an unconfirmed loop error; the failures end with one line saying so. A certificate whose loop closed, or
+    without a loop, has no such line."""
+    assert any(c.condition == "loop_fixed_point" and c.ok is False for c in remus_cert.conditions)
+    lines = remus_cert.summary().splitlines()
+    last = max(i for i, ln in enumerate(lines) if ln.startswith("  "))
+    assert lines[last] == f"  root cause first: {LOOP_NOT_CLOSED}" and "keep_up" in LOOP_NOT_CLOSED
+    closed = certify(load_scenario(EXAMPLES / "bluerov2_pier_brisk.toml"))
+    for cert in (pc_cert, closed):
+        assert LOOP_NOT_CLOSED not in cert.summary()

@@ -13,10 +13,15 @@ from verify.certificate.knobs import Knob, knobs_for
 from verify.certificate.record import CertificateRecord
 
 __all__ = ["certificate_text", "summary_text", "verdict_line", "tiers_line", "compare", "tried_lines", "knob_text",
-           "FAILURE_LINES"]
+           "FAILURE_LINES", "LOOP_NOT_CLOSED"]
 
 #: Failed conditions listed one per line in :func:`summary_text`; the others are named on one more line.
 FAILURE_LINES = 12
+#: Said under the failures when the velocity loop's fixed point did not close: ω̄, the tube and the backup were
+#: derived with the loop error the last round assumed, which no loop bound confirms.
+LOOP_NOT_CLOSED = ("loop_fixed_point -- the velocity loop's bound did not close, so every condition that reads "
+                   "omega_bar (keep_up, e_bar, the tube, the backup's) reads it with a loop error no bound confirms: "
+                   "make loop_fixed_point hold first")
 
 
 def _f(x: Any, d: int = 4) -> str:
@@ -179,6 +184,8 @@ def _failure_lines(cert: CertificateRecord) -> list[str]:
     rest = open_[FAILURE_LINES:]
     if rest:
         out.append(f"  ... and {len(rest)} more: " + ", ".join(c.condition for c in rest))
+    if any(c.condition == "loop_fixed_point" and c.ok is False for c in open_):
+        out.append(f"  root cause first: {LOOP_NOT_CLOSED}")
     return out
 
 

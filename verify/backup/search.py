@@ -267,13 +267,11 @@ def _best_shape(law: StationKeeping, level: float, omega_xy: float, handover: fl
     """The shape β on a grid with the most negative sampled level-set rate at ``level``, or None (the continuous
     law's shapes evaluated at once and pruned, :func:`verify.backup.continuous.continuous_best_shape`)."""
     shapes = np.round(np.arange(MIN_SHAPE, level - handover, MIN_SHAPE), 6)
-    if law.yaw_law == "continuous":
-        if shapes.size == 0:
-            return None
-        i, rate = continuous_best_shape(law, level, shapes, omega_xy, yaw_err=yaw_err)
-        return float(shapes[i]) if rate < 0.0 else None
     if shapes.size == 0:
         return None
+    if law.yaw_law == "continuous":
+        i, rate = continuous_best_shape(law, level, shapes, omega_xy, yaw_err=yaw_err)
+        return float(shapes[i]) if rate < 0.0 else None
     rates = rates_sampled(law, level, shapes, omega_xy, yaw_err=yaw_err)
     rates = np.where(np.isnan(rates), np.inf, rates)
     i = int(np.argmin(rates))   # the first of the most negative

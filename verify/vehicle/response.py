@@ -144,11 +144,12 @@ def impulse_sums(a: Sequence[Sequence[arb | float]], inputs: Sequence[Sequence[a
         A = arb_mat([[arb(x) for x in row] for row in a])
         B = arb_mat([[arb(inputs[j][i]) for j in range(len(inputs))] for i in range(n)])
         C = arb_mat([[arb(x) for x in row] for row in outputs])
-        key = (_exact_entries(A), _exact_entries(B), _exact_entries(C), _exact(arb(tick)), int(ticks_per_period),
+        h = arb(tick)
+        key = (_exact_entries(A), _exact_entries(B), _exact_entries(C), _exact(h), int(ticks_per_period),
                float(tol), int(max_terms))
         found = _MEMO.get(key)
         if found is None:
-            found = _sums(A, B, C, arb(tick), int(ticks_per_period), tol, max_terms)
+            found = _sums(A, B, C, h, int(ticks_per_period), tol, max_terms)
             if len(_MEMO) >= MEMO_SIZE:
                 del _MEMO[next(iter(_MEMO))]
             _MEMO[key] = found

@@ -3,6 +3,7 @@
 Usage::
 
     python benchmarks/pier_spread.py [--current 0 0.02 0.04 0.06 0.08 0.1] [--steps 6]
+                                     [--dt 0.01 --horizon 8 --behind 2.1]
 
 On ``examples/bluerov2_pier_underway.toml`` (the BlueROV2 Heavy at 0.2 m/s, a pier whose surface is 3 m from the
 path, a 0.2 s horizon of 25 ms steps, started under way), for each horizontal current per axis (``--current``, m/s;
@@ -11,7 +12,9 @@ share s of the published spread (``VehicleParams.shrunk(s)``: every interval of 
 midpoint to s of its half-width) at which ``verify.certify`` gives both tiers is bisected over [:data:`FLOOR`, 1]
 (1 is tried first, then ``--steps`` halvings). A rate is bisected only where it certifies above the best share found
 so far. Every share reported was itself certified; the bisection assumes a narrower box is no harder, and the share
-is a lower bound of the frontier to within 2^-steps. A study: nothing timed, nothing shipped.
+is a lower bound of the frontier to within 2^-steps. ``--dt`` (s), ``--horizon`` (steps) and ``--behind`` (m, the
+start's distance behind the target) change the file's MPC period, horizon and start for every cell. A study: nothing
+timed, nothing shipped.
 
 What it shows (``docs/plant.md`` section 4, "A pier 3 m off in 0.1 m/s of current"): each step of current costs
 share of the box, because the loop's error grows with the box and the plans' rates the current asks, and the
@@ -89,9 +92,16 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--current", type=float, nargs="+", default=list(CURRENTS),
                     help="horizontal current per axis (m/s)")
     ap.add_argument("--steps", type=int, default=6, help="halvings of each bisection")
+    ap.add_argument("--dt", type=float, default=None, help="the MPC period (s; default: the file's)")
+    ap.add_argument("--horizon", type=int, default=None, help="the horizon (steps; default: the file's)")
+    ap.add_argument("--behind", type=float, default=None, help="the start behind the target (m; default: the file's)")
     args = ap.parse_args(argv)
     base = load_scenario(SCENARIO)
-    print(f"{SCENARIO.name}: the largest share of the published spread with both tiers, per current")
+    changes = {"controller.dt": args.dt, "controller.horizon_steps": args.horizon,
+               "initial_state": None if args.behind is None else (-args.behind, 0.0, 0.0, 0.0)}
+    base = base.with_changes(**{k: v for k, v in changes.items() if v is not None})
+    print(f"{SCENARIO.name}: the largest share of the published spread with both tiers, per current; period "
+          f"{base.controller.dt:g} s, {base.controller.horizon_steps} steps, start {-base.initial_state[0]:g} m behind")
     for current in args.current:
         found = largest_share(current, args.steps, base=base)
         if found["rates"] is None:

@@ -54,13 +54,11 @@ def at_share(share: float, current: float, rates: tuple[float, float, float],
         "disturbance.amplitude": (current, current, vertical), "limits.rate": tuple(rates)})
 
 
-def certified(scenario: Scenario) -> tuple[bool, tuple[float, float, float] | None]:
-    """(both tiers certified, the loop's error E in m/s, m/s, rad/s or None where its bound did not close)."""
+def certified(scenario: Scenario) -> tuple[bool, tuple[float, float, float]]:
+    """(both tiers certified, the loop's error E in m/s, m/s, rad/s: inf where its bound did not close)."""
     from verify import certify
     cert = certify(scenario)
-    loop = cert.velocity_loop
-    error = None if loop is None or loop.error is None else tuple(float(x) for x in loop.error)
-    return bool(cert.tiers.safe and cert.tiers.tracking), error
+    return bool(cert.tiers.safe and cert.tiers.tracking), tuple(float(x) for x in cert.velocity_loop.error)
 
 
 def largest_share(current: float, steps: int = 6, rates: tuple[tuple[float, float, float], ...] = RATES,

@@ -8,7 +8,7 @@ Usage::
 On ``examples/bluerov2_pier_underway.toml`` (the BlueROV2 Heavy at 0.2 m/s, a pier whose surface is 3 m from the
 path, a 0.2 s horizon of 25 ms steps, started under way), for each horizontal current per axis (``--current``, m/s;
 the vertical stays the file's 0.1 m/s) and each of the plans' rates in :data:`RATES` (slowest first), the largest
-share s of the published spread (``VehicleParams.shrunk(s)``: every interval of the bundled vehicle shrunk about its
+share s of the published spread (``PlantSettings.shrunk(s)``: every interval of the bundled vehicle shrunk about its
 midpoint to s of its half-width) at which ``verify.certify`` gives both tiers is bisected over [:data:`FLOOR`, 1]
 (1 is tried first, then ``--steps`` halvings). A rate is bisected only where it certifies above the best share found
 so far. Every share reported was itself certified; the bisection assumes a narrower box is no harder, and the share
@@ -24,11 +24,9 @@ surge row of the terminal law pays for both; the whole published spread holds on
 from __future__ import annotations
 
 import argparse
-import dataclasses
 import sys
 from pathlib import Path
 
-from tubekit.model.vehicles import vehicle_params
 from tubekit.scenario import Scenario, load_scenario
 
 SCENARIO = Path(__file__).resolve().parent.parent / "examples" / "bluerov2_pier_underway.toml"
@@ -47,10 +45,8 @@ def at_share(share: float, current: float, rates: tuple[float, float, float],
     """The pier file with its vehicle's box at ``share`` of the published spread, ``current`` m/s of horizontal
     current per axis (the file's vertical kept) and the plans' ``rates``; its other vehicle overrides kept."""
     base = load_scenario(SCENARIO) if base is None else base
-    box = vehicle_params(base.plant.vehicle).shrunk(share)
-    over = tuple((k, box.interval(k) if isinstance(v, tuple) else v) for k, v in base.plant.overrides)
     vertical = base.disturbance.amplitude[2]
-    return base.with_changes(plant=dataclasses.replace(base.plant, overrides=over), **{
+    return base.with_changes(plant=base.plant.shrunk(share), **{
         "disturbance.amplitude": (current, current, vertical), "limits.rate": tuple(rates)})
 
 

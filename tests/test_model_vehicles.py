@@ -168,3 +168,22 @@ def test_thrusters_live_in_the_vehicle_table_and_replace_its_limits():
     assert PlantSettings("dynamic", "bluerov2_heavy").thrusters is None
     assert PlantSettings("dynamic", "bluerov2_heavy").to_dict() == {"kind": "dynamic",
                                                                    "vehicle": {"name": "bluerov2_heavy"}}
+
+
+def test_a_plant_shrunk_to_a_share_of_the_published_box_keeps_its_other_overrides():
+    """PlantSettings.shrunk(0.5): each interval coefficient of the bundled BlueROV2 box is its midpoint ± half its
+    half-width (worked out here from the published intervals), the loop's bandwidth override stays, and a share
+    outside [0, 1] names its field."""
+    plant = PlantSettings(kind="dynamic", vehicle="bluerov2_heavy",
+                          overrides=(("loop_bandwidth", 20.0), ("X_uu", (-100.0, -90.0))))
+    half = plant.shrunk(0.5)
+    published = vehicle_params("bluerov2_heavy")
+    assert dict(half.overrides)["loop_bandwidth"] == 20.0
+    for name in published.interval_fields:
+        lo, hi = published.interval(name)
+        mid, quarter = (lo + hi) / 2, (hi - lo) / 4
+        assert half.params.interval(name) == pytest.approx((mid - quarter, mid + quarter), rel=1e-12), name
+    assert plant.shrunk(0.0).params.is_point
+    assert plant.shrunk(1.0).params.interval("X_uu") == pytest.approx((-141.0, -34.96), rel=1e-12)
+    with pytest.raises(ConfigError, match="fraction"):
+        plant.shrunk(1.5)

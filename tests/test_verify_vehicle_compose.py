@@ -606,11 +606,7 @@ PIER_UNDERWAY = "examples/bluerov2_pier_underway.toml"
 def _at_share(sc, share: float):
     """``sc`` with its vehicle's box at ``share`` of the published spread about its midpoints (its other overrides
     kept)."""
-    import dataclasses
-    from tubekit.model.vehicles import vehicle_params
-    box = vehicle_params("bluerov2_heavy").shrunk(share)
-    over = tuple((k, box.interval(k) if isinstance(v, tuple) else v) for k, v in sc.plant.overrides)
-    return sc.with_changes(plant=dataclasses.replace(sc.plant, overrides=over))
+    return sc.with_changes(plant=sc.plant.shrunk(share))
 
 
 @pytest.mark.slow(15)

@@ -13,7 +13,7 @@ X_max, Z_max, N_max are derived instead of given.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field, fields
+from dataclasses import dataclass, field, fields, replace
 from pathlib import Path
 from typing import Any, Mapping
 
@@ -139,6 +139,16 @@ class PlantSettings:
     def settled(self) -> bool:
         """True when the velocity loop starts at its equilibrium at ``limits.initial`` (``start = "settled"``)."""
         return self.start == "settled"
+
+    def shrunk(self, share: float) -> PlantSettings:
+        """This plant over its bundled vehicle's coefficient box shrunk about its midpoints to ``share`` of each
+        half-width (:meth:`VehicleParams.shrunk`; 1 is the published box, 0 its midpoint): every interval coefficient
+        of the bundled box becomes an override, the other overrides (bandwidths, limits, thrusters) stay. Raises
+        ConfigError for a share outside [0, 1] or a ``truth`` value outside the new box."""
+        published = vehicle_params(self.vehicle)
+        box = published.shrunk(share)
+        spread = {name: getattr(box, name) for name in published.interval_fields}
+        return replace(self, overrides=tuple({**dict(self.overrides), **spread}.items()))
 
     def to_dict(self) -> dict[str, Any]:
         """The ``[plant]`` table (vehicle overrides under ``vehicle``, with ``name``; ``thrusters`` inside it)."""

@@ -314,7 +314,7 @@ def _scaled(factor: float) -> PlantSettings:
     """The BlueROV2 Heavy with every coefficient of its nominal point times ``factor`` (a point vehicle)."""
     nominal = PlantSettings("dynamic", "bluerov2_heavy").params.nominal.to_dict()
     return PlantSettings("dynamic", "bluerov2_heavy",
-                         overrides={k: factor * v for k, v in nominal.items() if k != "actuation"})
+                         overrides={k: factor * v for k, v in nominal.items() if not isinstance(v, str)})
 
 
 @pytest.mark.parametrize("factor", [0.2, 0.5, 1.6])

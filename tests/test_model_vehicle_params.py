@@ -74,6 +74,8 @@ def test_interval_of_an_unknown_or_non_numeric_name_is_a_value_error():
     ({"Z_max": 0.0}, "plant.vehicle.Z_max", "> 0"),                              # thrusters need it
     ({"fin_max": 0.2}, "plant.vehicle.fin_max", "unused with actuation = 'thrusters'"),
     ({"actuation": "oars"}, "plant.vehicle.actuation", "thrusters"),
+    ({"loop_feedforward": "measured"}, "plant.vehicle.loop_feedforward", "'model', 'none'"),
+    ({"loop_feedforward": 0}, "plant.vehicle.loop_feedforward", "'model', 'none'"),
     ({"N_vdot": [0.1, 0.3]}, "plant.vehicle.N_vdot", "M symmetric"),            # box: not symmetric
     ({"Y_rdot": [0.1, 0.3], "N_vdot": [0.1, 0.25]}, "plant.vehicle.N_vdot", "M symmetric"),
     # m22 = m - Y_vdot > 0 at the nominal but not at the worst end: 10 - (-5 .. 12) reaches -2

@@ -395,6 +395,24 @@ def test_a_settled_start_is_the_loops_equilibrium_wherever_the_truth_lies_in_the
     assert x[0] == pytest.approx(surge, abs=1e-8)  # 1 s at u_0 along x, no current
 
 
+@pytest.mark.parametrize("end", [0, 1])
+def test_without_a_model_feedforward_the_integrators_hold_the_whole_drag_and_a_settled_start_stays(end):
+    """With ``loop_feedforward = "none"`` the loop commands M̂ a only: at ν = the command with the integrators at 0
+    it commands no force at all, and started settled at 0.3 m/s at a corner of the BlueROV2's box the integrator
+    holds the truth's whole drag, so the vehicle stays at 0.3 m/s for 1 s."""
+    box = BLUEROV2_HEAVY.with_overrides({"loop_feedforward": "none"})
+    truth = box.with_point({k: box.interval(k)[end] for k in box.interval_fields})
+    sc = _settled("bluerov2_heavy", 0.3).with_changes(plant=PlantSettings(
+        "dynamic", vehicle="bluerov2_heavy", start="settled", overrides={"loop_feedforward": "none"}))
+    plant = DynamicPlant(sc, params=truth)
+    assert plant.thrust_command((0.3, 0.0, 0.0, 0.1), (0.3, 0.0, 0.1), (0.0, 0.0, 0.0))[0] == (0.0, 0.0, 0.0)
+    x = (0.0, 0.0, 0.0, 0.0)
+    for k in range(100):
+        x = plant.step_tuple(0.01 * k, x, (0.3, 0.0, 0.0), 0.005, 2)
+    drag = body_forces(truth, (0.3, 0.0, 0.0, 0.0))[0]
+    assert plant.state[4] == pytest.approx(drag, rel=1e-9) and plant.state[0] == pytest.approx(0.3, abs=1e-9)
+
+
 def test_a_settled_start_the_vehicle_cannot_hold_names_the_field():
     """The BlueROV2 Heavy's eight T200 do not hold 2.4 m/s against its drag: no equilibrium there."""
     with pytest.raises(ConfigError, match=r"^plant\.start: expected 'trimmed': the vehicle cannot hold 2\.4 m/s"):

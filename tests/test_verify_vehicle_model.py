@@ -126,3 +126,25 @@ def test_an_interval_thruster_lag_is_refused():
     with pytest.raises(ConfigError, match="plant.vehicle.thruster_time_constant"):
         point_time_constant(p)
     assert point_time_constant(BLUEROV2_HEAVY) == 0.05
+
+
+@pytest.mark.parametrize("vehicle", ["remus100", "bluerov2_heavy"])
+def test_the_force_hessian_is_the_gradients_central_difference_off_zero(vehicle):
+    """Property: at random velocities away from 0 (where the |x| terms are smooth) every ∂²n_i/∂ν_j∂ν_k of
+    body_force_hessian matches the central difference of body_force_gradient (an independent derivative)."""
+    from flint import arb
+    from tubekit.model.vehicles import vehicle_params
+    from verify.vehicle.model import body_force_gradient, body_force_hessian, nominal_balls
+    c = nominal_balls(vehicle_params(vehicle))
+    rng = np.random.default_rng(7)
+    for _ in range(10):
+        nu = rng.uniform(0.05, 1.0, 4) * rng.choice([-1.0, 1.0], 4)
+        hess = body_force_hessian(c, [arb(x) for x in nu])
+        for j in range(4):
+            step = np.zeros(4)
+            step[j] = 1e-6
+            up, down = (body_force_gradient(c, [arb(x) for x in nu + sgn * step]) for sgn in (1, -1))
+            for i in range(4):
+                for m in range(4):
+                    diff = (float(up[i][m].mid()) - float(down[i][m].mid())) / 2e-6
+                    assert float(hess[i][m][j].mid()) == pytest.approx(diff, rel=1e-6, abs=1e-6)

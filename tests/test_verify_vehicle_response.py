@@ -81,3 +81,20 @@ def test_the_memo_keeps_at_most_its_size(monkeypatch):
     for k in (1.0, 2.0, 3.0, 4.0, 5.0):
         impulse_sums([[-k]], [[1.0]], [[1.0]], tick=0.1, ticks_per_period=2)
     assert len(response._MEMO) == 3
+
+
+def test_the_weighted_sums_weigh_each_ticks_response_by_the_jumps_its_age_holds():
+    """Property: for ṡ = −k s (c = b = 1, g(i) = e^{−k i h} exactly), the weighted sums are Σ g(i)(i + 2) and
+    Σ g(i)(⌊(i + 1)/N⌋ + 1), summed here term by term to 1e-14, and the worst phase's weighted sum lies between a
+    single phase's and the full weighted sum; the unweighted sums are unchanged by asking for the weights."""
+    k, h, n = 3.0, 0.01, 4
+    s = impulse_sums([[-k]], [[1.0]], [[1.0]], tick=h, ticks_per_period=n, tol=1e-12, moments=True)
+    plain = impulse_sums([[-k]], [[1.0]], [[1.0]], tick=h, ticks_per_period=n, tol=1e-12)
+    g = [math.exp(-k * i * h) for i in range(20000)]
+    by_ticks = sum(x * (i + 2) for i, x in enumerate(g))
+    by_periods = sum(x * ((i + 1) // n + 1) for i, x in enumerate(g))
+    assert by_ticks <= s.moment_tick[0][0][0] <= by_ticks * (1 + 1e-6)
+    assert by_periods <= s.moment_tick[1][0][0] <= by_periods * (1 + 1e-6)
+    phase0 = sum(x * ((i + 1) // n + 1) for i, x in enumerate(g) if i % n == 0)
+    assert phase0 <= s.moment_period[1][0][0] <= s.moment_tick[1][0][0]
+    assert (s.tick, s.period, s.peak) == (plain.tick, plain.period, plain.peak)

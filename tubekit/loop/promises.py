@@ -302,9 +302,9 @@ def _plant_in_box(run: RunLog) -> list[Promise]:
     simulated = run.scenario.plant.truth_params
     outside: list[str] = []
     for name in box.to_dict():
-        if name == "actuation":
-            if simulated.actuation != box.actuation:
-                outside.append(f"actuation = {simulated.actuation!r}, certified {box.actuation!r}")
+        if name in ("actuation", "loop_feedforward"):  # a choice: the same on both
+            if getattr(simulated, name) != getattr(box, name):
+                outside.append(f"{name} = {getattr(simulated, name)!r}, certified {getattr(box, name)!r}")
             continue
         (lo, hi), value = box.interval(name), simulated.interval(name)[0]
         if not lo <= value <= hi:

@@ -25,13 +25,17 @@ import numpy as np
 from tubekit.exceptions import ConfigError
 from tubekit.validation import is_number
 
-__all__ = ["VehicleParams", "Coefficient", "ACTUATIONS", "CHANNEL_BANDWIDTHS"]
+__all__ = ["VehicleParams", "Coefficient", "ACTUATIONS", "FEEDFORWARDS", "CHANNEL_BANDWIDTHS"]
 
 #: A coefficient: a number, or the interval (lo, hi) with lo < hi.
 Coefficient = Union[float, tuple[float, float]]
 
 #: Actuation models: constant limits, or a propeller plus fins whose authority is ∝ u².
 ACTUATIONS = ("thrusters", "fins")
+
+#: What the velocity loop feeds forward: ``"model"`` the nominal forces at the measured velocity, τ_cmd = n̂(ν) + M̂ a
+#: (feedback linearisation); ``"none"`` nothing, τ_cmd = M̂ a (a PI loop whose integrators hold the drag).
+FEEDFORWARDS = ("model", "none")
 
 #: The per-channel bandwidths of the velocity loop, in the order of ν = (u, v, w, r) (0: ``loop_bandwidth``).
 CHANNEL_BANDWIDTHS = ("surge_loop_bandwidth", "sway_loop_bandwidth", "heave_loop_bandwidth", "yaw_loop_bandwidth")
@@ -116,10 +120,13 @@ class VehicleParams:
     heave_loop_bandwidth: Coefficient = 0.0      # rad/s, the heave loop's (0: loop_bandwidth)
     yaw_loop_bandwidth: Coefficient = 0.0        # rad/s, the yaw loop's (0: loop_bandwidth)
     actuation: str = "fins"                      # "thrusters" or "fins"
+    loop_feedforward: str = "model"              # "model" (τ_cmd = n̂(ν) + M̂ a) or "none" (τ_cmd = M̂ a)
 
     def __post_init__(self) -> None:
         if not isinstance(self.actuation, str) or self.actuation not in ACTUATIONS:
             raise ConfigError("plant.vehicle.actuation", f"one of {ACTUATIONS}", self.actuation)
+        if not isinstance(self.loop_feedforward, str) or self.loop_feedforward not in FEEDFORWARDS:
+            raise ConfigError("plant.vehicle.loop_feedforward", f"one of {FEEDFORWARDS}", self.loop_feedforward)
         for name in _NUMERIC:
             object.__setattr__(self, name, _coefficient(name, getattr(self, name)))
         for name in _POSITIVE + (("Z_max", "N_max") if self.actuation == "thrusters" else ("fin_max",)):
@@ -320,7 +327,8 @@ class VehicleParams:
                 raise ConfigError(f"plant.vehicle.{key}", f"one of the keys {sorted(known)}", key)
 
     def with_overrides(self, overrides: Mapping[str, Any]) -> VehicleParams:
-        """A copy with ``overrides`` (keys = field names; numbers, [lo, hi] or the actuation) applied and validated."""
+        """A copy with ``overrides`` (keys = field names; numbers, [lo, hi], the actuation or the loop's feedforward)
+        applied and validated."""
         self.check_keys(overrides)
         return replace(self, **dict(overrides))
 
@@ -336,5 +344,7 @@ def _abs_floor(ends: tuple[float, float]) -> float:
     return 0.0 if lo <= 0.0 <= hi else min(abs(lo), abs(hi))
 
 
+#: The fields that name a choice (strings), not a number or an interval.
+_CHOICES = ("actuation", "loop_feedforward")
 #: The numeric fields, in declaration order.
-_NUMERIC: tuple[str, ...] = tuple(f.name for f in fields(VehicleParams) if f.name != "actuation")
+_NUMERIC: tuple[str, ...] = tuple(f.name for f in fields(VehicleParams) if f.name not in _CHOICES)

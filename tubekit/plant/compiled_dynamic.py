@@ -70,7 +70,8 @@ def _saturate(c: float, lim: float) -> float:
 def _rhs(t: float, y: np.ndarray, command: np.ndarray, truth: np.ndarray, model: np.ndarray, control: np.ndarray,
          limits: np.ndarray, current: np.ndarray, lateral: bool, out: np.ndarray, peak: np.ndarray) -> None:
     """d/dt of ``y`` into ``out`` (``DynamicPlant._rhs``); ``control`` = (k_p of u, v, w, r, k_i of u, v, w, r,
-    1/T_thr), ``command`` = (u_c, w_c, r_c[, v_c]) (v_c = 0 when absent)."""
+    1/T_thr, 1 to feed the model's forces forward else 0), ``command`` = (u_c, w_c, r_c[, v_c]) (v_c = 0 when
+    absent)."""
     tau_inv = control[8]
     vc = command[3] if command.shape[0] > 3 else 0.0
     c1, c2, c3 = current_at(current, t)
@@ -82,8 +83,10 @@ def _rhs(t: float, y: np.ndarray, command: np.ndarray, truth: np.ndarray, model:
     det = truth[_M22] * truth[_M44] - truth[_M24] * truth[_M42]
     out[4], out[5] = (y[8] - n1) / truth[_M11], (truth[_M44] * b2 - truth[_M24] * b4) / det
     out[6], out[7] = (y[9] - n3) / truth[_M33], (truth[_M22] * b4 - truth[_M42] * b2) / det
-    # the loop (model): τ_cmd = n̂(ν) + M̂ (k_p e + k_i ∫e), saturated
+    # the loop (model): τ_cmd = n̂(ν) + M̂ (k_p e + k_i ∫e) (loop_feedforward "none": M̂ (k_p e + k_i ∫e)), saturated
     f1, f2, f3, f4 = _forces(model, u, v, w, r)
+    if control[9] == 0.0:
+        f1, f2, f3, f4 = 0.0, 0.0, 0.0, 0.0
     e0, e1, e2 = command[0] - u, command[1] - w, command[2] - r
     a0, a1, a2 = control[0] * e0 + control[4] * y[11], control[2] * e1 + control[6] * y[12], \
         control[3] * e2 + control[7] * y[13]

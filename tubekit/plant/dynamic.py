@@ -125,6 +125,7 @@ class DynamicPlant:
         self.override = override
         self._current_model = Plant(scenario.disturbance)
         self._mass = self.model.mass_entries
+        self._model_feedforward = self.model.loop_feedforward == "model"
         # per body velocity (u, v, w, r): the PI gains k_p = ω_c, k_i = ω_c²/4 of each channel's loop
         gains = self.model.loop_gains
         self._kp, self._ki = tuple(g[0] for g in gains), tuple(g[1] for g in gains)
@@ -149,6 +150,11 @@ class DynamicPlant:
             return float(o[0]), float(o[1]), float(o[2])
         return self._current_model.current_at(t)
 
+    def feedforward(self, nu: Sequence[float]) -> Floats4:
+        """The forces the loop feeds forward at body velocities ``nu`` (N, N, N, N m): the nominal n̂(ν) with
+        ``loop_feedforward = "model"``, zeros with ``"none"`` (the integrators hold the drag)."""
+        return body_forces(self.model, nu) if self._model_feedforward else (0.0, 0.0, 0.0, 0.0)
+
     def thrust_command(self, nu: Sequence[float], command: Sequence[float], integral: Sequence[float],
                        forces: Floats4 | None = None) -> tuple[tuple[float, float, float], tuple[bool, bool, bool]]:
         """τ_cmd (saturated at the truth's limits at surge ``nu[0]``) and which channels saturate.
@@ -156,7 +162,7 @@ class DynamicPlant:
         Feedforward n̂(ν) + M̂ (k_p e + k_i ∫e) of the nominal model (``forces``: n̂(ν) already evaluated).
         """
         m11, m22, m33, m44, m24, m42 = self._mass
-        n1, n2, n3, n4 = forces if forces is not None else body_forces(self.model, nu)
+        n1, n2, n3, n4 = forces if forces is not None else self.feedforward(nu)
         e = (command[0] - nu[0], command[1] - nu[2], command[2] - nu[3])
         a = [self._kp[c] * ei + self._ki[c] * ii for c, ei, ii in zip(_SURGE_HEAVE_YAW, e, integral)]
         raw = (n1 + m11 * a[0], n3 + m33 * a[1], n4 - m42 * n2 / m22 + (m44 - m42 * m24 / m22) * a[2])
@@ -179,7 +185,7 @@ class DynamicPlant:
         sway : float
             The commanded body sway velocity v_c (m/s).
         """
-        n2 = (forces if forces is not None else body_forces(self.model, nu))[1]
+        n2 = (forces if forces is not None else self.feedforward(nu))[1]
         # −k_p (v − v_c): at v_c = 0 the very floats of −k_p v (signed zeros too)
         raw = n2 + self._mass[1] * (-self._kp[1] * (nu[1] - sway) + self._ki[1] * integral)
         sat = min(max(raw, -self._sway_limit), self._sway_limit)
@@ -194,7 +200,7 @@ class DynamicPlant:
         cp, sp = math.cos(psi), math.sin(psi)
         u, v, w, r = nu
         acc = body_acceleration(self.params, nu, tau, y[14] if self.lateral else 0.0)
-        model_forces = body_forces(self.model, nu)
+        model_forces = self.feedforward(nu)
         cmd, saturated = self.thrust_command(nu, command, integral, model_forces)
         err = (command[0] - u, command[1] - w, command[2] - r)
         # conditional integration: hold the integral while its channel saturates in the error's direction
@@ -252,7 +258,7 @@ class DynamicPlant:
             ``plant.start``: n_1 exceeds the truth's surge thrust at u_0 (no equilibrium there).
         """
         nu = (float(surge), 0.0, 0.0, 0.0)
-        drag, nominal = body_forces(self.params, nu)[0], body_forces(self.model, nu)[0]
+        drag, nominal = body_forces(self.params, nu)[0], self.feedforward(nu)[0]
         limit = (self._limits or self.params.thrust_limits_at(nu[0]))[0]
         if abs(drag) > limit:
             raise ConfigError("plant.start", f"'trimmed': the vehicle cannot hold {surge:g} m/s (its drag "
@@ -321,13 +327,13 @@ class DynamicPlant:
 
     def _packed(self) -> tuple[np.ndarray, ...]:
         """The compiled routines' arrays, packed once: the truth's and the model's coefficients, (k_p per channel u,
-        v, w, r, then k_i, then 1/T),
+        v, w, r, then k_i, then 1/T, then 1 where the model's forces are fed forward, else 0),
         the actuator limits and the current."""
         if self._compiled is None:
             from tubekit.plant import compiled_dynamic
 
             self._compiled = (compiled_dynamic.coefficients(self.params), compiled_dynamic.coefficients(self.model),
-                              np.array([*self._kp, *self._ki, self._tau_inv]),
+                              np.array([*self._kp, *self._ki, self._tau_inv, float(self._model_feedforward)]),
                               compiled_dynamic.actuator_limits(self.params, self._sway_limit),
                               np.array(self._current_model.current_parameters))
         return self._compiled

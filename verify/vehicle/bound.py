@@ -68,6 +68,7 @@ from verify.vehicle.model import (arb_body_forces, channel_gradient, channel_mis
                                   point_time_constant, velocity_box, with_sway, without_sway)
 from verify.vehicle.loop_data import LoopData, loop_data_of, loop_matrix
 from verify.vehicle.cells import CellInputs, cell_inputs, cell_own_gains, cell_starts, channel_bounds
+from verify.vehicle.pi_loop import free_bounds, free_stability, free_start, free_why_open
 from verify.vehicle.saturation import (SURGE_BANDS, actuator_authority, rate_authority_conditions,
                                        saturation_conditions, triple)
 
@@ -329,16 +330,15 @@ def velocity_loop_bound(params: VehicleParams, *, v_max: Sequence[float], tick: 
     # the sway channel's command: 0 under plans, a lateral backup's own jumps
     jt_int, jp_int = with_sway(jt, sway_tick, loop.lateral), with_sway(jp, sway_period, loop.lateral)
     n = len(loop.names)
-    base = computed_bounds(loop, jt_int, jp_int)
+    starts = (start, start_mass, start_cells, free_start(loop, first, settled))
+    base = _round(loop, jt_int, jp_int, None, starts)[0]
     assumed = [[x * (1 + LOOP_INFLATION) + 1e-12 for x in row] for row in base]
     first_box = [row[0] for row in assumed]
     found, k, computed, inputs, growth = False, 0, base, None, None
     stop = f"no closing after {max_iterations} rounds"
     while loop.stable and k < max_iterations and not found:
         k += 1
-        inputs = input_bounds(loop, [r[0] for r in assumed], [r[2] for r in assumed], [r[3] for r in assumed],
-                              start, start_mass, start_cells)
-        computed = computed_bounds(loop, jt_int, jp_int, inputs)
+        computed, inputs = _round(loop, jt_int, jp_int, assumed, starts)
         found = all(computed[c][o] < assumed[c][o] for c in range(n) for o in range(4))
         if growth is None:  # against the jumps' own bounds only (an output no jump moves starts from ~0: no ratio)
             growth = [[computed[c][o] / assumed[c][o] if base[c][o] > 0.0 else math.nan for o in range(4)]
@@ -356,6 +356,21 @@ def velocity_loop_bound(params: VehicleParams, *, v_max: Sequence[float], tick: 
                                        if loop.lateral else None)
     return _result(loop, params, (v, h, d, jt, jp, first), assumed, computed, inputs, authority,
                    (k, max_iterations), found, rho, _why_open(loop, found, stop, growth, first_box))
+
+
+def _round(loop: LoopData, jump_tick: Sequence[float], jump_period: Sequence[float], assumed: list | None,
+           starts: tuple) -> tuple[list[list[float]], Inputs | None]:
+    """One round of the fixed point: the computed bounds (and the model loop's inputs) under ``assumed`` (None: the
+    jumps' own bounds), by Steps 4-5c, or by step 5d without a model feedforward (``starts``: the start terms of
+    :func:`start_terms`, then :func:`verify.vehicle.pi_loop.free_start`'s)."""
+    if loop.free is not None:
+        zero = (0.0,) * len(loop.names)
+        error, accel = ([r[0] for r in assumed], [r[3] for r in assumed]) if assumed is not None else (zero, zero)
+        return free_bounds(loop, loop.free, jump_tick, jump_period, error, accel, starts[3]), None
+    if assumed is None:
+        return computed_bounds(loop, jump_tick, jump_period), None
+    inputs = input_bounds(loop, [r[0] for r in assumed], [r[2] for r in assumed], [r[3] for r in assumed], *starts[:3])
+    return computed_bounds(loop, jump_tick, jump_period, inputs), inputs
 
 
 def _sway_command(params: VehicleParams, sway: Sequence[float]) -> tuple[float, float, float]:
@@ -405,6 +420,8 @@ def _why_open(loop: LoopData, found: bool, stop: str, growth: list | None, first
     if found or growth is None:
         return ""
     head = f"diverged ({stop})"
+    if loop.free is not None:
+        return free_why_open(loop, head)
     knobs = ("a narrower coefficient box, a smaller V, smaller command jumps (a gentler backup, a lower plan rate) "
              "or a faster loop (plant.vehicle.loop_bandwidth, where the thrusters' lag and limits allow it) lower it")
     rising = [(growth[c][o], c, o) for c in range(len(growth)) for o in range(4) if math.isfinite(growth[c][o])]
@@ -445,9 +462,10 @@ def _result(loop: LoopData, params: VehicleParams, given: tuple, assumed: list, 
     else:
         gamma = upper(hull_sway_bound(params, upper(arb(v[0]) + arb(error[0])), upper(arb(v[2]) + arb(error[2])),
                                       loop.surge_low(error[0])))
-    conds = [Condition(f"loop_stable[{ax}]", "||A_d^K||_inf < 1 (the sampled loop is stable; geometric tail)",
-                       s.rho, 1.0, s.stable, f"K = {s.terms} ticks summed term by term, A_d = exp(A h) in Arb, "
-                       f"lambda_{ax} = {lam:.4g} 1/s") for ax, s, lam in zip(loop.names, loop.sums, loop.slope)]
+    conds = free_stability(loop) if loop.free is not None else [
+        Condition(f"loop_stable[{ax}]", "||A_d^K||_inf < 1 (the sampled loop is stable; geometric tail)", s.rho, 1.0,
+                  s.stable, f"K = {s.terms} ticks summed term by term, A_d = exp(A h) in Arb, lambda_{ax} = {lam:.4g} "
+                  "1/s") for ax, s, lam in zip(loop.names, loop.sums, loop.slope)]
     ratio = max(computed[c][o] / assumed[c][o] for c in range(len(loop.names)) for o in range(4)) \
         if loop.stable else None
     if ratio is not None and not math.isfinite(ratio):

@@ -23,6 +23,7 @@ from verify.vehicle.model import (channel_gradient, channel_masses, hull_balls, 
                                   LATERAL_CHANNELS)
 from verify.vehicle.response import RESPONSE_PREC, ResponseSums, gain_balls, impulse_sums
 from verify.vehicle.cells import Cell, channel_cells
+from verify.vehicle.pi_loop import ChannelFacts, channel_facts
 
 __all__ = ["LoopData", "loop_data_of", "loop_matrix"]
 
@@ -77,9 +78,14 @@ class LoopData:
         # the mass mismatch enters in verify.vehicle.bound's second decomposition: h Σ g_J + |λ_c| h Σ g_n
         self.mass_gain_balls = tuple(tuple(h * g[0] + abs(arb(lam)) * g[3] for g in rows)
                                      for rows, lam in zip(self.gain_balls, self.slope))
+        # loop_feedforward "none" (τ_cmd = M̂ a): the frozen-slope bound's data (verify.vehicle.pi_loop), and none of
+        # the model loop's decompositions (their matrices are of τ_cmd = n̂(ν) + M̂ a)
+        self.model_feedforward = params.loop_feedforward == "model"
+        self.free: tuple[ChannelFacts, ...] | None = None if self.model_feedforward else \
+            tuple(channel_facts(self, c) for c in range(len(self.names)))
         # step 5c: per channel, its own constant coefficients split into cells (verify.vehicle.cells)
         self.cells: tuple[tuple[Cell, ...], ...] = tuple(channel_cells(self, c, a) for c, a in enumerate(bases)) \
-            if self.stable else tuple(() for _ in self.names)
+            if self.stable and self.model_feedforward else tuple(() for _ in self.names)
 
     def channel_gains(self, c: int) -> tuple[arb, arb]:
         """(k_p, k_i) of channel ``c`` (an index into ``names``) as balls."""
@@ -88,7 +94,9 @@ class LoopData:
 
     @property
     def stable(self) -> bool:
-        """Every channel's sampled loop is stable."""
+        """Every channel's sampled loop is stable (without a model feedforward: every piece of every channel)."""
+        if getattr(self, "free", None) is not None:
+            return all(f.stable for f in self.free)
         return all(s.stable for s in self.sums)
 
     def box(self, error: Sequence[float]) -> tuple[tuple[float, float, float], float]:

@@ -25,7 +25,7 @@ from tubekit.model.vehicle_params import VehicleParams
 from verify.kernel.intervals import _abs, enclose, point, upper
 
 __all__ = ["COEFFICIENTS", "MASS_FIELDS", "field_ball", "nominal_params", "hull_balls", "nominal_balls",
-           "arb_body_forces", "body_force_gradient", "channel_forces", "channel_gradient", "channel_masses",
+           "arb_body_forces", "body_force_gradient", "body_force_hessian", "channel_forces", "channel_hessian", "channel_gradient", "channel_masses",
            "channel_mismatch", "channel_mismatch_gradient", "velocity_box", "thrust_floor", "point_time_constant",
            "with_sway", "without_sway", "CHANNELS", "LATERAL_CHANNELS"]
 
@@ -101,6 +101,32 @@ def body_force_gradient(c: Mapping[str, arb], nu: Sequence[arb]) -> tuple[tuple[
     return g1, g2, g3, g4
 
 
+def _sign(x: arb) -> arb:
+    """d|x|/dx over the ball ``x``: ±1 off zero, [−1, 1] where the ball holds 0 (x|x| has a Lipschitz slope 2|x|)."""
+    if x > 0:
+        return arb(1)
+    if x < 0:
+        return arb(-1)
+    return arb(0, 1)
+
+
+def body_force_hessian(c: Mapping[str, arb], nu: Sequence[arb]) -> tuple[tuple[tuple[arb, ...], ...], ...]:
+    """∂²n_i/∂ν_j∂ν_k (i: n1..n4; j, k: u, v, w, r) over the box ``nu``, by hand from :func:`body_force_gradient`;
+    where a ball holds 0 the |x| terms' second derivative 2 sign(x) is taken as [−2, 2], the Lipschitz constant of
+    their slope (what the Taylor remainders of :mod:`verify.vehicle.pi_loop` read)."""
+    su, sv, sw, sr = (_sign(arb(x)) for x in nu)
+    m11, m22, m24, zero = c["m11"], c["m22"], c["m24"], arb(0)
+
+    def sym(uu: arb, uv: arb, uw: arb, ur: arb, vv: arb, vr: arb, ww: arb, rr: arb) -> tuple[tuple[arb, ...], ...]:
+        return ((uu, uv, uw, ur), (uv, vv, zero, vr), (uw, zero, ww, zero), (ur, vr, zero, rr))
+    h1 = sym(-2 * c["X_uu"] * su, zero, zero, zero, zero, -m22, zero, -2 * m24)
+    h2 = sym(zero, -c["Y_uv"], zero, m11 - c["Y_ur_lift"], -2 * c["Y_vv"] * sv, zero, zero, -2 * c["Y_rr"] * sr)
+    h3 = sym(zero, zero, -c["Z_uw"], zero, zero, zero, -2 * c["Z_ww"] * sw, zero)
+    h4 = sym(zero, m22 - m11 - c["N_uv_lift"], zero, m24 - c["N_ur_lift"], -2 * c["N_vv"] * sv, zero, zero,
+             -2 * c["N_rr"] * sr)
+    return h1, h2, h3, h4
+
+
 #: The commanded channels (u, w, r), and with a sway loop (u, v, w, r): the order of every per-channel tuple.
 CHANNELS, LATERAL_CHANNELS = "uwr", "uvwr"
 
@@ -126,6 +152,15 @@ def channel_gradient(c: Mapping[str, arb], nu: Sequence[arb], lateral: bool = Fa
     g1, g2, g3, g4 = body_force_gradient(c, nu)
     k = c["m42"] / c["m22"]
     return with_sway((g1, g3, tuple(a - k * b for a, b in zip(g4, g2))), g2, lateral)
+
+
+def channel_hessian(c: Mapping[str, arb], nu: Sequence[arb],
+                    lateral: bool = False) -> tuple[tuple[tuple[arb, ...], ...], ...]:
+    """∂²(n_u, n_w, n_r)/∂ν∂ν (4 x 4 each; ``lateral``: with the sway row's at index 1), n_r = n4 − (m42/m22) n2."""
+    h1, h2, h3, h4 = body_force_hessian(c, nu)
+    k = c["m42"] / c["m22"]
+    yaw = tuple(tuple(a - k * b for a, b in zip(r4, r2)) for r4, r2 in zip(h4, h2))
+    return with_sway((h1, h3, yaw), h2, lateral)
 
 
 def channel_masses(c: Mapping[str, arb], lateral: bool = False) -> tuple[arb, ...]:

@@ -56,6 +56,9 @@ class ResponseSums:
         ‖A_d^K‖_∞ (upper bound); the tail is certified when rho < 1.
     terms : int
         K, the number of ticks summed term by term.
+    moment_tick, moment_period : tuples indexed ``[weight][output][input]``, or empty
+        With ``moments``: the sums above with each term g(i) weighted by w_0(i) = i + 2 (the ticks in an age of
+        i + 1 ticks, and one more) and by w_1(i) = ⌊(i + 1)/N⌋ + 1 (the period boundaries in it, and one more).
     """
 
     tick: tuple[tuple[float, ...], ...]
@@ -63,6 +66,8 @@ class ResponseSums:
     peak: tuple[tuple[float, ...], ...]
     rho: float
     terms: int
+    moment_tick: tuple[tuple[tuple[float, ...], ...], ...] = ()
+    moment_period: tuple[tuple[tuple[float, ...], ...], ...] = ()
 
     @property
     def stable(self) -> bool:
@@ -115,7 +120,7 @@ def _tick_maxima(stacked: arb_mat, x: arb_mat, pieces: int) -> list[arb]:
 
 def impulse_sums(a: Sequence[Sequence[arb | float]], inputs: Sequence[Sequence[arb | float]],
                  outputs: Sequence[Sequence[arb | float]], *, tick: float, ticks_per_period: int,
-                 tol: float = 1e-8, max_terms: int = 20000) -> ResponseSums:
+                 tol: float = 1e-8, max_terms: int = 20000, moments: bool = False) -> ResponseSums:
     """The sums of the module doc for ṡ = A s, input columns ``inputs`` (n_in, n), output rows ``outputs``.
 
     Parameters
@@ -132,6 +137,10 @@ def impulse_sums(a: Sequence[Sequence[arb | float]], inputs: Sequence[Sequence[a
         Stop summing term by term once ‖A_d^i‖_∞ < ``tol``.
     max_terms : int
         Largest K; if ρ = ‖A_d^K‖_∞ is still >= 1 there the sums are +inf (not stable).
+    moments : bool
+        Also the weighted sums of :class:`ResponseSums` (``moment_tick``, ``moment_period``); their tail takes the
+        weight i + 2 <= (b + 2) K + 2 over the b-th block of K ticks: Σ_b ρ^b ((b + 2) K + 2) = (2K + 2)/(1 − ρ)
+        + K ρ/(1 − ρ)² times the unweighted tail's (1 − ρ).
 
     Notes
     -----
@@ -146,10 +155,10 @@ def impulse_sums(a: Sequence[Sequence[arb | float]], inputs: Sequence[Sequence[a
         C = arb_mat([[arb(x) for x in row] for row in outputs])
         h = arb(tick)
         key = (_exact_entries(A), _exact_entries(B), _exact_entries(C), _exact(h), int(ticks_per_period),
-               float(tol), int(max_terms))
+               float(tol), int(max_terms), bool(moments))
         found = _MEMO.get(key)
         if found is None:
-            found = _sums(A, B, C, h, int(ticks_per_period), tol, max_terms)
+            found = _sums(A, B, C, h, int(ticks_per_period), tol, max_terms, bool(moments))
             if len(_MEMO) >= MEMO_SIZE:
                 del _MEMO[next(iter(_MEMO))]
             _MEMO[key] = found
@@ -167,9 +176,10 @@ def _exact_entries(m: arb_mat) -> tuple[int, int, tuple[tuple[tuple[int, int], t
 
 
 def _sums(A: arb_mat, B: arb_mat, C: arb_mat, h: arb, ticks_per_period: int, tol: float,
-          max_terms: int) -> ResponseSums:
+          max_terms: int, moments: bool = False) -> ResponseSums:
     """:func:`impulse_sums` of the balls A (n x n), B (n x n_in), C (n_out x n), formed at the working precision."""
     n, n_in, n_out = A.nrows(), B.ncols(), C.nrows()
+    weighted = _Weighted(n_out, n_in, ticks_per_period) if moments else None
     ad = (A * h).exp()
     rows = _intra_tick_rows(A, C, h, INTRA_TICK_PIECES)
     stacked = _stacked(rows)
@@ -183,6 +193,8 @@ def _sums(A: arb_mat, B: arb_mat, C: arb_mat, h: arb, ticks_per_period: int, tol
         g_m = arb_mat(n_out, n_in, g)
         total_m = total_m + g_m
         phase_m[i % ticks_per_period] = phase_m[i % ticks_per_period] + g_m
+        if weighted is not None:
+            weighted.add(i, g_m)
         peak_flat = [raise_upper(p, x) for p, x in zip(peak_flat, g)]
         norm_sum += norm
         power = power * ad
@@ -194,7 +206,8 @@ def _sums(A: arb_mat, B: arb_mat, C: arb_mat, h: arb, ticks_per_period: int, tol
     rho = upper(norm)
     if not rho < 1.0:
         inf = tuple(tuple(math.inf for _ in range(n_in)) for _ in range(n_out))
-        return ResponseSums(tick=inf, period=inf, peak=inf, rho=rho, terms=i)
+        infs = (inf, inf) if moments else ()
+        return ResponseSums(tick=inf, period=inf, peak=inf, rho=rho, terms=i, moment_tick=infs, moment_period=infs)
     xk = power * B
     row_norm = [max(upper(_norm_inf(_row(r, o))) for r in rows) for o in range(n_out)]
     tails = [[arb(row_norm[o]) * norm_sum * _col_norm(xk, j) / (1 - arb(rho)) for j in range(n_in)]
@@ -204,7 +217,37 @@ def _sums(A: arb_mat, B: arb_mat, C: arb_mat, h: arb, ticks_per_period: int, tol
                               for j in range(n_in)) for o in range(n_out))
     # a single term of the tail is at most the whole tail
     peaks = tuple(tuple(max(peak[o][j], upper(tails[o][j])) for j in range(n_in)) for o in range(n_out))
-    return ResponseSums(tick=tick_sums, period=period_sums, peak=peaks, rho=rho, terms=i)
+    if weighted is None:
+        return ResponseSums(tick=tick_sums, period=period_sums, peak=peaks, rho=rho, terms=i)
+    r, k = arb(rho), arb(i)
+    factor = (2 * k + 2) + k * r / (1 - r)  # the weighted tail over the unweighted one (ResponseSums, moments)
+    moment_tick, moment_period = weighted.bounds([[t * factor for t in row] for row in tails])
+    return ResponseSums(tick=tick_sums, period=period_sums, peak=peaks, rho=rho, terms=i, moment_tick=moment_tick,
+                        moment_period=moment_period)
+
+
+class _Weighted:
+    """The weighted sums of :class:`ResponseSums` (``moment_tick``, ``moment_period``) as they are summed."""
+
+    def __init__(self, n_out: int, n_in: int, ticks_per_period: int) -> None:
+        self.n_out, self.n_in, self.ticks = n_out, n_in, ticks_per_period
+        self.total = [arb_mat(n_out, n_in) for _ in range(2)]
+        self.phase = [[arb_mat(n_out, n_in) for _ in range(ticks_per_period)] for _ in range(2)]
+
+    def add(self, i: int, g: arb_mat) -> None:
+        """Add the i-th tick's maxima ``g`` with the weights i + 2 and ⌊(i + 1)/N⌋ + 1."""
+        for w, weight in enumerate((i + 2, (i + 1) // self.ticks + 1)):
+            term = g * arb(weight)
+            self.total[w] = self.total[w] + term
+            self.phase[w][i % self.ticks] = self.phase[w][i % self.ticks] + term
+
+    def bounds(self, tails: list[list[arb]]) -> tuple[tuple, tuple]:
+        """(tick sums, worst-phase period sums) per weight, each with the weighted tail ``tails[o][j]`` added."""
+        rng_o, rng_j = range(self.n_out), range(self.n_in)
+        ticks = tuple(tuple(tuple(upper(t[o, j] + tails[o][j]) for j in rng_j) for o in rng_o) for t in self.total)
+        periods = tuple(tuple(tuple(max(upper(p[o, j] + tails[o][j]) for p in phases) for j in rng_j) for o in rng_o)
+                        for phases in self.phase)
+        return ticks, periods
 
 
 def gain_balls(sums: ResponseSums, tick: float) -> tuple[tuple[arb, ...], ...]:

@@ -33,6 +33,7 @@ class _Loop(Protocol):
     forces: str
     nominal: Mapping[str, arb]
     m_hat: tuple[arb, ...]
+    model_feedforward: bool
 
     def box(self, error: Sequence[float]) -> tuple[tuple[float, float, float], float]: ...
 
@@ -47,11 +48,13 @@ _ACTUATOR = {"X": "the surge thrust", "Y": "the lateral thrust", "Z": "the heave
 
 def thrust_peaks(loop: _Loop, box: tuple[float, float, float], gamma: float,
                   a_bound: Sequence[float], surge: tuple[float, float] | None = None) -> list[float]:
-    """sup|τ_cmd_c| = sup|n̂_c| + m̂_c sup|a| over the velocity box (N, N, N m); ``surge`` (lo, hi) (m/s): the
-    surge over that band instead of |u| <= box[0]."""
+    """sup|τ_cmd_c| = sup|n̂_c| + m̂_c sup|a| over the velocity box (N, N, N m), m̂_c sup|a| without a model
+    feedforward; ``surge`` (lo, hi) (m/s): the surge over that band instead of |u| <= box[0]."""
     nu = velocity_box(box[0], gamma, box[1], box[2])
     if surge is not None:
         nu = (enclose(surge[0], surge[1]), *nu[1:])
+    if not loop.model_feedforward:  # τ_cmd = M̂ a: the integrators hold the drag, inside sup|a|
+        return [upper(loop.m_hat[c] * arb(a_bound[c])) for c in range(len(loop.names))]
     forces = channel_forces(loop.nominal, nu, loop.lateral)
     return [upper(abs(forces[c]) + loop.m_hat[c] * arb(a_bound[c])) for c in range(len(loop.names))]
 

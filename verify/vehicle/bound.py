@@ -330,7 +330,7 @@ def velocity_loop_bound(params: VehicleParams, *, v_max: Sequence[float], tick: 
     # the sway channel's command: 0 under plans, a lateral backup's own jumps
     jt_int, jp_int = with_sway(jt, sway_tick, loop.lateral), with_sway(jp, sway_period, loop.lateral)
     n = len(loop.names)
-    starts = (start, start_mass, start_cells, free_start(loop, first, settled))
+    starts = (start, start_mass, start_cells, free_start(loop, first, settled) if loop.free is not None else ())
     base = _round(loop, jt_int, jp_int, None, starts)[0]
     assumed = [[x * (1 + LOOP_INFLATION) + 1e-12 for x in row] for row in base]
     first_box = [row[0] for row in assumed]

@@ -31,8 +31,9 @@ from typing import Callable, Protocol, Sequence
 
 from flint import arb, ctx
 
-from verify.kernel.intervals import enclose, upper
+from verify.kernel.intervals import upper
 from verify.theorem.design import Condition
+from verify.vehicle.cells import split_ball
 from verify.vehicle.model import channel_forces, channel_gradient, channel_hessian, velocity_box
 from verify.vehicle.response import RESPONSE_PREC, ResponseSums, impulse_sums
 
@@ -122,16 +123,6 @@ def _command_box(loop: _Loop) -> tuple[arb, arb, arb, arb]:
     return velocity_box(v[0], v[1], v[2], v[3]) if loop.lateral else velocity_box(v[0], 0.0, v[1], v[2])
 
 
-def _split(ball: arb, pieces: int) -> list[tuple[float, arb]]:
-    """``ball`` cut into ``pieces`` sub-balls covering it (one for a point), each with its midpoint as a float."""
-    lo, hi = float(ball.lower()), float(ball.upper())
-    if hi <= lo or pieces <= 1:
-        return [(float(ball.mid()), ball)]
-    edges = [lo + (hi - lo) * k / pieces for k in range(pieces + 1)]
-    edges[0], edges[-1] = math.nextafter(lo, -math.inf), math.nextafter(hi, math.inf)
-    return [(0.5 * (a + b), enclose(a, b)) for a, b in zip(edges, edges[1:])]
-
-
 #: Pieces each body velocity of a box is cut into where an enclosure is taken piece by piece (:func:`_hull`): a
 #: product of two wide balls (a coefficient's interval times a speed's) is enclosed loosely, a narrow speed's tightly.
 BOX_PIECES = 3
@@ -144,7 +135,7 @@ def _hull(values: Callable[[tuple[arb, ...]], Sequence[arb]], box: Sequence[arb]
     """The union, entry by entry, of ``values`` over the sub-boxes of ``box`` cut into :data:`BOX_PIECES` per
     velocity (:data:`OWN_PIECES` along the channel's own, index ``own``, if any): every point of the box lies in one sub-box,
     so the union encloses the values over the box."""
-    cuts = [[b for _, b in _split(x, OWN_PIECES if j == own else BOX_PIECES)] for j, x in enumerate(box)]
+    cuts = [split_ball(x, OWN_PIECES if j == own else BOX_PIECES) for j, x in enumerate(box)]
     out: list[arb] | None = None
     for sub in itertools.product(*cuts):
         got = list(values(sub))
@@ -152,10 +143,11 @@ def _hull(values: Callable[[tuple[arb, ...]], Sequence[arb]], box: Sequence[arb]
     return out if out is not None else []
 
 
-def _count(ball: arb, step: float, most: int) -> int:
-    """How many pieces of width at most ``step`` cover ``ball``, at most ``most`` (at least one)."""
+def _pieces(ball: arb, step: float, most: int) -> list[tuple[float, arb]]:
+    """``ball`` cut into pieces of width at most ``step`` (at most ``most``, :func:`verify.vehicle.cells.split_ball`),
+    each with its midpoint as a float."""
     width = float(ball.upper()) - float(ball.lower())
-    return max(1, min(most, math.ceil(width / step)))
+    return [(float(b.mid()), b) for b in split_ball(ball, max(1, min(most, math.ceil(width / step))))]
 
 
 def channel_facts(loop: _Loop, c: int) -> ChannelFacts:
@@ -170,8 +162,8 @@ def channel_facts(loop: _Loop, c: int) -> ChannelFacts:
     kp, ki = loop.gains[c]
     pieces = tuple(Piece(m, k, upper(abs(1 - arb(m) / mu_ball)), upper(abs(k_ball - arb(k))),
                          _piece_sums(m, k, kp, ki, loop.lag, loop.tick, loop.ticks))
-                   for m, mu_ball in _split(mu, _count(mu, MASS_STEP, MASS_PIECES))
-                   for k, k_ball in _split(kappa, _count(kappa, SLOPE_STEP, SLOPE_PIECES)))
+                   for m, mu_ball in _pieces(mu, MASS_STEP, MASS_PIECES)
+                   for k, k_ball in _pieces(kappa, SLOPE_STEP, SLOPE_PIECES))
     drive = abs(_hull(lambda b: (channel_forces(loop.hull, b, lat)[c],), nu, None)[0]) / m_hat
     return ChannelFacts(pieces=pieces, slope_range=upper(kappa.upper() - kappa.lower()), mu_max=upper(mu),
                         curvature=tuple(upper(abs(x) / m_hat) for x in hess),

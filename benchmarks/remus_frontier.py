@@ -5,8 +5,9 @@ For each surge limit ū of a grid (with the minimum surge u_min = ū / 2, yaw ra
 box shrunk about its midpoint to a fraction of its half-widths, and the published box itself), the velocity
 loop's bound is evaluated for the plans' jumps alone (``verify.vehicle.bound.velocity_loop_bound`` with
 ``surge_floor`` = u_min: the fins' authority over u >= u_min − E_u). A backup only adds jumps, so a cell whose loop
-does not close here cannot certify with any backup. Each cell prints E (m/s, m/s, rad/s) and the fins' need
-against their floor, or why the fixed point diverged (its first-round growth and channel). Nothing is timed.
+does not close here cannot certify with any backup. Each cell prints E (m/s, m/s, rad/s), the propeller's and the
+fins' need against their floor (X, Z, N) and the loop's conditions that fail, or why the fixed point diverged (its
+first-round growth and channel). Nothing is timed.
 
 ``--simulate`` adds what the vehicle does (no bound): the plant as simulated
 (:class:`tubekit.plant.dynamic.DynamicPlant`) at the box's midpoint and at three random points of each box, no
@@ -15,13 +16,15 @@ largest loop errors |u_c − u|, |r_c − r|, the sway |v| and the rudder's larg
 surge are printed.
 
 Usage: ``python benchmarks/remus_frontier.py [--u-max 0.6 1.0 ...] [--spread 0 0.05 1] [--r-max R] [--w-max W]
-[--rate RU RW RR] [--u-min U] [--simulate]`` (``--u-min``: the surge floor, default ū / 2; well under a second per
-cell, about 20 s per simulated cell).
+[--rate RU RW RR] [--u-min U] [--yaw-bandwidth W] [--heave-bandwidth W] [--simulate]`` (``--u-min``: the surge
+floor, default ū / 2; ``--yaw-bandwidth``, ``--heave-bandwidth``: those loops' bandwidths, rad/s, default the
+vehicle's; well under a second per cell, about 20 s per simulated cell).
 """
 
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import math
 import re
 
@@ -52,8 +55,9 @@ def cell(params: VehicleParams, u_max: float, r_max: float, w_max: float, rate: 
         growth = re.search(r"multiplied the bounds by up to ([0-9.e+]+) \((.*?)\)", by_name["loop_fixed_point"].detail)
         return "diverges" + (f" (x{growth.group(1)}, {growth.group(2)})" if growth else "")
     fins = "; ".join(f"{ch} need {by_name[f'loop_saturation[{ch}]'].lhs:.3g} vs {by_name[f'loop_saturation[{ch}]'].rhs:.3g}"
-                     for ch in ("Z", "N"))
-    verdict = "**closes, fins hold**" if all(c.ok for c in bound.conditions) else "fins short"
+                     for ch in ("X", "Z", "N"))
+    verdict = "**closes, fins hold**" if all(c.ok for c in bound.conditions) else \
+        "short: " + ", ".join(c.condition for c in bound.conditions if not c.ok)
     return f"E = ({bound.error[0]:.3f}, {bound.error[1]:.3f}, {bound.error[2]:.3f}); {fins}; {verdict}"
 
 
@@ -98,9 +102,11 @@ def simulated_rows(u_values, spreads, r_max: float, yaw_rate: float) -> list[str
     return rows
 
 
-def table(u_values, spreads, r_max: float, w_max: float, rate, u_min: float | None = None) -> list[str]:
-    """The rows (module doc), one per (box, ū); ``u_min`` None: ū / 2."""
-    base = vehicle_params("remus100")
+def table(u_values, spreads, r_max: float, w_max: float, rate, u_min: float | None = None,
+          bandwidths: dict[str, float] | None = None) -> list[str]:
+    """The rows (module doc), one per (box, ū); ``u_min`` None: ū / 2; ``bandwidths``: per-channel loop bandwidths
+    (``VehicleParams`` field → rad/s) over the vehicle's own."""
+    base = dataclasses.replace(vehicle_params("remus100"), **(bandwidths or {}))
     floor = "u_max / 2" if u_min is None else f"{u_min:g} m/s"
     rows = [f"REMUS 100, u_min = {floor}, |r| <= {r_max:g} rad/s, |w| <= {w_max:g} m/s, rate {list(rate)}"]
     for f in spreads:
@@ -121,12 +127,18 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--rate", type=float, nargs=3, default=[0.05, 0.01, 0.02])
     parser.add_argument("--u-min", type=float, default=None, help="the surge floor (m/s; default u_max / 2)")
     parser.add_argument("--simulate", action="store_true", help="add the simulated plant's errors (no bound)")
+    parser.add_argument("--yaw-bandwidth", type=float, default=None, help="the yaw loop's bandwidth (rad/s)")
+    parser.add_argument("--heave-bandwidth", type=float, default=None, help="the heave loop's bandwidth (rad/s)")
     args = parser.parse_args(argv)
     if not all(math.isfinite(x) and x > 0 for x in [*args.u_max, args.r_max, args.w_max, *args.rate]):
         parser.error("speeds and rates must be finite and > 0")
     if args.u_min is not None and not (math.isfinite(args.u_min) and 0 < args.u_min < min(args.u_max)):
         parser.error("--u-min must be finite, > 0 and below every --u-max")
-    print("\n".join(table(args.u_max, args.spread, args.r_max, args.w_max, tuple(args.rate), args.u_min)))
+    bandwidths = {f"{name}_loop_bandwidth": value for name, value in (("yaw", args.yaw_bandwidth),
+                                                                     ("heave", args.heave_bandwidth)) if value is not None}
+    if not all(math.isfinite(x) and x > 0 for x in bandwidths.values()):
+        parser.error("bandwidths must be finite and > 0")
+    print("\n".join(table(args.u_max, args.spread, args.r_max, args.w_max, tuple(args.rate), args.u_min, bandwidths)))
     if args.simulate:
         print("\n".join(simulated_rows(args.u_max, args.spread, args.r_max, args.rate[2])))
     return 0

@@ -21,7 +21,7 @@ def test_the_midpoint_closes_at_a_crawl_and_diverges_in_yaw_at_survey_speed():
     slow = mod.cell(params, 0.6, 0.1, 0.02, (0.05, 0.01, 0.02))
     assert slow.startswith("E = (") and "N need" in slow
     need, floor = (float(x) for x in slow.split("N need ")[1].split(";")[0].split(" vs "))
-    assert 0.0 < floor < need and slow.endswith("fins short")
+    assert 0.0 < floor < need and "loop_saturation[N]" in slow.split("short: ")[1]
     assert mod.cell(params, 1.5, 0.1, 0.02, (0.05, 0.01, 0.02)).startswith("diverges (x")
     assert "channel r" in mod.cell(params, 1.5, 0.1, 0.02, (0.05, 0.01, 0.02))
 
@@ -65,3 +65,20 @@ def test_at_survey_speed_with_a_high_floor_and_gentle_yaw_the_loop_closes_and_th
     assert "diverges" in published and "channel u" in published
     with pytest.raises(SystemExit):
         mod.main(["--u-max", "1.0", "--u-min", "1.2"])
+
+
+def test_with_the_surveys_loop_bandwidths_the_published_box_closes_and_only_the_propeller_and_rudder_are_short():
+    """The survey file's loops (yaw 10 rad/s, heave 4 rad/s), u in [1.0, 1.2] m/s, |r| <= 0.02 rad/s, plans' rate
+    (0.05, 0.005, 0.004) (docs/plant.md section 4): over the published box the loop's bound closes, the stern
+    planes hold, and what is short is the surge thrust (the need above Prestero's 10.1 N, the box's weakest
+    propeller) and the rudder; with the vehicle's own 5 rad/s loops the same cell's fixed point diverges."""
+    mod = _module()
+    args = ([1.2], [1.0], 0.02, 0.01, (0.05, 0.005, 0.004), 1.0)
+    row = mod.table(*args, {"yaw_loop_bandwidth": 10.0, "heave_loop_bandwidth": 4.0})[1]
+    assert "E = (" in row and row.endswith("short: loop_saturation[X], loop_saturation[N]"), row
+    needs = {ch: tuple(float(x) for x in row.split(f"{ch} need ")[1].split(";")[0].split(" vs ")) for ch in "XZN"}
+    assert needs["X"][1] == vehicle_params("remus100").interval("X_max")[0] < needs["X"][0]
+    assert needs["Z"][0] < needs["Z"][1] and needs["N"][0] > needs["N"][1] > 0.0
+    assert "diverges" in mod.table(*args)[1]
+    with pytest.raises(SystemExit):
+        mod.main(["--u-max", "1.2", "--yaw-bandwidth", "0"])

@@ -54,8 +54,8 @@ def cell(params: VehicleParams, u_max: float, r_max: float, w_max: float, rate: 
     if not by_name["loop_fixed_point"].ok:
         growth = re.search(r"multiplied the bounds by up to ([0-9.e+]+) \((.*?)\)", by_name["loop_fixed_point"].detail)
         return "diverges" + (f" (x{growth.group(1)}, {growth.group(2)})" if growth else "")
-    fins = "; ".join(f"{ch} need {by_name[f'loop_saturation[{ch}]'].lhs:.3g} vs {by_name[f'loop_saturation[{ch}]'].rhs:.3g}"
-                     for ch in ("X", "Z", "N"))
+    saturation = {ch: by_name[f"loop_saturation[{ch}]"] for ch in ("X", "Z", "N")}
+    fins = "; ".join(f"{ch} need {c.lhs:.3g} vs {c.rhs:.3g}" for ch, c in saturation.items())
     verdict = "**closes, fins hold**" if all(c.ok for c in bound.conditions) else \
         "short: " + ", ".join(c.condition for c in bound.conditions if not c.ok)
     return f"E = ({bound.error[0]:.3f}, {bound.error[1]:.3f}, {bound.error[2]:.3f}); {fins}; {verdict}"
@@ -88,9 +88,11 @@ def simulated(params: VehicleParams, u_max: float, r_max: float, yaw_rate: float
     return worst[0], worst[1], worst[2], worst[3]
 
 
-def simulated_rows(u_values, spreads, r_max: float, yaw_rate: float) -> list[str]:
-    """``--simulate``'s rows: the largest errors over the midpoint and three random points of each box."""
-    base = vehicle_params("remus100")
+def simulated_rows(u_values, spreads, r_max: float, yaw_rate: float,
+                   bandwidths: dict[str, float] | None = None) -> list[str]:
+    """``--simulate``'s rows: the largest errors over the midpoint and three random points of each box (``bandwidths``
+    as in :func:`table`)."""
+    base = dataclasses.replace(vehicle_params("remus100"), **(bandwidths or {}))
     rows = [f"simulated: yaw command ±{r_max:g} rad/s at {yaw_rate:g} rad/s², 60 s, no current"]
     for f in spreads:
         params = base.shrunk(f)
@@ -134,13 +136,13 @@ def main(argv: list[str] | None = None) -> int:
         parser.error("speeds and rates must be finite and > 0")
     if args.u_min is not None and not (math.isfinite(args.u_min) and 0 < args.u_min < min(args.u_max)):
         parser.error("--u-min must be finite, > 0 and below every --u-max")
-    bandwidths = {f"{name}_loop_bandwidth": value for name, value in (("yaw", args.yaw_bandwidth),
-                                                                     ("heave", args.heave_bandwidth)) if value is not None}
+    given = (("yaw", args.yaw_bandwidth), ("heave", args.heave_bandwidth))
+    bandwidths = {f"{name}_loop_bandwidth": value for name, value in given if value is not None}
     if not all(math.isfinite(x) and x > 0 for x in bandwidths.values()):
         parser.error("bandwidths must be finite and > 0")
     print("\n".join(table(args.u_max, args.spread, args.r_max, args.w_max, tuple(args.rate), args.u_min, bandwidths)))
     if args.simulate:
-        print("\n".join(simulated_rows(args.u_max, args.spread, args.r_max, args.rate[2])))
+        print("\n".join(simulated_rows(args.u_max, args.spread, args.r_max, args.rate[2], bandwidths)))
     return 0
 
 

@@ -95,7 +95,7 @@ class LoopData:
     @property
     def stable(self) -> bool:
         """Every channel's sampled loop is stable (without a model feedforward: every piece of every channel)."""
-        if getattr(self, "free", None) is not None:
+        if self.free is not None:
             return all(f.stable for f in self.free)
         return all(s.stable for s in self.sums)
 

@@ -25,7 +25,8 @@ from tubekit.model.vehicle_params import VehicleParams
 from verify.kernel.intervals import _abs, enclose, point, upper
 
 __all__ = ["COEFFICIENTS", "MASS_FIELDS", "field_ball", "nominal_params", "hull_balls", "nominal_balls",
-           "arb_body_forces", "body_force_gradient", "body_force_hessian", "channel_forces", "channel_hessian", "channel_gradient", "channel_masses",
+           "arb_body_forces", "body_force_gradient", "body_force_hessian", "channel_forces", "channel_hessian",
+           "channel_gradient", "channel_masses",
            "channel_mismatch", "channel_mismatch_gradient", "velocity_box", "thrust_floor", "point_time_constant",
            "with_sway", "without_sway", "CHANNELS", "LATERAL_CHANNELS"]
 

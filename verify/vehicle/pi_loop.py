@@ -37,7 +37,8 @@ from verify.vehicle.cells import split_ball
 from verify.vehicle.model import channel_forces, channel_gradient, channel_hessian, velocity_box
 from verify.vehicle.response import RESPONSE_PREC, ResponseSums, impulse_sums
 
-__all__ = ["MASS_STEP", "MASS_PIECES", "SLOPE_STEP", "SLOPE_PIECES", "TAIL_TOLERANCE", "BOX_PIECES", "OWN_PIECES", "Piece", "ChannelFacts", "channel_facts", "free_start", "free_bounds"]
+__all__ = ["MASS_STEP", "MASS_PIECES", "SLOPE_STEP", "SLOPE_PIECES", "TAIL_TOLERANCE", "BOX_PIECES", "OWN_PIECES",
+           "Piece", "ChannelFacts", "channel_facts", "free_start", "free_bounds", "free_stability", "free_why_open"]
 
 #: Width of the pieces the mass ratio μ = m̂_c/m_c is cut into (at most :data:`MASS_PIECES`; a point: one).
 MASS_STEP = 0.05
@@ -133,8 +134,8 @@ OWN_PIECES = 48
 
 def _hull(values: Callable[[tuple[arb, ...]], Sequence[arb]], box: Sequence[arb], own: int | None) -> list[arb]:
     """The union, entry by entry, of ``values`` over the sub-boxes of ``box`` cut into :data:`BOX_PIECES` per
-    velocity (:data:`OWN_PIECES` along the channel's own, index ``own``, if any): every point of the box lies in one sub-box,
-    so the union encloses the values over the box."""
+    velocity (:data:`OWN_PIECES` along the channel's own, index ``own``, if any): every point of the box lies in one
+    sub-box, so the union encloses the values over the box."""
     cuts = [split_ball(x, OWN_PIECES if j == own else BOX_PIECES) for j, x in enumerate(box)]
     out: list[arb] | None = None
     for sub in itertools.product(*cuts):

@@ -156,3 +156,17 @@ def test_the_spread_campaigns_draw_only_the_truth_of_their_wider_boxes(name, spr
     assert vehicle["loop_bandwidth"] == 20.0
     assert vehicle["X_uu"] == pytest.approx([-141.0 * (1 + spread), -141.0 * (1 - spread)])
 
+
+
+def test_the_published_campaign_draws_the_drag_and_the_top_speed_and_derives_the_thrust():
+    """Property: examples/remus100_published_campaign.toml draws every interval coefficient but X_max, which each run
+    takes from its drawn drag and top speed (X_max = |X_uu| s²), inside the published interval."""
+    from tubekit.app.campaign_spec import load_spec
+    spec = load_spec(ROOT / "examples" / "remus100_published_campaign.toml")
+    assert spec.runs == 200 and sorted(k for k, _ in spec.sample) == ["disturbance.period", "plant.truth"]
+    for k in range(10):
+        plant = spec.plan(k).scenario.plant
+        assert "X_max" not in dict(plant.truth) and {"X_uu", "top_speed"} <= set(dict(plant.truth))
+        truth = plant.truth_params
+        assert truth.X_max == pytest.approx(abs(truth.X_uu) * truth.top_speed ** 2, rel=1e-12)
+        assert 10.1 <= truth.X_max <= 41.2

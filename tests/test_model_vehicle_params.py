@@ -187,3 +187,40 @@ def test_each_channel_runs_at_its_own_bandwidth_or_the_loop_bandwidth():
     own = VehicleParams(**{**POINT, "yaw_loop_bandwidth": 12.0, "heave_loop_bandwidth": [2.0, 6.0]})
     assert own.loop_gains == ((8.0, 16.0), (8.0, 16.0), (4.0, 4.0), (12.0, 36.0))
     assert VehicleParams(**{**POINT, "yaw_loop_bandwidth": 12.0}).to_dict()["yaw_loop_bandwidth"] == 12.0
+
+
+#: REMUS 100's bundled box with the thrust tied to the drag by each source's own top speed (m/s).
+TIED = (2.497, 2.571)
+
+
+@pytest.mark.parametrize("change, field, match", [
+    ({"top_speed": -1.0}, "plant.vehicle.top_speed", "speed > 0 at every point"),
+    ({"top_speed": [0.0, 2.5]}, "plant.vehicle.top_speed", "speed > 0 at every point"),
+    # 6.23 kg/m x 2.6² = 42.1 N: more than the published 41.2 N, so the tie would widen X_max's interval
+    ({"top_speed": [2.5, 2.6]}, "plant.vehicle.X_max", "holding every thrust the top speed ties"),
+    ({"top_speed": [2.4, 2.5]}, "plant.vehicle.X_max", r"in \[9\.33"),       # 1.62 x 2.4² = 9.33 N < 10.1
+])
+def test_a_top_speed_that_is_not_a_speed_or_leaves_x_max_s_interval_names_the_field(change, field, match):
+    with pytest.raises(ConfigError, match=match) as err:
+        VehicleParams(**change)
+    assert err.value.field == field
+
+
+def test_a_tied_vehicle_s_points_take_the_thrust_that_holds_them_at_their_top_speed():
+    """The nominal, a truth point and a sample each have X_max = |X_uu| s² (REMUS 100 has no linear surge drag):
+    at the midpoint 3.925 kg/m x 2.534² = 25.20 N (by hand), not the midpoint of X_max's interval (25.65 N)."""
+    box = VehicleParams(top_speed=TIED)
+    assert box.tied and not VehicleParams().tied
+    assert box.nominal.X_max == pytest.approx(3.925 * 2.534 ** 2, rel=1e-12)
+    weakest = box.with_point({"X_uu": -1.62, "top_speed": 2.497})
+    assert weakest.X_max == pytest.approx(1.62 * 2.497 ** 2) and weakest.X_max > 10.1
+    for seed in range(20):
+        point = box.sample(np.random.default_rng(seed))
+        assert point.X_max == pytest.approx(abs(point.X_uu) * point.top_speed ** 2, rel=1e-12)
+        assert 10.1 <= point.X_max <= 41.2
+
+
+def test_a_tied_vehicle_s_truth_may_not_set_its_thrust():
+    with pytest.raises(ConfigError, match="tied to the drag by top_speed") as err:
+        VehicleParams(top_speed=TIED).with_point({"X_max": 20.0})
+    assert err.value.field == "plant.truth.X_max"

@@ -222,18 +222,6 @@ def test_a_torpedo_at_survey_speed_is_told_its_hulls_sway_couples_the_channels()
     assert fixed.ok is False and "hull's free sway" in fixed.detail and "cannot close on its own" not in fixed.detail
 
 
-def test_a_point_vehicle_has_no_mismatch_and_no_mass_part_in_its_own_gain():
-    """At a point of the coefficient box the controller's model is the plant: the own loop gain's mismatch part is
-    exactly 0 (the mismatch is the model at the coefficients' differences), its mass part 0 up to the balls' rounding,
-    and only the nominal drag's slope over V remains (> 0: quadratic drag)."""
-    from verify.vehicle.bound import own_gains
-    from verify.vehicle.loop_data import loop_data_of
-    loop = loop_data_of(BLUEROV2_HEAVY.nominal, V, H, TICKS)
-    gains = own_gains(loop, (0.01, 0.01, 0.01, 0.01) if loop.lateral else (0.01, 0.01, 0.01))
-    assert all(mism == 0.0 and 0.0 <= mass < 1e-12 and drag >= 0.0 for mism, drag, mass in gains)
-    assert max(drag for _, drag, _ in gains) > 0.0
-
-
 #: von Benzon's BlueROV2 Heavy (kg, kg/s, kg/m), the midpoint of the ±10 % box below (docs/plant.md section 3.2).
 _VON_BENZON = {"X_udot": -6.36, "Y_vdot": -7.12, "Z_wdot": -18.69, "N_rdot": -0.2215, "X_u": -13.7, "Z_w": -33.0,
                "X_uu": -141.0, "Y_vv": -217.0, "Z_ww": -190.0, "N_rr": -1.5}

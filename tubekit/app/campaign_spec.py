@@ -263,7 +263,8 @@ def _distribution(key: str, entry: Any, base: dict) -> Distribution:
 
 
 def _coefficient_box(field: str, entry: Any, base: dict) -> Distribution:
-    """``{ box = true }``: the base vehicle's interval coefficients, each drawn uniformly in its interval."""
+    """``{ box = true }``: the base vehicle's interval coefficients, each drawn uniformly in its interval (X_max of a
+    vehicle whose thrust is tied to its drag, ``top_speed``, is derived from the draw instead)."""
     if entry != {"box": True}:
         raise ConfigError(field, "{ box = true } (every interval coefficient of the vehicle drawn in its interval)",
                           entry)
@@ -272,7 +273,8 @@ def _coefficient_box(field: str, entry: Any, base: dict) -> Distribution:
         raise ConfigError(field, "a base scenario on the dynamic plant ([plant] kind = \"dynamic\"): the kinematic "
                           "plant simulates no coefficient", plant.kind)
     params = plant.params
-    names = tuple(params.interval_fields)
+    # a thrust tied to the drag by the top speed is derived from the drawn hull, never drawn itself
+    names = tuple(n for n in params.interval_fields if not (params.tied and n == "X_max"))
     if not names:
         raise ConfigError(field, "a vehicle with at least one coefficient given as an interval [lo, hi]",
                           base.get("plant", {}).get("vehicle"))

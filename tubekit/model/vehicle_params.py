@@ -80,6 +80,10 @@ class VehicleParams:
     loop, :attr:`lateral`; 0: no lateral authority, the hull's sway is free);
     ``"fins"``: |X| <= X_max (propeller), |Z| <= |Z_uuds| u² fin_max (stern planes),
     |N| <= |N_uudr| u² fin_max (rudder). Every channel lags by ``thruster_time_constant`` (s).
+    ``top_speed`` s > 0 (a number or an interval, m/s) ties the surge thrust to the surge drag: each hull's
+    X_max = |X_u| s + |X_uu| s² (the thrust that holds it at its top speed running straight), for some s in the
+    interval; X_max's own interval must hold every such value, and a point vehicle's X_max is that value
+    (:meth:`nominal`, :meth:`with_point` and :meth:`sample` derive it). 0: X_max independent of the drag.
     """
 
     m: Coefficient = (30.48, 31.93)              # kg: Prestero W/g; Fossen's spheroid
@@ -107,6 +111,7 @@ class VehicleParams:
     N_uv_lift: Coefficient = 10.57               # kg, N_uv -24.0 minus the Munk moment -34.57 (Prestero)
     N_ur_lift: Coefficient = -3.93               # kg m/rad, N_ur -2.00 minus N_ura = Y_rdot = 1.93
     X_max: Coefficient = (10.1, 41.2)            # N: Prestero's drag at 2.5 m/s; Fossen's propeller there
+    top_speed: Coefficient = 0.0                 # m/s: > 0 ties X_max to the drag, X_max = |X_u| s + |X_uu| s²
     Z_max: Coefficient = 0.0                     # N (thrusters only)
     Y_max: Coefficient = 0.0                     # N, lateral thrust (thrusters only; 0: none, the sway is free)
     N_max: Coefficient = 0.0                     # N m (thrusters only)
@@ -146,6 +151,7 @@ class VehicleParams:
             self._require(name, lo >= 0.0 and (hi == 0.0 or lo > 0.0), "0 (the loop_bandwidth) or a number > 0 "
                           "at every point of the box")
         self._check_lateral()
+        self._check_top_speed()
         self._require("N_vdot", self.interval("N_vdot") == self.interval("Y_rdot"),
                       f"the value of Y_rdot, {self.Y_rdot!r} (M symmetric at every point of the box)")
         self._check_positive_definite()
@@ -166,6 +172,43 @@ class VehicleParams:
                 self._require(name, self.interval(name) == (0.0, 0.0), "0 when Y_max > 0: the sway loop regulates "
                               "sway and yaw as separate channels, which needs m x_g - Y_rdot = 0 (M diagonal in sway "
                               "and yaw); give Y_max = 0 to keep the hull's free sway")
+
+    def _check_top_speed(self) -> None:
+        """top_speed is 0 or > 0 over the box; when > 0, X_max's interval holds every tied thrust (a point: equals
+        it, to rounding)."""
+        lo, hi = self.interval("top_speed")
+        self._require("top_speed", lo >= 0.0 and (hi == 0.0 or lo > 0.0), "0 (X_max independent of the drag) or a "
+                      "speed > 0 at every point of the box (m/s)")
+        if hi == 0.0:
+            return
+        t_lo, t_hi = self.tied_thrust_range
+        x_lo, x_hi = self.interval("X_max")
+        slack = 1e-9 * max(1.0, abs(t_hi))
+        if not (x_lo - slack <= t_lo and t_hi <= x_hi + slack):
+            raise ConfigError("plant.vehicle.X_max", f"an interval holding every thrust the top speed ties to the "
+                              f"drag, |X_u| s + |X_uu| s^2 in [{t_lo:.6g}, {t_hi:.6g}] N (or a smaller top_speed)",
+                              self.X_max)
+
+    @property
+    def tied(self) -> bool:
+        """True when the surge thrust is tied to the drag by a top speed (``top_speed`` > 0)."""
+        return self.interval("top_speed")[1] > 0.0
+
+    @property
+    def tied_thrust_range(self) -> tuple[float, float]:
+        """(smallest, largest) |X_u| s + |X_uu| s² over the box and the top speed s (N); tied vehicles only."""
+        s_lo, s_hi = self.interval("top_speed")
+        lin_lo, lin_hi = _abs_ends(self.interval("X_u"))
+        quad_lo, quad_hi = _abs_ends(self.interval("X_uu"))
+        return lin_lo * s_lo + quad_lo * s_lo * s_lo, lin_hi * s_hi + quad_hi * s_hi * s_hi
+
+    def _tied_point(self, point: dict[str, float]) -> dict[str, float]:
+        """``point`` (values of interval fields) with X_max derived from its drag and top speed, when tied."""
+        if not self.tied:
+            return point
+        at = {n: point.get(n, 0.5 * sum(self.interval(n))) for n in ("X_u", "X_uu", "top_speed")}
+        s = at["top_speed"]
+        return {**point, "X_max": abs(at["X_u"]) * s + abs(at["X_uu"]) * s * s}
 
     @property
     def loop_gains(self) -> tuple[tuple[float, float], tuple[float, float], tuple[float, float], tuple[float, float]]:
@@ -223,7 +266,7 @@ class VehicleParams:
     def nominal(self) -> VehicleParams:
         """Every interval replaced by its midpoint (the controller's model); built once per vehicle (the velocity
         loop's bound reads it at every evaluation)."""
-        mid = {n: 0.5 * (self.interval(n)[0] + self.interval(n)[1]) for n in self.interval_fields}
+        mid = self._tied_point({n: 0.5 * (self.interval(n)[0] + self.interval(n)[1]) for n in self.interval_fields})
         return replace(self, **mid) if mid else self
 
     def shrunk(self, fraction: float) -> VehicleParams:
@@ -242,7 +285,7 @@ class VehicleParams:
 
     def sample(self, rng: np.random.Generator) -> VehicleParams:
         """A point drawn uniformly in the box (N_vdot tied to Y_rdot, M stays symmetric)."""
-        point = {n: float(rng.uniform(*self.interval(n))) for n in self.interval_fields}
+        point = self._tied_point({n: float(rng.uniform(*self.interval(n))) for n in self.interval_fields})
         if "Y_rdot" in point:
             point["N_vdot"] = point["Y_rdot"]
         return replace(self, **point) if point else self
@@ -254,6 +297,9 @@ class VehicleParams:
         ConfigError naming ``plant.truth.<name>``.
         """
         vals = dict(values)
+        if self.tied and "X_max" in vals:
+            raise ConfigError("plant.truth.X_max", "absent: X_max is tied to the drag by top_speed (give "
+                              "plant.truth.top_speed, X_u or X_uu)", vals["X_max"])
         for name, value in vals.items():
             if name not in self.interval_fields:
                 raise ConfigError(f"plant.truth.{name}", f"a coefficient given as an interval: one of "
@@ -267,7 +313,8 @@ class VehicleParams:
         for a, b in (("Y_rdot", "N_vdot"), ("N_vdot", "Y_rdot")):
             if a in vals:
                 vals[b] = vals[a]
-        return replace(self.nominal, **{k: float(v) for k, v in vals.items()})
+        tied = self._tied_point({k: float(v) for k, v in vals.items()})
+        return replace(self.nominal, **tied)
 
     # ---- point-only quantities -------------------------------------------------------------
     def _point_only(self, what: str) -> None:
@@ -336,6 +383,11 @@ class VehicleParams:
         """Every parameter by name (intervals as [lo, hi] lists: TOML and JSON round-trip)."""
         return {f.name: (list(v) if isinstance(v, tuple) else v)
                 for f in fields(self) for v in (getattr(self, f.name),)}
+
+
+def _abs_ends(ends: tuple[float, float]) -> tuple[float, float]:
+    """(min |x|, max |x|) over [lo, hi]."""
+    return _abs_floor(ends), max(abs(ends[0]), abs(ends[1]))
 
 
 def _abs_floor(ends: tuple[float, float]) -> float:

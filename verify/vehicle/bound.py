@@ -67,13 +67,15 @@ from tubekit.model.vehicle_params import VehicleParams
 from verify.vehicle.model import (arb_body_forces, channel_gradient, channel_mismatch, channel_mismatch_gradient,
                                   point_time_constant, velocity_box, with_sway, without_sway)
 from verify.vehicle.loop_data import LoopData, loop_data_of, loop_matrix
-from verify.vehicle.cells import CellInputs, cell_inputs, cell_own_gains, cell_starts, channel_bounds
-from verify.vehicle.pi_loop import free_bounds, free_stability, free_start, free_why_open
+from verify.vehicle.cells import CellInputs, cell_inputs, cell_starts, channel_bounds
+from verify.vehicle.pi_loop import free_bounds, free_stability, free_start
+from verify.vehicle.why_open import open_cause, own_gains
 from verify.vehicle.saturation import (SURGE_BANDS, actuator_authority, rate_authority_conditions,
                                        saturation_conditions, triple)
 
 __all__ = ["LoopBound", "velocity_loop_bound", "actuator_authority", "loop_matrix", "computed_bounds",
            "input_bounds", "start_bounds", "start_bounds_nominal", "start_terms", "own_gains", "Inputs",
+           "command_excess",
            "rate_authority_conditions", "LOOP_MAX_ITERATIONS", "LOOP_INFLATION", "SURGE_BANDS"]
 
 #: Default bound on the fixed-point iterations (a count, not seconds).
@@ -248,16 +250,27 @@ def _in_cells(loop: LoopData, c: int, jump_tick: arb, jump_period: arb, inputs: 
     return channel_bounds(cells, jump_tick, jump_period, inputs.drag[c], inputs.cells[c])
 
 
-def _mass_in_state(loop: LoopData, c: int, o: int, jumps: arb, inputs: Inputs) -> float:
-    """Output ``o`` of channel ``c`` in the second decomposition (module doc), given its jumps' part ``jumps``."""
+def _mass_in_state(loop: LoopData, c: int, o: int, jumps: arb, inputs: Inputs, mismatch: bool = True) -> float:
+    """Output ``o`` of channel ``c`` in the second decomposition (module doc), given its jumps' part ``jumps``;
+    ``mismatch`` False: for o = 1, sup|(k_i, k_p, 0) x| alone (a without its − d/m̂)."""
     _, _, h_rate, h_drag, peak = loop.gain_balls[c][o]
     x = (jumps + h_rate * arb(inputs.rate_mass[c]) + h_drag * arb(inputs.drag[c])
          + loop.mass_gain_balls[c][o] * arb(inputs.mass[c]) + peak * arb(inputs.start_mass[c]))
-    if o == 1:
+    if o == 1 and mismatch:
         x += arb(inputs.mismatch[c])
     if o == 3:
         x *= arb(inputs.mass_ratio[c])
     return upper(x)
+
+
+def command_excess(loop: LoopData, jump_tick: Sequence[float], jump_period: Sequence[float], inputs: Inputs) -> float:
+    """sup|τ_cmd_u − n_u(ν; θ)| (N) of the surge channel, by the second decomposition (module doc): there
+    a = (k_i, k_p, 0) x − d/m̂ with d = n̂ − n(θ) exactly, so τ_cmd = n̂ + m̂ a = n(ν; θ) + m̂ (k_i, k_p, 0) x, and this
+    is m̂_u sup|(k_i, k_p, 0) x| under the inputs' assumptions (what :mod:`verify.vehicle.propeller` weighs against
+    each hull's own thrust)."""
+    jt, jp = arb(jump_tick[0]), arb(jump_period[0])
+    g_tick, g_period = loop.gain_balls[0][1][:2]
+    return upper(loop.m_hat[0] * arb(_mass_in_state(loop, 0, 1, jt * g_tick + (jp - jt) * g_period, inputs, False)))
 
 
 def _validate(params: VehicleParams, v_max: Any, tick: Any, period: Any, jump_tick: Any, jump_period: Any,
@@ -354,8 +367,9 @@ def velocity_loop_bound(params: VehicleParams, *, v_max: Sequence[float], tick: 
     else:  # over |v| <= E_v with a sway loop, else the free hull's γ̄
         authority = actuator_authority(params, v, floor_u, upper(arb(sway_max) + arb(computed[1][0]))
                                        if loop.lateral else None)
+    excess = command_excess(loop, jt_int, jp_int, inputs) if found and inputs and getattr(params, "tied", 0) else None
     return _result(loop, params, (v, h, d, jt, jp, first), assumed, computed, inputs, authority,
-                   (k, max_iterations), found, rho, _why_open(loop, found, stop, growth, first_box))
+                   (k, max_iterations), found, rho, open_cause(loop, found, stop, growth, first_box), excess)
 
 
 def _round(loop: LoopData, jump_tick: Sequence[float], jump_period: Sequence[float], assumed: list | None,
@@ -384,74 +398,11 @@ def _sway_command(params: VehicleParams, sway: Sequence[float]) -> tuple[float, 
     return values[0], values[1], max(values[1], values[2])
 
 
-def own_gains(loop: LoopData, error: Sequence[float]) -> tuple[tuple[float, float, float], ...]:
-    """Per channel, the three parts of its own small-gain loop over the box |y_c| <= V_c + E_c (``error``), in the
-    decomposition where they add up to least: the second (module doc) or, in its worst cell, the third
-    (:func:`verify.vehicle.cells.cell_own_gains`). sup μ × the L1 gain to ẏ of (the mismatch's own slope — in a cell
-    its residual about δ_k —, the nominal drag's slope variation sup|∂n̂_c/∂y_c/m̂_c − λ_c|, the mass mismatch
-    sup|1 − 1/μ| — in a cell |1 − μ_k/μ|), each per unit Ŷ_c (dimensionless). A channel whose parts add up to 1 or
-    more cannot close whatever the others do."""
-    box, gamma = loop.box(error)
-    if not math.isfinite(gamma):
-        return tuple((math.inf,) * 3 for _ in loop.names)
-    nu = velocity_box(box[0], gamma, box[1], box[2])
-    grads = channel_gradient(loop.nominal, nu, loop.lateral)
-    d_grad = channel_mismatch_gradient(loop.nominal, loop.hull, nu, loop.lateral)
-    out = []
-    for c in range(len(loop.names)):
-        own, mu = loop.own[c], loop.m_hat[c] / loop.m_true[c]
-        _, _, h_rate, h_drag, _ = loop.gain_balls[c][3]
-        drag_slope = abs(grads[c][own] / loop.m_hat[c] - arb(loop.slope[c]))
-        parts = tuple(upper(mu * x) for x in (h_rate * abs(d_grad[c][own]) / loop.m_hat[c], h_drag * drag_slope,
-                                              loop.mass_gain_balls[c][3] * abs(1 - 1 / mu)))
-        in_cells = cell_own_gains(loop, c, nu, drag_slope)
-        out.append(parts if in_cells is None or sum(parts) <= sum(in_cells) else in_cells)
-    return tuple(out)
-
-
-#: What the fixed point bounds, per channel, in the order of :func:`computed_bounds`' rows.
-_QUANTITIES = ("sup|e|", "sup|a|", "sup|z|", "sup|ydot|")
-
-
-def _why_open(loop: LoopData, found: bool, stop: str, growth: list | None, first_box: Sequence[float] = ()) -> str:
-    """The root cause of a fixed point that did not close (empty when it closed), in words an owner can act on: a
-    channel whose own loop gain (:func:`own_gains`, at the first round's box) is 1 or more, with its three parts,
-    else the coupling between the channels."""
-    if found or growth is None:
-        return ""
-    head = f"diverged ({stop})"
-    if loop.free is not None:
-        return free_why_open(loop, head)
-    knobs = ("a narrower coefficient box, a smaller V, smaller command jumps (a gentler backup, a lower plan rate) "
-             "or a faster loop (plant.vehicle.loop_bandwidth, where the thrusters' lag and limits allow it) lower it")
-    rising = [(growth[c][o], c, o) for c in range(len(growth)) for o in range(4) if math.isfinite(growth[c][o])]
-    if rising:
-        g, c, o = max(rising)
-        head += (f"; the first round multiplied the bounds by up to {g:.3g} ({_QUANTITIES[o]} of channel "
-                 f"{loop.names[c]})")
-    gains = own_gains(loop, first_box) if first_box else ()
-    worst = max(range(len(gains)), key=lambda c: sum(gains[c]), default=None)
-    if worst is not None and sum(gains[worst]) >= 1.0:
-        mism, drag, mass = gains[worst]
-        return (f"{head}; channel {loop.names[worst]} cannot close on its own: its own loop gain is "
-                f"{mism + drag + mass:.3g} >= 1 ({mism:.3g} from the drag mismatch's slope, the intervals of its "
-                f"damping coefficients; {drag:.3g} from the nominal drag's slope over V + E; {mass:.3g} from its "
-                f"added-mass interval; in the decomposition where they are least) (docs/plant.md, section 4); {knobs}")
-    if worst is None:
-        return f"{head}; the small-gain loop's gain is not below 1 here (docs/plant.md, section 4); {knobs}"
-    through = ("the cross terms (Coriolis, the mismatch's other slopes)" if loop.lateral else
-               "the cross terms and the hull's free sway (its bound γ̄ and its rate through the sway row, which grow "
-               "with E_u and E_r)")
-    return (f"{head}; at the first round's box every channel's own loop gain is below 1 (the largest "
-            f"{sum(gains[worst]):.3g}, channel {loop.names[worst]}), but the channels drive one another through "
-            f"{through} and the slopes grow with E: together the small-gain loop's gain is not below 1 here "
-            f"(docs/plant.md, section 4); {knobs}")
-
-
 def _result(loop: LoopData, params: VehicleParams, given: tuple, assumed: list, computed: list, inputs: Inputs | None,
             authority: tuple, iterations: tuple[int, int], found: bool, rho: tuple | None,
-            why_open: str = "") -> LoopBound:
-    """The :class:`LoopBound` with every condition of the theorem (bounds +inf when not certified)."""
+            why_open: str = "", surge_excess: float | None = None) -> LoopBound:
+    """The :class:`LoopBound` with every condition of the theorem (bounds +inf when not certified); ``surge_excess``:
+    :func:`command_excess` of a vehicle whose thrust is tied to its drag (None: not tied, or no bound)."""
     v, h, d, jt, jp, first = given
     lat = loop.lateral
     error = without_sway(tuple(r[0] for r in computed), lat) if found else (math.inf,) * 3
@@ -473,7 +424,8 @@ def _result(loop: LoopData, params: VehicleParams, given: tuple, assumed: list, 
     conds.append(Condition("loop_fixed_point", "max computed/assumed of (sup|e|, sup|a|, sup|z|, sup|ydot|) < 1 "
                            "(first exit)", ratio, 1.0, found, f"{iterations[0]} iterations (at most {iterations[1]})"
                            + (f"; {why_open}" if why_open else "")))
-    conds += saturation_conditions(loop, params, v, assumed, closed=found or not loop.stable)
+    conds += saturation_conditions(loop, params, v, assumed, closed=found or not loop.stable,
+                                   surge_excess=surge_excess)
     how = ("E_v of the sway loop (lateral thrust regulates the sway to 0)" if lat else
            "hull_sway_bound over |u| <= V_u + E_u (u >= u_min − E_u under a surge floor), |r| <= V_r + E_r and Θ")
     conds.append(Condition("loop_sway", "gamma_bar finite (sway damped over the box)" if not lat else

@@ -22,6 +22,7 @@ from tubekit.validation import finite, nonnegative, positive
 from verify.kernel.intervals import enclose, lower, upper
 from verify.theorem.design import Condition, hull_sway_bound
 from verify.vehicle.model import CHANNELS, channel_forces, channel_masses, hull_balls, thrust_floor, velocity_box
+from verify.vehicle.propeller import tied_surge_authority, tied_surge_need
 
 
 
@@ -110,6 +111,9 @@ def _authority(params: VehicleParams, v: tuple[float, float, float], surge_floor
         forces = channel_forces(hull, (enclose(lo, hi), *nu[1:]) if banded else nu)
         floor = thrust_floor(params, hi, lo)
         worst = [min(w, lower((arb(floor[c]) - abs(forces[c])) / masses[c])) for c, w in enumerate(worst)]
+    if getattr(params, "tied", False):  # each hull's thrust against its own drag (verify.vehicle.propeller, T2)
+        bands = _surge_bands(surge_floor, v[0]) if banded else [(-v[0], v[0])]
+        worst[0] = tied_surge_authority(params, (v[0], v[1], v[2]), gamma, bands)
     return tuple(worst)
 
 
@@ -123,10 +127,12 @@ def rate_authority_conditions(authority: Sequence[float], rate: Sequence[float])
 
 
 def saturation_conditions(loop: _Loop, params: VehicleParams, v: Sequence[float], assumed: list,
-                closed: bool = True) -> list[Condition]:
+                          closed: bool = True, surge_excess: float | None = None) -> list[Condition]:
     """``loop_saturation[X|Z|N]``: sup|n̂_c| + m̂_c Â_c < the smallest limit over |u| <= V_u + E_u and Θ (and
     u >= u_min − E_u, the relative surge under the loop's surge floor, ``loop.surge_low``); not evaluated (no
-    number) when the fixed point did not ``closed`` (its assumed bounds mean nothing then)."""
+    number) when the fixed point did not ``closed`` (its assumed bounds mean nothing then). ``surge_excess`` (N,
+    :func:`verify.vehicle.bound.command_excess`) on a vehicle whose thrust is tied to its drag: X is each hull's
+    own need against its own thrust instead (:func:`verify.vehicle.propeller.tied_surge_need`)."""
     box, sway = loop.box([r[0] for r in assumed])
     a_assumed = [r[1] for r in assumed]
     finite_box = closed and all(math.isfinite(x) for x in (*box, sway, *a_assumed))
@@ -137,6 +143,11 @@ def saturation_conditions(loop: _Loop, params: VehicleParams, v: Sequence[float]
     else:
         floor = thrust_floor(params, u_bar, u_low, loop.lateral)
         peaks = thrust_peaks(loop, box, sway, a_assumed) if finite_box else [math.inf] * len(loop.names)
+    tied = finite_box and surge_excess is not None and getattr(params, "tied", False)
+    if tied:
+        bands = _surge_bands(u_low, u_bar) if 0.0 < u_low < u_bar else [(-u_bar, u_bar)]
+        peaks, floor = list(peaks), list(floor)
+        peaks[0], floor[0] = tied_surge_need(params, box, sway, bands, surge_excess)
     conds = []
     for c, ch in enumerate(loop.forces):
         why = (f"sup|n_hat_{loop.names[c]}| + m_hat sup|a| over {u_low:.4g} <= |u| <= {u_bar:.4g} m/s against "
@@ -153,7 +164,11 @@ def saturation_conditions(loop: _Loop, params: VehicleParams, v: Sequence[float]
         if not closed:  # the assumed bounds of a fixed point that did not close mean nothing: no number
             peak, why = None, "not evaluated: the loop bound did not close (root cause: loop_fixed_point)" + (
                 "" if floor[c] > 0 else f"; and {why}")
-        if ch == "X":
+        if ch == "X" and tied:
+            why = (f"each hull's sup|n_u| + {surge_excess:.4g} N (m_hat_u sup|(k_i, k_p, 0) x|) against its own "
+                   f"thrust, tied to its drag by top_speed, in the worst of {len(bands)} surge bands x the drag's "
+                   "cells (verify.vehicle.propeller, step T1)")
+        elif ch == "X":
             why += _top_speed_note(params, v[0])
         conds.append(Condition(f"loop_saturation[{ch}]", f"sup|tau_cmd_{ch}| < smallest {ch} limit over the box",
                                peak, floor[c], bool(peak is not None and peak < floor[c]), why))

@@ -43,21 +43,21 @@ def drag_cells(params: VehicleParams) -> list[tuple[dict[str, arb], float]]:
     """Per cell of X_u|u| (:data:`DRAG_CELLS` equal cells of its interval): the hull's balls with that cell, and
     X_floor(cell) (N), the smallest thrust a hull of the cell has (module doc)."""
     base = hull_balls(params)
-    s_lo = params.interval("top_speed")[0]
+    s_lo = arb(params.interval("top_speed")[0])
     x_lo = params.interval("X_max")[0]
-    lin = min(abs(x) for x in params.interval("X_u")) if not _holds_zero(params.interval("X_u")) else 0.0
+    lin = arb(_least_abs(*params.interval("X_u")))
     lo, hi = params.interval("X_uu")
     edges = [lo + (hi - lo) * k / DRAG_CELLS for k in range(DRAG_CELLS + 1)] if hi > lo else [lo, hi]
     out = []
     for a, b in zip(edges[:-1], edges[1:]):
-        quad = 0.0 if a <= 0.0 <= b else min(abs(a), abs(b))
-        tied = lower(arb(lin) * arb(s_lo) + arb(quad) * arb(s_lo) * arb(s_lo))
+        tied = lower(lin * s_lo + arb(_least_abs(a, b)) * s_lo * s_lo)
         out.append(({**base, "X_uu": enclose(a, b)}, max(x_lo, tied)))
     return out
 
 
-def _holds_zero(ends: tuple[float, float]) -> bool:
-    return ends[0] <= 0.0 <= ends[1]
+def _least_abs(lo: float, hi: float) -> float:
+    """min |x| over [lo, hi]."""
+    return 0.0 if lo <= 0.0 <= hi else min(abs(lo), abs(hi))
 
 
 def _surge_force(hull: dict[str, arb], box: Sequence[float], sway: float, surge: tuple[float, float]) -> arb:

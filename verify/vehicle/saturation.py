@@ -143,7 +143,7 @@ def saturation_conditions(loop: _Loop, params: VehicleParams, v: Sequence[float]
     else:
         floor = thrust_floor(params, u_bar, u_low, loop.lateral)
         peaks = thrust_peaks(loop, box, sway, a_assumed) if finite_box else [math.inf] * len(loop.names)
-    tied = finite_box and surge_excess is not None and getattr(params, "tied", False)
+    tied = finite_box and surge_excess is not None  # given only for a thrust tied to the drag
     if tied:
         bands = _surge_bands(u_low, u_bar) if 0.0 < u_low < u_bar else [(-u_bar, u_bar)]
         peaks, floor = list(peaks), list(floor)

@@ -44,8 +44,7 @@ def _corner(scenario, end: int):
     """``scenario`` with its simulated hull at the lower (0) or upper (1) end of every coefficient interval (a thrust
     tied to the drag by the top speed is derived from the corner, not taken from X_max's interval)."""
     params = scenario.plant.params
-    corner = {k: v[end] for k, v in vars(params).items() if not k.startswith("_") and isinstance(v, tuple)
-              and not (params.tied and k == "X_max")}
+    corner = {k: params.interval(k)[end] for k in params.free_fields}
     return scenario.with_changes(plant=dataclasses.replace(scenario.plant, truth=tuple(corner.items())))
 
 

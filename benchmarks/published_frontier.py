@@ -89,8 +89,9 @@ def row(cert) -> str:
     """One row's text: tiers, failed conditions with their numbers, E and X_f."""
     tiers = "both" if cert.tiers.tracking else "safe" if cert.tiers.safe else "none"
     failed = "; ".join(f"{c.condition} {_number(c.lhs)} vs {_number(c.rhs)}" for c in cert.failures[:4])
-    where = re.search(r"X_f: d in \[([0-9.]+), ([0-9.]+)\] m.*?\|bearing\| <= ([0-9.]+)", cert.summary())
-    xf = f"X_f d in [{where.group(1)}, {where.group(2)}] m, bearing <= {where.group(3)} rad" if where else ""
+    law = cert.design.terminal
+    xf = "" if law is None else (f"X_f d in [{law.d_lo:.4g}, {law.d_hi:.4g}] m"
+                                 + (f", bearing <= {law.bearing_max:.3g} rad" if law.has_bearing else ""))
     error = ", ".join(_number(e) for e in cert.velocity_loop.error)
     return f"{tiers} | {failed or '-'} | E = ({error}) | {xf or '-'}"
 

@@ -273,8 +273,7 @@ def _coefficient_box(field: str, entry: Any, base: dict) -> Distribution:
         raise ConfigError(field, "a base scenario on the dynamic plant ([plant] kind = \"dynamic\"): the kinematic "
                           "plant simulates no coefficient", plant.kind)
     params = plant.params
-    # a thrust tied to the drag by the top speed is derived from the drawn hull, never drawn itself
-    names = tuple(n for n in params.interval_fields if not (params.tied and n == "X_max"))
+    names = params.free_fields  # a thrust tied to the drag is derived from the drawn hull, never drawn itself
     if not names:
         raise ConfigError(field, "a vehicle with at least one coefficient given as an interval [lo, hi]",
                           base.get("plant", {}).get("vehicle"))

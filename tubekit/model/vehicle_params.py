@@ -258,6 +258,12 @@ class VehicleParams:
         return self._intervals  # type: ignore[attr-defined, no-any-return]
 
     @property
+    def free_fields(self) -> tuple[str, ...]:
+        """The interval fields a point of the box is given by (:meth:`with_point`, a campaign's draw): every one
+        but X_max when the thrust is tied to the drag (:attr:`tied`: then X_max is derived from the point)."""
+        return tuple(n for n in self.interval_fields if not (self.tied and n == "X_max"))
+
+    @property
     def is_point(self) -> bool:
         """True when no field is an interval."""
         return not self._intervals  # type: ignore[attr-defined]
@@ -297,10 +303,10 @@ class VehicleParams:
         ConfigError naming ``plant.truth.<name>``.
         """
         vals = dict(values)
-        if self.tied and "X_max" in vals:
-            raise ConfigError("plant.truth.X_max", "absent: X_max is tied to the drag by top_speed (give "
-                              "plant.truth.top_speed, X_u or X_uu)", vals["X_max"])
         for name, value in vals.items():
+            if name in self.interval_fields and name not in self.free_fields:
+                raise ConfigError(f"plant.truth.{name}", "absent: X_max is tied to the drag by top_speed (give "
+                                  "plant.truth.top_speed, X_u or X_uu)", value)
             if name not in self.interval_fields:
                 raise ConfigError(f"plant.truth.{name}", f"a coefficient given as an interval: one of "
                                   f"{list(self.interval_fields)}", value)

@@ -367,8 +367,7 @@ def velocity_loop_bound(params: VehicleParams, *, v_max: Sequence[float], tick: 
     else:  # over |v| <= E_v with a sway loop, else the free hull's γ̄
         authority = actuator_authority(params, v, floor_u, upper(arb(sway_max) + arb(computed[1][0]))
                                        if loop.lateral else None)
-    excess = command_excess(loop, jt_int, jp_int, inputs) if found and inputs and getattr(params, "tied", False) \
-        else None
+    excess = command_excess(loop, jt_int, jp_int, inputs) if found and inputs and params.tied else None
     return _result(loop, params, (v, h, d, jt, jp, first), assumed, computed, inputs, authority,
                    (k, max_iterations), found, rho, open_cause(loop, found, stop, growth, first_box), excess)
 

@@ -31,7 +31,7 @@ from flint import arb
 
 from tubekit.model.vehicle_params import VehicleParams
 from verify.kernel.intervals import enclose, lower, upper
-from verify.vehicle.model import arb_body_forces, hull_balls
+from verify.vehicle.model import arb_body_forces, hull_balls, velocity_box
 
 __all__ = ["DRAG_CELLS", "drag_cells", "tied_surge_need", "tied_surge_authority"]
 
@@ -45,25 +45,19 @@ def drag_cells(params: VehicleParams) -> list[tuple[dict[str, arb], float]]:
     base = hull_balls(params)
     s_lo = arb(params.interval("top_speed")[0])
     x_lo = params.interval("X_max")[0]
-    lin = arb(_least_abs(*params.interval("X_u")))
+    linear = arb(-params.interval("X_u")[1])  # damping is <= 0 over the box: the least |x| is at the upper end
     lo, hi = params.interval("X_uu")
     edges = [lo + (hi - lo) * k / DRAG_CELLS for k in range(DRAG_CELLS + 1)] if hi > lo else [lo, hi]
     out = []
     for a, b in zip(edges[:-1], edges[1:]):
-        tied = lower(lin * s_lo + arb(_least_abs(a, b)) * s_lo * s_lo)
+        tied = lower(linear * s_lo + arb(-b) * s_lo * s_lo)
         out.append(({**base, "X_uu": enclose(a, b)}, max(x_lo, tied)))
     return out
 
 
-def _least_abs(lo: float, hi: float) -> float:
-    """min |x| over [lo, hi]."""
-    return 0.0 if lo <= 0.0 <= hi else min(abs(lo), abs(hi))
-
-
 def _surge_force(hull: dict[str, arb], box: Sequence[float], sway: float, surge: tuple[float, float]) -> arb:
     """n_u over the surge band ``surge`` (m/s), |v| <= ``sway``, |w| <= box[1], |r| <= box[2] and the cell's hull."""
-    nu = (enclose(*surge), enclose(-sway, sway), enclose(-box[1], box[1]), enclose(-box[2], box[2]))
-    return arb_body_forces(hull, nu)[0]
+    return arb_body_forces(hull, (enclose(*surge), *velocity_box(0.0, sway, box[1], box[2])[1:]))[0]
 
 
 def tied_surge_need(params: VehicleParams, box: Sequence[float], sway: float, bands: Sequence[tuple[float, float]],

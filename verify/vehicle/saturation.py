@@ -111,7 +111,7 @@ def _authority(params: VehicleParams, v: tuple[float, float, float], surge_floor
         forces = channel_forces(hull, (enclose(lo, hi), *nu[1:]) if banded else nu)
         floor = thrust_floor(params, hi, lo)
         worst = [min(w, lower((arb(floor[c]) - abs(forces[c])) / masses[c])) for c, w in enumerate(worst)]
-    if getattr(params, "tied", False):  # each hull's thrust against its own drag (verify.vehicle.propeller, T2)
+    if params.tied:  # each hull's thrust against its own drag (verify.vehicle.propeller, T2)
         bands = _surge_bands(surge_floor, v[0]) if banded else [(-v[0], v[0])]
         worst[0] = tied_surge_authority(params, (v[0], v[1], v[2]), gamma, bands)
     return tuple(worst)

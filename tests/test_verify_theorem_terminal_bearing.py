@@ -9,6 +9,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 from hypothesis import given, settings
+from flint import arb
 from hypothesis import strategies as st
 
 import verify
@@ -145,6 +146,41 @@ def test_under_rate_limited_plans_the_row_faces_and_the_bearing_face_hold_togeth
     names = {c.condition for c in rated.design.conditions}
     assert {"terminal_rate[u]", "terminal_rate[r]", "terminal_invariant[row_r]", "terminal_invariant[bearing]",
             "terminal_surge_floor"} <= names
+
+
+def _first_admitted_by_a_scan(b, law) -> float | None:
+    """The reference: the grid φ_f = i · BEARING_STEP scanned upward from i = 1, stopping where φ_f + asin(D_xy /
+    d_lo) reaches π/2; the first point where δ P_min sin Φ_0 − L_c − A δ²/2 > 0 and Φ_0 + η − atan(that / x_max) <=
+    φ_f − 1e-6 (the float inequality of ``terminal_invariant[bearing]``)."""
+    arc = completion_arc(b, law)
+    if arc is None:
+        return None
+    dev = math.asin(min(1.0, b.dev_xy / law.d_lo))
+    chord = upper(arb(b.dt) * (arb(b.speed_xy) + arb(law.gain_d) * arc.spread) * arc.beta.tan())
+    loss = chord + b.accel_xy * b.dt ** 2 / 2
+    eta = b.accel_xy * b.dt / b.speed_floor_xy
+    for i in range(1, int(math.pi / 2 / BEARING_STEP)):
+        phi = i * BEARING_STEP
+        if phi + dev >= math.pi / 2:
+            return None
+        lateral = b.dt * b.speed_floor_xy * math.sin(phi + dev) - loss
+        if lateral > 0 and phi + dev + eta - math.atan(lateral / upper(arc.x_max)) <= phi - 1e-6:
+            return phi
+    return None
+
+
+def test_the_smallest_bearing_found_by_bisection_is_the_one_a_scan_upward_finds(rated):
+    """Every gentlest law of the survey's coarse grid at each heading room (the laws ``bearing_row_sets`` searches a
+    face for), and each with a tenth of its radial gain: the bisection returns the grid point an upward scan finds,
+    None where the scan finds none, and both outcomes occur."""
+    b = terminal_bounds(SURVEY_RATED, rated.design, rated.region)
+    laws = [gentle for law in _grid(b, _grid_points(WIDTHS, LOWER_ENDS)) for fa in (1.0, 0.3, 0.05)
+            for gentle in row_sets(b, [dataclasses.replace(law, alpha_max=law.alpha_max * fa)])]
+    laws += [dataclasses.replace(law, gain_d=law.gain_d / 10) for law in laws]
+    found = [(smallest_bearing(b, law), _first_admitted_by_a_scan(b, law)) for law in laws]
+    assert len(found) > 100
+    assert all(bisected == scanned for bisected, scanned in found)
+    assert any(scanned is None for _, scanned in found) and any(scanned is not None for _, scanned in found)
 
 
 @pytest.mark.slow

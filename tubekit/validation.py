@@ -76,6 +76,9 @@ def duration_seconds(field: str, value: Any) -> float:
 
 def is_number(value: Any) -> bool:
     """Whether ``value`` is a real number: an int or float (numpy's too); never a bool, a string or None."""
+    kind = type(value)
+    if kind is float or kind is int:  # the common case, first (a bool's type is bool, not int)
+        return True
     return isinstance(value, (int, float, np.integer, np.floating)) and not isinstance(value, (bool, np.bool_))
 
 
@@ -84,6 +87,8 @@ def finite(field: str, value: Any) -> float:
 
     Types are strict: a string (``"100"``), a boolean or None is not a number.
     """
+    if type(value) is float and math.isfinite(value):  # the common case, first
+        return value
     if not is_number(value):
         raise ConfigError(field, "a finite number", value)
     try:

@@ -91,9 +91,8 @@ class TerminalLaw:
         if not isinstance(self.los_feedforward, bool):
             raise ConfigError("terminal.los_feedforward", "a bool (True: the yaw row follows the line of sight's "
                               "turn)", self.los_feedforward)
-        for f in fields(self):
-            if f.name != "los_feedforward":
-                finite(f"terminal.{f.name}", getattr(self, f.name))
+        for name in _NUMBER_FIELDS:
+            finite(f"terminal.{name}", getattr(self, name))
         positive("terminal.d_lo", self.d_lo)
         if not self.d_lo <= self.d_star <= self.d_hi:
             raise ConfigError("terminal.d_star", f"within [d_lo, d_hi] = [{self.d_lo}, {self.d_hi}] m", self.d_star)
@@ -187,3 +186,7 @@ class TerminalLaw:
         if values["los_feedforward"] not in (0.0, 1.0):
             raise ConfigError(f"{where}.los_feedforward", "1.0 or 0.0", d["los_feedforward"])
         return cls(**{**values, "los_feedforward": values["los_feedforward"] == 1.0})
+
+
+#: The twelve number fields of :class:`TerminalLaw` (all but ``los_feedforward``), validated in its order.
+_NUMBER_FIELDS = tuple(f.name for f in fields(TerminalLaw) if f.name != "los_feedforward")

@@ -66,7 +66,12 @@ def lateral_chord(b: TerminalBounds, law: TerminalLaw, arc: CompletionArc) -> ar
 def smallest_bearing(b: TerminalBounds, law: TerminalLaw) -> float | None:
     """The smallest φ_f on the :data:`BEARING_STEP` grid below π/2 for which the float version of
     ``terminal_invariant[bearing]`` holds for ``law`` (its other faces as given, the arc's bounds at their
-    unfavourable ends); None when none does. The Arb condition decides; this only proposes."""
+    unfavourable ends); None when none does. The Arb condition decides; this only proposes.
+
+    Found by bisection: over the grid points whose start bearing Φ_0 = φ_f + asin(D_xy / d_lo) is below π/2 the
+    inequality's left side less φ_f, asin(D_xy / d_lo) + η − atan((δ P_min sin Φ_0 − L_c − A δ²/2) / x_max), falls
+    as φ_f grows (sin Φ_0 rises), so once it holds it holds at every larger φ_f: the first grid point where it
+    holds is the one a scan upward finds, after about nine evaluations instead of up to 313."""
     arc = completion_arc(b, law) if b.speed_floor_xy > 0.0 else None
     if arc is None:
         return None
@@ -74,15 +79,27 @@ def smallest_bearing(b: TerminalBounds, law: TerminalLaw) -> float | None:
     dev = math.asin(min(1.0, b.dev_xy / law.d_lo))
     loss = upper(lateral_chord(b, law, arc)) + b.accel_xy * dt * dt / 2
     turn, x_max = b.accel_xy * dt / b.speed_floor_xy, upper(arc.x_max)
-    for i in range(1, int(math.pi / 2 / BEARING_STEP)):
+
+    def holds(i: int) -> bool:
         phi = i * BEARING_STEP
         start = phi + dev
-        if start >= math.pi / 2:
-            return None
         lateral = dt * b.speed_floor_xy * math.sin(start) - loss
-        if lateral > 0 and start + turn - math.atan(lateral / x_max) <= phi - 1e-6:
-            return phi
-    return None
+        return lateral > 0 and start + turn - math.atan(lateral / x_max) <= phi - 1e-6
+
+    end = int(math.pi / 2 / BEARING_STEP)  # the grid is 1 .. end - 1, cut at the first point where Φ_0 reaches π/2
+    top = max(1, math.ceil((math.pi / 2 - dev) / BEARING_STEP) - 2)  # a few points before that cut
+    while top < end and top * BEARING_STEP + dev < math.pi / 2:
+        top += 1
+    if top <= 1 or not holds(top - 1):
+        return None
+    lo, hi = 1, top - 1  # holds(hi)
+    while lo < hi:
+        mid = (lo + hi) // 2
+        if holds(mid):
+            hi = mid
+        else:
+            lo = mid + 1
+    return lo * BEARING_STEP
 
 
 def bearing_sets(b: TerminalBounds, laws: Iterable[TerminalLaw]) -> list[TerminalLaw]:

@@ -1,7 +1,9 @@
 """The README's promises: every command in it runs and exits as it says; its Python runs; its links exist.
 
 Every fenced command block is executed (in a scratch directory that sees ``verify/`` and ``examples/``),
-each line with the exit code its comment states (``# exit 3``; 0 when none). The Quick start's two
+each line with the exit code its comment states (``# exit 3``; 0 when none): each line is its own test, run
+through ``tubekit.app.cli.main`` (the console script's entry point) so the suite spreads them over its workers,
+and one chain of them runs as a process to show the installed command itself works. The Quick start's two
 lines are the only ones not run verbatim: ``pip install -e . && tubekit reproduce`` (a 100 s study on
 two plants) is stood in for by the README's own ``tubekit reproduce --quick`` line, which runs the same
 command for 10 simulated seconds, and ``pip install -e ".[test]" && pytest`` is this suite (CI runs it
@@ -14,10 +16,11 @@ import re
 import shlex
 import subprocess
 import sys
-from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
 import pytest
+
+from tubekit.app.cli import main
 
 ROOT = Path(__file__).resolve().parent.parent
 README = (ROOT / "README.md").read_text()
@@ -44,18 +47,30 @@ def _expected_exit(line: str) -> int:
     return int(found.group(1)) if found else 0
 
 
-def _run(line: str, cwd: Path) -> tuple[str, list[tuple[int, str]]]:
-    """Run ``line`` (``A && B``: each in turn, stopping at a failure); per part its exit code and stderr."""
-    results = []
-    for part in line.split("#", 1)[0].split("&&"):
-        argv = shlex.split(part)
-        assert argv[0] == "tubekit", f"README command not a tubekit command: {part!r}"
-        proc = subprocess.run([sys.executable, "-m", "tubekit", *argv[1:]], cwd=cwd, capture_output=True,
-                              text=True, timeout=600)
-        results.append((proc.returncode, proc.stderr))
-        if proc.returncode != 0:
-            break
-    return line, results
+def _parts(line: str) -> list[list[str]]:
+    """The argv of each command of ``line`` (``A && B``), its comment dropped; each starts with ``tubekit``."""
+    parts = [shlex.split(part) for part in line.split("#", 1)[0].split("&&")]
+    for argv in parts:
+        assert argv[0] == "tubekit", f"README command not a tubekit command: {argv!r}"
+    return parts
+
+
+def _wanted(line: str) -> list[int]:
+    """The exit codes the README states for ``line``: 0 for every command of a chain but the last."""
+    return [0] * (len(_parts(line)) - 1) + [_expected_exit(line)]
+
+
+def _slug(line: str) -> str:
+    return re.sub(r"\W+", "_", line.split("#", 1)[0].replace("tubekit ", "")).strip("_")[:70]
+
+
+@pytest.fixture
+def readme_dir(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> Path:
+    """A scratch working directory that sees ``verify/`` and ``examples/``, as a reader's checkout does."""
+    for name in ("verify", "examples"):
+        (tmp_path / name).symlink_to(ROOT / name)
+    monkeypatch.chdir(tmp_path)
+    return tmp_path
 
 
 def test_quick_start_has_exactly_two_commands():
@@ -77,20 +92,34 @@ def test_the_dynamic_vehicles_section_is_reserved():
     assert "## Dynamic vehicles" in README
 
 
-@pytest.mark.slow(80)
-def test_every_readme_command_runs_and_exits_as_stated(tmp_path):
-    """Each command line, two at a time: the exit code its comment states, no traceback."""
-    for name in ("verify", "examples"):
-        (tmp_path / name).symlink_to(ROOT / name)
-    commands = _commands()
-    assert len(commands) >= 6
-    with ThreadPoolExecutor(max_workers=2) as pool:
-        outcomes = list(pool.map(lambda ln: _run(ln, tmp_path), commands))
-    for line, results in outcomes:
-        codes = [code for code, _ in results]
-        want = [0] * (len(line.split("#", 1)[0].split("&&")) - 1) + [_expected_exit(line)]
-        assert codes == want, f"{line!r}: exit codes {codes}, README says {want}\n{results[-1][1][-2000:]}"
-        assert not any("Traceback" in err for _, err in results), f"{line!r} printed a traceback"
+def test_the_readme_has_its_commands():
+    assert len(_commands()) >= 6
+
+
+@pytest.mark.parametrize("line", _commands(), ids=_slug)
+def test_each_readme_command_exits_as_stated(line: str, readme_dir: Path, capsys: pytest.CaptureFixture) -> None:
+    """The command line's exit codes are the ones its comment states (a chain stops at its first failure)."""
+    codes = []
+    for argv in _parts(line):
+        codes.append(main(argv[1:]))
+        if codes[-1] != 0:
+            break
+    assert codes == _wanted(line), f"{line!r}: exit codes {codes}, README says {_wanted(line)}\n" \
+                                   f"{capsys.readouterr().err[-2000:]}"
+
+
+def test_a_readme_chain_runs_as_a_process(readme_dir: Path) -> None:
+    """The certify-then-recheck chain through ``python -m tubekit``, each as its own process: the exit codes the
+    README states, no traceback, and the certificate file written between them."""
+    line = next(ln for ln in _commands() if "--json" in ln and "recheck" in ln)
+    codes = []
+    for argv in _parts(line):
+        proc = subprocess.run([sys.executable, "-m", "tubekit", *argv[1:]], cwd=readme_dir, capture_output=True,
+                              text=True, timeout=600)
+        assert "Traceback" not in proc.stderr, proc.stderr[-2000:]
+        codes.append(proc.returncode)
+    assert codes == _wanted(line)
+    assert (readme_dir / "cert.json").is_file()
 
 
 def test_python_examples_run():

@@ -337,10 +337,28 @@ def _screen_tops(cells: Sequence[Cell], jump_tick: float, jump_rest: float, w_n:
                  inputs: Sequence[CellInputs]) -> np.ndarray:
     """(cells, 4) floats: per cell and output, Σ sup|g| × sup|input| (+ sup|D| in row 1, × sup|μ| in row 3); +inf
     where a product is not a number (an infinite input against a zero gain), so that such a cell is formed."""
-    tops = np.array([cell.gain_tops for cell in cells])                       # (cells, 4, 6)
+    tops, mu_tops = _stacked_tops(cells)
     ins = np.array([[jump_tick, jump_rest, i.rate, w_n, i.start, i.mass] for i in inputs], dtype=float)
     with np.errstate(invalid="ignore", over="ignore"):
         x = np.einsum("kog,kg->ko", tops, ins)
         x[:, 1] += np.array([i.mismatch for i in inputs], dtype=float)
-        x[:, 3] *= np.array([cell.mu_top for cell in cells], dtype=float)
+        x[:, 3] *= mu_tops
     return np.where(np.isnan(x), np.inf, x)
+
+
+#: :func:`_stacked_tops` of the channels' cell tuples met last (each entry holds its tuple, so its id stays its own).
+_STACKED: dict[int, tuple[Sequence[Cell], np.ndarray, np.ndarray]] = {}
+
+
+def _stacked_tops(cells: Sequence[Cell]) -> tuple[np.ndarray, np.ndarray]:
+    """((cells, 4, 6) gain tops, (cells,) sup|μ|) of ``cells`` stacked: formed once per tuple of cells, as the fixed
+    point's rounds screen the same channel's cells again and again (a tuple of one cell is stacked each time)."""
+    entry = _STACKED.get(id(cells))
+    if entry is None or entry[0] is not cells:
+        entry = (cells, np.array([cell.gain_tops for cell in cells]),
+                 np.array([cell.mu_top for cell in cells], dtype=float))
+        if len(cells) > 1:
+            if len(_STACKED) >= 64:
+                del _STACKED[next(iter(_STACKED))]
+            _STACKED[id(cells)] = entry
+    return entry[1], entry[2]

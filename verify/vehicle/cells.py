@@ -259,21 +259,47 @@ def cell_inputs(loop: LoopFacts, c: int, nu: Sequence[arb], rates: Sequence[arb]
     own, m_hat, y_dot = loop.own[c], loop.m_hat[c], arb(accel)
     d_rest, g_rest = _rest(loop, c, nu)
     cross = sum((abs(g) * x for j, (g, x) in enumerate(zip(g_rest, rates)) if j != own), arb(0)) / m_hat
-    size, damped, massed = _abs(nu[own]), {}, {}
-    out = []
-    for k, cell in enumerate(cells):
-        key = (cell.pieces[1:], cell.slope)  # the damping's pieces fix Δa, Δb and δ_k: the same balls below
-        if key not in damped:
-            d_own, g_own = _own_damping(cell, nu[own], size)
-            damped[key] = (upper(abs((g_rest[own] + g_own) / m_hat - arb(cell.slope)) * y_dot + cross),
-                           upper(abs(d_rest + d_own) / m_hat))
-        mass_key = (cell.pieces[0], cell.mu_centre)  # the mass piece fixes μ and μ_k
-        if mass_key not in massed:
-            massed[mass_key] = upper(cell.mass_residual * y_dot)
-        rate, mismatch = damped[key]
-        out.append(CellInputs(rate=rate, mass=massed[mass_key], mismatch=mismatch,
-                              start=mismatch if starts is None else starts[k]))
-    return tuple(out)
+    size = _abs(nu[own])
+    damping_cells, mass_cells, index = _cell_groups(cells)
+    damped = []
+    for cell in damping_cells:
+        d_own, g_own = _own_damping(cell, nu[own], size)
+        damped.append((upper(abs((g_rest[own] + g_own) / m_hat - arb(cell.slope)) * y_dot + cross),
+                       upper(abs(d_rest + d_own) / m_hat)))
+    massed = [upper(cell.mass_residual * y_dot) for cell in mass_cells]
+    return tuple(CellInputs(rate=damped[i][0], mass=massed[j], mismatch=damped[i][1],
+                            start=damped[i][1] if starts is None else starts[k]) for k, (i, j) in enumerate(index))
+
+
+#: :func:`_cell_groups` of the channels' cell tuples met last (each entry holds its tuple, so its id stays its own).
+_GROUPS: dict[int, tuple] = {}
+
+
+def _cell_groups(cells: Sequence[Cell]) -> tuple[list[Cell], list[Cell], list[tuple[int, int]]]:
+    """(the first cell of each damping key, the first of each mass key, per cell its two keys' indices): cells with
+    the same damping pieces and δ_k share their damping's residuals (the pieces fix Δa, Δb), cells with the same
+    mass piece and μ_k their mass residual, so :func:`cell_inputs` forms each once. Grouped once per tuple of
+    cells."""
+    entry = _GROUPS.get(id(cells))
+    if entry is not None and entry[0] is cells:
+        return entry[1]
+    damping: dict[tuple, int] = {}
+    mass: dict[tuple, int] = {}
+    damping_cells, mass_cells, index = [], [], []
+    for cell in cells:
+        key, mass_key = (cell.pieces[1:], cell.slope), (cell.pieces[0], cell.mu_centre)
+        if key not in damping:
+            damping[key] = len(damping_cells)
+            damping_cells.append(cell)
+        if mass_key not in mass:
+            mass[mass_key] = len(mass_cells)
+            mass_cells.append(cell)
+        index.append((damping[key], mass[mass_key]))
+    groups = (damping_cells, mass_cells, index)
+    if len(_GROUPS) >= 64:
+        del _GROUPS[next(iter(_GROUPS))]
+    _GROUPS[id(cells)] = (cells, groups)
+    return groups
 
 
 def cell_own_gains(loop: LoopFacts, c: int, nu: Sequence[arb], drag_slope: arb) -> tuple[float, float, float] | None:

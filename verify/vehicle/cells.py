@@ -31,7 +31,7 @@ import itertools
 import math
 from dataclasses import dataclass
 from functools import cached_property
-from typing import Mapping, Protocol, Sequence
+from typing import Mapping, NamedTuple, Protocol, Sequence
 
 import numpy as np
 from flint import arb, ctx
@@ -259,47 +259,16 @@ def cell_inputs(loop: LoopFacts, c: int, nu: Sequence[arb], rates: Sequence[arb]
     own, m_hat, y_dot = loop.own[c], loop.m_hat[c], arb(accel)
     d_rest, g_rest = _rest(loop, c, nu)
     cross = sum((abs(g) * x for j, (g, x) in enumerate(zip(g_rest, rates)) if j != own), arb(0)) / m_hat
-    size = _abs(nu[own])
-    damping_cells, mass_cells, index = _cell_groups(cells)
+    size, table = _abs(nu[own]), _table(cells)
     damped = []
-    for cell in damping_cells:
+    for cell in table.damping_cells:
         d_own, g_own = _own_damping(cell, nu[own], size)
         damped.append((upper(abs((g_rest[own] + g_own) / m_hat - arb(cell.slope)) * y_dot + cross),
                        upper(abs(d_rest + d_own) / m_hat)))
-    massed = [upper(cell.mass_residual * y_dot) for cell in mass_cells]
+    massed = [upper(cell.mass_residual * y_dot) for cell in table.mass_cells]
     return tuple(CellInputs(rate=damped[i][0], mass=massed[j], mismatch=damped[i][1],
-                            start=damped[i][1] if starts is None else starts[k]) for k, (i, j) in enumerate(index))
-
-
-#: :func:`_cell_groups` of the channels' cell tuples met last (each entry holds its tuple, so its id stays its own).
-_GROUPS: dict[int, tuple] = {}
-
-
-def _cell_groups(cells: Sequence[Cell]) -> tuple[list[Cell], list[Cell], list[tuple[int, int]]]:
-    """(the first cell of each damping key, the first of each mass key, per cell its two keys' indices): cells with
-    the same damping pieces and δ_k share their damping's residuals (the pieces fix Δa, Δb), cells with the same
-    mass piece and μ_k their mass residual, so :func:`cell_inputs` forms each once. Grouped once per tuple of
-    cells."""
-    entry = _GROUPS.get(id(cells))
-    if entry is not None and entry[0] is cells:
-        return entry[1]
-    damping: dict[tuple, int] = {}
-    mass: dict[tuple, int] = {}
-    damping_cells, mass_cells, index = [], [], []
-    for cell in cells:
-        key, mass_key = (cell.pieces[1:], cell.slope), (cell.pieces[0], cell.mu_centre)
-        if key not in damping:
-            damping[key] = len(damping_cells)
-            damping_cells.append(cell)
-        if mass_key not in mass:
-            mass[mass_key] = len(mass_cells)
-            mass_cells.append(cell)
-        index.append((damping[key], mass[mass_key]))
-    groups = (damping_cells, mass_cells, index)
-    if len(_GROUPS) >= 64:
-        del _GROUPS[next(iter(_GROUPS))]
-    _GROUPS[id(cells)] = (cells, groups)
-    return groups
+                            start=damped[i][1] if starts is None else starts[k])
+                 for k, (i, j) in enumerate(table.index))
 
 
 def cell_own_gains(loop: LoopFacts, c: int, nu: Sequence[arb], drag_slope: arb) -> tuple[float, float, float] | None:
@@ -363,28 +332,52 @@ def _screen_tops(cells: Sequence[Cell], jump_tick: float, jump_rest: float, w_n:
                  inputs: Sequence[CellInputs]) -> np.ndarray:
     """(cells, 4) floats: per cell and output, Σ sup|g| × sup|input| (+ sup|D| in row 1, × sup|μ| in row 3); +inf
     where a product is not a number (an infinite input against a zero gain), so that such a cell is formed."""
-    tops, mu_tops = _stacked_tops(cells)
+    table = _table(cells)
     ins = np.array([[jump_tick, jump_rest, i.rate, w_n, i.start, i.mass] for i in inputs], dtype=float)
     with np.errstate(invalid="ignore", over="ignore"):
-        x = np.einsum("kog,kg->ko", tops, ins)
+        x = np.einsum("kog,kg->ko", table.tops, ins)
         x[:, 1] += np.array([i.mismatch for i in inputs], dtype=float)
-        x[:, 3] *= mu_tops
+        x[:, 3] *= table.mu_tops
     return np.where(np.isnan(x), np.inf, x)
 
 
-#: :func:`_stacked_tops` of the channels' cell tuples met last (each entry holds its tuple, so its id stays its own).
-_STACKED: dict[int, tuple[Sequence[Cell], np.ndarray, np.ndarray]] = {}
+class _CellTable(NamedTuple):
+    """What the fixed point's rounds read of one channel's cells, formed once per tuple of cells (:func:`_table`)."""
+
+    damping_cells: list[Cell]      # the first cell of each damping key (its pieces and δ_k fix Δa, Δb)
+    mass_cells: list[Cell]         # the first cell of each mass key (its piece and μ_k fix μ)
+    index: list[tuple[int, int]]   # per cell, its damping key's and mass key's index
+    tops: np.ndarray               # (cells, 4, 6): each cell's Cell.gain_tops
+    mu_tops: np.ndarray            # (cells,): each cell's Cell.mu_top
 
 
-def _stacked_tops(cells: Sequence[Cell]) -> tuple[np.ndarray, np.ndarray]:
-    """((cells, 4, 6) gain tops, (cells,) sup|μ|) of ``cells`` stacked: formed once per tuple of cells, as the fixed
-    point's rounds screen the same channel's cells again and again (a tuple of one cell is stacked each time)."""
-    entry = _STACKED.get(id(cells))
-    if entry is None or entry[0] is not cells:
-        entry = (cells, np.array([cell.gain_tops for cell in cells]),
-                 np.array([cell.mu_top for cell in cells], dtype=float))
-        if len(cells) > 1:
-            if len(_STACKED) >= 64:
-                del _STACKED[next(iter(_STACKED))]
-            _STACKED[id(cells)] = entry
-    return entry[1], entry[2]
+#: :func:`_table` of the channels' cell tuples met last, by id (each entry holds its tuple, so the id stays its own).
+_TABLES: dict[int, tuple[Sequence[Cell], _CellTable]] = {}
+
+
+def _table(cells: Sequence[Cell]) -> _CellTable:
+    """The :class:`_CellTable` of ``cells``: cells sharing a damping key share the residuals :func:`cell_inputs`
+    forms for it, cells sharing a mass key their mass residual, and :func:`_screen_tops` reads the stacked tops. Kept
+    for tuples of more than one cell (a channel's, met in every round; :func:`cell_bound`'s one-cell tuples are
+    new each time)."""
+    entry = _TABLES.get(id(cells))
+    if entry is not None and entry[0] is cells:
+        return entry[1]
+    damping: dict[tuple, int] = {}
+    mass: dict[tuple, int] = {}
+    table = _CellTable([], [], [], np.array([cell.gain_tops for cell in cells]),
+                       np.array([cell.mu_top for cell in cells], dtype=float))
+    for cell in cells:
+        key, mass_key = (cell.pieces[1:], cell.slope), (cell.pieces[0], cell.mu_centre)
+        if key not in damping:
+            damping[key] = len(table.damping_cells)
+            table.damping_cells.append(cell)
+        if mass_key not in mass:
+            mass[mass_key] = len(table.mass_cells)
+            table.mass_cells.append(cell)
+        table.index.append((damping[key], mass[mass_key]))
+    if len(cells) > 1:
+        if len(_TABLES) >= 64:
+            del _TABLES[next(iter(_TABLES))]
+        _TABLES[id(cells)] = (cells, table)
+    return table

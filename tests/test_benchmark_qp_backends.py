@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import os
+
 import pytest
 
 import verify
@@ -19,8 +21,13 @@ if compiler() is None:
 
 @pytest.fixture(scope="module", autouse=True)
 def cache(tmp_path_factory):
+    """A generated-solver cache of this run's own: shared by the suite's workers (the run's base directory, which
+    each worker's lies in), so a pattern one worker compiled the other loads (the cache takes concurrent builders);
+    never a previous run's."""
+    base = tmp_path_factory.getbasetemp()
+    root = (base.parent if os.environ.get("PYTEST_XDIST_WORKER") else base) / "qocogen-shared"
     with pytest.MonkeyPatch.context() as mp:
-        mp.setenv("TUBEKIT_QOCOGEN_CACHE", str(tmp_path_factory.mktemp("qocogen")))
+        mp.setenv("TUBEKIT_QOCOGEN_CACHE", str(root))
         yield
 
 

@@ -9,7 +9,6 @@ from pathlib import Path
 import numpy as np
 import pytest
 from hypothesis import given, settings
-from flint import arb
 from hypothesis import strategies as st
 
 import verify
@@ -21,7 +20,8 @@ from verify.kernel.intervals import upper
 from verify.theorem.completion_bounds import completion_arc
 from verify.theorem.terminal import (FINE_LOWER_ENDS, FINE_WIDTHS, LOWER_ENDS, WIDTHS, _grid, _grid_points, law_conditions,
                                      terminal_bounds)
-from verify.theorem.terminal_bearing import BEARING_STEP, bearing_row_sets, bearing_sets, smallest_bearing
+from verify.theorem.terminal_bearing import (BEARING_STEP, bearing_row_sets, bearing_sets, lateral_chord,
+                                             smallest_bearing)
 from verify.theorem.terminal_rows import row_changes, row_sets
 
 TRACKED = load_scenario(Path(__file__).resolve().parents[1] / "examples" / "keep_moving_tracked.toml")
@@ -156,8 +156,7 @@ def _first_admitted_by_a_scan(b, law) -> float | None:
     if arc is None:
         return None
     dev = math.asin(min(1.0, b.dev_xy / law.d_lo))
-    chord = upper(arb(b.dt) * (arb(b.speed_xy) + arb(law.gain_d) * arc.spread) * arc.beta.tan())
-    loss = chord + b.accel_xy * b.dt ** 2 / 2
+    loss = upper(lateral_chord(b, law, arc)) + b.accel_xy * b.dt ** 2 / 2
     eta = b.accel_xy * b.dt / b.speed_floor_xy
     for i in range(1, int(math.pi / 2 / BEARING_STEP)):
         phi = i * BEARING_STEP

@@ -135,6 +135,30 @@ def test_bad_arguments_are_refused(kwargs, match):
         design_backup(**{**PAPER, **kwargs})
 
 
+def test_past_the_first_fitting_level_a_level_where_no_shape_has_a_negative_rate_is_not_bounded():
+    """In 0.2 m/s of current with a yaw-rate error of 0.1 rad/s no shape of the slowest surge (0.25 m/s, the widest
+    yaw band) has a negative rate at any level from 2 m on (computed below), and ``fits`` < 1 from 2 m on: its scan
+    past the first fitting level skips every level, so ``fits`` (the velocity loop's bound, the costly step) is
+    asked only by the bisection, at most ceil(log2 48) + 1 = 7 times, where it was asked at each of the 41 levels
+    as well."""
+    from verify.backup.search import MIN_SHAPE, _Search, _best_shape
+    wxy, yaw_error = 0.2, 0.1
+    asked: dict[tuple[float, float], list[float]] = {}
+
+    def fits(law, safe: SafeSet) -> float:
+        if safe.shape == MIN_SHAPE:
+            asked.setdefault((law.surge, law.yaw_band), []).append(safe.level)
+        return 0.5 if safe.level >= 2.0 else 2.0
+
+    cert = design_backup(**{**PAPER, "omega_xy": wxy}, smooth=True, fits=fits, yaw_rate_error=yaw_error)
+    assert cert.certified and cert.safe_set.level == 2.0
+    search = _Search(wxy, 0.1, LIMITS, TICK, HAND, 1024, yaw_error, True, 0.2, fits)  # the gentle grid
+    levels = [float(x) for x in search._levels()]
+    law = search._law(0.625 * LIMITS[0], LIMITS[2], 0.5)
+    assert all(_best_shape(law, x, wxy, HAND[0], yaw_error) is None for x in levels if x >= 2.0)
+    assert 0 < len(asked[(law.surge, law.yaw_band)]) <= math.ceil(math.log2(len(levels))) + 1
+
+
 @settings(max_examples=60, deadline=None, derandomize=True)
 @given(n=st.integers(1, 60), first=st.integers(0, 60))
 def test_the_first_fitting_level_is_found_by_bisection(n, first):

@@ -15,10 +15,12 @@ Every smoothing length (fades, ramp, heave band) shrinks as β grows, so the com
 β of the grid: a level where even that does not fit is *hopeless* and skipped before its shape is searched. The
 levels grow gentler as they grow (longer fades and ramp), so the hopeless levels of a law are taken to be a
 prefix of the grid and the first level that is not is found by bisection (:meth:`_Search.first_fitting`: about
-six evaluations of ``fits`` per law instead of one per level). That is a property of the search, not of the
-proof: measured on the shipped dynamic scenario that reaches the search (70 series of levels, not one ratio
-rising with the level; ``tests/test_verify_vehicle_compose.py``), and where it failed the search would only
-return a larger safe set, proved like any other. When none fits it returns the candidate with the smallest
+six evaluations of ``fits`` per law instead of one per level). Past that level the scan evaluates ``fits`` only
+where some shape has a negative rate (:meth:`_Search._defer`): elsewhere the level is skipped whatever the ratio,
+and by the same prefix property it is not hopeless, so :meth:`_Search.fallback` has no use for it. The prefix is
+a property of the search, not of the proof: measured on the shipped dynamic scenario that reaches the search
+(70 series of levels, not one ratio rising with the level; ``tests/test_verify_vehicle_compose.py``), and where
+it failed the search would only return a larger safe set, proved like any other. When none fits it returns the candidate with the smallest
 ratio, proved (certified or not), so the caller can say by how much.
 
 The smooth designs' yaw bands are :data:`SMOOTH_BAND_FRACTIONS` of the unstable angle χ_u (the widest band
@@ -117,7 +119,9 @@ class _Search:
     fits: Fits | None
     last: BackupCertificate | None = None
     closest: tuple[float, StationKeeping, SafeSet] | None = None
-    ratios: dict[tuple[StationKeeping, float], float] = dataclasses.field(default_factory=dict)
+    #: Each (law, level) asked, in asking order: its ratio at β = MIN_SHAPE, or None while it is deferred
+    #: (:meth:`_defer`: asked where no shape could follow, bounded only if :meth:`fallback` reads it).
+    ratios: dict[tuple[StationKeeping, float], float | None] = dataclasses.field(default_factory=dict)
 
     def _levels(self) -> np.ndarray:
         if self.fits is not None:
@@ -155,10 +159,18 @@ class _Search:
         does not fit at ``level``; then no β does, and the level is only remembered for :meth:`fallback`."""
         if self.fits is None:
             return False
-        if (law, level) not in self.ratios:
+        ratio = self.ratios.get((law, level))
+        if ratio is None:  # not asked yet, or deferred
             trial, safe = self._candidate(law, level, MIN_SHAPE)
-            self.ratios[(law, level)] = float(self.fits(trial, safe))
-        return self.ratios[(law, level)] >= 1.0
+            ratio = self.ratios[(law, level)] = float(self.fits(trial, safe))
+        return ratio >= 1.0
+
+    def _defer(self, law: StationKeeping, level: float) -> None:
+        """Record that the scan reached ``level`` where no shape has a negative rate: the level is skipped whether
+        or not it is hopeless, so it is not bounded. It lies past the law's first fitting level, so under the
+        prefix property (module doc) it is not hopeless, and :meth:`fallback` passes it over."""
+        if self.fits is not None:
+            self.ratios.setdefault((law, level), None)
 
     def first_fitting(self, law: StationKeeping, levels: np.ndarray) -> int | None:
         """Index of the first of ``levels`` (ascending, m) that is not hopeless for ``law``, by bisection on the
@@ -193,10 +205,11 @@ class _Search:
             if start is None:
                 continue
             for level in levels[start:]:
-                if self._hopeless(law, float(level)):
-                    continue
                 shape = _best_shape(law, float(level), self.wxy, self.handover[0], self.e_r)
-                if shape is None:
+                if shape is None:  # skipped either way: the loop bound only if fallback asks for it
+                    self._defer(law, float(level))
+                    continue
+                if self._hopeless(law, float(level)):
                     continue
                 trial, safe = self._candidate(law, float(level), shape)
                 if not self._fits(trial, safe):
@@ -213,7 +226,7 @@ class _Search:
         level 6 m."""
         family: dict[StationKeeping, tuple[float, float]] = {}
         for (law, level), ratio in self.ratios.items():  # each law's gentlest hopeless level (in asking order)
-            if ratio < 1.0:
+            if ratio is None or ratio < 1.0:  # deferred: past the law's first fitting level, so not hopeless
                 continue
             if law not in family or ratio < family[law][0]:
                 family[law] = (ratio, level)

@@ -20,8 +20,8 @@ where some shape has a negative rate (:meth:`_Search._defer`): elsewhere the lev
 and by the same prefix property it is not hopeless, so :meth:`_Search.fallback` has no use for it. The prefix is
 a property of the search, not of the proof: measured on the shipped dynamic scenario that reaches the search
 (70 series of levels, not one ratio rising with the level; ``tests/test_verify_vehicle_compose.py``), and where
-it failed the search would only return a larger safe set, proved like any other. When none fits it returns the candidate with the smallest
-ratio, proved (certified or not), so the caller can say by how much.
+it failed the search would only return a larger safe set, proved like any other. When none fits it returns the
+candidate with the smallest ratio, proved (certified or not), so the caller can say by how much.
 
 The smooth designs' yaw bands are :data:`SMOOTH_BAND_FRACTIONS` of the unstable angle χ_u (the widest band
 χ_u/2 is the gentlest yaw command: the command's rate grows like k (k + E_r)/χ_0), then :data:`NARROW_YAW_BAND`.

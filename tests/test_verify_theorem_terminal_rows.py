@@ -200,6 +200,22 @@ def test_the_gentle_gains_are_the_smallest_that_keep_the_set_invariant(certs):
     assert law.turn < 0.2 and law.gain_d < 0.2      # gentle: under a fifth of alpha turned a period
 
 
+def test_the_smallest_gains_read_the_set_and_not_the_laws_own_gains_or_faces(certs):
+    """The memo of ``_smallest_gains`` is keyed on the bounds and X_f's set only: computed afresh, the sizing gives
+    the same gains whatever the law's own turn, gains and row faces are, and other gains for a narrower heading
+    room (a field of the key)."""
+    from verify.theorem.terminal_rows import _sized_gains, _smallest_gains
+    cert = certs["line"]
+    b = terminal_bounds(SMOOTH, cert.design, cert.region)
+    law = cert.design.terminal
+    fresh = _sized_gains(b, law)
+    assert fresh is not None and _smallest_gains(b, law) == fresh
+    for change in ({"turn": 1.0}, {"gain_d": 0.5, "gain_z": 0.5}, {"row_u": 9.0, "row_w": 9.0, "row_r": 9.0}):
+        assert _sized_gains(b, dataclasses.replace(law, **change)) == fresh, change
+    narrower = dataclasses.replace(law, alpha_max=0.8 * law.alpha_max)
+    assert _smallest_gains(b, narrower) == _sized_gains(b, narrower) != fresh
+
+
 def test_the_row_changes_grow_with_the_deviation(certs):
     """The deviation-side bounds K(deviation) are increasing in D_xy and D_psi (the sum is what terminal_rate
     reads): doubling the replay's deviation raises every channel's bound that reads it."""

@@ -39,7 +39,8 @@ by at most δ |Δω̂| (T_max / 12 + sin β / 2) more.
 By induction with step 17, every candidate is rate-limited, ends in X_f with its faces, and a plan exists at every
 period. The law's gains are chosen as small as X_f's invariance allows (:func:`gentle_law`): the row's change
 grows with them. Each face is as wide as the jump leaves, S = J − K(deviation) less a thousandth of J, never
-narrower than K(arc): the plans meet a wide face more easily, and the completion still lands within J. Every inequality is in Arb with the slack :data:`verify.theorem.completion_bounds.FLOAT_SLACK`.
+narrower than K(arc): the plans meet a wide face more easily, and the completion still lands within J. Every
+inequality is in Arb with the slack :data:`verify.theorem.completion_bounds.FLOAT_SLACK`.
 """
 
 from __future__ import annotations
@@ -48,7 +49,7 @@ import copy
 import dataclasses
 import math
 
-from flint import arb
+from flint import arb, ctx
 
 from tubekit.model.terminal_law import TerminalLaw
 
@@ -152,11 +153,35 @@ def row_conditions(b: TerminalBounds, law: TerminalLaw, arc: CompletionArc,
     return out
 
 
+#: :func:`_smallest_gains` by its key (:func:`_gains_key`), at most :data:`_GAINS_KEEP` kept: the bearing face's
+#: sets of one grid point share it whenever their faces agree (a third of the calls certifying the torpedo AUV).
+_GAINS: dict[tuple, tuple[float, float, float] | None] = {}
+_GAINS_KEEP = 8192
+
+
+def _gains_key(b: TerminalBounds, law: TerminalLaw) -> tuple:
+    """What :func:`_smallest_gains` reads: the bounds, X_f's set (d_lo, d_hi, d*, α_max, z_max and the bearing
+    face), the feedforward flag and the working precision; not the law's own gains or row faces, which the sizing
+    rounds replace (:func:`_sized`) and :func:`verify.theorem.completion_bounds.completion_arc` does not read."""
+    return (b, law.d_lo, law.d_hi, law.d_star, law.alpha_max, law.z_max, law.bearing_max, law.los_feedforward,
+            ctx.prec)
+
+
 def _smallest_gains(b: TerminalBounds, law: TerminalLaw) -> tuple[float, float, float] | None:
     """(g, λ, λ_z): the smallest turn and gains (floats) under which X_f of ``law`` is invariant (step 17's
     ``terminal_invariant[d_lo|d_hi|alpha|e_z]``), found by a few fixed-point rounds on the completion's own bounds
     (:func:`verify.theorem.completion_bounds.completion_arc`: Y depends on g and λ); None when the set cannot be
-    invariant. A sizing: the Arb conditions decide."""
+    invariant. A sizing: the Arb conditions decide. Memoised on :func:`_gains_key`."""
+    key = _gains_key(b, law)
+    if key not in _GAINS:
+        if len(_GAINS) >= _GAINS_KEEP:
+            del _GAINS[next(iter(_GAINS))]
+        _GAINS[key] = _sized_gains(b, law)
+    return _GAINS[key]
+
+
+def _sized_gains(b: TerminalBounds, law: TerminalLaw) -> tuple[float, float, float] | None:
+    """:func:`_smallest_gains` without the memo."""
     dt, dxy, curve = b.dt, b.dev_xy, b.accel_xy * b.dt * b.dt / 2
     below = law.d_star - law.d_lo + dxy
     g, lam = 0.01, 0.0

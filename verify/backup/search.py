@@ -119,8 +119,8 @@ class _Search:
     fits: Fits | None
     last: BackupCertificate | None = None
     closest: tuple[float, StationKeeping, SafeSet] | None = None
-    #: Each (law, level) asked, in asking order: its ratio at β = MIN_SHAPE, or None while it is deferred
-    #: (:meth:`_defer`: asked where no shape could follow, bounded only if :meth:`fallback` reads it).
+    #: Each (law, level) asked, in asking order: its ratio at β = MIN_SHAPE, or None for a level the scan passed
+    #: without bounding it (:meth:`_defer`: no shape has a negative rate there; :meth:`fallback` passes it over).
     ratios: dict[tuple[StationKeeping, float], float | None] = dataclasses.field(default_factory=dict)
 
     def _levels(self) -> np.ndarray:

@@ -161,8 +161,9 @@ _GAINS_KEEP = 8192
 
 def _gains_key(b: TerminalBounds, law: TerminalLaw) -> tuple:
     """What :func:`_smallest_gains` reads: the bounds, X_f's set (d_lo, d_hi, d*, α_max, z_max and the bearing
-    face), the feedforward flag and the working precision; not the law's own gains or row faces, which the sizing
-    rounds replace (:func:`_sized`) and :func:`verify.theorem.completion_bounds.completion_arc` does not read."""
+    face), the feedforward flag and the working precision; not the law's own turn and radial gain (each sizing round
+    replaces them, :func:`_sized`), nor its depth gain or row faces (neither the sizing nor
+    :func:`verify.theorem.completion_bounds.completion_arc` reads them)."""
     return (b, law.d_lo, law.d_hi, law.d_star, law.alpha_max, law.z_max, law.bearing_max, law.los_feedforward,
             ctx.prec)
 

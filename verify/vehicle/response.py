@@ -20,6 +20,7 @@ k < Q, of exp(A [0, h]); the terms i < K summed; the tail i >= K bounded by the 
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass
 from typing import Sequence
@@ -112,16 +113,8 @@ def _tick_maxima(stacked: arb_mat, x: arb_mat, pieces: int) -> list[arb]:
     ``stacked`` is :func:`_stacked` of the Q row blocks (entry for entry the same products as one block at a time)."""
     prods = (stacked * x).entries()
     block = len(prods) // pieces
-    if pieces == 4:  # the default: the same unions, in the same order, without the inner loop
-        return [abs(a.union(b).union(c).union(d)) for a, b, c, d in
-                zip(prods[:block], prods[block:2 * block], prods[2 * block:3 * block], prods[3 * block:])]
-    out = []
-    for idx in range(block):
-        hull = prods[idx]
-        for k in range(1, pieces):
-            hull = hull.union(prods[k * block + idx])
-        out.append(abs(hull))
-    return out
+    return [abs(functools.reduce(arb.union, parts))  # piece 0 ∪ piece 1 ∪ ..., left to right
+            for parts in zip(*(prods[k * block:(k + 1) * block] for k in range(pieces)))]
 
 
 def impulse_sums(a: Sequence[Sequence[arb | float]], inputs: Sequence[Sequence[arb | float]],

@@ -206,7 +206,7 @@ class _Search:
                 continue
             for level in levels[start:]:
                 shape = _best_shape(law, float(level), self.wxy, self.handover[0], self.e_r)
-                if shape is None:  # skipped either way: the loop bound only if fallback asks for it
+                if shape is None:  # skipped whatever its ratio: not bounded (fallback passes it over)
                     self._defer(law, float(level))
                     continue
                 if self._hopeless(law, float(level)):

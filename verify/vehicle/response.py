@@ -79,13 +79,8 @@ class ResponseSums:
 def _norm_inf(m: arb_mat) -> arb:
     """‖m‖_∞ (largest absolute row sum) as an upper-bound ball (each row summed left to right from 0)."""
     entries, cols = m.entries(), m.ncols()
-    out = None
-    for start in range(0, len(entries), cols):
-        row = arb(0)
-        for x in entries[start:start + cols]:
-            row = row + abs(x)
-        out = row if out is None else out.max(row)
-    return out
+    rows = [sum(map(abs, entries[start:start + cols]), arb(0)) for start in range(0, len(entries), cols)]
+    return functools.reduce(arb.max, rows)
 
 
 def _col_norm(m: arb_mat, j: int) -> arb:

@@ -196,14 +196,39 @@ def test_the_feedforwards_laws_are_searched_only_where_they_could_lower_what_fai
     import verify.theorem.terminal as terminal
 
     built = []
-    sets = terminal._sets
+    sets = terminal._grid_sets
 
     def spy(b, fine=False, feedforward=False):
         built.append(feedforward)
         return sets(b, fine, feedforward)
-    monkeypatch.setattr(terminal, "_sets", spy)
+    monkeypatch.setattr(terminal, "_grid_sets", spy)
     cert = verify.certify(PC.with_changes(**{"limits.rate": rate}))
     assert not cert.tiers.tracking and any(built) is searched
     if not searched:
         assert "terminal_rate[w]" in {c.condition for c in cert.failures}
         assert "terminal_rate[w]" in terminal.FEEDFORWARD_CANNOT_LOWER
+
+
+def test_the_search_builds_the_grids_sets_only_as_far_as_it_reads_them(monkeypatch):
+    """``examples/keep_moving_survey.toml`` (a surge floor and rate-limited plans: each set of the grid needs its
+    gentle gains, row faces and bearing face): the first set of the grid is built with a small share of the row-face
+    sizings the whole grid needs, and reading the grid on from there gives the sets that building the whole grid at
+    once gives, in the same order."""
+    import verify.theorem.terminal as terminal
+    import verify.theorem.terminal_rows as rows
+    from verify.theorem.terminal_bearing import bearing_row_sets
+    sc = load_scenario(Path(__file__).resolve().parents[1] / "examples" / "keep_moving_survey.toml")
+    cert = verify.certify(sc)
+    b = terminal_bounds(sc, cert.design, cert.region)
+    assert b.surge_floor is not None and b.jumps is not None
+    sized: list[object] = []
+    with_gains = rows._with_gains
+    monkeypatch.setattr(rows, "_with_gains", lambda *args: sized.append(args[1]) or with_gains(*args))
+    terminal._built_sets.cache_clear()
+    first = next(iter(terminal._grid_sets(b)))
+    to_first = len(sized)
+    whole = terminal._sets(b)
+    assert whole[0] == first and len(whole) > 100
+    assert 0 < 20 * to_first < len(sized)
+    grid = terminal._grid(b, terminal._grid_points(terminal.WIDTHS, terminal.LOWER_ENDS), tuple(terminal.ANGLES))
+    assert list(whole) == bearing_row_sets(b, grid)

@@ -6,6 +6,8 @@ import math
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 from scipy.integrate import quad
 from scipy.linalg import expm
 
@@ -98,3 +100,40 @@ def test_the_weighted_sums_weigh_each_ticks_response_by_the_jumps_its_age_holds(
     phase0 = sum(x * ((i + 1) // n + 1) for i, x in enumerate(g) if i % n == 0)
     assert phase0 <= s.moment_period[1][0][0] <= s.moment_tick[1][0][0]
     assert (s.tick, s.period, s.peak) == (plain.tick, plain.period, plain.peak)
+
+
+@settings(derandomize=True, max_examples=200, deadline=None)
+@given(mid=st.floats(1e-12, 4.0), rad_share=st.sampled_from([0.0, 1e-30, 1e-12, 1e-3, 0.005, 0.0101, 0.5]),
+       tol=st.sampled_from([1e-8, 1e-4, 0.3]))
+def test_the_stopping_rule_read_from_floats_decides_as_the_exact_bounds_do(mid, rad_share, tol):
+    """Property: ``_done`` with the ball's float top decides as the exact rule ‖A_d^i‖ < tol, or < 1/2 with the
+    radius above 1 % of it, decides on the exact upper bounds, near both thresholds too."""
+    from flint import arb
+    from verify.kernel.intervals import upper
+    from verify.vehicle.response import _done, _float_top
+    for norm in (arb(mid, mid * rad_share), arb(tol, tol * rad_share), arb(0.5, 0.5 * rad_share)):
+        exact = upper(norm) < tol or (upper(norm) < 0.5 and upper(norm.rad()) > 0.01 * upper(norm))
+        assert _done(norm, _float_top(norm), tol) is exact
+
+
+
+def test_the_peaks_are_the_exact_running_maxima_of_every_ticks_response():
+    """The peak of each output and input is the largest exact upper bound of g(i) over the ticks summed (a lightly
+    damped loop whose response rises, then rings down), though most ticks pass an entry over on its norm bound."""
+    from flint import arb, arb_mat, ctx
+    from verify.kernel.intervals import upper
+    from verify.vehicle import response
+    a = [[0.0, 1.0, 0.0], [-40.0, -1.5, 1.0], [0.0, 0.0, -8.0]]
+    inputs, outputs = [[0.0, 1.0, 0.0], [0.0, 0.0, 1.0]], [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [2.0, -1.0, 0.5]]
+    sums = response.impulse_sums(a, inputs, outputs, tick=0.01, ticks_per_period=10)
+    with ctx.workprec(response.RESPONSE_PREC):
+        A, h = arb_mat(a), arb(0.01)
+        B, C = arb_mat([list(col) for col in zip(*inputs)]), arb_mat(outputs)
+        stacked = response._stacked(response._intra_tick_rows(A, C, h, response.INTRA_TICK_PIECES))
+        ad, power, best = (A * h).exp(), arb_mat(3, 3, [arb(int(r == c)) for r in range(3) for c in range(3)]), [0.0] * 6
+        for _ in range(sums.terms):
+            g = response._tick_maxima(stacked, power * B, response.INTRA_TICK_PIECES)
+            best = [max(p, upper(x)) for p, x in zip(best, g)]
+            power = power * ad
+    assert [list(row) for row in sums.peak] == [best[o * 2:(o + 1) * 2] for o in range(3)]
+    assert sums.terms > 300 and best[0] > 0.01

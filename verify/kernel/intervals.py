@@ -73,8 +73,8 @@ def upper(x: arb) -> float:
     """A float >= every point of ``x`` (``inf`` if ``x`` is not finite)."""
     if not x.is_finite():
         return math.inf
-    u = x.upper()
-    f = float(u.mid())
+    u = x.upper()  # an exact ball: its float is its midpoint's
+    f = float(u)
     while not (arb(f) >= u):
         f = math.nextafter(f, math.inf)
     return f
@@ -96,7 +96,7 @@ def lower(x: arb) -> float:
     if not x.is_finite():
         return -math.inf
     lo = x.lower()
-    f = float(lo.mid())
+    f = float(lo)
     while not (arb(f) <= lo):
         f = math.nextafter(f, -math.inf)
     return f

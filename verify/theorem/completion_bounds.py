@@ -19,11 +19,12 @@ __all__ = ["TerminalBounds", "CompletionArc", "completion_arc", "feedforward_res
 
 #: Every inequality of the completion holds with this slack (m or rad), so the run's float check agrees.
 FLOAT_SLACK = 1e-9
+_SLACK = arb(FLOAT_SLACK)  # the float's exact ball
 
 
 def slack_condition(name: str, text: str, lhs: arb, rhs: arb, detail: str = "") -> Condition:
     """The condition lhs + :data:`FLOAT_SLACK` <= rhs, in Arb (lhs's upper end, rhs's lower end reported)."""
-    ok = bool((lhs + arb(FLOAT_SLACK)) <= rhs) and lhs.is_finite() and rhs.is_finite()
+    ok = bool((lhs + _SLACK) <= rhs) and lhs.is_finite() and rhs.is_finite()
     return Condition(name, text, upper(lhs) if lhs.is_finite() else math.inf,
                      lower(rhs) if rhs.is_finite() else math.inf, ok, detail)
 

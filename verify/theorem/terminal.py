@@ -48,7 +48,7 @@ import itertools
 import math
 from typing import Callable, Iterator
 
-from flint import arb
+from flint import arb, ctx
 
 from tubekit.design_inputs import ARC_SAMPLES
 from tubekit.model.backup import SafeSet
@@ -63,8 +63,8 @@ from verify.theorem.path_clearance import (PathFootprint, contains, horizon_end,
                                           path_workspace)
 from verify.theorem.completion_bounds import FLOAT_SLACK, CompletionArc, TerminalBounds, completion_arc
 from verify.theorem.completion_bounds import slack_condition as _cond  # lhs + FLOAT_SLACK <= rhs, in Arb
-from verify.theorem.terminal_bearing import bearing_conditions, bearing_row_sets, bearing_sets
-from verify.theorem.terminal_rows import row_conditions, row_sets
+from verify.theorem.terminal_bearing import bearing_conditions, iter_bearing_row_sets, iter_bearing_sets
+from verify.theorem.terminal_rows import iter_row_sets, row_conditions
 
 __all__ = ["TerminalBounds", "terminal_bounds", "law_conditions", "footprint_of", "sensing_condition",
            "design_terminal", "with_terminal", "proves_feasibility", "FLOAT_SLACK", "TERMINAL_PREFIXES",
@@ -215,6 +215,11 @@ def sensing_condition(scenario: Scenario, b: TerminalBounds, safe: SafeSet) -> C
 
 
 def _sets(b: TerminalBounds, fine: bool = False, feedforward: bool = False) -> tuple[TerminalLaw, ...]:
+    """:func:`_grid_sets`, every set built (the search itself takes them as it goes)."""
+    return tuple(_grid_sets(b, fine, feedforward))
+
+
+def _grid_sets(b: TerminalBounds, fine: bool = False, feedforward: bool = False) -> _BuiltSets:
     """The grid of terminal sets and their gains, largest first (module doc); under a surge floor each with its
     bearing face (:func:`verify.theorem.terminal_bearing.bearing_sets`). ``fine``: the refinement's sets that the
     coarse grid does not have (:data:`FINE_LOWER_ENDS`, :data:`FINE_WIDTHS`); ``feedforward``: the laws with the
@@ -228,16 +233,46 @@ def _sets(b: TerminalBounds, fine: bool = False, feedforward: bool = False) -> t
     return _built_sets(b, points, tuple(ANGLES), feedforward)
 
 
+class _BuiltSets:
+    """A grid's sets, each built when a search first reaches it and kept: a search that stops at the first set
+    meeting its conditions builds none past it (the gentle gains and faces of a set are most of the work), and a
+    later search over the same grid replays the built ones, then builds on at the working precision they began at.
+    The same sets in the same order as building them all at once."""
+
+    def __init__(self, source: Iterator[TerminalLaw]) -> None:
+        self._source: Iterator[TerminalLaw] | None = source
+        self._built: list[TerminalLaw] = []
+        self._prec = ctx.prec
+
+    def __iter__(self) -> Iterator[TerminalLaw]:
+        i = 0
+        while i < len(self._built) or self._more():
+            yield self._built[i]
+            i += 1
+
+    def _more(self) -> bool:
+        """Build the next set; False when the grid is spent."""
+        if self._source is None:
+            return False
+        with ctx.workprec(self._prec):
+            law = next(self._source, None)
+        if law is None:
+            self._source = None
+            return False
+        self._built.append(law)
+        return True
+
+
 @functools.lru_cache(maxsize=64)
 def _built_sets(b: TerminalBounds, points: tuple[tuple[float, float], ...], angles: tuple[float, ...],
-                feedforward: bool) -> tuple[TerminalLaw, ...]:
-    """:func:`_sets` for the grid ``points`` and heading fractions ``angles``."""
+                feedforward: bool) -> _BuiltSets:
+    """:func:`_grid_sets` for the grid ``points`` and heading fractions ``angles``."""
     laws = _grid(b, list(points), angles)
     if feedforward:
         laws = [dataclasses.replace(law, los_feedforward=True) for law in laws]
     if b.jumps is not None:
-        return tuple(bearing_row_sets(b, laws) if b.surge_floor is not None else row_sets(b, laws))
-    return tuple(bearing_sets(b, laws) if b.surge_floor is not None else laws)
+        return _BuiltSets(iter_bearing_row_sets(b, laws) if b.surge_floor is not None else iter_row_sets(b, laws))
+    return _BuiltSets(iter_bearing_sets(b, laws) if b.surge_floor is not None else iter(laws))
 
 
 def _refined(b: TerminalBounds, wanted: Callable[[], bool]) -> Iterator[TerminalLaw]:
@@ -246,10 +281,10 @@ def _refined(b: TerminalBounds, wanted: Callable[[], bool]) -> Iterator[Terminal
     once the memoryless sets are spent, the same grid's laws with the line-of-sight feedforward, coarse and fine
     (step 17e: the yaw row follows the line of sight's turn instead of catching it up); none without rate limits."""
     if b.jumps is not None:
-        yield from _sets(b, fine=True)
+        yield from _grid_sets(b, fine=True)
         if wanted():
-            yield from _sets(b, feedforward=True)
-            yield from _sets(b, fine=True, feedforward=True)
+            yield from _grid_sets(b, feedforward=True)
+            yield from _grid_sets(b, fine=True, feedforward=True)
 
 
 def _started(b: TerminalBounds, distance: float, wanted: Callable[[], bool]) -> Iterator[TerminalLaw]:
@@ -386,7 +421,7 @@ def design_terminal(scenario: Scenario, design: Design, region: Region, safe: Sa
         return all(c.ok for c in design.conditions) and not any(
             not c.ok and c.condition in FEEDFORWARD_CANNOT_LOWER for c in best)
 
-    for law in itertools.chain(_sets(b), _refined(b, fed), _started(b, start_distance(scenario), fed)):
+    for law in itertools.chain(_grid_sets(b), _refined(b, fed), _started(b, start_distance(scenario), fed)):
         own = law_conditions(b, law)
         if not all(c.ok for c in own):
             miss = _shortfall(own)

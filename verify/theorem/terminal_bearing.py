@@ -33,7 +33,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
-from typing import Iterable
+from typing import Iterable, Iterator
 
 from flint import arb
 
@@ -43,10 +43,10 @@ from verify.kernel.intervals import upper
 from verify.theorem.completion_bounds import (CompletionArc, TerminalBounds, completion_arc, slack_condition,
                                              start_bearing)
 from verify.theorem.design import Condition
-from verify.theorem.terminal_rows import GAIN_FACTORS, gentle_law, row_sets
+from verify.theorem.terminal_rows import GAIN_FACTORS, gentle_law, iter_row_sets
 
-__all__ = ["bearing_conditions", "bearing_sets", "bearing_row_sets", "GENTLE_FACTOR", "smallest_bearing", "lateral_chord",
-           "ALPHA_FRACTIONS", "GAIN_FRACTIONS", "BEARING_STEP"]
+__all__ = ["bearing_conditions", "bearing_sets", "bearing_row_sets", "iter_bearing_sets", "iter_bearing_row_sets",
+           "GENTLE_FACTOR", "smallest_bearing", "lateral_chord", "ALPHA_FRACTIONS", "GAIN_FRACTIONS", "BEARING_STEP"]
 
 #: Fractions of each grid set's heading room α_f tried under a surge floor (largest first).
 ALPHA_FRACTIONS = (1.0, 0.3, 0.1, 0.05)
@@ -106,7 +106,11 @@ def bearing_sets(b: TerminalBounds, laws: Iterable[TerminalLaw]) -> list[Termina
     """Each set of ``laws`` with narrower heading rooms and smaller radial gains (:data:`ALPHA_FRACTIONS`,
     :data:`GAIN_FRACTIONS`; the turn fraction g recomputed from r̄̄) and its smallest bearing face; sets without
     one are dropped."""
-    out = []
+    return list(iter_bearing_sets(b, laws))
+
+
+def iter_bearing_sets(b: TerminalBounds, laws: Iterable[TerminalLaw]) -> Iterator[TerminalLaw]:
+    """:func:`bearing_sets`, each set built when it is asked for."""
     rb, dt = b.v_bar[2], b.dt
     for law in laws:
         for fa in ALPHA_FRACTIONS:
@@ -117,8 +121,7 @@ def bearing_sets(b: TerminalBounds, laws: Iterable[TerminalLaw]) -> list[Termina
                 cand = dataclasses.replace(law, alpha_max=alpha, turn=turn, gain_d=law.gain_d * fg)
                 phi = smallest_bearing(b, cand)
                 if phi is not None:
-                    out.append(dataclasses.replace(cand, bearing_max=phi))
-    return out
+                    yield dataclasses.replace(cand, bearing_max=phi)
 
 
 def bearing_row_sets(b: TerminalBounds, laws: Iterable[TerminalLaw]) -> list[TerminalLaw]:
@@ -127,17 +130,22 @@ def bearing_row_sets(b: TerminalBounds, laws: Iterable[TerminalLaw]) -> list[Ter
     smallest gains, which :func:`bearing_sets`' fractions of the grid's gains would break) and its smallest bearing
     face; then the gains re-derived with the lateral bound the face narrows (step 17b) and the face again, first
     when it is no wider. Sets without a face are dropped."""
-    out = []
+    return list(iter_bearing_row_sets(b, laws))
+
+
+def iter_bearing_row_sets(b: TerminalBounds, laws: Iterable[TerminalLaw]) -> Iterator[TerminalLaw]:
+    """:func:`bearing_row_sets`, each set built when it is asked for."""
     for law in laws:
         for fa in ALPHA_FRACTIONS:
-            for gentle in row_sets(b, [dataclasses.replace(law, alpha_max=law.alpha_max * fa)]):
+            for gentle in iter_row_sets(b, [dataclasses.replace(law, alpha_max=law.alpha_max * fa)]):
                 phi = smallest_bearing(b, gentle)
                 if phi is None:
                     continue
                 first = dataclasses.replace(gentle, bearing_max=phi)
                 again = _regained(b, first)
-                out.extend([again, first] if again is not None else [first])
-    return out
+                if again is not None:
+                    yield again
+                yield first
 
 
 def _regained(b: TerminalBounds, law: TerminalLaw) -> TerminalLaw | None:

@@ -48,6 +48,7 @@ from __future__ import annotations
 import copy
 import dataclasses
 import math
+from typing import Iterable, Iterator
 
 from flint import arb, ctx
 
@@ -59,7 +60,7 @@ from verify.theorem.completion_bounds import CompletionArc, TerminalBounds, comp
 from verify.theorem.completion_bounds import slack_condition as _cond
 
 __all__ = ["RowChanges", "row_changes", "feedforward_change", "row_conditions", "gentle_law", "row_sets",
-           "GAIN_FACTORS"]
+           "iter_row_sets", "GAIN_FACTORS"]
 
 #: The smallest invariant gains are tried times these factors (the Arb conditions need a little room).
 GAIN_FACTORS = (1.02, 1.1, 1.3)
@@ -207,11 +208,16 @@ def _sized_gains(b: TerminalBounds, law: TerminalLaw) -> tuple[float, float, flo
 
 
 def _sized(law: TerminalLaw, turn: float, gain_d: float) -> TerminalLaw:
-    """``law`` with the trial ``turn`` and ``gain_d`` of a sizing round, not validated again (the rounds build
-    thousands; every law the search returns is built by :func:`dataclasses.replace`, which validates it)."""
+    """``law`` with the trial ``turn`` and ``gain_d`` of a sizing round (:func:`_unchecked`)."""
+    return _unchecked(law, turn=turn, gain_d=gain_d)
+
+
+def _unchecked(law: TerminalLaw, **fields: float) -> TerminalLaw:
+    """``law`` with ``fields`` replaced, not validated again: a trial law the search builds by the thousand and
+    never returns (every law it returns is built by :func:`dataclasses.replace`, which validates it)."""
     trial = copy.copy(law)
-    object.__setattr__(trial, "turn", turn)
-    object.__setattr__(trial, "gain_d", gain_d)
+    for name, value in fields.items():
+        object.__setattr__(trial, name, value)
     return trial
 
 
@@ -229,7 +235,7 @@ def _with_gains(b: TerminalBounds, law: TerminalLaw, gains: tuple[float, float, 
     g, lam, lam_z = (factor * x for x in gains)
     if not (g <= 1.0 and lam * b.dt <= 1.0 and lam_z * b.dt <= 1.0):
         return None
-    trial = dataclasses.replace(law, turn=g, gain_d=lam, gain_z=lam_z, row_u=1.0, row_w=1.0, row_r=1.0)
+    trial = _unchecked(law, turn=g, gain_d=lam, gain_z=lam_z, row_u=1.0, row_w=1.0, row_r=1.0)
     arc = completion_arc(b, trial)
     if arc is None:
         return None
@@ -251,13 +257,16 @@ def _face(k_arc: arb, k_dev: arb, jump: float) -> float:
     return max(tight, lower(arb(jump) * (1 - arb(FACE_ROOM)) - k_dev))
 
 
-def row_sets(b: TerminalBounds, laws: list[TerminalLaw]) -> list[TerminalLaw]:
+def row_sets(b: TerminalBounds, laws: Iterable[TerminalLaw]) -> list[TerminalLaw]:
     """Each set of the grid ``laws`` with gentle gains (:data:`GAIN_FACTORS`) and its row faces, in order."""
-    out = []
+    return list(iter_row_sets(b, laws))
+
+
+def iter_row_sets(b: TerminalBounds, laws: Iterable[TerminalLaw]) -> Iterator[TerminalLaw]:
+    """:func:`row_sets`, each set built when it is asked for."""
     for law in laws:
         gains = _smallest_gains(b, law)  # once per set: the factors scale it
         for factor in GAIN_FACTORS:
             gentle = _with_gains(b, law, gains, factor)
             if gentle is not None:
-                out.append(gentle)
-    return out
+                yield gentle

@@ -108,8 +108,10 @@ def _tick_maxima(stacked: arb_mat, x: arb_mat, pieces: int) -> list[arb]:
     ``stacked`` is :func:`_stacked` of the Q row blocks (entry for entry the same products as one block at a time)."""
     prods = (stacked * x).entries()
     block = len(prods) // pieces
-    return [abs(functools.reduce(arb.union, parts))  # piece 0 ∪ piece 1 ∪ ..., left to right
-            for parts in zip(*(prods[k * block:(k + 1) * block] for k in range(pieces)))]
+    hull = prods[:block]
+    for k in range(1, pieces):  # piece 0 ∪ piece 1 ∪ ..., left to right
+        hull = map(arb.union, hull, prods[k * block:(k + 1) * block])
+    return list(map(abs, hull))
 
 
 def impulse_sums(a: Sequence[Sequence[arb | float]], inputs: Sequence[Sequence[arb | float]],
@@ -180,19 +182,23 @@ def _sums(A: arb_mat, B: arb_mat, C: arb_mat, h: arb, ticks_per_period: int, tol
     total_m = arb_mat(n_out, n_in)
     phase_m = [arb_mat(n_out, n_in) for _ in range(ticks_per_period)]
     peak_flat = [0.0] * (n_out * n_in)
+    row_norm = [max(upper(_norm_inf(_row(r, o))) for r in rows) for o in range(n_out)]
+    scales = [upper(arb(row_norm[o]) * _col_norm(B, j)) for o in range(n_out) for j in range(n_in)]
     power, norm_sum, i = arb_mat(n, n, [arb(int(r == c)) for r in range(n) for c in range(n)]), arb(0), 0
     norm = _norm_inf(power)
-    while i < max_terms and not (i >= ticks_per_period and _done(norm, tol)):
+    top = _float_top(norm)
+    while i < max_terms and not (i >= ticks_per_period and _done(norm, top, tol)):
         g = _tick_maxima(stacked, power * B, INTRA_TICK_PIECES)
         g_m = arb_mat(n_out, n_in, g)
         total_m = total_m + g_m
         phase_m[i % ticks_per_period] = phase_m[i % ticks_per_period] + g_m
         if weighted is not None:
             weighted.add(i, g_m)
-        peak_flat = [raise_upper(p, x) for p, x in zip(peak_flat, g)]
+        peak_flat = _raise_peaks(peak_flat, g, scales, top)
         norm_sum += norm
         power = power * ad
         norm = _norm_inf(power)
+        top = _float_top(norm)
         i += 1
     total = [[total_m[o, j] for j in range(n_in)] for o in range(n_out)]
     phase = [[[m[o, j] for j in range(n_in)] for o in range(n_out)] for m in phase_m]
@@ -203,7 +209,6 @@ def _sums(A: arb_mat, B: arb_mat, C: arb_mat, h: arb, ticks_per_period: int, tol
         infs = (inf, inf) if moments else ()
         return ResponseSums(tick=inf, period=inf, peak=inf, rho=rho, terms=i, moment_tick=infs, moment_period=infs)
     xk = power * B
-    row_norm = [max(upper(_norm_inf(_row(r, o))) for r in rows) for o in range(n_out)]
     tails = [[arb(row_norm[o]) * norm_sum * _col_norm(xk, j) / (1 - arb(rho)) for j in range(n_in)]
              for o in range(n_out)]
     tick_sums = tuple(tuple(upper(total[o][j] + tails[o][j]) for j in range(n_in)) for o in range(n_out))
@@ -254,10 +259,37 @@ def gain_balls(sums: ResponseSums, tick: float) -> tuple[tuple[arb, ...], ...]:
                  for o in range(len(sums.tick)))
 
 
-def _done(norm: arb, tol: float) -> bool:
-    """Stop summing: ‖A_d^i‖_∞ < tol, or < 1/2 with the ball's radius above 1 % of it (precision spent)."""
-    top = upper(norm)
-    return top < tol or (top < 0.5 and upper(norm.rad()) > 0.01 * top)
+#: A relative margin far above the rounding of a float's mid + rad against the ball's exact upper bound (a few ulps):
+#: a test decided on the floats with it decides as the exact one would.
+_NEAR = 1e-9
+
+
+def _float_top(norm: arb) -> float:
+    """mid + rad of ``norm`` in floats: within a few ulps of :func:`upper` of it (nan or inf where it is not finite)."""
+    return float(norm.mid()) + float(norm.rad())
+
+
+def _done(norm: arb, top: float, tol: float) -> bool:
+    """Stop summing: ‖A_d^i‖_∞ < tol, or < 1/2 with the ball's radius above 1 % of it (precision spent).
+
+    ``top`` is :func:`_float_top` of ``norm``: where it stands clear of both thresholds (by :data:`_NEAR`) the answer
+    is no without the exact upper bound; near either one the exact bounds decide."""
+    if top > tol * (1 + _NEAR) and (top > 0.5 * (1 + _NEAR) or float(norm.rad()) < 0.01 * top * (1 - _NEAR)):
+        return False
+    exact = upper(norm)
+    return exact < tol or (exact < 0.5 and upper(norm.rad()) > 0.01 * exact)
+
+
+def _raise_peaks(peaks: list[float], g: list[arb], scales: list[float], top: float) -> list[float]:
+    """The running maxima ``peaks`` raised by this tick's maxima ``g`` (flat ``[output][input]``).
+
+    g[o, j] = max_k |c_k,o A_d^i b_j| <= ‖c_k,o‖_1 ‖A_d^i‖_∞ ‖b_j‖_∞ = ``scales[o, j]`` ``top`` (the rows' largest
+    norm over the pieces times the column's, times ‖A_d^i‖_∞ as :func:`_float_top`), and Arb's ball of g stays
+    within its rounding (a relative 2^-30 at worst, the radii's) of that. An entry whose bound is below half its
+    peak cannot raise it and is passed over without the exact upper bound; the others are
+    :func:`verify.kernel.intervals.raise_upper`: the same maxima, a float comparison a tick once the response has
+    decayed."""
+    return [p if s * top < 0.5 * p else raise_upper(p, x) for p, x, s in zip(peaks, g, scales)]
 
 
 def _row(m: arb_mat, o: int) -> arb_mat:

@@ -110,10 +110,11 @@ def test_the_stopping_rule_read_from_floats_decides_as_the_exact_bounds_do(mid, 
     radius above 1 % of it, decides on the exact upper bounds, near both thresholds too."""
     from flint import arb
     from verify.kernel.intervals import upper
-    from verify.vehicle.response import _done, _float_top
+    from verify.kernel.intervals import float_top
+    from verify.vehicle.response import _done
     for norm in (arb(mid, mid * rad_share), arb(tol, tol * rad_share), arb(0.5, 0.5 * rad_share)):
         exact = upper(norm) < tol or (upper(norm) < 0.5 and upper(norm.rad()) > 0.01 * upper(norm))
-        assert _done(norm, _float_top(norm), tol) is exact
+        assert _done(norm, float_top(norm), tol) is exact
 
 
 
@@ -130,7 +131,8 @@ def test_the_peaks_are_the_exact_running_maxima_of_every_ticks_response():
         A, h = arb_mat(a), arb(0.01)
         B, C = arb_mat([list(col) for col in zip(*inputs)]), arb_mat(outputs)
         stacked = response._stacked(response._intra_tick_rows(A, C, h, response.INTRA_TICK_PIECES))
-        ad, power, best = (A * h).exp(), arb_mat(3, 3, [arb(int(r == c)) for r in range(3) for c in range(3)]), [0.0] * 6
+        ad, best = (A * h).exp(), [0.0] * 6
+        power = arb_mat(3, 3, [arb(int(r == c)) for r in range(3) for c in range(3)])
         for _ in range(sums.terms):
             g = response._tick_maxima(stacked, power * B, response.INTRA_TICK_PIECES)
             best = [max(p, upper(x)) for p, x in zip(best, g)]

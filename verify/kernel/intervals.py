@@ -34,6 +34,7 @@ if TYPE_CHECKING:  # sympy is imported on first compilation: the precompiled obj
 __all__ = [
     "bisect_sup",
     "raise_upper",
+    "float_top",
     "enclose",
     "point",
     "upper",
@@ -80,12 +81,17 @@ def upper(x: arb) -> float:
     return f
 
 
+def float_top(x: arb) -> float:
+    """mid + rad of ``x`` in floats: within a few ulps of :func:`upper` of it (nan or inf where it is not finite)."""
+    return float(x.mid()) + float(x.rad())
+
+
 def raise_upper(best: float, x: arb) -> float:
     """max(``best``, :func:`upper` of ``x``) for a ball ``x`` >= 0 (an absolute value, a norm): the exact upper bound
     is taken only where the ball's float top, mid + rad, comes within a relative 1e-12 of ``best`` or is not finite;
     below that its upper bound, at most a few ulps above mid + rad, cannot reach ``best``. A running maximum over
     many balls then costs about one float conversion a ball."""
-    top = float(x.mid()) + float(x.rad())
+    top = float_top(x)
     if top < best * (1.0 - 1e-12):
         return best
     return max(best, upper(x))

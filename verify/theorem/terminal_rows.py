@@ -163,7 +163,7 @@ _GAINS_KEEP = 8192
 def _gains_key(b: TerminalBounds, law: TerminalLaw) -> tuple:
     """What :func:`_smallest_gains` reads: the bounds, X_f's set (d_lo, d_hi, d*, α_max, z_max and the bearing
     face), the feedforward flag and the working precision; not the law's own turn and radial gain (each sizing round
-    replaces them, :func:`_sized`), nor its depth gain or row faces (neither the sizing nor
+    replaces them, :func:`_sized_gains`), nor its depth gain or row faces (neither the sizing nor
     :func:`verify.theorem.completion_bounds.completion_arc` reads them)."""
     return (b, law.d_lo, law.d_hi, law.d_star, law.alpha_max, law.z_max, law.bearing_max, law.los_feedforward,
             ctx.prec)
@@ -189,7 +189,7 @@ def _sized_gains(b: TerminalBounds, law: TerminalLaw) -> tuple[float, float, flo
     g, lam = 0.01, 0.0
     for _ in range(12):
         before = (g, lam)
-        arc = completion_arc(b, _sized(law, g, lam))
+        arc = completion_arc(b, _unchecked(law, turn=g, gain_d=lam))
         if arc is None or not arc.x_min > 0:
             return None
         a0, lateral, x_min, x_max = (float(x.mid()) for x in (arc.a0, arc.lateral, arc.x_min, arc.x_max))
@@ -205,11 +205,6 @@ def _sized_gains(b: TerminalBounds, law: TerminalLaw) -> tuple[float, float, flo
             break  # settled: the rounds left would move the gains by less than the float slack matters
     lam_z = (b.dev_z + b.accel_z * dt * dt / 2 + GAIN_SLACK) / (dt * (law.z_max + b.dev_z))
     return g, lam, lam_z
-
-
-def _sized(law: TerminalLaw, turn: float, gain_d: float) -> TerminalLaw:
-    """``law`` with the trial ``turn`` and ``gain_d`` of a sizing round (:func:`_unchecked`)."""
-    return _unchecked(law, turn=turn, gain_d=gain_d)
 
 
 def _unchecked(law: TerminalLaw, **fields: float) -> TerminalLaw:

@@ -27,7 +27,7 @@ from typing import Sequence
 
 from flint import arb, arb_mat, ctx
 
-from verify.kernel.intervals import raise_upper, upper
+from verify.kernel.intervals import float_top, raise_upper, upper
 
 __all__ = ["ResponseSums", "impulse_sums", "gain_balls", "RESPONSE_PREC", "INTRA_TICK_PIECES", "MEMO_SIZE"]
 
@@ -186,7 +186,7 @@ def _sums(A: arb_mat, B: arb_mat, C: arb_mat, h: arb, ticks_per_period: int, tol
     scales = [upper(arb(row_norm[o]) * _col_norm(B, j)) for o in range(n_out) for j in range(n_in)]
     power, norm_sum, i = arb_mat(n, n, [arb(int(r == c)) for r in range(n) for c in range(n)]), arb(0), 0
     norm = _norm_inf(power)
-    top = _float_top(norm)
+    top = float_top(norm)
     while i < max_terms and not (i >= ticks_per_period and _done(norm, top, tol)):
         g = _tick_maxima(stacked, power * B, INTRA_TICK_PIECES)
         g_m = arb_mat(n_out, n_in, g)
@@ -198,7 +198,7 @@ def _sums(A: arb_mat, B: arb_mat, C: arb_mat, h: arb, ticks_per_period: int, tol
         norm_sum += norm
         power = power * ad
         norm = _norm_inf(power)
-        top = _float_top(norm)
+        top = float_top(norm)
         i += 1
     total = [[total_m[o, j] for j in range(n_in)] for o in range(n_out)]
     phase = [[[m[o, j] for j in range(n_in)] for o in range(n_out)] for m in phase_m]
@@ -264,16 +264,11 @@ def gain_balls(sums: ResponseSums, tick: float) -> tuple[tuple[arb, ...], ...]:
 _NEAR = 1e-9
 
 
-def _float_top(norm: arb) -> float:
-    """mid + rad of ``norm`` in floats: within a few ulps of :func:`upper` of it (nan or inf where it is not finite)."""
-    return float(norm.mid()) + float(norm.rad())
-
-
 def _done(norm: arb, top: float, tol: float) -> bool:
     """Stop summing: ‖A_d^i‖_∞ < tol, or < 1/2 with the ball's radius above 1 % of it (precision spent).
 
-    ``top`` is :func:`_float_top` of ``norm``: where it stands clear of both thresholds (by :data:`_NEAR`) the answer
-    is no without the exact upper bound; near either one the exact bounds decide."""
+    ``top`` is :func:`verify.kernel.intervals.float_top` of ``norm``: where it stands clear of both thresholds (by
+    :data:`_NEAR`) the answer is no without the exact upper bound; near either one the exact bounds decide."""
     if top > tol * (1 + _NEAR) and (top > 0.5 * (1 + _NEAR) or float(norm.rad()) < 0.01 * top * (1 - _NEAR)):
         return False
     exact = upper(norm)
@@ -284,9 +279,9 @@ def _raise_peaks(peaks: list[float], g: list[arb], scales: list[float], top: flo
     """The running maxima ``peaks`` raised by this tick's maxima ``g`` (flat ``[output][input]``).
 
     g[o, j] = max_k |c_k,o A_d^i b_j| <= ‖c_k,o‖_1 ‖A_d^i‖_∞ ‖b_j‖_∞ = ``scales[o, j]`` ``top`` (the rows' largest
-    norm over the pieces times the column's, times ‖A_d^i‖_∞ as :func:`_float_top`), and Arb's ball of g stays
-    within its rounding (a relative 2^-30 at worst, the radii's) of that. An entry whose bound is below half its
-    peak cannot raise it and is passed over without the exact upper bound; the others are
+    norm over the pieces times the column's, times ‖A_d^i‖_∞ as :func:`verify.kernel.intervals.float_top`), and
+    Arb's ball of g stays within its rounding (a relative 2^-30 at worst, the radii's) of that. An entry whose bound
+    is below half its peak cannot raise it and is passed over without the exact upper bound; the others are
     :func:`verify.kernel.intervals.raise_upper`: the same maxima, a float comparison a tick once the response has
     decayed."""
     return [p if s * top < 0.5 * p else raise_upper(p, x) for p, x, s in zip(peaks, g, scales)]

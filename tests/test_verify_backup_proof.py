@@ -7,11 +7,13 @@ import math
 
 import numpy as np
 import pytest
+from hypothesis import given, settings, strategies as st
 
 from tubekit.exceptions import ConfigError
 from tubekit.model.backup import StationKeeping, axis_angle, line_of_sight_angle
 from tubekit.model.backup import SafeSet
 from verify.backup import certify_backup, design_backup, planar_rate_bound
+from verify.backup.proof import held_rate_sampled
 
 LIMITS = (0.4, 0.3, 0.5)  # the paper's V
 TICK = 0.01  # 100 Hz ancillary rate
@@ -240,3 +242,38 @@ def test_the_sampled_rate_of_many_shapes_at_once_is_each_shapes_own_to_the_bit()
         together = rates_sampled(LAW, 1.5, shapes, omega, yaw_err=0.01)
         assert together.tolist() == [alone(float(b), omega, 0.01) for b in shapes]
         assert rate_sampled(LAW, SafeSet(level=1.5, shape=0.5, depth=1.0), omega, yaw_err=0.01) == together[9]
+
+
+@st.composite
+def _station_keeping(draw, yaw_law: str):
+    """A station-keeping law with the yaw law ``yaw_law`` and a safe set around it with room for a tick."""
+    continuous = yaw_law == "continuous"
+    law = StationKeeping(surge=draw(st.floats(0.15, 0.5)), yaw_rate=draw(st.floats(0.1, 1.0)),
+                         yaw_band=draw(st.floats(0.02, 0.3)), heave=0.3, heave_band=0.01, yaw_law=yaw_law,
+                         unstable=draw(st.floats(0.3, 1.2)) if continuous else 0.0)
+    shape = draw(st.floats(0.05, 1.0))
+    return law, SafeSet(level=shape + draw(st.floats(0.05, 2.0)), shape=shape, depth=0.1)
+
+
+@pytest.mark.parametrize("yaw_law", ["ridge", "continuous"])
+@settings(max_examples=25, deadline=None, derandomize=True)
+@given(data=st.data(), omega_xy=st.floats(0.0, 0.3), yaw_err=st.floats(0.0, 0.2))
+def test_the_bisections_bound_is_at_least_every_sampled_held_rate(yaw_law, data, omega_xy, yaw_err):
+    """Property: the Arb bisection's bound of V̇ on V = c is at least every sampled held rate (the values the search
+    reads to refute a candidate before its proof), for both yaw laws, with or without a yaw-rate error; so a
+    positive sample means ``backup_level_set`` fails."""
+    law, safe = data.draw(_station_keeping(yaw_law))
+    sampled = held_rate_sampled(law, safe, omega_xy, TICK, yaw_err=yaw_err)
+    bound, _ = planar_rate_bound(law, safe, omega_xy, TICK, 1024, yaw_err)
+    assert bound >= sampled - 1e-12
+    if sampled > 0.0:
+        cert = certify_backup(law, safe, omega_xy=omega_xy, omega_z=0.1, limits=LIMITS, tick=TICK,
+                              max_boxes=1024, yaw_rate_error=yaw_err)
+        assert not cert.certified and "backup_level_set" in [c.condition for c in cert.failures]
+
+
+def test_the_held_rate_is_the_no_hold_rate_when_the_tick_does_not_move_the_angle():
+    """With the input held for no angle (Δ = 0 when the tick is tiny) the held rate is the sampled rate of the same
+    instant: the two samplers agree on the ridge law to a float's rounding at the tick's Δ."""
+    from verify.backup.proof import rate_sampled
+    assert held_rate_sampled(LAW, SAFE, 0.12, 1e-9) == pytest.approx(rate_sampled(LAW, SAFE, 0.12), abs=1e-7)

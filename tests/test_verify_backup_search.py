@@ -179,3 +179,26 @@ def test_the_first_fitting_level_is_found_by_bisection(n, first):
     assert got == (first if first < n else None)
     assert len(asked) <= math.ceil(math.log2(n)) + 1
     assert set(asked) <= set(float(x) for x in levels)  # levels of the grid only
+
+
+@pytest.mark.parametrize("omega_xy, smooth", [(0.3, False), (0.39, True)])
+def test_passing_over_the_candidates_refuted_by_their_samples_changes_no_design(omega_xy, smooth, monkeypatch):
+    """The search passes over a candidate whose sampled held rate is positive (its proof would refute it after its
+    whole bisection budget) and proves the last one it passed over if it is the one returned. On a current where it
+    passes over dozens and certifies (0.3 m/s) and on one where nothing certifies and the fallback returns the
+    last refuted candidate (0.39 m/s, the smooth design), the result is the search's that proves every candidate,
+    to the last number."""
+    from verify.backup.search import _Search
+    kwargs = dict(PAPER, omega_xy=omega_xy, smooth=smooth, max_boxes=128)
+    passed_over = []
+    refuted = _Search._refuted
+
+    def counted(self, law, safe):
+        passed_over.append(refuted(self, law, safe))
+        return passed_over[-1]
+
+    monkeypatch.setattr(_Search, "_refuted", counted)
+    fast = design_backup(**kwargs)
+    monkeypatch.setattr(_Search, "_refuted", lambda self, law, safe: False)
+    assert sum(passed_over) >= 50 and fast.certified is (omega_xy < 0.35)
+    assert fast.to_dict() == design_backup(**kwargs).to_dict()

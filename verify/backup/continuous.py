@@ -35,8 +35,8 @@ from verify.theorem.design import Condition
 from verify.kernel.intervals import bisect_sup, enclose, lower, upper
 
 __all__ = ["continuous_rate_bound", "continuous_rate_sampled", "continuous_rate_sampled_shapes",
-           "continuous_best_shape", "COARSE_STRIDE", "unstable_condition", "cone_angle", "shape_enclosure",
-           "yaw_shape_enclosure"]
+           "continuous_held_rate_sampled", "continuous_best_shape", "COARSE_STRIDE", "unstable_condition",
+           "cone_angle", "shape_enclosure", "yaw_shape_enclosure"]
 
 _PI_UP = math.nextafter(math.pi, math.inf)
 
@@ -228,3 +228,27 @@ def continuous_rate_sampled(law: StationKeeping, safe: SafeSet, omega_xy: float,
                             yaw_err: float = 0.0) -> float:
     """:func:`continuous_rate_sampled_shapes` (m/s) for the shape of ``safe``."""
     return float(continuous_rate_sampled_shapes(law, safe.level, np.array([safe.shape]), omega_xy, n, yaw_err)[0])
+
+
+def continuous_held_rate_sampled(law: StationKeeping, safe: SafeSet, omega_xy: float, delta: float, n: int = 1441,
+                                 yaw_err: float = 0.0) -> float:
+    """The largest V̇ (m/s) at sampled x ∈ [0, π] (where d > 0) with the input held from x' = x − Δ or x + Δ and the
+    worst ω: −u_b cos x' cos x + ω̄_xy √(1 + (g/d)²) + g (−k ρ(x') + u_b cos x' sin x / d) + |g| E_r.
+
+    Each is a value of the expression :func:`_rate_upper` encloses on every interval [a, b] holding x (its held
+    angles [a − Δ, b + Δ] hold x', ρ π-periodic), so the bisection's bound is at least each of them: a positive
+    one means :func:`continuous_rate_bound` cannot be negative (the search's refutation, before the bisection)."""
+    x = np.linspace(0.0, math.pi, n)
+    a, slope, _ = _profiles(law, x)
+    d = safe.level - safe.shape * a
+    g = safe.shape * slope
+    inside = d > 0.0
+    x, d, g = x[inside], d[inside], g[inside]
+    base = omega_xy * np.sqrt(1.0 + (g / d) ** 2) + np.abs(g) * yaw_err
+    best = -math.inf
+    for held in (x - delta, x + delta):
+        _, _, rho = _profiles(law, np.mod(held, math.pi))
+        surge = law.surge * np.cos(held)
+        rate = base - surge * np.cos(x) + g * (-law.yaw_rate * rho + surge * np.sin(x) / d)
+        best = max(best, float(rate.max(initial=-math.inf)))
+    return best

@@ -56,12 +56,13 @@ from tubekit.model.loiter import Loiter
 from tubekit.validation import nonnegative, positive
 from verify.theorem.design import Condition
 from verify.kernel.intervals import bisect_sup, enclose, lower, upper
-from verify.backup.continuous import continuous_rate_bound, continuous_rate_sampled, unstable_condition
+from verify.backup.continuous import (continuous_held_rate_sampled, continuous_rate_bound, continuous_rate_sampled,
+                                      unstable_condition)
 from verify.backup.protocol import BackupCertificate
 from verify.backup.rate import backup_command_rate, backup_tick_change
 
 __all__ = ["BackupCertificate", "planar_rate_bound", "certify_backup", "ramp_window", "tick_distance", "rate_sampled",
-           "rates_sampled", "ridge_rate", "hold_conditions", "angle_step", "checked_bounds",
+           "rates_sampled", "held_rate_sampled", "ridge_rate", "hold_conditions", "angle_step", "checked_bounds",
            "backup_command_rate", "backup_tick_change", "BACKUP_MAX_BOXES"]
 
 #: Bisection budget of :func:`planar_rate_bound` (intervals of χ examined): a work unit, not seconds.
@@ -102,6 +103,33 @@ def rate_sampled(law: StationKeeping, safe: SafeSet, omega_xy: float, n: int = 7
     if law.yaw_law == "continuous":
         return continuous_rate_sampled(law, safe, omega_xy, 2 * n - 1, yaw_err)
     return float(rates_sampled(law, safe.level, np.array([float(safe.shape)]), omega_xy, n, yaw_err)[0])
+
+
+def held_rate_sampled(law: StationKeeping, safe: SafeSet, omega_xy: float, tick: float, n: int = 721,
+                      yaw_err: float = 0.0) -> float:
+    """The largest V̇ (m/s) at sampled χ (where d > 0) with the input held from χ' at either end of the tick's drift
+    Δ (:func:`angle_step`) and the worst ω; ``inf`` when c − β − h (u_b + ω̄_xy) <= 0 (no Δ: the bisection's own
+    verdict). Each is a value the bisection's bound of every interval holding χ encloses (:func:`_rate_upper`: χ'
+    within its held angles, the yaw term at its lowest held angle), so a positive one means
+    :func:`planar_rate_bound` is not negative: the search refutes ``backup_level_set`` without the bisection."""
+    d_tick = tick_distance(law, safe, omega_xy, tick)
+    if not d_tick > 0.0:
+        return math.inf
+    delta = angle_step(law, omega_xy, tick, d_tick, yaw_err)
+    if law.yaw_law == "continuous":
+        return continuous_held_rate_sampled(law, safe, omega_xy, delta, 2 * n - 1, yaw_err)
+    chi = np.linspace(0.0, math.pi / 2, n)
+    gp = safe.shape * np.sin(chi)
+    d = safe.level - safe.shape * (1 - np.cos(chi))
+    inside = d > 0.0
+    chi, gp, d = chi[inside], gp[inside], d[inside]
+    turn = -law.yaw_rate * np.clip((chi - delta) / law.yaw_band, -1.0, 1.0)
+    base = omega_xy * np.sqrt(1 + (gp / d) ** 2) + gp * (turn + yaw_err)
+    best = -math.inf
+    for held in (np.maximum(chi - delta, -math.pi / 2), np.minimum(chi + delta, math.pi / 2)):
+        surge = law.surge * np.cos(held)
+        best = max(best, float((base - surge * np.cos(chi) + gp * surge * np.sin(chi) / d).max(initial=-math.inf)))
+    return best
 
 
 def rates_sampled(law: StationKeeping, level: float, shapes: np.ndarray, omega_xy: float, n: int = 721,

@@ -38,12 +38,13 @@ from flint import arb
 from tubekit.model.backup import SafeSet, StationKeeping
 from tubekit.validation import nonnegative, positive
 from verify.backup.continuous import cone_angle, continuous_best_shape
-from verify.backup.proof import BACKUP_MAX_BOXES, certify_backup, ramp_window, rates_sampled, tick_distance
+from verify.backup.proof import (BACKUP_MAX_BOXES, certify_backup, held_rate_sampled, ramp_window, rates_sampled,
+                                 tick_distance)
 from verify.backup.protocol import BackupCertificate, Fits
 from verify.kernel.intervals import lower, upper
 
 __all__ = ["design_backup", "UNSTABLE_FRACTION", "SMOOTH_BAND_FRACTIONS", "NARROW_YAW_BAND", "SMOOTH_SEARCH_BOXES",
-           "GENTLE_LEVEL_STEP", "GENTLE_MAX_LEVEL", "Fits"]
+           "GENTLE_LEVEL_STEP", "GENTLE_MAX_LEVEL", "REFUTE_MARGIN", "Fits"]
 
 #: The smooth design's unstable axis angle χ_u as a fraction of the cone angle χ_c = acos √(ω̄_xy/u_b).
 UNSTABLE_FRACTION = 0.8
@@ -56,6 +57,10 @@ SMOOTH_SEARCH_BOXES = 1024
 #: Level step (m) and largest level (m) of a gentle search (``fits`` given).
 GENTLE_LEVEL_STEP = 0.25
 GENTLE_MAX_LEVEL = 12.0
+
+#: A sampled held rate above this (m/s) refutes a candidate before its proof (:meth:`_Search._refuted`): far above
+#: the floats' rounding of rates of order 1 m/s, so the proof, in Arb, would refute it too.
+REFUTE_MARGIN = 1e-9
 
 #: The smallest shape β (m) of the grid: the gentlest command at a level (the longest fades and ramp).
 MIN_SHAPE = 0.05
@@ -118,6 +123,8 @@ class _Search:
     min_level: float
     fits: Fits | None
     last: BackupCertificate | None = None
+    #: The last candidate refuted by :meth:`_refuted` (not proved) when it came after :attr:`last`, else None.
+    last_refuted: tuple[StationKeeping, SafeSet] | None = None
     closest: tuple[float, StationKeeping, SafeSet] | None = None
     #: Each (law, level) asked, in asking order: its ratio at β = MIN_SHAPE, or None for a level the scan passed
     #: without bounding it (:meth:`_defer`: no shape has a negative rate there; :meth:`fallback` passes it over).
@@ -212,13 +219,22 @@ class _Search:
                 if self._hopeless(law, float(level)):
                     continue
                 trial, safe = self._candidate(law, float(level), shape)
-                if not self._fits(trial, safe):
+                if not self._fits(trial, safe) or self._refuted(trial, safe):
                     continue
-                self.last = self._certify(trial, safe)
+                self.last, self.last_refuted = self._certify(trial, safe), None
                 if self.last.certified:
                     best = self.last
                     break
         return best
+
+    def _refuted(self, law: StationKeeping, safe: SafeSet) -> bool:
+        """True when a sampled held rate is positive (:func:`verify.backup.proof.held_rate_sampled`, by more than
+        :data:`REFUTE_MARGIN`): the proof would refute ``backup_level_set`` after spending its whole bisection
+        budget. The candidate is then the last refuted one; :meth:`fallback` proves it if it is returned."""
+        if not held_rate_sampled(law, safe, self.wxy, self.h, yaw_err=self.e_r) > REFUTE_MARGIN:
+            return False
+        self.last, self.last_refuted = None, (law, safe)
+        return True
 
     def fallback(self) -> BackupCertificate:
         """Nothing certified (and fitting): the closest candidate proved (each law's hopeless level with the smallest
@@ -243,6 +259,8 @@ class _Search:
             self.closest = gentlest  # every best shape broke the loop: the fixed point needs a finite E to go on
         if self.closest is not None:
             return self._certify(self.closest[1], self.closest[2])
+        if self.last_refuted is not None:
+            return self._certify(*self.last_refuted)
         if self.last is not None:
             return self.last
         _, depth = self._depth()

@@ -1,7 +1,10 @@
 """The backup's design: a deterministic grid search whose every candidate is proved by :func:`certify_backup`.
 
 :func:`design_backup` searches surge fractions u_b of ū (above ω̄_xy), safe-set levels c and shapes β; the float
-rate of :func:`verify.backup.proof.rate_sampled` filters, :func:`verify.backup.certify_backup` proves. Without
+rate of :func:`verify.backup.proof.rate_sampled` filters, :func:`verify.backup.certify_backup` proves. A candidate
+whose sampled held rate is positive (:func:`verify.backup.proof.held_rate_sampled`: values every interval bound of
+the proof's bisection encloses) is refuted without the bisection, and proved only if :meth:`_Search.fallback`
+returns it: the same designs, without spending a whole bisection budget on each refuted candidate. Without
 ``fits`` it returns the certified design with the smallest safe radius.
 
 **Gentle designs** (``smooth=True``, issue 22). On the dynamic plant the backup's command is followed by a

@@ -28,7 +28,7 @@ import math
 import sys
 from dataclasses import dataclass
 
-__all__ = ["SteadyTurn", "steady_turn", "corner_turns", "STEADY_FIELDS", "main"]
+__all__ = ["SteadyTurn", "steady_turn", "steady_fields", "corner_turns", "STEADY_FIELDS", "main"]
 
 #: The box's coefficients that enter the steady sway and yaw rows (the mass entries m11, m22, m24 and the damping),
 #: and the rudder.
@@ -87,10 +87,15 @@ def steady_turn(params, u: float, rudder: float = 1.0) -> SteadyTurn | None:
     return None
 
 
+def steady_fields(box) -> list[str]:
+    """The fields of :data:`STEADY_FIELDS` that are intervals of ``box`` (the corners' axes)."""
+    return [n for n in STEADY_FIELDS if n in box.free_fields]
+
+
 def corner_turns(box, u: float, rudder: float = 1.0) -> list[tuple[dict[str, float], SteadyTurn | None]]:
     """Each corner of ``box`` (a :class:`tubekit.model.vehicle_params.VehicleParams`) over its intervals among
     :data:`STEADY_FIELDS`, with its steady turn at ``u`` (m/s); the other coefficients at their midpoints."""
-    names = [n for n in STEADY_FIELDS if n in box.free_fields]
+    names = steady_fields(box)
     out = []
     for ends in itertools.product((0, 1), repeat=len(names)):
         corner = {n: box.interval(n)[e] for n, e in zip(names, ends)}
@@ -118,7 +123,7 @@ def main(argv: list[str] | None = None) -> int:
     if box.actuation != "fins":
         ap.error(f"--vehicle: expected a vehicle with fins, got {args.vehicle!r} ({box.actuation})")
     print(f"{args.vehicle}: steady turn with the rudder at {args.rudder:g} of {box.fin_max:g} rad, "
-          f"{2 ** len([n for n in STEADY_FIELDS if n in box.free_fields])} corners")
+          f"{2 ** len(steady_fields(box))} corners")
     print("| u (m/s) | slowest corner r (rad/s) | its radius (m) | midpoint r | fastest corner r |")
     print("|---|---|---|---|---|")
     for u in args.speed:

@@ -19,8 +19,7 @@ TURN = load_script("benchmarks/steady_turn.py", "steady_turn_benchmark")
 @st.composite
 def remus_points(draw):
     """A point hull of the bundled REMUS 100 box: each steady field drawn inside its interval."""
-    point = {name: draw(st.floats(*REMUS100.interval(name))) for name in TURN.STEADY_FIELDS
-             if name in REMUS100.free_fields}
+    point = {name: draw(st.floats(*REMUS100.interval(name))) for name in TURN.steady_fields(REMUS100)}
     return REMUS100.with_point(point)
 
 

@@ -37,10 +37,17 @@ def scenario():
 
 
 @pytest.mark.slow
-def test_the_generated_solver_answers_the_recorded_subproblems_as_clarabel_does(scenario):
-    """Every subproblem of 1 s of the certified run (its periods' solves), solved by each backend: no failure, the
-    plan's inputs within 1e-3 of Clarabel's and the objective within 1e-5 relative (QOCO's defaults, 1e-7, against
-    the real-time Clarabel's 1e-6)."""
+def test_the_generated_solver_built_once_answers_as_clarabel_does_at_each_tolerance_and_in_the_certified_run(scenario):
+    """One test, so the suite's workers never both build the paper's pattern (a build takes a core for about 20 s;
+    a second builder would wait on the key's lock):
+
+    * every subproblem of 1 s of the certified run (its periods' solves), solved by each backend: no failure, the
+      plan's inputs within 1e-3 of Clarabel's and the objective within 1e-5 relative (QOCO's defaults, 1e-7, against
+      the real-time Clarabel's 1e-6);
+    * the tolerance study on the same problems at the default and two looser tolerances: the default is its own
+      reference (no difference), every setting solves every problem, and the loosest needs no more iterations than
+      the default;
+    * the certified run of 2 s on the generated solver keeps its promises, its tracking as Clarabel's."""
     problems, inputs = STUDY.record(scenario, 1.0)
     assert len(problems) >= 10 and inputs.size == 3 * 8
     rows = STUDY.compare(problems, inputs, ("clarabel", "qocogen"))
@@ -49,19 +56,6 @@ def test_the_generated_solver_answers_the_recorded_subproblems_as_clarabel_does(
     assert (gen["failed"], gen["inaccurate"]) == (0, 0)
     assert gen["max_input_diff"] < 1e-3 and gen["max_objective_gap"] < 1e-5
 
-
-@pytest.mark.slow
-def test_the_certified_run_on_the_generated_solver_keeps_its_promises(scenario):
-    rows = STUDY.closed_loop(scenario, 2.0, ("clarabel", "qocogen"))
-    assert rows["qocogen"]["broken"] == [] == rows["clarabel"]["broken"]
-    assert rows["qocogen"]["tracking_rmse"] == pytest.approx(rows["clarabel"]["tracking_rmse"], abs=1e-3)
-    assert rows["qocogen"]["backup_s"] == 0.0
-
-
-def test_the_tolerance_study_compares_each_setting_with_the_default_on_the_same_problems(scenario):
-    """1 s of recorded subproblems at the default and two looser tolerances: the default is its own reference (no
-    difference), every setting solves every problem, and the loosest needs no more iterations than the default."""
-    problems, inputs = STUDY.record(scenario, 1.0)
     rows = STUDY.qocogen_tolerances(problems, inputs, (1e-6, 1e-4))
     assert list(rows) == ["1e-07 (default)", "1e-06", "0.0001"]
     assert rows["1e-07 (default)"]["max_input_diff"] == 0.0
@@ -69,3 +63,8 @@ def test_the_tolerance_study_compares_each_setting_with_the_default_on_the_same_
         assert row["failed"] == 0 and len(row["iterations"]) == len(problems)
     assert sum(rows["0.0001"]["iterations"]) <= sum(rows["1e-07 (default)"]["iterations"])
     assert 0.0 < rows["0.0001"]["max_input_diff"] < 0.1
+
+    loop = STUDY.closed_loop(scenario, 2.0, ("clarabel", "qocogen"))
+    assert loop["qocogen"]["broken"] == [] == loop["clarabel"]["broken"]
+    assert loop["qocogen"]["tracking_rmse"] == pytest.approx(loop["clarabel"]["tracking_rmse"], abs=1e-3)
+    assert loop["qocogen"]["backup_s"] == 0.0

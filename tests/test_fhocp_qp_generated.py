@@ -57,7 +57,8 @@ def test_a_pattern_is_built_once_and_loaded_afterwards(cache, caplog):
     with caplog.at_level("INFO", logger="tubekit.fhocp.qp.generated"):
         again = generated.build_solver(_program((2.0, -3.0, 0.5, -1.0)))     # the same pattern, other values
     assert again == library and again.stat().st_mtime_ns == stamp and caplog.text == ""
-    assert [p.name for p in cache.iterdir()] == [library.parent.name]   # no scratch directory left behind
+    # no scratch directory left behind: the library's directory and its key's build lock
+    assert sorted(p.name for p in cache.iterdir()) == [library.parent.name, library.parent.name + ".lock"]
     data = _program()
     solver = generated.GeneratedSolver(library, data, dict(generated.SETTING_DEFAULTS))
     code, objective, _ = solver.solve(data)
@@ -76,7 +77,7 @@ def test_a_failed_compilation_is_reported_with_the_compilers_words_and_leaves_no
     monkeypatch.setattr(generated, "COMPILE_FLAGS", ("--no-such-flag-for-any-compiler",))
     with pytest.raises(NotAvailableError, match=r"could not compile its generated solver:\n.*no-such-flag"):
         generated.build_solver(_program())
-    assert list(cache.iterdir()) == []
+    assert [p.name for p in cache.iterdir()] == [generated.pattern_key(_program()) + ".lock"]  # no directory
 
 
 def test_without_a_compiler_the_build_names_what_is_missing(cache, monkeypatch):
@@ -86,16 +87,52 @@ def test_without_a_compiler_the_build_names_what_is_missing(cache, monkeypatch):
 
 
 def test_a_key_another_process_put_in_place_first_is_used(cache, monkeypatch):
-    """Two builders of one key: the rename of the second fails on the first's directory, and its library is used."""
+    """Two builders of one key without the lock (no ``fcntl``): the rename of the second fails on the first's
+    directory, and its library is used."""
     data = _program()
     first = generated.build_solver(data)
     real_is_file = type(first).is_file
     calls = {"n": 0}
 
-    def missing_once(path):  # the first look finds nothing, as if the other process had not finished yet
+    def missing_twice(path):  # both looks (before and under the lock) find nothing, as if the other were not done
         calls["n"] += 1
-        return False if calls["n"] == 1 else real_is_file(path)
+        return False if calls["n"] <= 2 else real_is_file(path)
 
-    monkeypatch.setattr(type(first), "is_file", missing_once)
+    monkeypatch.setattr(type(first), "is_file", missing_twice)
     assert generated.build_solver(data) == first
-    assert sorted(p.name for p in cache.iterdir()) == [first.parent.name]
+    assert sorted(p.name for p in cache.iterdir()) == [first.parent.name, first.parent.name + ".lock"]
+
+
+def test_a_builder_waits_for_the_keys_lock_and_loads_what_its_holder_built(cache, monkeypatch):
+    """While another process holds the key's build lock, a builder that found no library waits for it, then loads
+    the library the holder put in place and compiles nothing."""
+    import fcntl
+    import threading
+    data = _program()
+    final = cache / generated.pattern_key(data)
+    monkeypatch.setattr(generated, "_build_into", lambda *args: pytest.fail("compiled what the holder built"))
+    asking, real_flock = threading.Event(), fcntl.flock
+
+    def flock(fd, op):  # the builder has looked for the library (none yet) and asks for the lock
+        if threading.current_thread() is not threading.main_thread():
+            asking.set()
+        return real_flock(fd, op)
+    monkeypatch.setattr(fcntl, "flock", flock)
+    outcome: list[object] = []
+
+    def build() -> None:
+        try:
+            outcome.append(generated.build_solver(data))
+        except BaseException as exc:  # reported by the main thread
+            outcome.append(exc)
+    with open(final.with_name(final.name + ".lock"), "a+b") as held:  # another open file: another lock holder
+        real_flock(held.fileno(), fcntl.LOCK_EX)
+        builder = threading.Thread(target=build)
+        builder.start()
+        while not asking.wait(0.05) and builder.is_alive():  # a builder that never asks ends (and fails) instead
+            pass
+        final.mkdir()
+        (final / generated._LIBRARY).write_bytes(b"built by the holder")
+        real_flock(held.fileno(), fcntl.LOCK_UN)
+    builder.join()
+    assert outcome == [final / generated._LIBRARY]

@@ -385,9 +385,11 @@ def loop_for_law(scenario: Scenario, law: BackupLaw, safe: SafeSet, assumed: tup
 
 
 #: The last fixed points solved in this process, by their inputs (:func:`solve_dynamic` is a pure function of them;
-#: a re-check and the certificate it re-checks, or a table of edits of one certificate, solve it once).
+#: a re-check and the certificate it re-checks, or a table of edits of one certificate, solve it once). At most
+#: ``_SOLVED_KEEP``, the oldest dropped first: a solution and its key hold about 40 kB (bluerov2_pier, measured), so
+#: a full memo holds about 10 MB.
 _SOLVED: dict[str, DynamicSolution] = {}
-_SOLVED_KEEP = 4
+_SOLVED_KEEP = 256
 
 
 def _solved_key(scenario: Scenario, region: Region, gains: GainBounds, sigmas: tuple[float, ...]) -> str:

@@ -8,8 +8,10 @@ turns a :class:`~tubekit.fhocp.qp.base.ConeProgramData` into such a solver:
    cone rows, the cone, qocogen's version, the shim, the compiler and its flags, the machine);
 2. :func:`build_solver` generates the C sources into a fresh directory under :func:`cache_root`, adds a small shim
    (:data:`SHIM`: a workspace per solver, every value array updated by pointer, no copy in Python), compiles one
-   shared library with the system C compiler and moves the directory into place atomically (two processes that
-   build the same key at once both succeed; one directory is kept);
+   shared library with the system C compiler and moves the directory into place atomically. Processes that need
+   the same key at once (a campaign's workers on their first period) take the key's build lock in turn (an
+   ``flock`` on ``<key>.lock``, released when its holder exits, however it exits): one compiles, the others load
+   what it built. Where ``fcntl`` is missing each builds its own and the rename keeps one directory;
 3. :class:`GeneratedSolver` loads the library and solves with numpy buffers passed by pointer.
 
 The cache is a build artefact, like numba's: ``TUBEKIT_QOCOGEN_CACHE`` names its root, else
@@ -22,6 +24,7 @@ from __future__ import annotations
 
 import contextlib
 import ctypes
+import importlib.util
 import hashlib
 import importlib.metadata
 import io
@@ -34,6 +37,7 @@ import tempfile
 import time
 from functools import lru_cache
 from pathlib import Path
+from typing import Iterator
 
 import numpy as np
 import scipy.sparse as sp
@@ -184,6 +188,31 @@ def build_solver(data: ConeProgramData) -> Path:
     if (final / _LIBRARY).is_file():
         return final / _LIBRARY
     final.parent.mkdir(parents=True, exist_ok=True)
+    with _build_lock(final.with_name(final.name + ".lock")):
+        if (final / _LIBRARY).is_file():  # another process built it while this one waited
+            return final / _LIBRARY
+        _build_into(data, final, found[0])
+    return final / _LIBRARY
+
+
+@contextlib.contextmanager
+def _build_lock(path: Path) -> Iterator[None]:
+    """An exclusive ``flock`` on ``path`` for the block (waiting for its holder; the kernel releases it when the
+    holder's process ends); no lock where ``fcntl`` is missing (module doc, step 2)."""
+    if importlib.util.find_spec("fcntl") is None:
+        yield
+        return
+    import fcntl
+    with open(path, "a+b") as handle:
+        fcntl.flock(handle.fileno(), fcntl.LOCK_EX)
+        try:
+            yield
+        finally:
+            fcntl.flock(handle.fileno(), fcntl.LOCK_UN)
+
+
+def _build_into(data: ConeProgramData, final: Path, cc: str) -> None:
+    """Generate ``data``'s solver, compile it with ``cc`` and move it into ``final`` (module doc, step 2)."""
     scratch = Path(tempfile.mkdtemp(prefix=".build-", dir=final.parent))
     LOGGER.info("qocogen: generating and compiling a solver for this subproblem's pattern (%d variables, %d rows; "
                 "once per machine, seconds) into %s", data.n, data.m, final)
@@ -192,7 +221,7 @@ def build_solver(data: ConeProgramData) -> Path:
         _generate(data, scratch)
         src = scratch / "solver"
         (src / "tk_shim.c").write_text(SHIM)
-        cmd = [found[0], *COMPILE_FLAGS, "-o", str(src / _LIBRARY), *(str(src / s) for s in _SOURCES), "-lm"]
+        cmd = [cc, *COMPILE_FLAGS, "-o", str(src / _LIBRARY), *(str(src / s) for s in _SOURCES), "-lm"]
         out = subprocess.run(cmd, capture_output=True, text=True, check=False)
         if out.returncode != 0:
             tail = "\n".join(out.stderr.splitlines()[-5:])
@@ -205,7 +234,6 @@ def build_solver(data: ConeProgramData) -> Path:
     finally:
         shutil.rmtree(scratch, ignore_errors=True)
     LOGGER.info("qocogen: solver ready after %.1f s", time.perf_counter() - started)
-    return final / _LIBRARY
 
 
 class GeneratedSolver:

@@ -20,6 +20,9 @@ sector behind the target that its bearing face allows (step 17b), with no loiter
 theorem needs them, ``docs/verify.md`` step 17c), the terminal set then with its row faces and its bearing face
 together (``verify.theorem.terminal_bearing.bearing_row_sets``); ``--start``: the start's distance behind the target.
 
+``--clearing``: under each cell refused by ``path_clearance``, the refused footprint's sector and the largest
+half-angle or reach that would clear the obstacle (:func:`clearing`).
+
 ``--vehicle NAME``: the dynamic plant instead (``[plant] kind = "dynamic"``, the bundled vehicle's box shrunk about
 its midpoint to ``--spread`` of its half-widths, :meth:`tubekit.model.vehicle_params.VehicleParams.shrunk`; 0: the
 midpoint, 1: the published box), with ``--w-max`` and the vertical current ``--current-z``: the velocity loop's
@@ -42,7 +45,7 @@ SPEEDS = (0.6, 1.0, 1.5)
 CURRENTS = (0.1, 0.2, 0.3)
 OFFSETS = (5.0, 30.0)
 
-__all__ = ["survey", "cell", "main"]
+__all__ = ["survey", "cell", "clearing", "main"]
 
 
 def survey(speed: float, current: float, offset: float, *, u_min: float = 0.5, u_max: float = 2.0,
@@ -102,6 +105,61 @@ def cell(speed: float, current: float, offset: float, **limits: float | str | tu
             "yaw_error": float(cert.design.problem.yaw_rate_error)}
 
 
+def clearing(speed: float, current: float, offset: float, **limits: float | str | tuple[float, float, float] | None
+             ) -> dict | None:
+    """Where a cell fails ``path_clearance``, what its terminal set's footprint would have to lose: the last
+    footprint the search measured and refused (the narrowest set's, the one the certificate reports), its half-angle
+    ``cone`` (rad), sector ``reach`` (m), ``ball`` and ``arc_pad`` (m, the pads about the arc's sector), the largest
+    half-angle at that reach (``clearing_cone``) and the largest reach at that half-angle (``clearing_reach``) that
+    clear every obstacle (bisected to 1e-6 of each with :func:`verify.theorem.path_clearance.path_clearance`, the
+    search's own check), the ``shortfall`` (m) and the condition's ``detail``. None when no footprint was refused."""
+    import dataclasses
+
+    import verify
+    import verify.theorem.terminal as terminal
+    from verify.theorem.path_clearance import horizon_end, path_clearance
+
+    sc = survey(speed, current, offset, **limits)
+    refused = []
+    measured = terminal.path_clearance
+
+    def recorded(scenario, foot, t_end):
+        out = measured(scenario, foot, t_end)
+        if not all(c.ok for c in out):
+            refused.append((foot, out))
+        return out
+    terminal.path_clearance = recorded  # a study's probe, restored below
+    try:
+        verify.certify(sc)
+    finally:
+        terminal.path_clearance = measured
+    if not refused:
+        return None
+    foot, conds = refused[-1]
+    t_end = horizon_end(sc)
+
+    def clears(**fields: float) -> bool:
+        return all(c.ok for c in path_clearance(sc, dataclasses.replace(foot, **fields), t_end))
+
+    def scaled(share: float) -> dict:
+        return {"cone_reach": share * foot.cone_reach, "reach": foot.reach - (1 - share) * foot.cone_reach,
+                "cone_outer": share * foot.cone_outer, "outer": foot.outer - (1 - share) * foot.cone_outer}
+    return {"cone": foot.cone, "reach": foot.cone_reach, "ball": foot.ball, "arc_pad": foot.reach - foot.cone_reach,
+            "shortfall": -min(c.lhs for c in conds if not c.ok),
+            "detail": next(c.detail for c in conds if not c.ok),
+            "clearing_cone": _largest(lambda x: clears(cone=x), foot.cone),
+            "clearing_reach": _largest(lambda x: clears(**scaled(x)), 1.0) * foot.cone_reach}
+
+
+def _largest(holds, top: float) -> float:
+    """The largest x in [0, ``top``] with ``holds(x)`` (holds is monotone: true below, false above), to 1e-6 of top."""
+    lo, hi = 0.0, top
+    while hi - lo > 1e-6 * top:
+        mid = (lo + hi) / 2
+        lo, hi = (mid, hi) if holds(mid) else (lo, mid)
+    return lo
+
+
 def _text(res: dict) -> str:
     notes = "" if res["loiter_radius"] is None else f" (loiter {res['loiter_radius']:.3g} m)"
     notes += f" (E_r {res['yaw_error']:.3g} rad/s)" if res["yaw_error"] > 0 else ""
@@ -109,6 +167,15 @@ def _text(res: dict) -> str:
         return "both" + notes
     head = "safe; tracking: " if res["tiers"] == "safe" else ""
     return head + ", ".join(res["failed"][:3]) + notes
+
+
+def _clearing_text(speed: float, current: float, res: dict | None) -> str:
+    where = f"  {speed:g} m/s in {current:g} m/s: "
+    if res is None:
+        return where + "no footprint refused by path_clearance"
+    return (where + f"X_f's sector {res['cone']:.3g} rad, {res['reach']:.3g} m, short by {res['shortfall']:.3g} m; "
+            f"it clears with a half-angle <= {res['clearing_cone']:.4g} rad at that reach, or a reach <= "
+            f"{res['clearing_reach']:.4g} m at that half-angle")
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -135,6 +202,8 @@ def main(argv: list[str] | None = None) -> int:
                     help="plant.vehicle.heave_loop_bandwidth (rad/s; 0: the vehicle's loop_bandwidth)")
     ap.add_argument("--rock-x", type=float, default=40.0,
                     help="the obstacle's position along the path (m; the target starts at 0)")
+    ap.add_argument("--clearing", action="store_true",
+                    help="under each cell refused by path_clearance, what its X_f's footprint would have to lose")
     args = ap.parse_args(argv)
     limits = {"u_min": args.u_min, "u_max": args.u_max, "r_max": args.r_max, "epsilon": args.epsilon,
               "backup": args.backup, "rate": args.rate, "start": args.start, "e_d_max": args.e_d_max,
@@ -153,8 +222,11 @@ def main(argv: list[str] | None = None) -> int:
         print("| target (m/s) \\ current (m/s) | " + " | ".join(f"{c:g}" for c in args.current) + " |")
         print("|---" * (len(args.current) + 1) + "|")
         for speed in args.speed:
-            row = [_text(cell(speed, c, offset, **limits)) for c in args.current]
-            print(f"| {speed:g} | " + " | ".join(row) + " |")
+            cells = [cell(speed, c, offset, **limits) for c in args.current]
+            print(f"| {speed:g} | " + " | ".join(_text(res) for res in cells) + " |")
+            for c, res in zip(args.current, cells):
+                if args.clearing and any(name.startswith("path_clearance") for name in res["failed"]):
+                    print(_clearing_text(speed, c, clearing(speed, c, offset, **limits)))
     return 0
 
 

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 from pathlib import Path
 
 import pytest
@@ -153,3 +154,20 @@ def test_started_settled_the_survey_keeps_both_tiers_in_twice_the_current_and_st
     trimmed = verify.certify(scenario.with_changes(plant=dataclasses.replace(scenario.plant, start="trimmed")))
     assert [f.condition for f in trimmed.failures] == ["terminal_surge_floor"]
     assert trimmed.velocity_loop.error[0] > cert.velocity_loop.error[0]
+
+
+def test_at_one_and_a_half_metres_per_second_under_rate_limits_the_rock_lies_inside_x_f_s_sector_by_metres():
+    """1.5 m/s in 0.3 m/s of current, u in [1.07, 1.9] m/s, r_max 0.13 rad/s (the torpedo's hard-over turn at
+    1.07 m/s, docs/plant.md section 4), no backup, plans (0.1, 0.005, 0.02), the start 20 m behind: the rock 5 m off
+    the line refuses the cell by ``path_clearance``; the refused footprint's sector (0.41 rad, 24.9 m) would clear it
+    only narrowed to about 0.15 rad or shortened to about 9.5 m. By hand: the sector sweeps a strip reaching
+    radius x sin(cone) beside the path, which must stay clear of the rock's centre (5 m off) by its radius and the
+    arc's pads (the ball, the arc's half-run): sin(cone) x radius <= 5 − 0.5 − pads."""
+    res = STUDY.clearing(1.5, 0.3, 5.0, u_min=1.07, u_max=1.9, r_max=0.13, backup="none", rate=(0.1, 0.005, 0.02),
+                         start=20.0, e_d_max=30.0, sensing=250.0, current_z=0.005, w_max=0.007, rock_x=0.0)
+    assert res is not None and res["cone"] == pytest.approx(0.407, abs=1e-3)
+    assert res["reach"] == pytest.approx(24.88, abs=0.01)
+    side = 5.0 - 0.5 - res["ball"] - res["arc_pad"]  # the rock's centre less its radius and the arc's pads
+    assert res["clearing_cone"] == pytest.approx(math.asin(side / res["reach"]), abs=2e-3)
+    assert res["clearing_reach"] == pytest.approx(side / math.sin(res["cone"]), abs=0.05)
+    assert "horizontally it lies up to" in res["detail"]

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+import re
 
 import numpy as np
 import pytest
@@ -87,6 +88,43 @@ def test_the_sector_distance_is_the_distance_to_the_sector(cx, cy, heading, cone
         assert got <= sampled + 1e-9 and sampled <= got + spacing
     else:
         assert sampled <= spacing
+
+
+@settings(max_examples=60, deadline=None, derandomize=True)
+@given(heading=st.floats(-math.pi, math.pi), cone=st.floats(0.05, 1.5), radius=st.floats(1.0, 6.0),
+       bearing=st.floats(-1.0, 1.0), reach=st.floats(0.05, 0.95))
+def test_inside_the_sector_the_distance_is_minus_the_distance_to_its_nearest_side(heading, cone, radius, bearing,
+                                                                                   reach):
+    """Property: a point of a convex sector (half-angle < π/2) at bearing ``bearing`` × ``cone`` from its axis and
+    ``reach`` × ``radius`` from its apex gets minus its distance to the nearest side, by hand: the arc
+    (radius − |w|) or an edge (|w| sin(cone − |bearing|)); so the value is continuous across the edges (1-Lipschitz)
+    instead of jumping to |w| − radius inside."""
+    phi, dist = bearing * cone, reach * radius
+    p = np.array([[0.3, -0.2, 0.0]])
+    axis = np.array([math.cos(heading), math.sin(heading)])
+    ray = np.array([math.cos(phi) * axis[0] - math.sin(phi) * axis[1],
+                    math.sin(phi) * axis[0] + math.cos(phi) * axis[1]])
+    centre = np.array([p[0, 0] + dist * ray[0], p[0, 1] + dist * ray[1], 0.0])
+    got = float(_sector_distance(centre, p, axis[None, :], cone, radius, half=math.inf)[0])
+    assert got == pytest.approx(-min(radius - dist, dist * math.sin(cone - abs(phi))), abs=1e-9)
+
+
+def test_a_shortfall_capped_by_the_depth_face_names_the_horizontal_overlap():
+    """By hand: a target on the x axis at 0.2 m/s, the sector of half-angle 0.3 rad and radius 10 m behind it, no
+    pads, half-height 0.5 m; a rock of radius 0.4 m 1 m off the path at the target's depth. Where it lies deep in the
+    sector the clearance is the depth face's, −0.5 − 0.4 − ball 0.3 = −1.2 m; horizontally it lies up to
+    min(10 − |w|, |w| sin(0.3 − φ)) + 0.7 inside, largest where the edge and the arc are equally near (2.23 m
+    with the pads, from a dense search), which the detail names."""
+    sc = _line(1.0)
+    sector = PathFootprint(reach=10.0, rise=0.5, ball=0.3, outer=10.0, outer_height=0.5, cone=0.3, cone_reach=10.0,
+                           cone_outer=10.0)
+    cond = path_clearance(sc, sector, horizon_end(sc))[0]
+    assert not cond.ok and cond.lhs == pytest.approx(-1.2, abs=6e-4)
+    along = np.linspace(1e-3, 10.0, 200001)  # the target's distance past the rock (m), the rock 1 m to its side
+    w, phi = np.hypot(along, 1.0), np.arctan2(1.0, along)
+    deepest = float(np.max(np.where(phi < 0.3, np.minimum(10.0 - w, w * np.sin(0.3 - phi)), -np.inf))) + 0.7
+    found = float(re.search(r"horizontally it lies up to ([0-9.]+) m inside", cond.detail).group(1))
+    assert found == pytest.approx(deepest, abs=5e-3) and "the shortfall shown is the depth face's" in cond.detail
 
 
 def test_a_half_turn_sector_is_the_disc():

@@ -19,11 +19,14 @@ A / P_min rad/s, which adds (radius) (A / P_min) h / 2 to the allowance.
 each distance is 1-Lipschitz in p_d, so between samples it changes by at most v̄ h / 2 (v̄ the target's speed
 bound, h the spacing), which is subtracted (with a relative 1e-9 for the float evaluation). Its lhs is the
 smallest clearance (m) left beyond what is needed; ``detail`` gives the time and the path's distance from
-the obstacle's centre. :func:`path_workspace` does the same for the workspace walls.
+the obstacle's centre, and, when a failing clearance is a depth face's (the obstacle within the footprint's horizontal
+extent, where the signed distance is the nearer face's), the largest horizontal overlap along the path.
+:func:`path_workspace` does the same for the workspace walls.
 """
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from dataclasses import dataclass
 
@@ -123,7 +126,8 @@ def _sector_distance(centre: np.ndarray, p: np.ndarray, back: np.ndarray, cone: 
                      half: float) -> np.ndarray:
     """Signed distance (m) from ``centre`` (3,) to the sectors of half-angle ``cone`` (rad, <= π) and ``radius``
     about each row of ``p`` (n, 3) around the horizontal unit directions ``back`` (n, 2), extruded to half-height
-    ``half``: outside the angular range the nearer edge segment, inside it |w| − radius (negative inside)."""
+    ``half``: outside the angular range the nearer edge segment, inside it beyond the radius |w| − radius, and within
+    the sector minus the distance to its nearest side (the arc or an edge; the arc alone for the disc, ``cone`` π)."""
     w = centre[:2][None, :] - p[:, :2]
     dist = np.hypot(w[:, 0], w[:, 1])
     cos_in = np.einsum("ij,ij->i", w, back)
@@ -134,7 +138,9 @@ def _sector_distance(centre: np.ndarray, p: np.ndarray, back: np.ndarray, cone: 
         e = np.stack([c * back[:, 0] - s * back[:, 1], s * back[:, 0] + c * back[:, 1]], axis=1)
         along = np.clip(np.einsum("ij,ij->i", w, e), 0.0, radius)
         edges.append(np.hypot(w[:, 0] - along * e[:, 0], w[:, 1] - along * e[:, 1]))
-    h = np.where(inside, dist - radius, np.minimum(*edges))
+    beside = np.minimum(*edges)
+    within = dist - radius if cone >= math.pi else np.maximum(dist - radius, -beside)  # -(nearest side) inside
+    h = np.where(inside, within, beside)
     v = np.abs(p[:, 2] - centre[2]) - half
     outside = np.hypot(np.maximum(0.0, h), np.maximum(0.0, v))
     return np.where((h <= 0.0) & (v <= 0.0), np.maximum(h, v), outside)
@@ -191,8 +197,23 @@ def path_clearance(scenario: Scenario, foot: PathFootprint, t_end: PathSamples |
             f"path_clearance[{i}]", "smallest clearance of the candidate's completion from the obstacle over the "
             "target's path, minus the Lipschitz allowance, > 0", slack, 0.0, slack > 0.0,
             f"{head} at t = {t[k]:.1f} s (the target's horizontal distance from the obstacle's centre; binding: "
-            f"{part}; X_f reaches {foot.reach:.3g} m, footprint {foot.outer:.3g} m)"))
+            f"{part}; X_f reaches {foot.reach:.3g} m, footprint {foot.outer:.3g} m)"
+            + ("" if slack > 0.0 else _depth_note(foot, path, c, o.radius, float(both[k])))))
     return tuple(out)
+
+
+def _depth_note(foot: PathFootprint, path: PathSamples, centre: np.ndarray, radius: float, clearance: float) -> str:
+    """Where the smallest clearance (m) is a depth face's (the obstacle lies within the footprint's horizontal
+    extent), the largest horizontal overlap along the path and its time: what the footprint must lose sideways, which
+    a shortfall capped by the depth face does not show. Empty otherwise."""
+    flat = dataclasses.replace(foot, rise=math.inf, outer_height=math.inf)  # no depth face: the horizontal clearance
+    arc, end, _ = _footprints(flat, path, centre, radius)
+    across = np.minimum(arc, end)
+    k = int(np.argmin(across))
+    if not float(across[k]) < clearance - 1e-9:
+        return ""
+    return (f"; horizontally it lies up to {-float(across[k]):.3g} m inside the footprint (t = {path.times[k]:.1f} "
+            f"s): the shortfall shown is the depth face's")
 
 
 def path_workspace(scenario: Scenario, foot: PathFootprint, t_end: PathSamples | float) -> tuple[Condition, ...]:

@@ -39,6 +39,7 @@ from __future__ import annotations
 import argparse
 import sys
 from pathlib import Path
+from typing import Callable
 
 SCENARIO = Path(__file__).resolve().parent.parent / "examples" / "keep_moving_tracked.toml"
 SPEEDS = (0.6, 1.0, 1.5)
@@ -151,7 +152,7 @@ def clearing(speed: float, current: float, offset: float, **limits: float | str 
             "clearing_reach": _largest(lambda x: clears(**scaled(x)), 1.0) * foot.cone_reach}
 
 
-def _largest(holds, top: float) -> float:
+def _largest(holds: Callable[[float], bool], top: float) -> float:
     """The largest x in [0, ``top``] with ``holds(x)`` (holds is monotone: true below, false above), to 1e-6 of top."""
     lo, hi = 0.0, top
     while hi - lo > 1e-6 * top:

@@ -24,9 +24,9 @@ from __future__ import annotations
 
 import contextlib
 import ctypes
-import importlib.util
 import hashlib
 import importlib.metadata
+import importlib.util
 import io
 import logging
 import os

@@ -124,8 +124,8 @@ def clearing(speed: float, current: float, offset: float, **limits: float | str 
     refused = []
     measured = terminal.path_clearance
 
-    def recorded(scenario, foot, t_end):
-        out = measured(scenario, foot, t_end)
+    def recorded(scenario, foot, t_end, **how):
+        out = measured(scenario, foot, t_end, **how)
         if not all(c.ok for c in out):
             refused.append((foot, out))
         return out

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import re
 
@@ -114,12 +115,14 @@ def test_a_shortfall_capped_by_the_depth_face_names_the_horizontal_overlap():
     pads, half-height 0.5 m; a rock of radius 0.4 m 1 m off the path at the target's depth. Where it lies deep in the
     sector the clearance is the depth face's, −0.5 − 0.4 − ball 0.3 = −1.2 m; horizontally it lies up to
     min(10 − |w|, |w| sin(0.3 − φ)) + 0.7 inside, largest where the edge and the arc are equally near (2.23 m
-    with the pads, from a dense search), which the detail names."""
+    with the pads, from a dense search), which the detail names when asked to explain (a certificate's report; not
+    the search's pass)."""
     sc = _line(1.0)
     sector = PathFootprint(reach=10.0, rise=0.5, ball=0.3, outer=10.0, outer_height=0.5, cone=0.3, cone_reach=10.0,
                            cone_outer=10.0)
-    cond = path_clearance(sc, sector, horizon_end(sc))[0]
+    quiet, cond = (path_clearance(sc, sector, horizon_end(sc), explain=explain)[0] for explain in (False, True))
     assert not cond.ok and cond.lhs == pytest.approx(-1.2, abs=6e-4)
+    assert quiet == dataclasses.replace(cond, detail=quiet.detail) and "horizontally" not in quiet.detail
     along = np.linspace(1e-3, 10.0, 200001)  # the target's distance past the rock (m), the rock 1 m to its side
     w, phi = np.hypot(along, 1.0), np.arctan2(1.0, along)
     deepest = float(np.max(np.where(phi < 0.3, np.minimum(10.0 - w, w * np.sin(0.3 - phi)), -np.inf))) + 0.7

@@ -176,8 +176,11 @@ def _footprints(foot: PathFootprint, path: PathSamples, c: np.ndarray, radius: f
     return arc, end, foot.turn_rate * max(foot.cone_reach, foot.cone_outer) * spacing / 2.0
 
 
-def path_clearance(scenario: Scenario, foot: PathFootprint, t_end: PathSamples | float) -> tuple[Condition, ...]:
-    """``path_clearance[i]`` for each obstacle (module doc); ``t_end``: the end time (s) or its samples."""
+def path_clearance(scenario: Scenario, foot: PathFootprint, t_end: PathSamples | float, *,
+                   explain: bool = False) -> tuple[Condition, ...]:
+    """``path_clearance[i]`` for each obstacle (module doc); ``t_end``: the end time (s) or its samples. ``explain``:
+    a failing condition's detail also names the horizontal overlap where the depth face caps its shortfall (another
+    pass over the path: for the conditions a certificate reports, not for every set a search refuses)."""
     path = _samples(scenario, t_end)
     t, p, allowance = path.times, path.positions, path.allowance
     out = []
@@ -198,7 +201,7 @@ def path_clearance(scenario: Scenario, foot: PathFootprint, t_end: PathSamples |
             "target's path, minus the Lipschitz allowance, > 0", slack, 0.0, slack > 0.0,
             f"{head} at t = {t[k]:.1f} s (the target's horizontal distance from the obstacle's centre; binding: "
             f"{part}; X_f reaches {foot.reach:.3g} m, footprint {foot.outer:.3g} m)"
-            + ("" if slack > 0.0 else _depth_note(foot, path, c, o.radius, float(both[k])))))
+            + (_depth_note(foot, path, c, o.radius, float(both[k])) if explain and not slack > 0.0 else "")))
     return tuple(out)
 
 

@@ -407,8 +407,8 @@ def design_terminal(scenario: Scenario, design: Design, region: Region, safe: Sa
     sensing = None if safe is None else sensing_condition(scenario, b, safe)
     path = path_samples(scenario, horizon_end(scenario))
 
-    def geometry(foot: PathFootprint) -> tuple[Condition, ...]:
-        return path_clearance(scenario, foot, path) + path_workspace(scenario, foot, path)
+    def geometry(foot: PathFootprint, explain: bool = False) -> tuple[Condition, ...]:
+        return path_clearance(scenario, foot, path, explain=explain) + path_workspace(scenario, foot, path)
 
     closest: tuple[tuple[int, float], tuple[Condition, ...]] | None = None
     narrowest: tuple[float, TerminalLaw, tuple[Condition, ...]] | None = None
@@ -441,11 +441,10 @@ def design_terminal(scenario: Scenario, design: Design, region: Region, safe: Sa
                 blocked.append(foot)
         if narrowest is None or law.d_hi < narrowest[0]:
             narrowest = (law.d_hi, law, conds)
-    if narrowest is not None:
+    if narrowest is not None:  # its path measured again, explained (the search's pass did not say why it failed)
         _, law, conds = narrowest
-        if any(c.condition.startswith("path_") for c in conds):
-            return None, conds
-        return None, conds + geometry(footprint_of(scenario, design, b, law, safe))
+        rest = tuple(c for c in conds if not c.condition.startswith("path_"))
+        return None, rest + geometry(footprint_of(scenario, design, b, law, safe), explain=True)
     return None, closest[1] if closest is not None else (_no_set(b),)
 
 

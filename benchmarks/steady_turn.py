@@ -28,7 +28,7 @@ import math
 import sys
 from dataclasses import dataclass
 
-__all__ = ["SteadyTurn", "steady_turn", "steady_fields", "corner_turns", "STEADY_FIELDS", "main"]
+__all__ = ["SteadyTurn", "steady_turn", "steady_fields", "steady_sway", "corner_turns", "STEADY_FIELDS", "main"]
 
 #: The box's coefficients that enter the steady sway and yaw rows (the mass entries m11, m22, m24 and the damping),
 #: and the rudder.
@@ -52,7 +52,7 @@ class SteadyTurn:
         return self.u / self.r
 
 
-def _sway(params, u: float, r: float) -> float:
+def steady_sway(params, u: float, r: float) -> float:
     """The v where the sway row n_2(u, v, 0, r) vanishes (m/s)."""
     from scipy.optimize import brentq
 
@@ -73,7 +73,7 @@ def steady_turn(params, u: float, rudder: float = 1.0) -> SteadyTurn | None:
     moment = abs(params.N_uudr) * u * u * params.fin_max * rudder
 
     def excess(r: float) -> float:
-        return body_forces(params, (u, _sway(params, u, r), 0.0, r))[3] - moment
+        return body_forces(params, (u, steady_sway(params, u, r), 0.0, r))[3] - moment
 
     lo = 0.0
     f_lo = excess(lo)
@@ -82,7 +82,7 @@ def steady_turn(params, u: float, rudder: float = 1.0) -> SteadyTurn | None:
         f_hi = excess(hi)
         if f_lo < 0.0 <= f_hi:
             r = brentq(excess, lo, hi, xtol=1e-14)
-            return SteadyTurn(u=u, v=_sway(params, u, r), r=r, moment=moment)
+            return SteadyTurn(u=u, v=steady_sway(params, u, r), r=r, moment=moment)
         lo, f_lo = hi, f_hi
     return None
 

@@ -42,8 +42,6 @@ import sys
 from dataclasses import dataclass
 from pathlib import Path
 
-import numpy as np
-
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 __all__ = ["YawDemand", "yaw_demand", "surge_demand", "corner_points", "worst_yaw", "simulated_ramp", "YAW_FIELDS",
@@ -102,40 +100,23 @@ def yaw_demand(params, u: float, r_max: float, yaw_rate: float) -> YawDemand:
 
     _, m22, _, m44, m24, m42 = params.mass_entries
     ramp = 2.0 * r_max / yaw_rate
+    # the two phases, each with its own (r(t), ṙ): the ramp from −r_max at ρ_r on [0, ramp], then the hold at +r_max
+    phases = ((0.0, ramp, lambda t: -r_max + yaw_rate * t, yaw_rate), (ramp, ramp + HOLD_AFTER, lambda t: r_max, 0.0))
 
-    def command(t: float) -> tuple[float, float]:
-        """(r, ṙ) of the command ``t`` s after the ramp's start (the ramp's own rate on [0, ramp))."""
-        if t < 0.0:
-            return -r_max, 0.0
-        if t < ramp:
-            return -r_max + yaw_rate * t, yaw_rate
-        return r_max, 0.0
-
-    def moment(t: float, v: float, r_dot: float | None = None) -> float:
-        r, slope = command(t)
-        slope = slope if r_dot is None else r_dot
+    def moment(v: float, r: float, r_dot: float) -> float:
         n2, n4 = _rows(params, u, v, r)
-        v_dot = -(n2 + m24 * slope) / m22
-        return m42 * v_dot + m44 * slope + n4
+        return m42 * (-(n2 + m24 * r_dot) / m22) + m44 * r_dot + n4
 
-    def sway_rate(t: float, y: np.ndarray) -> list[float]:
-        r, slope = command(t)
-        return [-(_rows(params, u, y[0], r)[0] + m24 * slope) / m22]
-
-    v0 = steady_sway(params, u, -r_max)
-    times, sways, best = [], [], (0.0, 0.0)
-    for start, stop in ((0.0, ramp), (ramp, ramp + HOLD_AFTER)):
-        sol = solve_ivp(sway_rate, (start, stop), [v0], rtol=1e-10, atol=1e-12)
-        times += list(sol.t)
-        sways += list(sol.y[0])
+    v0, best, held = steady_sway(params, u, -r_max), (0.0, 0.0), 0.0
+    for start, stop, yaw, r_dot in phases:
+        sol = solve_ivp(lambda t, y, yaw=yaw, r_dot=r_dot: [-(_rows(params, u, y[0], yaw(t))[0] + m24 * r_dot) / m22],
+                        (start, stop), [v0], rtol=1e-10, atol=1e-12)
+        for t, v in zip(sol.t, sol.y[0]):  # each point a witness, the phase's ends included
+            best = max(best, (abs(moment(float(v), yaw(t), r_dot)), float(t)))
         v0 = float(sol.y[0][-1])
-        # at the ramp's end the command's rate is still ρ_r just before it: the left limit is a witness too
-        best = max(best, (abs(moment(stop, v0, yaw_rate if stop == ramp else None)), stop))
-    for t, v in zip(times, sways):
-        best = max(best, (abs(moment(t, v)), t))
+        held = abs(moment(v0, yaw(stop), r_dot))
     rudder = abs(params.N_uudr) * u * u * params.fin_max
-    return YawDemand(peak=float(best[0]), at=float(best[1]), rudder=float(rudder),
-                     steady=float(abs(moment(times[-1], sways[-1]))))
+    return YawDemand(peak=best[0], at=best[1], rudder=float(rudder), steady=float(held))
 
 
 def surge_demand(params, u_max: float, surge_rate: float, top_speed: float = 0.0) -> tuple[float, float]:

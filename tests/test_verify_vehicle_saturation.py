@@ -14,7 +14,7 @@ from tubekit.model.vehicle_sets import BLUEROV2_HEAVY
 from tubekit.model.vehicles import vehicle_params
 from tubekit.plant.dynamic import body_forces
 from verify.vehicle.bound import velocity_loop_bound
-from verify.vehicle.saturation import actuator_authority, straight_top_speed, triple
+from verify.vehicle.saturation import _top_speed_note, actuator_authority, straight_top_speed, triple
 
 V, H, TICKS = (0.4, 0.3, 0.5), 0.01, 10
 JT, JP = (0.002, 0.002, 0.002), (0.02, 0.02, 0.02)
@@ -97,6 +97,19 @@ def test_the_weakest_hulls_top_speed_is_the_smallest_thrust_against_the_largest_
     linear = dataclasses.replace(nominal, X_u=-2.0, X_uu=-4.0, X_max=10.0)
     assert straight_top_speed(linear) == pytest.approx(1.350781059358212, rel=1e-9)  # 4 u^2 + 2 u = 10
     assert straight_top_speed(dataclasses.replace(nominal, X_u=0.0, X_uu=0.0)) == math.inf
+
+
+def test_a_thrust_tied_to_the_drag_tops_out_at_the_slowest_top_speed_and_the_surge_note_says_nothing_below_it():
+    """With top_speed [2.497, 2.571] every hull's thrust holds it at 2.497 m/s or faster (the thrust is tied to its
+    own drag), so a diverging loop at V_u = 1.9 m/s over the published box is not told its hull tops out at
+    sqrt(10.1 / 6.23) = 1.27 m/s (that pair is the untied box's); above 2.497 m/s the note still comes."""
+    tied = dataclasses.replace(vehicle_params("remus100"), top_speed=(2.497, 2.571))
+    assert straight_top_speed(tied) == 2.497
+    bound = velocity_loop_bound(tied, v_max=(1.9, 0.007, 0.05), tick=0.01, period=0.1, jump_tick=(0.0, 0.0, 0.0),
+                                jump_period=(0.005, 0.0005, 0.002), surge_floor=1.07)
+    x = {c.condition: c for c in bound.conditions}["loop_saturation[X]"]
+    assert not bound.certified and "top speed" not in x.detail
+    assert "top speed, about 2.497 m/s" in _top_speed_note(tied, 2.6)
 
 
 def test_a_loop_that_does_not_close_names_the_top_speed_it_asks_for_and_no_overflowed_number():

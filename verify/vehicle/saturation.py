@@ -191,7 +191,10 @@ def straight_top_speed(params: VehicleParams) -> float:
     |X_u| u + |X_u|u|| u² = X_min, the largest drag of the box (each coefficient's most negative end) against the
     smallest surge thrust over |u| <= 10 m/s; +inf when the box has no drag. A diagnostic (plain floats), not a
     proof step: a hull of the box cannot hold a surge above it, so a loop commanding one has at least the
-    difference as its error."""
+    difference as its error. With a thrust tied to the drag (``top_speed`` [s_lo, s_hi]) every hull's thrust
+    holds it at s_lo or faster (``verify.vehicle.propeller``), so the weakest top speed is s_lo."""
+    if params.tied:
+        return float(params.interval("top_speed")[0])
     linear, quadratic = -float(params.interval("X_u")[0]), -float(params.interval("X_uu")[0])
     thrust = float(thrust_floor(params, 10.0)[0])
     if quadratic <= 0.0:

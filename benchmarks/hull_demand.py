@@ -29,7 +29,7 @@ corner that needs most, under the same yaw command: the largest |r_c − r| and 
 limit (a run that saturates is a counterexample to ``loop_saturation[N]`` for that command box and box).
 
 Usage: ``python benchmarks/hull_demand.py [--vehicle remus100] [--u-min 1.07] [--u-max 1.9] [--r-max 0.1]
-[--rate 0.3 0.005 0.1] [--top-speed 2.497] [--simulate]`` (about 20 s for the corners; ``--simulate`` a few more).
+[--rate 0.3 0.005 0.1] [--top-speed 2.497] [--simulate]`` (about 30 s for the corners; ``--simulate`` a second more).
 Nothing is timed.
 """
 

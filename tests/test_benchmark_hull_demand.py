@@ -91,8 +91,8 @@ def test_the_command_box_the_rock_five_metres_off_asks_at_one_and_a_half_metres_
     assert thrust == pytest.approx(1.62 * 2.497 ** 2, rel=1e-9) and need / thrust > 1.5
 
 
-def test_the_same_hull_follows_the_command_box_that_keeps_the_rock_seventeen_metres_off_without_saturating():
-    """The same corner under the box the kinematic theorem certifies with the rock 17 m off at 1.5 m/s (r_max
+def test_the_same_hull_follows_the_command_box_that_keeps_the_rock_twelve_and_a_half_metres_off_without_saturating():
+    """The same corner under the box the kinematic theorem certifies with the rock 12.5 m off at 1.5 m/s (r_max
     0.05 rad/s, yaw plans at 0.02 rad/s^2, tests/test_benchmark_survey_frontier.py): its need is inside its rudder
     and the closed loop follows the ramp without saturating (the study's verdicts go both ways)."""
     hull = REMUS100.with_point(NEEDY)

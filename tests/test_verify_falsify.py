@@ -134,7 +134,7 @@ def test_a_run_from_a_start_with_no_tracking_tier_refutes_nothing_by_its_tube():
     assert replace(unclaimed, broken=("clearance",)).counterexample
     from pathlib import Path
     sc = load_scenario(Path(__file__).resolve().parents[1] / "examples" / "keep_moving_survey.toml")
-    res = falsify_closed_loop(sc, budget=5, seed=0, duration=10.0)
+    res = falsify_closed_loop(sc, budget=3, seed=0, duration=10.0)
     beyond = [r for r in res.runs if not r.vacuous and not r.claims_tube and r.ratio > 1.0]
     assert beyond and not res.found and res.worst.claims_tube
     assert "certifies no tracking tier" in res.summary()

@@ -149,13 +149,11 @@ def simulated_ramp(params, u: float, r_max: float, yaw_rate: float, tick: float 
     """(max |r_c − r| (rad/s), seconds the rudder is at its limit) of the closed loop on the point hull ``params``
     (its bundled loop gains), surge command ``u`` held, the yaw command of :func:`yaw_demand` stepped every
     ``period`` s, from ``holds[0]`` s before the ramp (settling at −r_max) to ``holds[1]`` s after it."""
-    from tubekit.plant.dynamic import DynamicPlant
-    from tubekit.scenario import scenario_from_dict
+    from remus_frontier import still_water_scenario
 
-    scenario = scenario_from_dict({"plant": {"kind": "dynamic", "vehicle": {
-        k: v for k, v in params.to_dict().items() if k != "name"}},
-        "disturbance": {"amplitude": [0.0, 0.0, 0.0], "sway": {"gain": 0.0, "bound": 0.0}}})
-    plant = DynamicPlant(scenario, params=params)
+    from tubekit.plant.dynamic import DynamicPlant
+
+    plant = DynamicPlant(still_water_scenario(params), params=params)
     pose, command, t = (0.0, 0.0, 0.0, 0.0), [u, 0.0, -r_max], 0.0
     worst, saturated = 0.0, 0.0
     settle = int(round(holds[0] / period))

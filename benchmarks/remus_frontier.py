@@ -33,7 +33,7 @@ import numpy as np
 from tubekit.model.vehicles import vehicle_params
 from tubekit.model.vehicle_params import VehicleParams
 from tubekit.plant.dynamic import DynamicPlant
-from tubekit.scenario import scenario_from_dict
+from tubekit.scenario import Scenario, scenario_from_dict
 from verify.vehicle.bound import velocity_loop_bound
 
 U_MAX = (0.6, 0.8, 1.0, 1.5, 2.0)
@@ -61,15 +61,21 @@ def cell(params: VehicleParams, u_max: float, r_max: float, w_max: float, rate: 
     return f"E = ({bound.error[0]:.3f}, {bound.error[1]:.3f}, {bound.error[2]:.3f}); {fins}; {verdict}"
 
 
+def still_water_scenario(params: VehicleParams) -> Scenario:
+    """A dynamic-plant scenario of the vehicle ``params`` (a box or a point) in still water: no current, no sway
+    disturbance, every other setting the default (what the simulated rows fly)."""
+    return scenario_from_dict({"plant": {"kind": "dynamic", "vehicle": {
+        k: v for k, v in params.to_dict().items() if k != "name"}},
+        "disturbance": {"amplitude": [0.0, 0.0, 0.0], "sway": {"gain": 0.0, "bound": 0.0}}})
+
+
 def simulated(params: VehicleParams, u_max: float, r_max: float, yaw_rate: float, seed: int | None,
               seconds: float = 60.0) -> tuple[float, float, float, float]:
     """(max |u_c − u|, max |r_c − r|, max |v|, max |N| / (|N_uuδr| u² δ_max)) (m/s, rad/s, m/s, the share of the
     rudder's moment at the current surge) of the plant at ``params``' midpoint (``seed`` None) or a random point of
     its box, surge command ``u_max``, yaw command sweeping ±``r_max`` at ``yaw_rate`` (rad/s²), reversing every
     15 s, no current (module doc)."""
-    scenario = scenario_from_dict({"plant": {"kind": "dynamic", "vehicle": {
-        k: v for k, v in params.to_dict().items() if k != "name"}},
-        "disturbance": {"amplitude": [0.0, 0.0, 0.0], "sway": {"gain": 0.0, "bound": 0.0}}})
+    scenario = still_water_scenario(params)
     box = scenario.plant.params
     truth = box.nominal if seed is None else box.sample(np.random.default_rng(seed))
     plant = DynamicPlant(scenario, params=truth)

@@ -23,6 +23,10 @@ together (``verify.theorem.terminal_bearing.bearing_row_sets``); ``--start``: th
 ``--clearing``: under each cell refused by ``path_clearance``, the refused footprint's sector and the largest
 half-angle or reach that would clear the obstacle (:func:`clearing`).
 
+``--nearest TOP``: under each cell, the nearest the obstacle may stand to the path with both tiers certified, on a
+grid of ``--nearest-step`` m in [0, TOP] (:func:`nearest`: a bisection, the obstacle being no harder to keep clear
+the farther it stands; "none" when it does not certify at TOP either). Each step is one certificate.
+
 ``--vehicle NAME``: the dynamic plant instead (``[plant] kind = "dynamic"``, the bundled vehicle's box shrunk about
 its midpoint to ``--spread`` of its half-widths, :meth:`tubekit.model.vehicle_params.VehicleParams.shrunk`; 0: the
 midpoint, 1: the published box), with ``--w-max`` and the vertical current ``--current-z``: the velocity loop's
@@ -31,7 +35,8 @@ channels keep the vehicle's ``loop_bandwidth``); ``--heave-bandwidth W``: its he
 
 Usage: ``python benchmarks/survey_frontier.py [--speed 0.6 1.0 1.5] [--current 0.1 0.2 0.3] [--offset 5 30]
 [--backup none] [--rate 0.5 0.5 1.0] [--start 7] [--e-d-max 60] [--sensing 150] [--vehicle remus100 --spread 0
---w-max 0.015 --current-z 0.005 --yaw-bandwidth 10]`` (about a second per cell; a few on the dynamic plant).
+--w-max 0.015 --current-z 0.005 --yaw-bandwidth 10] [--nearest 40 --nearest-step 0.5]`` (about a second per cell;
+a few on the dynamic plant).
 """
 
 from __future__ import annotations
@@ -46,7 +51,7 @@ SPEEDS = (0.6, 1.0, 1.5)
 CURRENTS = (0.1, 0.2, 0.3)
 OFFSETS = (5.0, 30.0)
 
-__all__ = ["survey", "cell", "clearing", "main"]
+__all__ = ["survey", "cell", "clearing", "nearest", "main"]
 
 
 def survey(speed: float, current: float, offset: float, *, u_min: float = 0.5, u_max: float = 2.0,
@@ -152,6 +157,30 @@ def clearing(speed: float, current: float, offset: float, **limits: float | str 
             "clearing_reach": _largest(lambda x: clears(**scaled(x)), 1.0) * foot.cone_reach}
 
 
+def nearest(speed: float, current: float, top: float, step: float = 0.5,
+            **limits: float | str | tuple[float, float, float] | None) -> float | None:
+    """The smallest obstacle offset (m) on the grid k ``step``, k >= 0, up to ``top``, at which :func:`cell` gives
+    both tiers; None when ``top`` does not (then no offset of the grid does). The obstacle moves straight away from
+    the path, so every footprint that cleared it still clears it and the search's first set is kept: both tiers at
+    one offset hold at every farther one, and a bisection over the grid finds the edge."""
+    if not (step > 0.0 and top >= 0.0):
+        raise ValueError(f"nearest: need step > 0 and top >= 0, got step {step}, top {top}")
+    return _smallest(lambda offset: cell(speed, current, offset, **limits)["tiers"] == "both", top, step)
+
+
+def _smallest(holds: Callable[[float], bool], top: float, step: float) -> float | None:
+    """The smallest x = k ``step`` <= ``top`` with ``holds(x)``, for ``holds`` monotone (false below, true above);
+    None when ``holds(top)`` is false. About log2(top / step) + 1 calls."""
+    last = int(top / step + 1e-9)
+    if not holds(last * step):
+        return None
+    lo, hi = 0, last  # holds at hi
+    while lo < hi:
+        mid = (lo + hi) // 2
+        lo, hi = (lo, mid) if holds(mid * step) else (mid + 1, hi)
+    return hi * step
+
+
 def _largest(holds: Callable[[float], bool], top: float) -> float:
     """The largest x in [0, ``top``] with ``holds(x)`` (holds is monotone: true below, false above), to 1e-6 of top."""
     lo, hi = 0.0, top
@@ -205,7 +234,12 @@ def main(argv: list[str] | None = None) -> int:
                     help="the obstacle's position along the path (m; the target starts at 0)")
     ap.add_argument("--clearing", action="store_true",
                     help="under each cell refused by path_clearance, what its X_f's footprint would have to lose")
+    ap.add_argument("--nearest", type=float, default=None, metavar="TOP",
+                    help="under each cell, the nearest offset (m, up to TOP) with both tiers")
+    ap.add_argument("--nearest-step", type=float, default=0.5, help="the grid of --nearest (m)")
     args = ap.parse_args(argv)
+    if args.nearest is not None and not (args.nearest >= 0.0 and args.nearest_step > 0.0):
+        ap.error("--nearest needs TOP >= 0 and --nearest-step > 0")
     limits = {"u_min": args.u_min, "u_max": args.u_max, "r_max": args.r_max, "epsilon": args.epsilon,
               "backup": args.backup, "rate": args.rate, "start": args.start, "e_d_max": args.e_d_max,
               "sensing": args.sensing, "vehicle": args.vehicle, "spread": args.spread, "w_max": args.w_max,
@@ -228,6 +262,11 @@ def main(argv: list[str] | None = None) -> int:
             for c, res in zip(args.current, cells):
                 if args.clearing and any(name.startswith("path_clearance") for name in res["failed"]):
                     print(_clearing_text(speed, c, clearing(speed, c, offset, **limits)))
+                if args.nearest is not None:
+                    edge = nearest(speed, c, args.nearest, args.nearest_step, **limits)
+                    print(f"  {speed:g} m/s in {c:g} m/s: both tiers with the obstacle "
+                          + (f"{edge:g} m off the path or farther" if edge is not None else
+                             f"nowhere up to {args.nearest:g} m off the path"))
     return 0
 
 

@@ -6,6 +6,8 @@ import math
 from pathlib import Path
 
 import pytest
+from hypothesis import given
+from hypothesis import strategies as st
 
 from .corners import assert_holds_share
 from .scripts import load_script
@@ -193,3 +195,40 @@ def test_a_command_box_the_published_hull_can_follow_keeps_the_rock_twelve_and_a
                   e_d_max=45.0, sensing=400.0, current_z=0.005, w_max=0.007, rock_x=0.0)
     assert STUDY.cell(1.5, 0.3, 12.5, **limits)["tiers"] == "both"
     assert STUDY.cell(1.5, 0.3, 12.0, **limits)["failed"] == ["path_clearance[0]"]
+
+
+@given(step=st.sampled_from([0.25, 0.5, 1.0]), cells=st.integers(0, 200), edge=st.integers(0, 250))
+def test_the_nearest_offset_is_the_first_grid_point_that_holds(step, cells, edge):
+    """Property: for an obstacle that certifies from the grid point ``edge`` on, the search over ``cells`` grid
+    points returns that point (None when it lies past the last), asking about log2(cells) + 2 cells."""
+    asked = []
+
+    def holds(offset):
+        asked.append(offset)
+        return offset >= edge * step - 1e-12
+
+    found = STUDY._smallest(holds, cells * step, step)
+    assert found == (edge * step if edge <= cells else None)
+    assert len(asked) <= math.log2(cells + 1) + 2
+
+
+def test_the_nearest_offset_refuses_a_grid_it_cannot_walk():
+    with pytest.raises(ValueError, match="need step > 0 and top >= 0"):
+        STUDY.nearest(1.5, 0.3, 10.0, step=0.0)
+    with pytest.raises(ValueError, match="need step > 0 and top >= 0"):
+        STUDY.nearest(1.5, 0.3, -1.0)
+
+
+def test_the_nearest_option_prints_the_edge_under_each_cell(monkeypatch, capsys):
+    """``--nearest TOP``: one line under each cell, from the study's own cells (here a stand-in certifying from 7 m
+    off the path on, and nowhere at 2 m/s)."""
+    def fake_cell(speed, current, offset, **limits):
+        return {"tiers": "both" if speed < 2.0 and offset >= 7.0 else "none", "failed": [] if offset >= 7.0 else
+                ["path_clearance[0]"], "loiter_radius": None, "yaw_error": 0.0}
+    monkeypatch.setattr(STUDY, "cell", fake_cell)
+    assert STUDY.main(["--speed", "1.5", "2.0", "--current", "0.3", "--offset", "5", "--nearest", "20"]) == 0
+    out = capsys.readouterr().out
+    assert "1.5 m/s in 0.3 m/s: both tiers with the obstacle 7 m off the path or farther" in out
+    assert "2 m/s in 0.3 m/s: both tiers with the obstacle nowhere up to 20 m off the path" in out
+    with pytest.raises(SystemExit):
+        STUDY.main(["--nearest", "20", "--nearest-step", "0"])

@@ -66,7 +66,6 @@ def pytest_runtest_logfinish(nodeid: str, location: tuple[str, int | None, str])
     a session)."""
     if not _FULL_COLLECTION_SINCE_FREEZE[0]:
         return
-    _FULL_COLLECTION_SINCE_FREEZE[0] = False
     if gc.get_freeze_count() > 2 * _FROZEN_AFTER_RECLAIM[0]:  # reclaim the frozen cycles once their count doubles
         gc.unfreeze()
         gc.collect()
@@ -74,6 +73,7 @@ def pytest_runtest_logfinish(nodeid: str, location: tuple[str, int | None, str])
         _FROZEN_AFTER_RECLAIM[0] = gc.get_freeze_count()
     else:
         gc.freeze()
+    _FULL_COLLECTION_SINCE_FREEZE[0] = False  # after the reclaim's own collection: its survivors are frozen already
 
 
 # ---- certificates shared by several test modules (computed once per session) -------------------------------
